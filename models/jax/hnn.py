@@ -1,0 +1,29 @@
+"""The Hamiltonian neural network (jax): H = MLP([x, y, extra]); (xdot, ydot) = (dH/dy, -dH/dx).
+
+x, y (..., dof) are canonical (q, p), or deliberately non-canonical (q, qdot) to replicate the failure;
+extra (..., extra_inputs) or None is fed to the MLP but not differentiated. angle_wrap wraps x.
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from models.jax.base import Model
+from models.jax.mlp import mlp, mlp_input, wrap_angles
+
+
+class HNN(Model):
+    def _hamiltonian(self, x, y, extra=None):
+        z = mlp_input(self.spec, [wrap_angles(self.spec, x), y, *self._parts(extra)])
+        return mlp(self.params, z, self.spec)[..., 0]
+
+    def hamiltonian(self, x, y, extra=None):
+        """H (...,)."""
+        self._check_state(x, y, extra)
+        return self._hamiltonian(x, y, extra)
+
+    def time_derivative(self, x, y, extra=None):
+        """(xdot, ydot) = (dH/dy, -dH/dx), each (..., dof)."""
+        self._check_state(x, y, extra)
+        dh_dx, dh_dy = jax.grad(lambda a, b: jnp.sum(self._hamiltonian(a, b, extra)), argnums=(0, 1))(x, y)
+        return dh_dy, -dh_dx

@@ -1,0 +1,133 @@
+"""Euler-Lagrange accelerations of any scalar L(q, qdot), and the LNN model (JAX).
+
+`euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None) -> (qddot, n_fallback)`
+  L_fn(q, qdot[, extra]) -> (...,) for q, qdot (..., d), acting on each sample independently.
+  q, qdot (..., d); extra (..., e) or None. qddot (..., d); n_fallback an int scalar array.
+  "paper": per sample, q'' = pinv(H) (dL/dq - J qdot), H = jax.hessian(L, 1), J = the full mixed
+           Jacobian jax.jacobian(jax.jacobian(L, 1), 0), pinv by SVD with rtol = 10 d eps
+           (`models.numerics.pinv_rtol`); n_fallback = 0.
+  "fast":  one reverse pass for (dL/dq, dL/dqdot) summed over the batch, pushed forward along d + 1
+           tangents at once (the d unit vectors in qdot -> the Hessian columns; qdot in q -> the mixed
+           term J qdot as ONE Jacobian-vector product), then a linear solve. Fallback: where the
+           reciprocal 1-norm condition number of H is below `models.numerics.rcond_min` (or the inverse
+           is not finite) the sample takes the paper's pinv result and is counted in n_fallback.
+           Indefinite but well-conditioned H are solved exactly (pinv would give the same).
+`euler_lagrange(...)` returns qddot only; `velocity_hessian(L_fn, q, qdot, extra)` -> (..., d, d).
+Mirrored line for line by `models.torch.lnn`.
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+from jax import lax
+
+from models.jax.base import Model
+from models.jax.mlp import mlp, mlp_input, wrap_angles
+from models.numerics import pinv_rtol, rcond_min
+
+
+def _call(L_fn, q, qdot, extra):
+    return L_fn(q, qdot) if extra is None else L_fn(q, qdot, extra)
+
+
+def _flat(x, d):
+    return None if x is None else x.reshape(-1, x.shape[-1] if d is None else d)
+
+
+def fast_terms(L_fn, q, qdot, extra=None):
+    """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), by forward-over-reverse."""
+    d = q.shape[-1]
+    grads = jax.grad(lambda a, b: jnp.sum(_call(L_fn, a, b, extra)), argnums=(0, 1))
+    eye = jnp.broadcast_to(jnp.eye(d, dtype=q.dtype)[:, None, :], (d, *q.shape))
+    t_q = jnp.concatenate([jnp.zeros((d, *q.shape), q.dtype), qdot[None]])
+    t_qdot = jnp.concatenate([eye, jnp.zeros_like(qdot)[None]])
+    (g_q, _), (_, dg_qdot) = jax.vmap(lambda a, b: jax.jvp(grads, (q, qdot), (a, b)))(t_q, t_qdot)
+    return jnp.moveaxis(dg_qdot[:d], 0, -1), g_q[0] - dg_qdot[d]
+
+
+def paper_terms(L_fn, q, qdot, extra=None):
+    """On flat (B, d), per sample: (H (B, d, d), rhs = dL/dq - J qdot (B, d)) with full Jacobians."""
+    def one(q1, qd1, e1):
+        f = lambda a, b: _call(L_fn, a, b, e1)  # noqa: E731
+        hess = jax.hessian(f, 1)(q1, qd1)
+        mixed = jax.jacobian(jax.jacobian(f, 1), 0)(q1, qd1)
+        return hess, jax.grad(f, 0)(q1, qd1) - mixed @ qd1
+    if extra is None:
+        return jax.vmap(lambda a, b: one(a, b, None))(q, qdot)
+    return jax.vmap(one)(q, qdot, extra)
+
+
+def pinv_solve(hess, rhs):
+    """pinv(H) rhs per sample, H (B, d, d), rhs (B, d), rtol = 10 d eps."""
+    rtol = pinv_rtol(str(hess.dtype), hess.shape[-1])
+    return (jnp.linalg.pinv(hess, rtol=rtol) @ rhs[..., None])[..., 0]
+
+
+def _norm1(a):
+    return jnp.max(jnp.sum(jnp.abs(a), axis=-2), axis=-1)
+
+
+def solve_with_fallback(hess, rhs):
+    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted."""
+    d = hess.shape[-1]
+    h = lax.stop_gradient(hess)
+    rcond = 1.0 / (_norm1(h) * _norm1(jnp.linalg.inv(h)))
+    bad = ~(jnp.isfinite(rcond) & (rcond >= rcond_min(str(hess.dtype), d)))
+    safe = jnp.where(bad[:, None, None], jnp.eye(d, dtype=hess.dtype), hess)
+    x = jnp.linalg.solve(safe, rhs[..., None])[..., 0]
+    x = lax.cond(jnp.any(bad), lambda: jnp.where(bad[:, None], pinv_solve(hess, rhs), x), lambda: x)
+    return x, jnp.sum(bad)
+
+
+def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):
+    """(qddot (..., d), n_fallback) from the Euler-Lagrange equation of L_fn; see the module doc."""
+    d, batch = q.shape[-1], q.shape[:-1]
+    qf, qdf, ef = _flat(q, d), _flat(qdot, d), _flat(extra, None)
+    if formulation == "paper":
+        hess, rhs = paper_terms(L_fn, qf, qdf, ef)
+        return pinv_solve(hess, rhs).reshape(*batch, d), jnp.zeros((), jnp.int64)
+    if formulation != "fast":
+        raise ValueError(f"unknown formulation {formulation!r}; valid: fast, paper")
+    hess, rhs = fast_terms(L_fn, qf, qdf, ef)
+    x, n_bad = solve_with_fallback(hess, rhs)
+    return x.reshape(*batch, d), n_bad
+
+
+def euler_lagrange(L_fn, q, qdot, formulation="fast", extra=None):
+    """qddot (..., d) from the Euler-Lagrange equation of L_fn (fallbacks counted but dropped)."""
+    return euler_lagrange_info(L_fn, q, qdot, formulation, extra)[0]
+
+
+def velocity_hessian(L_fn, q, qdot, extra=None):
+    """d^2 L / dqdot^2, (..., d, d), by forward-over-reverse."""
+    d = q.shape[-1]
+    hess, _ = fast_terms(L_fn, _flat(q, d), _flat(qdot, d), _flat(extra, None))
+    return hess.reshape(*q.shape, d)
+
+
+class LNN(Model):
+    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None."""
+
+    def _lagrangian(self, q, qdot, extra=None):
+        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        return mlp(self.params, x, self.spec)[..., 0]
+
+    def lagrangian(self, q, qdot, extra=None):
+        """L (...,)."""
+        self._check_state(q, qdot, extra)
+        return self._lagrangian(q, qdot, extra)
+
+    def velocity_hessian(self, q, qdot, extra=None):
+        """(..., dof, dof)."""
+        self._check_state(q, qdot, extra)
+        return velocity_hessian(self._lagrangian, q, qdot, extra if self.spec.extra_inputs else None)
+
+    def acceleration_info(self, q, qdot, extra=None):
+        """(qddot (..., dof), n_fallback) with spec.formulation."""
+        self._check_state(q, qdot, extra)
+        extra = extra if self.spec.extra_inputs else None
+        return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+
+    def acceleration(self, q, qdot, extra=None):
+        """qddot (..., dof)."""
+        return self.acceleration_info(q, qdot, extra)[0]

@@ -1,0 +1,121 @@
+"""The framework-neutral model spec: one frozen dataclass both frameworks build from.
+
+`ModelSpec(kind, dof, hidden, activation, init, dtype, extra_inputs, formulation, n_out,
+angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius)` is validated on creation
+(unknown names and bad sizes raise ValueError listing what is valid) and round-trips through
+`to_dict()` / `from_dict()` (plain JSON types).
+
+Per kind, the MLP input width and output width (see `mlp_sizes`):
+  baseline: [q, qdot, extra]            (2*dof + extra_inputs) -> n_out (default dof)
+  lnn, hnn: [q, qdot, extra] / [x, y, extra]  (2*dof + extra_inputs) -> 1
+  delan:    q (dof) -> hidden[-1], trunk only (every layer activated); heads in `models.params`
+  lgn:      [q_nb, qdot_nb] of one node's 2r+1 neighbours (2*(2r+1)) -> 1
+Formulations: lnn "fast" | "paper"; lgn "banded" (alias "fast") | "dense" | "paper";
+other kinds ignore it.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from models.activations import ACTIVATIONS
+
+KINDS = ("baseline", "lnn", "hnn", "delan", "lgn")
+INITS = ("cranmer2020", "pytorch_default", "xavier", "kaiming")
+FORMULATIONS = ("fast", "paper", "dense", "banded")
+DTYPES = ("float32", "float64")
+_KIND_FORMULATIONS = {"lnn": ("fast", "paper"), "lgn": ("fast", "banded", "dense", "paper")}
+
+
+def _choices(what: str, value, valid) -> None:
+    if value not in valid:
+        raise ValueError(f"unknown {what} {value!r}; valid: {', '.join(map(str, valid))}")
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """What a model is, independent of the framework.
+
+    dof: degrees of freedom (trailing dim of q); for lgn the nominal grid size (any n at call time).
+    hidden: hidden layer widths, e.g. (600, 600, 600).
+    extra_inputs: extra MLP inputs not differentiated (e.g. the relativistic field g, or tau/qddot
+        for a baseline), shape (..., extra_inputs).
+    n_out: baseline output width (default dof); must be None or 1 for lnn/hnn/lgn; unused by delan.
+    angle_wrap: wrap q to [-pi, pi) before the MLP.
+    input_scale: per-feature multipliers of the MLP input vector (length = MLP input width).
+    delan_eps: epsilon of M = L L^T + eps I. delan_diag_offset: diag(L) = softplus(raw + offset).
+    lgn_radius: neighbours on each side of a node in the density MLP.
+    """
+
+    kind: str
+    dof: int
+    hidden: tuple = (600, 600, 600)
+    activation: str = "softplus"
+    init: str = "cranmer2020"
+    dtype: str = "float32"
+    extra_inputs: int = 0
+    formulation: str = "fast"
+    n_out: int | None = None
+    angle_wrap: bool = False
+    input_scale: tuple | None = None
+    delan_eps: float = 0.01
+    delan_diag_offset: float = 2.0
+    lgn_radius: int = 1
+
+    def __post_init__(self):
+        _choices("kind", self.kind, KINDS)
+        _choices("activation", self.activation, ACTIVATIONS)
+        _choices("init", self.init, INITS)
+        _choices("dtype", self.dtype, DTYPES)
+        _choices("formulation", self.formulation, FORMULATIONS)
+        if self.kind in _KIND_FORMULATIONS:
+            _choices(f"formulation for kind {self.kind!r}", self.formulation, _KIND_FORMULATIONS[self.kind])
+        if isinstance(self.dof, bool) or not isinstance(self.dof, int) or self.dof < 1:
+            raise ValueError(f"dof must be an int >= 1, got {self.dof!r}")
+        hidden = tuple(self.hidden) if isinstance(self.hidden, (list, tuple)) else None
+        if not hidden or any(isinstance(h, bool) or not isinstance(h, int) or h < 1 for h in hidden):
+            raise ValueError(f"hidden must be a non-empty sequence of ints >= 1, got {self.hidden!r}")
+        object.__setattr__(self, "hidden", hidden)
+        if not isinstance(self.extra_inputs, int) or self.extra_inputs < 0:
+            raise ValueError(f"extra_inputs must be an int >= 0, got {self.extra_inputs!r}")
+        if self.extra_inputs and self.kind in ("delan", "lgn"):
+            raise ValueError(f"kind {self.kind!r} takes no extra_inputs (got {self.extra_inputs})")
+        if self.n_out is not None:
+            if not isinstance(self.n_out, int) or self.n_out < 1:
+                raise ValueError(f"n_out must be None or an int >= 1, got {self.n_out!r}")
+            if self.kind in ("lnn", "hnn", "lgn") and self.n_out != 1:
+                raise ValueError(f"kind {self.kind!r} has a scalar output; n_out must be None or 1")
+        if not isinstance(self.lgn_radius, int) or self.lgn_radius < 1:
+            raise ValueError(f"lgn_radius must be an int >= 1, got {self.lgn_radius!r}")
+        if not self.delan_eps >= 0:
+            raise ValueError(f"delan_eps must be >= 0, got {self.delan_eps!r}")
+        if self.input_scale is not None:
+            scale = tuple(float(s) for s in self.input_scale)
+            if len(scale) != self.mlp_sizes()[0]:
+                raise ValueError(f"input_scale needs {self.mlp_sizes()[0]} entries (the MLP input width), "
+                                 f"got {len(scale)}")
+            object.__setattr__(self, "input_scale", scale)
+
+    def mlp_sizes(self) -> tuple:
+        """Layer widths of the (trunk) MLP, input first: e.g. (4, 600, 600, 600, 1)."""
+        if self.kind == "delan":
+            return (self.dof, *self.hidden)
+        if self.kind == "lgn":
+            return (2 * (2 * self.lgn_radius + 1), *self.hidden, 1)
+        n_in = 2 * self.dof + self.extra_inputs
+        n_out = (self.n_out or self.dof) if self.kind == "baseline" else 1
+        return (n_in, *self.hidden, n_out)
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["hidden"] = list(self.hidden)
+        d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> ModelSpec:
+        d = dict(d)
+        d["hidden"] = tuple(d.get("hidden", cls.hidden))
+        if d.get("input_scale") is not None:
+            d["input_scale"] = tuple(d["input_scale"])
+        return cls(**d)

@@ -1,0 +1,23 @@
+"""The feed-forward baseline (torch): qddot = MLP([q, qdot, extra]) (the LNN paper's baseline), or any
+direct map such as the DeLaN comparison's inverse model tau = MLP([q, qdot, qddot = extra]).
+
+q, qdot (..., dof), extra (..., extra_inputs) or None -> (..., n_out), n_out = dof by default.
+"""
+from __future__ import annotations
+
+import torch
+
+from models.torch.base import Model
+from models.torch.mlp import mlp, mlp_input, wrap_angles
+
+
+class Baseline(Model):
+    def acceleration(self, q, qdot, extra=None):
+        """MLP output (..., n_out)."""
+        self._check_state(q, qdot, extra)
+        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        return mlp(self.params, x, self.spec)
+
+    def acceleration_info(self, q, qdot, extra=None):
+        """(acceleration (..., n_out), 0): no fallback exists."""
+        return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64)

@@ -1,0 +1,132 @@
+"""Euler-Lagrange accelerations of any scalar L(q, qdot), and the LNN model (PyTorch, torch.func).
+
+Mirrors `models.jax.lnn` line for line (see its docstring for the formulations and the fallback).
+`euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None) -> (qddot (..., d), n_fallback)`,
+`euler_lagrange(...) -> qddot`, `velocity_hessian(L_fn, q, qdot, extra) -> (..., d, d)`.
+Outputs stay differentiable w.r.t. tensors L_fn closes over (the nn.Parameters): loss.backward() works.
+"""
+from __future__ import annotations
+
+import torch
+from torch.func import grad, hessian, jacrev, jvp, vmap
+
+from models.numerics import pinv_rtol, rcond_min
+from models.torch.base import Model
+from models.torch.mlp import mlp, mlp_input, wrap_angles
+
+
+def _dtype_name(x) -> str:
+    return str(x.dtype).removeprefix("torch.")
+
+
+def _call(L_fn, q, qdot, extra):
+    return L_fn(q, qdot) if extra is None else L_fn(q, qdot, extra)
+
+
+def _flat(x, d):
+    return None if x is None else x.reshape(-1, x.shape[-1] if d is None else d)
+
+
+def fast_terms(L_fn, q, qdot, extra=None):
+    """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), by forward-over-reverse."""
+    d = q.shape[-1]
+    grads = grad(lambda a, b: torch.sum(_call(L_fn, a, b, extra)), argnums=(0, 1))
+    eye = torch.eye(d, dtype=q.dtype)[:, None, :].expand(d, *q.shape)
+    t_q = torch.cat([torch.zeros((d, *q.shape), dtype=q.dtype), qdot[None]])
+    t_qdot = torch.cat([eye, torch.zeros_like(qdot)[None]])
+    (g_q, _), (_, dg_qdot) = vmap(lambda a, b: jvp(grads, (q, qdot), (a, b)))(t_q, t_qdot)
+    return torch.movedim(dg_qdot[:d], 0, -1), g_q[0] - dg_qdot[d]
+
+
+def paper_terms(L_fn, q, qdot, extra=None):
+    """On flat (B, d), per sample: (H (B, d, d), rhs = dL/dq - J qdot (B, d)) with full Jacobians."""
+    def one(q1, qd1, e1):
+        f = lambda a, b: _call(L_fn, a, b, e1)  # noqa: E731
+        hess = hessian(f, 1)(q1, qd1)
+        mixed = jacrev(jacrev(f, 1), 0)(q1, qd1)
+        return hess, grad(f, 0)(q1, qd1) - mixed @ qd1
+    if extra is None:
+        return vmap(lambda a, b: one(a, b, None))(q, qdot)
+    return vmap(one)(q, qdot, extra)
+
+
+def pinv_solve(hess, rhs):
+    """pinv(H) rhs per sample, H (B, d, d), rhs (B, d), rtol = 10 d eps."""
+    rtol = pinv_rtol(_dtype_name(hess), hess.shape[-1])
+    # torch's SVD raises on non-finite input where JAX returns NaN: give NaN for those samples too
+    finite = torch.isfinite(hess).flatten(-2).all(-1)
+    safe = torch.where(finite[..., None, None], hess, torch.zeros_like(hess))
+    x = (torch.linalg.pinv(safe, rtol=rtol) @ rhs[..., None])[..., 0]
+    return torch.where(finite[..., None], x, torch.full_like(x, float("nan")))
+
+
+def _norm1(a):
+    return torch.amax(torch.sum(torch.abs(a), dim=-2), dim=-1)
+
+
+def solve_with_fallback(hess, rhs):
+    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted."""
+    d = hess.shape[-1]
+    h = hess.detach()
+    inv, info = torch.linalg.inv_ex(h)
+    rcond = 1.0 / (_norm1(h) * _norm1(inv))
+    bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
+    safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype), hess)
+    x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
+    if bool(torch.any(bad)):
+        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
+    return x, torch.sum(bad)
+
+
+def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):
+    """(qddot (..., d), n_fallback) from the Euler-Lagrange equation of L_fn; see the module doc."""
+    d, batch = q.shape[-1], q.shape[:-1]
+    qf, qdf, ef = _flat(q, d), _flat(qdot, d), _flat(extra, None)
+    if formulation == "paper":
+        hess, rhs = paper_terms(L_fn, qf, qdf, ef)
+        return pinv_solve(hess, rhs).reshape(*batch, d), torch.zeros((), dtype=torch.int64)
+    if formulation != "fast":
+        raise ValueError(f"unknown formulation {formulation!r}; valid: fast, paper")
+    hess, rhs = fast_terms(L_fn, qf, qdf, ef)
+    x, n_bad = solve_with_fallback(hess, rhs)
+    return x.reshape(*batch, d), n_bad
+
+
+def euler_lagrange(L_fn, q, qdot, formulation="fast", extra=None):
+    """qddot (..., d) from the Euler-Lagrange equation of L_fn (fallbacks counted but dropped)."""
+    return euler_lagrange_info(L_fn, q, qdot, formulation, extra)[0]
+
+
+def velocity_hessian(L_fn, q, qdot, extra=None):
+    """d^2 L / dqdot^2, (..., d, d), by forward-over-reverse."""
+    d = q.shape[-1]
+    hess, _ = fast_terms(L_fn, _flat(q, d), _flat(qdot, d), _flat(extra, None))
+    return hess.reshape(*q.shape, d)
+
+
+class LNN(Model):
+    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None."""
+
+    def _lagrangian(self, q, qdot, extra=None):
+        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        return mlp(self.params, x, self.spec)[..., 0]
+
+    def lagrangian(self, q, qdot, extra=None):
+        """L (...,)."""
+        self._check_state(q, qdot, extra)
+        return self._lagrangian(q, qdot, extra)
+
+    def velocity_hessian(self, q, qdot, extra=None):
+        """(..., dof, dof)."""
+        self._check_state(q, qdot, extra)
+        return velocity_hessian(self._lagrangian, q, qdot, extra if self.spec.extra_inputs else None)
+
+    def acceleration_info(self, q, qdot, extra=None):
+        """(qddot (..., dof), n_fallback) with spec.formulation."""
+        self._check_state(q, qdot, extra)
+        extra = extra if self.spec.extra_inputs else None
+        return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+
+    def acceleration(self, q, qdot, extra=None):
+        """qddot (..., dof)."""
+        return self.acceleration_info(q, qdot, extra)[0]

@@ -1,0 +1,97 @@
+"""NumPy views of a trained model in either framework, for evaluation.
+
+`adapter(framework, spec, params)` returns an object with the model's public methods
+(`acceleration`, `time_derivative`, `inverse_dynamics`, `mass_matrix`, `coriolis`, `gravity`,
+`acceleration_info`, ...) taking and returning float64 NumPy arrays. Inputs are cast to the
+model's dtype; large batches are evaluated in chunks. JAX methods are jit-compiled once per method.
+So evaluation code (metrics, rollouts) is written once and judges both frameworks alike.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+CHUNK = 8192
+
+
+class _Adapter:
+    def __init__(self, spec, params):
+        self.spec = spec
+        self.kind = spec.kind
+        self._fns = {}
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        if name not in self._fns:
+            self._fns[name] = self._compile(name)
+        fn = self._fns[name]
+
+        def call(*args):
+            args = [None if a is None else np.asarray(a, np.float64) for a in args]
+            n = next(a.shape[0] for a in args if a is not None)
+            outs = [fn(*[None if a is None else a[i:i + CHUNK] for a in args]) for i in range(0, max(n, 1), CHUNK)]
+            if isinstance(outs[0], tuple):
+                return tuple(_join([o[j] for o in outs]) for j in range(len(outs[0])))
+            return _join(outs)
+        return call
+
+
+def _join(parts):
+    parts = [np.asarray(p, dtype=np.float64) for p in parts]
+    if parts[0].ndim == 0:
+        return np.sum(parts)
+    return np.concatenate(parts, axis=0)
+
+
+class JaxAdapter(_Adapter):
+    def __init__(self, spec, params):
+        super().__init__(spec, params)
+        import jax.numpy as jnp
+
+        import models.jax
+
+        self._jnp = jnp
+        self.model = models.jax.build(spec, params)
+
+    def _compile(self, name):
+        import equinox as eqx
+
+        jnp, dtype = self._jnp, self._jnp.dtype(self.spec.dtype)
+        f = eqx.filter_jit(lambda m, *a: getattr(m, name)(*a))
+
+        def run(*args):
+            a = [None if x is None else jnp.asarray(x, dtype) for x in args]
+            out = f(self.model, *a)
+            return tuple(np.asarray(o) for o in out) if isinstance(out, tuple) else np.asarray(out)
+        return run
+
+
+class TorchAdapter(_Adapter):
+    def __init__(self, spec, params):
+        super().__init__(spec, params)
+        import torch
+
+        import models.torch
+
+        self._torch = torch
+        self.model = models.torch.build(spec, params)
+
+    def _compile(self, name):
+        torch, dtype = self._torch, getattr(self._torch, self.spec.dtype)
+        method = getattr(self.model, name)
+
+        def run(*args):
+            a = [None if x is None else torch.as_tensor(x, dtype=dtype) for x in args]
+            with torch.no_grad():
+                out = method(*a)
+            conv = lambda o: o.detach().cpu().numpy() if hasattr(o, "detach") else np.asarray(o)  # noqa: E731
+            return tuple(conv(o) for o in out) if isinstance(out, tuple) else conv(out)
+        return run
+
+
+def adapter(framework: str, spec, params):
+    if framework == "jax":
+        return JaxAdapter(spec, params)
+    if framework == "torch":
+        return TorchAdapter(spec, params)
+    raise ValueError(f"unknown framework {framework!r}; valid: jax, torch")

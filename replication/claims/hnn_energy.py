@@ -1,0 +1,44 @@
+"""Claim 10 (HNN, as compared in both papers): an HNN conserves energy better than a baseline on the
+mass-spring and the pendulum. HNN on canonical (q, p) with targets (qdot, pdot); baseline MLP
+(q, qdot) -> qdd. Metric: max over the rollout of |E_pred - E_true| / scale, mean over initial states."""
+from replication.claims.base import Claim, ModelEntry
+from replication.protocol import Protocol
+
+W = {"smoke": (16, 16), "quick": (128, 128), "paper": (200, 200)}
+_hnn = {"kind": "hnn", "activation": "tanh", "init": "xavier"}
+_base_m = {"kind": "baseline", "activation": "tanh", "init": "xavier"}
+HAM = {"task": "hamiltonian", "coords": "qp"}
+MODELS = (ModelEntry("hnn_spring", _hnn, hidden=W, overrides={"data": "spring_iid", **HAM}),
+          ModelEntry("baseline_spring", _base_m, hidden=W, overrides={"data": "spring_iid"}),
+          ModelEntry("hnn_pendulum", _hnn, hidden=W, overrides={"data": "pendulum_iid", **HAM}),
+          ModelEntry("baseline_pendulum", _base_m, hidden=W, overrides={"data": "pendulum_iid"}))
+_base = Protocol(data="spring_iid", steps=20, batch=32, n_train=640, n_heldout=512, loss="mse", lr=1e-3,
+                 schedule="onecycle", log_every=5)
+PROTOCOLS = {"smoke": _base,
+             "quick": _base.replace(steps=2000, batch=128, n_train=128 * 200, n_heldout=5000, log_every=50),
+             "paper": _base.replace(steps=20_000, batch=256, n_train=256 * 500, n_heldout=20_000, log_every=500)}
+EVAL = {"smoke": {"n_ics": 3, "t_end": 2.0, "n_t": 21, "dt": 0.01, "energy_scale": 1.0},
+        "quick": {"n_ics": 10, "t_end": 30.0, "n_t": 301, "dt": 0.01, "energy_scale": 1.0},
+        "paper": {"n_ics": 25, "t_end": 100.0, "n_t": 1000, "dt": 0.01, "energy_scale": 1.0}}
+
+
+def _verdict(v):
+    rows, strong, weak = [], True, False
+    for s in ("spring", "pendulum"):
+        h, b = v.get(f"hnn_{s}"), v.get(f"baseline_{s}")
+        if h is None or b is None:
+            return "not run", f"missing {s}"
+        strong &= h * 3 < b
+        weak |= h < b
+        rows.append(f"{s}: hnn {h:.3g} vs baseline {b:.3g}")
+    return ("reproduced" if strong else "partly" if weak else "not reproduced"), "; ".join(rows)
+
+
+CLAIM = Claim(
+    id="hnn_energy", number=10, paper="HNN", section="§3 (spring, pendulum)",
+    title="HNN conserves energy better than a baseline on the mass-spring and the pendulum",
+    system="spring, pendulum", models=MODELS, protocols=PROTOCOLS, evaluate="energy_rollout",
+    metric="energy_err_max", metric_label="max_t |E_pred - E_true|, mean over initial states",
+    published={m.label: None for m in MODELS},
+    verdict_rule="hnn * 3 < baseline on both systems (partly: on one)", verdict=_verdict, eval_config=EVAL,
+)

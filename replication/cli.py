@@ -1,0 +1,114 @@
+"""The `lagbench` command line: list, run, report, fit, bench."""
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+
+
+def _csv(s):
+    return [x.strip() for x in s.split(",") if x.strip()] if s else None
+
+
+def cmd_list(args):
+    import systems
+    from models import ACTIVATIONS, INITS, KINDS
+    from replication.claims import CLAIMS, PROFILES
+
+    print("systems:    " + ", ".join(systems.names()))
+    print("models:     " + ", ".join(KINDS))
+    print("activations:" + " " + ", ".join(ACTIVATIONS))
+    print("inits:      " + ", ".join(INITS))
+    print("profiles:   " + ", ".join(PROFILES))
+    print("claims:")
+    for c in CLAIMS.values():
+        print(f"  {c.number:>2} {c.id:<17} [{c.paper} {c.section}] {c.title}")
+        print(f"     models: {', '.join(m.label for m in c.models)}")
+
+
+def cmd_run(args):
+    from replication.runner import run
+
+    summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
+                  frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
+                  progress=not args.quiet)
+    for c in summary["claims"]:
+        print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
+
+
+def cmd_report(args):
+    import reports
+
+    paths = reports.build_report(args.results, args.out)
+    for k, v in paths.items():
+        print(f"{k}: {v}")
+
+
+def cmd_fit(args):
+    from replication.fit import fit
+
+    d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
+            hidden=tuple(int(x) for x in args.hidden.split(",")), batch=args.batch, lr=args.lr, seed=args.seed,
+            loss=args.loss)
+    print(f"{d['status']}: held-out L1 {d['metrics'].get('heldout_l1')}, written to {args.out}")
+
+
+def cmd_bench(args):
+    from replication.bench import run_bench
+
+    run_bench(out=args.out, quick=not args.full)
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog="lagbench", description="Replication suite for learned Lagrangian and "
+                                "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.")
+    p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("list", help="list systems, models, claims and profiles")
+    s.set_defaults(func=cmd_list)
+    s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units")
+    s.add_argument("--profile", default="quick", help="smoke | quick | paper (default: quick)")
+    s.add_argument("--claims", help="comma-separated claim ids (default: all; see `lagbench list`)")
+    s.add_argument("--models", help="comma-separated model labels to restrict to")
+    s.add_argument("--frameworks", default="jax,torch", help="jax,torch (default both)")
+    s.add_argument("--seeds", type=int, help="seeds per claim (default: the profile's)")
+    s.add_argument("--out", help="results folder (default: results/<profile>)")
+    s.add_argument("--quiet", action="store_true", help="no progress bars")
+    s.set_defaults(func=cmd_run)
+    s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder")
+    s.add_argument("--results", default="results/quick")
+    s.add_argument("--out", default="report/quick")
+    s.set_defaults(func=cmd_report)
+    s = sub.add_parser("fit", help="train a model on your own .npz/.csv data (format: README)")
+    s.add_argument("--data", required=True, help="a .npz or .csv file with q*, qdot*, qddot* (and tau*) columns")
+    s.add_argument("--model", required=True, help="lnn | hnn | delan | baseline")
+    s.add_argument("--out", default="results/fit")
+    s.add_argument("--framework", default="jax", help="jax | torch")
+    s.add_argument("--steps", type=int, default=2000)
+    s.add_argument("--batch", type=int, default=256)
+    s.add_argument("--hidden", default="128,128")
+    s.add_argument("--lr", type=float, default=1e-3)
+    s.add_argument("--loss", default="l1", help="l1 | mse")
+    s.add_argument("--seed", type=int, default=0)
+    s.set_defaults(func=cmd_fit)
+    s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)")
+    s.add_argument("--out", default="results/quick")
+    s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow)")
+    s.set_defaults(func=cmd_bench)
+    return p
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
+    try:
+        args.func(args)
+    except (KeyError, ValueError, FileNotFoundError) as e:
+        msg = e.args[0] if isinstance(e, KeyError) and e.args else e
+        print(f"lagbench: error: {msg}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

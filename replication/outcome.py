@@ -1,0 +1,25 @@
+"""What a training loop returns, the same record for both frameworks."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass
+class TrainOutcome:
+    params: dict            # last good parameters, init_params layout (NumPy)
+    log: list               # rows: step, loss, grad_norm, lr, wall_s
+    failure: dict | None    # None, or {"kind", "step", "message"}
+    train_time_s: float
+    steps_done: int
+    batch: int
+
+    @property
+    def samples_per_s(self) -> float:
+        return self.steps_done * self.batch / self.train_time_s if self.train_time_s > 0 else float("nan")
+
+
+def nonfinite_failure(step: int, loss: float, gnorm: float) -> dict:
+    what = "loss" if loss != loss or abs(loss) == float("inf") else "gradient"
+    return {"kind": f"non_finite_{what}", "step": int(step),
+            "message": f"non-finite {what} at step {step} (loss={loss}, grad_norm={gnorm}); "
+                       f"kept the parameters from before step {step}"}

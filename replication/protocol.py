@@ -1,0 +1,95 @@
+"""The training protocol: everything that must be identical across JAX and PyTorch, in one frozen record.
+
+A `Protocol` fixes the data (system, distribution, pool size, held-out size, coordinates), the loss,
+the optimiser (Adam; b1, b2, eps), the learning rate as a pure function of the step (see
+`replication.schedules`), the L2 penalty, the number of steps, the batch size, the dtype and the
+seed. The batch order is drawn once in NumPy from the seed (`replication.data.BatchStream`) and fed
+to both frameworks, so two frameworks given one protocol see the same numbers in the same order.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from dataclasses import dataclass, field
+
+LOSSES = ("l1", "mse", "l1_gamma")
+SCHEDULES = ("constant", "step", "onecycle")
+DTYPES = ("float32", "float64")
+TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
+COORDS = ("qqdot", "qp")
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """One training protocol. Sizes are in samples; `steps` optimiser steps of `batch` samples.
+
+    data:      name of a data recipe in `replication.data.RECIPES` (e.g. "double_pendulum_iid").
+    system_params: system parameter overrides as sorted (name, value) pairs.
+    n_train:   size of the training pool; with `resample` a fresh pool is drawn every epoch
+               (the original double-pendulum protocol), else one pool is shuffled every epoch.
+    task:      what the model predicts (see `TASKS`); coords: inputs (q, qdot) or canonical (q, p).
+    loss:      "l1" (per-sample sum of |error| over components, mean over the batch, as the
+               original code), "mse" (per-sample sum of squares), "l1_gamma" (l1 weighted by 1+gamma,
+               normalised by the sum of weights; the relativistic protocol).
+    lr/schedule: peak learning rate and its shape; `lr_min_ratio` and `lr_start` parametrise the
+               one-cycle cosine, `lr_step_every`/`lr_step_gamma` the step decay.
+    l2:        coefficient of sum(theta^2) added to the loss (the original code's weight penalty).
+    """
+
+    data: str
+    steps: int
+    batch: int
+    n_train: int
+    n_heldout: int = 10_000
+    system_params: tuple = ()
+    resample: bool = False
+    task: str = "acceleration"
+    coords: str = "qqdot"
+    loss: str = "l1"
+    lr: float = 1e-3
+    schedule: str = "onecycle"
+    lr_start: float = 0.2
+    lr_min_ratio: float = 1e-4
+    lr_step_every: int = 1000
+    lr_step_gamma: float = 0.1
+    b1: float = 0.9
+    b2: float = 0.999
+    eps: float = 1e-8
+    l2: float = 0.0
+    dtype: str = "float32"
+    log_every: int = 50
+    eval: dict = field(default_factory=dict, hash=False, compare=True)
+
+    def __post_init__(self):
+        checks = [("loss", LOSSES), ("schedule", SCHEDULES), ("dtype", DTYPES), ("task", TASKS),
+                  ("coords", COORDS)]
+        for name, valid in checks:
+            if getattr(self, name) not in valid:
+                raise ValueError(f"unknown {name} {getattr(self, name)!r}; valid: {', '.join(valid)}")
+        for name in ("steps", "batch", "n_train", "n_heldout"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"protocol {name} must be a positive integer, got {getattr(self, name)!r}")
+        if self.batch > self.n_train:
+            raise ValueError(f"batch {self.batch} exceeds the training pool n_train={self.n_train}")
+        if not self.lr > 0:
+            raise ValueError(f"learning rate must be positive, got {self.lr}")
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["system_params"] = [list(p) for p in self.system_params]
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Protocol:
+        d = dict(d)
+        d["system_params"] = tuple(tuple(p) for p in d.get("system_params", ()))
+        return cls(**d)
+
+    def replace(self, **changes) -> Protocol:
+        return dataclasses.replace(self, **changes)
+
+    def key(self) -> str:
+        """A short stable hash of everything in the protocol."""
+        blob = json.dumps(self.to_dict(), sort_keys=True, default=str).encode()
+        return hashlib.sha256(blob).hexdigest()[:16]

@@ -1,0 +1,135 @@
+"""Result files: atomic writes, checksums, and the unit layout of `replication/RESULTS.md`.
+
+Every file is written to a temporary name in the same folder and renamed into place, so a killed
+run never leaves a half-written file under a final name. A unit's `result.json` carries the sha256
+of each of its other files and a checksum of itself (sha256 of the canonical JSON without the
+"checksum" key: `json.dumps(d, sort_keys=True, separators=(",", ":"))`). `load_result` verifies
+both and raises `CorruptResult` on any mismatch; the runner then reruns the unit.
+"""
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+SCHEMA = 1
+
+
+class CorruptResult(Exception):
+    """A result or cache file failed its checksum, or could not be parsed."""
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _clean(obj):
+    """JSON-safe: NumPy scalars to Python, non-finite floats to None."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _clean(obj.tolist())
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def canonical(d: dict) -> bytes:
+    return json.dumps(d, sort_keys=True, separators=(",", ":")).encode()
+
+
+def sha256_bytes(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def sha256_file(path: Path) -> str:
+    return sha256_bytes(Path(path).read_bytes())
+
+
+def write_json(path: Path, d: dict, *, checksum: bool = False) -> dict:
+    d = _clean(d)
+    if checksum:
+        d.pop("checksum", None)
+        d["checksum"] = sha256_bytes(canonical(d))
+    _atomic_write_bytes(Path(path), json.dumps(d, indent=1, sort_keys=True).encode())
+    return d
+
+
+def read_json(path: Path) -> dict:
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise CorruptResult(f"{path}: cannot read JSON ({e})") from e
+
+
+def write_csv(path: Path, df) -> str:
+    buf = io.StringIO()
+    df.to_csv(buf, index=False)
+    data = buf.getvalue().encode()
+    _atomic_write_bytes(Path(path), data)
+    return sha256_bytes(data)
+
+
+def write_npz(path: Path, arrays: dict) -> str:
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **{k: np.asarray(v) for k, v in arrays.items()})
+    data = buf.getvalue()
+    _atomic_write_bytes(Path(path), data)
+    return sha256_bytes(data)
+
+
+def load_npz(path: Path) -> dict:
+    try:
+        with np.load(path) as z:
+            return {k: z[k] for k in z.files}
+    except Exception as e:  # zipfile/pickle/value errors all mean the file is unusable
+        raise CorruptResult(f"{path}: cannot read arrays ({e})") from e
+
+
+def unit_dir(out: Path, claim: str, framework: str, model: str, seed: int) -> Path:
+    return Path(out) / "units" / claim / framework / model / f"seed{seed}"
+
+
+def load_result(folder: Path) -> dict:
+    """The verified result.json of a unit folder; CorruptResult if it or a listed file is bad."""
+    folder = Path(folder)
+    d = read_json(folder / "result.json")
+    expected = d.get("checksum")
+    body = {k: v for k, v in d.items() if k != "checksum"}
+    if expected is None or sha256_bytes(canonical(body)) != expected:
+        raise CorruptResult(f"{folder / 'result.json'}: checksum mismatch")
+    for name, digest in (d.get("files") or {}).items():
+        f = folder / name
+        if not f.exists() or sha256_file(f) != digest:
+            raise CorruptResult(f"{f}: missing or checksum mismatch")
+    return d
+
+
+def is_finished(folder: Path) -> bool:
+    try:
+        load_result(folder)
+        return True
+    except CorruptResult:
+        return False

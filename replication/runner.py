@@ -1,0 +1,103 @@
+"""`lagbench run`: enumerate units, skip finished ones, run the rest with progress bars, summarise.
+
+A unit is finished when its result.json verifies (checksum and file hashes); anything else (absent,
+half-written, corrupt) is (re)run. Units are independent and deterministic given their seed, so an
+interrupted run resumes where it stopped and ends with the same numbers as an uninterrupted one.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+from tqdm.auto import tqdm
+
+from replication import environment as env
+from replication import results as R
+from replication.claims import CLAIMS, PROFILES
+from replication.claims import get as get_claim
+from replication.units import Unit, run_unit
+from replication.verdicts import write_summary
+
+log = logging.getLogger("lagbench")
+FRAMEWORKS = ("jax", "torch")
+
+
+def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None) -> list:
+    if profile not in PROFILES:
+        raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
+    for fw in frameworks:
+        if fw not in FRAMEWORKS:
+            raise ValueError(f"unknown framework {fw!r}; valid: {', '.join(FRAMEWORKS)}")
+    chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
+    units = []
+    for claim in chosen:
+        n = claim.seeds.get(profile, 1)
+        if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
+            n = seeds if max(claim.seeds.values()) > 1 else 1
+        for entry in claim.models:
+            if models and entry.label not in models:
+                continue
+            for fw in frameworks:
+                for seed in range(n):
+                    units.append(Unit(claim, entry, fw, seed, profile))
+    return units
+
+
+def estimate_seconds(units, out) -> float:
+    """Time 3 training steps of each distinct configuration (after one to compile) and scale up."""
+    from replication.training import run_training
+
+    seen, total = {}, 0.0
+    for u in units:
+        if not u.entry.train or R.is_finished(u.folder(out)):
+            continue
+        p, spec = u.protocol(), u.spec()
+        key = (u.framework, spec, p.replace(steps=1))
+        if key not in seen:
+            probe = p.replace(steps=4, log_every=1, schedule="constant", n_train=max(p.batch * 4, p.batch))
+            o = run_training(u.framework, spec, probe, 0)
+            walls = [r["wall_s"] for r in o.log]
+            seen[key] = (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
+        total += seen[key] * p.steps
+    return total
+
+
+def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
+        progress=True) -> dict:
+    out = Path(out)
+    units = plan(profile, claims, frameworks, seeds, models)
+    R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
+    manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
+                "claims": sorted({u.claim.id for u in units}), "versions": env.versions(),
+                "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
+    if profile == "paper":
+        est = estimate_seconds(units, out)
+        print(f"lagbench: the paper profile's training is estimated at {est / 3600:.1f} h on this machine "
+              f"({env.hardware()['cpu']}, GPU: {env.hardware()['gpu']}); it resumes if interrupted.", flush=True)
+        manifest["estimated_train_s"] = est
+    R.write_json(out / "run.json", manifest)
+    todo = [u for u in units if not R.is_finished(u.folder(out))]
+    log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
+    failures, t0 = [], time.perf_counter()
+    bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
+    for u in bar:
+        bar.set_postfix_str(u.name)
+        steps = u.protocol().steps if u.entry.train else 0
+        inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
+        last = {"step": -1}
+
+        def on_log(row, inner=inner, last=last):
+            inner.update(row["step"] - last["step"])
+            last["step"] = row["step"]
+            inner.set_postfix(loss=f"{row['loss']:.3g}")
+
+        d = run_unit(u, out, on_log=on_log)
+        inner.close()
+        if d["status"] != "ok":
+            failures.append(f"{u.name}: {d['failure']['message']}")
+    summary = write_summary(out, profile)
+    manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
+                    units_run=len(todo), failures=failures)
+    R.write_json(out / "run.json", manifest)
+    return summary

@@ -1,0 +1,62 @@
+"""The PyTorch training loop (torch.optim.Adam). Mirrors `train_jax.py` line for line.
+
+`train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome`: the same steps, the same
+learning rate per step (set on the optimiser before each step), the same logging, and the same
+stop at the first non-finite loss or gradient (checked before the update is applied).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import torch
+
+import models.torch
+from replication.objective import loss_value, predict
+from replication.outcome import TrainOutcome, nonfinite_failure
+from replication.schedules import learning_rate
+
+
+def _to_torch(batch: dict, dtype) -> dict:
+    return {k: torch.as_tensor(v, dtype=dtype) for k, v in batch.items()}
+
+
+def make_loss(spec, protocol):
+    def loss_fn(model, batch):
+        pred = predict(model, spec.kind, protocol.task, batch, torch.cat)
+        loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss)
+        if protocol.l2:
+            loss = loss + protocol.l2 * sum((p * p).sum() for p in model.parameters())
+        return loss
+    return loss_fn
+
+
+def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
+    dtype = getattr(torch, protocol.dtype)
+    model = models.torch.build(spec, params)
+    loss_fn = make_loss(spec, protocol)
+    opt = torch.optim.Adam(model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
+                           eps=protocol.eps, weight_decay=0.0, foreach=False)
+    log, failure, t0 = [], None, time.perf_counter()
+    for k in range(protocol.steps):
+        lr = learning_rate(protocol, k)
+        batch = _to_torch(stream.batch(k), dtype)
+        for group in opt.param_groups:
+            group["lr"] = lr
+        opt.zero_grad(set_to_none=True)
+        loss = loss_fn(model, batch)
+        loss.backward()
+        gnorm = float(torch.sqrt(sum((p.grad * p.grad).sum() for p in model.parameters() if p.grad is not None)))
+        loss = float(loss.detach())
+        if not (np.isfinite(loss) and np.isfinite(gnorm)):
+            failure = nonfinite_failure(k, loss, gnorm)
+            break
+        opt.step()
+        if k % protocol.log_every == 0 or k == protocol.steps - 1:
+            row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr, "wall_s": time.perf_counter() - t0}
+            log.append(row)
+            if on_log:
+                on_log(row)
+    wall = time.perf_counter() - t0
+    return TrainOutcome(params=models.torch.to_params(model), log=log, failure=failure, train_time_s=wall,
+                        steps_done=k + 1 if failure is None else k, batch=protocol.batch)

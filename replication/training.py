@@ -1,0 +1,62 @@
+"""Train one (framework, spec, protocol, seed), with a cache so that claims sharing a model train it once.
+
+`train_cached(out, framework, spec, protocol, seed)` -> TrainOutcome. The cache folder
+`OUT/trained/<framework>/<key>/` holds checkpoint.npz (last good parameters), train_log.csv and
+train.json (timings, failure, file checksums); a corrupt entry is retrained, never trusted.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from models import init_params
+from replication import results as R
+from replication.data import BatchStream
+from replication.outcome import TrainOutcome
+
+log = logging.getLogger("lagbench")
+
+
+def train_key(framework, spec, protocol, seed) -> str:
+    blob = json.dumps({"fw": framework, "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
+                      sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:20]
+
+
+def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    params = init_params(spec, seed=seed)
+    stream = BatchStream(protocol, seed)
+    if framework == "jax":
+        from replication.train_jax import train
+    elif framework == "torch":
+        from replication.train_torch import train
+    else:
+        raise ValueError(f"unknown framework {framework!r}; valid: jax, torch")
+    return train(spec, params, protocol, stream, on_log=on_log)
+
+
+def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    folder = Path(out) / "trained" / framework / train_key(framework, spec, protocol, seed)
+    try:
+        meta = R.load_result(folder) if (folder / "result.json").exists() else None
+    except R.CorruptResult as e:
+        log.warning("retraining: %s", e)
+        meta = None
+    if meta is not None:
+        return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
+                            log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
+                            failure=meta["failure"], train_time_s=meta["train_time_s"],
+                            steps_done=meta["steps_done"], batch=meta["batch"])
+    outcome = run_training(framework, spec, protocol, seed, on_log=on_log)
+    files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
+             "train_log.csv": R.write_csv(folder / "train_log.csv", pd.DataFrame(
+                 outcome.log, columns=["step", "loss", "grad_norm", "lr", "wall_s"]))}
+    R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
+                                          "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
+                                          "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
+                 checksum=True)
+    return outcome

@@ -1,0 +1,50 @@
+"""Entry point: ``build_report(results_dir, out_dir) -> dict`` (what ``lagbench report`` calls).
+
+Reads only the result files of ``replication/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
+training code. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
+``figures/*.png``. Returns ``{"markdown": Path, "typst": Path, "pdf": Path, "figures": [Path, ...]}``.
+An empty or missing results folder still yields a report that says nothing was run.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from pathlib import Path
+
+from reports.document import Figure, Section, tables_and_figures
+from reports.environment import environment_sections, sources_sections
+from reports.findings import findings_sections
+from reports.load import load_results
+from reports.markdown import render_markdown
+from reports.pdf import write_pdf
+from reports.sections_claims import summary_sections, theme_sections
+from reports.sections_speed import agreement_sections, speed_sections
+
+TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
+
+
+def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
+    res = load_results(results_dir)
+    sections = summary_sections(res)
+    sections += theme_sections(res, out_dir)
+    sections += speed_sections(res, out_dir)
+    sections += agreement_sections(res)
+    sections += findings_sections(res)
+    sections += environment_sections(res, now)
+    return sections + sources_sections(res, sections)
+
+
+def build_report(results_dir: str | Path, out_dir: str | Path, *, pdf: bool = True) -> dict:
+    """Build REPORT.md (and REPORT.pdf unless ``pdf=False``) from ``results_dir`` into ``out_dir``."""
+    out_dir = Path(out_dir)
+    (out_dir / "figures").mkdir(parents=True, exist_ok=True)
+    for old in (out_dir / "figures").glob("*.png"):
+        old.unlink()
+    sections = build_sections(Path(results_dir), out_dir)
+    md = out_dir / "REPORT.md"
+    md.write_text(render_markdown(TITLE, sections), encoding="utf-8")
+    figures = [out_dir / b.path for b in tables_and_figures(sections) if isinstance(b, Figure)]
+    paths: dict = {"markdown": md, "figures": figures}
+    if pdf:
+        paths["typst"], paths["pdf"] = write_pdf(TITLE, sections, out_dir)
+    return paths

@@ -1,0 +1,114 @@
+"""Comparison tables: cross-framework agreement and the cheapest model reaching the best error.
+
+``cross_framework_table`` compares every framework with the first one (per claim and model: means,
+relative difference of means, and the largest per-seed difference over seeds run in both).
+``cheapest_table`` picks, per claim, among (framework, model) whose mean claim metric is within
+``tolerance`` x the best (lowest) mean, the one with the highest training throughput
+(``train_samples_per_s``; else the shortest ``train_time_s``). ``bench_cheapest_table`` does the same per
+system from ``bench/inference.csv`` (error vs ``samples_per_s``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from reports.document import NOT_RUN
+from reports.fmt import num, summarise
+from reports.load import Results
+from reports.tables import claim_models, values
+
+TOLERANCE = 2.0
+
+
+def cross_framework_table(res: Results) -> pd.DataFrame | None:
+    fws = res.frameworks
+    if len(fws) < 2:
+        return None
+    ref, rows = fws[0], []
+    for claim in res.claims:
+        metric = claim.get("metric")
+        vals = values(res.claim_units(claim["id"]), metric)
+        for model in claim_models(res, claim):
+            for fw in fws[1:]:
+                a, b = vals.get(ref, {}).get(model), vals.get(fw, {}).get(model)
+                by_seed = {}
+                for u in res.usable(claim["id"]):
+                    if u.model == model and u.framework in (ref, fw) and metric:
+                        by_seed.setdefault(u.seed, {})[u.framework] = u.metric(metric)
+                diffs = [abs(d[ref] - d[fw]) for d in by_seed.values()
+                         if d.get(ref) is not None and d.get(fw) is not None]
+                rel = NOT_RUN
+                if a and b:
+                    scale = max(abs(a["mean"]), abs(b["mean"]))
+                    rel = num(abs(a["mean"] - b["mean"]) / scale) if scale > 0 else "0"
+                rows.append({
+                    "claim": claim["id"], "model": model, "metric": metric or "unknown",
+                    ref: num(a["mean"]) if a else NOT_RUN, fw: num(b["mean"]) if b else NOT_RUN,
+                    "rel. diff of means": rel,
+                    "max per-seed abs. diff": num(max(diffs)) if diffs else NOT_RUN,
+                    "seeds in both": str(len(diffs)),
+                })
+    return pd.DataFrame(rows) if rows else None
+
+
+def _cost(units) -> tuple[str, float] | None:
+    """('samples/s', value) (higher is cheaper) or ('train s', value) (lower is cheaper)."""
+    thr = summarise([u.result.get("train_samples_per_s") for u in units
+                     if isinstance(u.result.get("train_samples_per_s"), int | float)])
+    if thr["n"]:
+        return "samples/s", thr["mean"]
+    t = summarise([u.result.get("train_time_s") for u in units if isinstance(u.result.get("train_time_s"), int | float)])
+    return ("train s", t["mean"]) if t["n"] else None
+
+
+def cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataFrame | None:
+    rows = []
+    for claim in res.claims:
+        metric, units = claim.get("metric"), res.usable(claim["id"])
+        vals = values(units, metric)
+        cands = []
+        for fw, per in vals.items():
+            for model, s in per.items():
+                cost = _cost([u for u in units if u.framework == fw and u.model == model])
+                cands.append((s["mean"], fw, model, cost))
+        finite = [c for c in cands if math.isfinite(c[0])]
+        if not finite:
+            continue
+        best = min(finite, key=lambda c: c[0])
+        ok = [c for c in finite if c[0] <= best[0] * tolerance or c[0] == best[0]]
+        with_cost = [c for c in ok if c[3] is not None]
+        if with_cost:
+            pick = max(with_cost, key=lambda c: c[3][1] if c[3][0] == "samples/s" else -c[3][1])
+        else:
+            pick = best
+        rows.append({
+            "claim": claim["id"], "system": str(claim.get("system", "unknown")), "metric": metric,
+            "best": f"{best[2]} ({best[1]}): {num(best[0])}",
+            "cheapest within tolerance": f"{pick[2]} ({pick[1]}): {num(pick[0])}",
+            "its cost": f"{num(pick[3][1])} {pick[3][0]}" if pick[3] else "not recorded",
+        })
+    return pd.DataFrame(rows) if rows else None
+
+
+def bench_cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataFrame | None:
+    df = res.bench.get("inference")
+    if df is None or df.empty:
+        return None
+    df = df[pd.to_numeric(df["error"], errors="coerce").notna()].copy()
+    df["error"] = df["error"].astype(float)
+    df["samples_per_s"] = pd.to_numeric(df["samples_per_s"], errors="coerce")
+    rows = []
+    for system, g in df.groupby("system", sort=True):
+        best = g.loc[g["error"].idxmin()]
+        ok = g[g["error"] <= best["error"] * tolerance].dropna(subset=["samples_per_s"])
+        pick = ok.loc[ok["samples_per_s"].idxmax()] if len(ok) else best
+
+        def name(r):
+            return f"{r['model']}/{r['formulation']} ({r['framework']}, {r['dtype']})"
+
+        rows.append({"system": str(system), "best error": f"{name(best)}: {num(best['error'])}",
+                     "cheapest within tolerance": f"{name(pick)}: {num(pick['error'])}",
+                     "samples/s": num(pick["samples_per_s"])})
+    return pd.DataFrame(rows) if rows else None

@@ -1,0 +1,234 @@
+"""Per-claim figures, one function each; matplotlib without pyplot (no global state, Agg via savefig).
+
+Every function takes the claim's usable units and a PNG path, writes the figure and returns True, or
+returns False (writing nothing) when the units lack the data it needs. Inputs:
+- ``energy_drift``: ``timeseries.csv`` rows with ``quantity == "energy_err"`` (traj, t, value).
+- ``trajectory``: ``arrays.npz`` keys ``t`` (T,), ``q_true`` and ``q_pred`` ((T, n) or (n_traj, T, n)).
+- ``wave_spacetime``: ``arrays.npz`` keys ``x`` (n,), ``t`` (T,), ``field_true``/``field_pred`` (T, n).
+- ``delan_decomposition``: ``arrays.npz`` pairs ``M_true/M_pred``, ``c_true/c_pred``, ``g_true/g_pred``
+  (and ``tau_true/tau_pred``) of any matching shapes; drawn as predicted-vs-true parity plots.
+- ``training_curves``: ``train_log.csv`` (step, loss) averaged over seeds per model and framework.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from reports.load import Unit
+
+DPI = 130
+LINESTYLES = ["-", "--", ":", "-."]
+MARKERS = ["o", "s", "^", "D", "v", "P"]
+
+
+def new_figure(ncols: int = 1, nrows: int = 1, width: float = 6.4, height: float = 3.4, gap: float = 0.95,
+               right: float = 0.2):
+    """Fixed margins, ``gap`` between panels and ``right`` margin (inches) instead of constrained layout,
+    which doubles the drawing time."""
+    fig = Figure(figsize=(width, height * nrows))
+    axes = fig.subplots(nrows, ncols, squeeze=False)
+    panel = (width - 1.05 - right - gap * (ncols - 1)) / ncols
+    fig.subplots_adjust(left=1.05 / width, right=1 - right / width, bottom=0.55 / height, top=1 - 0.4 / height,
+                        wspace=gap / panel, hspace=0.35)
+    return fig, list(axes.ravel())
+
+
+def save(fig: Figure, path: Path) -> bool:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=DPI)
+    return True
+
+
+def colour(i: int) -> str:
+    return f"C{i % 10}"
+
+
+def style_index(values: list[str]) -> dict[str, int]:
+    return {v: i for i, v in enumerate(dict.fromkeys(values))}
+
+
+def log_if_spread(ax, values, axis: str = "y", decades: float = 1.5) -> None:
+    arr = np.asarray(values, dtype=float)
+    arr = arr[np.isfinite(arr)]
+    if arr.size and (arr > 0).all() and np.log10(arr.max() / arr.min()) >= decades:
+        (ax.set_yscale if axis == "y" else ax.set_xscale)("log")
+
+
+def ticks_at(ax, values, axis: str = "x") -> None:
+    """Label a log axis at the given values (plain numbers) instead of 2×10⁰-style minor labels."""
+    vals = sorted({float(v) for v in values if np.isfinite(v) and v > 0})
+    if 0 < len(vals) <= 8:
+        setter = ax.set_xticks if axis == "x" else ax.set_yticks
+        setter(vals, [f"{v:g}" for v in vals])
+        setter([], minor=True)
+
+
+def _groups(units: list[Unit]) -> dict[tuple[str, str], list[Unit]]:
+    out: dict[tuple[str, str], list[Unit]] = {}
+    for u in units:
+        out.setdefault((u.model, u.framework), []).append(u)
+    return out
+
+
+def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative energy error") -> bool:
+    curves = {}
+    for key, group in _groups(units).items():
+        per_seed = []
+        for u in group:
+            ts = u.table("timeseries.csv")
+            if ts is None or not {"t", "quantity", "value"} <= set(ts.columns):
+                continue
+            e = ts[ts["quantity"] == "energy_err"]
+            if len(e):
+                per_seed.append(e.groupby("t")["value"].mean())
+        if per_seed:
+            curves[key] = per_seed
+    if not curves:
+        return False
+    fig, (ax,) = new_figure()
+    models = style_index([k[0] for k in curves])
+    fws = style_index([k[1] for k in curves])
+    allv = []
+    for (model, fw), seeds in curves.items():
+        t = seeds[0].index.to_numpy(dtype=float)
+        stack = np.vstack([s.reindex(seeds[0].index).to_numpy(dtype=float) for s in seeds])
+        mean = np.nanmean(stack, axis=0)
+        allv.extend(stack.ravel())
+        kw = {"color": colour(models[model]), "ls": LINESTYLES[fws[fw] % 4]}
+        ax.plot(t, mean, label=f"{model} ({fw}, {len(seeds)} seed{'s' * (len(seeds) > 1)})", **kw)
+        if len(seeds) > 1:
+            ax.fill_between(t, np.nanmin(stack, 0), np.nanmax(stack, 0), color=kw["color"], alpha=0.15, lw=0)
+    log_if_spread(ax, allv)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel(f"{scale_label} (–)")
+    ax.set_title("Energy drift against truth", fontsize=10)
+    ax.legend(fontsize=7)
+    return save(fig, path)
+
+
+def _first_with(units: list[Unit], keys: tuple[str, ...]) -> dict[tuple[str, str], dict]:
+    """First unit (lowest seed) per (model, framework) whose arrays hold all ``keys``."""
+    out = {}
+    for key, group in _groups(units).items():
+        for u in group:
+            arr = u.arrays()
+            if arr is not None and all(k in arr for k in keys):
+                out[key] = arr
+                break
+    return out
+
+
+def trajectory(units: list[Unit], path: Path) -> bool:
+    found = _first_with(units, ("t", "q_true", "q_pred"))
+    if not found:
+        return False
+
+    def first_traj(q):
+        q = np.asarray(q, dtype=float)
+        return q[0] if q.ndim == 3 else (q[:, None] if q.ndim == 1 else q)
+
+    ref = next(iter(found.values()))
+    dof = min(first_traj(ref["q_true"]).shape[1], 4)
+    fig, axes = new_figure(ncols=dof, width=3.3 * dof)
+    models = style_index([k[0] for k in found])
+    fws = style_index([k[1] for k in found])
+    for j, ax in enumerate(axes):
+        t = np.asarray(ref["t"], dtype=float)
+        ax.plot(t, first_traj(ref["q_true"])[: len(t), j], color="k", lw=2, alpha=0.5, label="truth")
+        for (model, fw), arr in found.items():
+            tt = np.asarray(arr["t"], dtype=float)
+            qp = first_traj(arr["q_pred"])
+            ax.plot(tt[: len(qp)], qp[: len(tt), j], color=colour(models[model]),
+                    ls=LINESTYLES[fws[fw] % 4], lw=1, label=f"{model} ({fw})")
+        ax.set_xlabel("time t (s)")
+        ax.set_ylabel(f"q{j + 1} (rad or m)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Trajectory from one initial condition (first seed)")
+    return save(fig, path)
+
+
+def wave_spacetime(units: list[Unit], path: Path) -> bool:
+    found = _first_with(units, ("x", "t", "field_true", "field_pred"))
+    if not found:
+        return False
+    (model, fw), arr = next(iter(found.items()))
+    x, t = np.asarray(arr["x"], float), np.asarray(arr["t"], float)
+    true, pred = np.asarray(arr["field_true"], float), np.asarray(arr["field_pred"], float)
+    fig, axes = new_figure(ncols=3, width=11, height=3.4, gap=1.7, right=1.0)
+    extent = (x.min(), x.max(), t.max(), t.min())
+    vmax = np.nanmax(np.abs(true)) or 1.0
+    panels = [("truth", true, "RdBu_r", vmax), (f"{model} ({fw})", pred, "RdBu_r", vmax),
+              ("prediction − truth", pred - true, "PuOr_r", np.nanmax(np.abs(pred - true)) or 1.0)]
+    for ax, (name, field, cmap, lim) in zip(axes, panels, strict=True):
+        im = ax.imshow(field, aspect="auto", extent=extent, cmap=cmap, vmin=-lim, vmax=lim)
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("position x (m)")
+        ax.set_ylabel("time t (s)")
+        fig.colorbar(im, ax=ax, label="displacement u (m)")
+    return save(fig, path)
+
+
+DECOMPOSITION = [("M", r"inertia $M(q)$"), ("c", r"Coriolis/centrifugal $c(q, \dot q)$"),
+                 ("g", r"gravity $g(q)$"), ("tau", r"torque $\tau$")]
+
+
+def delan_decomposition(units: list[Unit], path: Path) -> bool:
+    found = {}
+    for key, group in _groups(units).items():
+        for u in group:
+            arr = u.arrays() or {}
+            terms = [(k, name) for k, name in DECOMPOSITION if f"{k}_true" in arr and f"{k}_pred" in arr]
+            if terms:
+                found[key] = (arr, terms)
+                break
+    if not found:
+        return False
+    terms = list(dict.fromkeys(t for _, ts in found.values() for t in ts))
+    fig, axes = new_figure(ncols=len(terms), width=3.2 * len(terms), height=3.2)
+    for ax, (k, name) in zip(axes, terms, strict=True):
+        lo, hi = np.inf, -np.inf
+        for i, ((model, fw), (arr, _)) in enumerate(found.items()):
+            if f"{k}_true" not in arr:
+                continue
+            a = np.asarray(arr[f"{k}_true"], float).ravel()
+            b = np.asarray(arr[f"{k}_pred"], float).ravel()
+            ax.scatter(a, b, s=4, alpha=0.5, color=colour(i), marker=MARKERS[i % 6], label=f"{model} ({fw})")
+            lo, hi = min(lo, np.nanmin(a)), max(hi, np.nanmax(a))
+        ax.plot([lo, hi], [lo, hi], color="k", lw=0.8, label="pred = true")
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("true (SI units)")
+        ax.set_ylabel("predicted (SI units)")
+    axes[0].legend(fontsize=7)
+    return save(fig, path)
+
+
+def training_curves(units: list[Unit], path: Path) -> bool:
+    curves = {}
+    for key, group in _groups(units).items():
+        logs = []
+        for u in group:
+            log = u.table("train_log.csv")
+            if log is not None and {"step", "loss"} <= set(log.columns) and len(log):
+                logs.append(log.groupby("step")["loss"].mean())
+        if logs:
+            curves[key] = logs
+    if not curves:
+        return False
+    fig, (ax,) = new_figure(height=3.8)
+    models = style_index([k[0] for k in curves])
+    fws = style_index([k[1] for k in curves])
+    allv = []
+    for (model, fw), logs in curves.items():
+        idx = logs[0].index
+        stack = np.vstack([s.reindex(idx).to_numpy(dtype=float) for s in logs])
+        allv.extend(stack.ravel())
+        ax.plot(idx.to_numpy(), np.nanmean(stack, 0), color=colour(models[model]),
+                ls=LINESTYLES[fws[fw] % 4], label=f"{model} ({fw})")
+    log_if_spread(ax, allv, decades=1.0)
+    ax.set_xlabel("training step")
+    ax.set_ylabel("training loss (mean over seeds)")
+    ax.legend(fontsize=7, ncols=2)
+    return save(fig, path)

@@ -1,0 +1,151 @@
+"""Speed, scaling and data-efficiency figures; same contract as :mod:`reports.figures`.
+
+- ``speed_error``: one point per usable unit: x = ``train_samples_per_s`` (else ``train_time_s``),
+  y = the claim metric; colour per model, marker per framework.
+- ``bench_speed_error``: ``bench/inference.csv``: samples_per_s vs error, one panel per system.
+- ``bench_scaling``: ``bench/scaling.csv``: seconds_per_eval vs n per study, formulation and framework.
+- ``data_efficiency``: the claim metric against training-set size N, from model labels ``<model>_n<N>``
+  (the runner's convention, e.g. ``delan_n64``); the plain ``<model>`` joins at its protocol ``n_train``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from reports.figures import MARKERS, colour, log_if_spread, new_figure, save, style_index, ticks_at
+from reports.load import Unit
+
+SIZE_METRIC = re.compile(r"^(?P<base>.+)_n(?P<n>\d+)$")
+
+
+def _x(u: Unit) -> tuple[str, float] | None:
+    for key, label in (("train_samples_per_s", "training throughput (samples/s)"),
+                       ("train_time_s", "training time (s)")):
+        v = u.result.get(key)
+        if isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v):
+            return label, float(v)
+    return None
+
+
+def speed_error(units: list[Unit], metric: str, path: Path) -> bool:
+    pts = [(u, _x(u), u.metric(metric)) for u in units]
+    pts = [(u, x, y) for u, x, y in pts if x is not None and y is not None]
+    if not pts:
+        return False
+    label = pts[0][1][0]
+    pts = [p for p in pts if p[1][0] == label]
+    fig, (ax,) = new_figure(height=3.6)
+    models = style_index([u.model for u, _, _ in pts])
+    fws = style_index([u.framework for u, _, _ in pts])
+    seen = set()
+    for u, (_, x), y in pts:
+        key = (u.model, u.framework)
+        ax.scatter(x, y, color=colour(models[u.model]), marker=MARKERS[fws[u.framework] % 6], s=30,
+                   label=f"{u.model} ({u.framework})" if key not in seen else None)
+        seen.add(key)
+    log_if_spread(ax, [x for _, (_, x), _ in pts], axis="x", decades=1.0)
+    log_if_spread(ax, [y for *_, y in pts], decades=1.0)
+    ax.set_xlabel(label)
+    ax.set_ylabel(f"{metric} (claim metric, lower is better)")
+    ax.legend(fontsize=7)
+    return save(fig, path)
+
+
+def bench_speed_error(df: pd.DataFrame | None, path: Path) -> bool:
+    if df is None:
+        return False
+    df = df.assign(error=pd.to_numeric(df["error"], errors="coerce"),
+                   samples_per_s=pd.to_numeric(df["samples_per_s"], errors="coerce")).dropna(
+        subset=["error", "samples_per_s"])
+    if df.empty:
+        return False
+    systems = sorted(df["system"].astype(str).unique())[:6]
+    fig, axes = new_figure(ncols=len(systems), width=3.4 * len(systems), height=3.4)
+    for ax, system in zip(axes, systems, strict=True):
+        g = df[df["system"].astype(str) == system]
+        labels = style_index(list(g["model"].astype(str) + "/" + g["formulation"].astype(str)))
+        fws = style_index(list(g["framework"].astype(str)))
+        for (model, form, fw), h in g.groupby(["model", "formulation", "framework"], sort=True):
+            ax.scatter(h["samples_per_s"], h["error"], color=colour(labels[f"{model}/{form}"]),
+                       marker=MARKERS[fws[str(fw)] % 6], s=25, label=f"{model}/{form} ({fw})")
+        log_if_spread(ax, g["samples_per_s"], axis="x", decades=1.0)
+        log_if_spread(ax, g["error"], decades=1.0)
+        ax.set_title(system, fontsize=9)
+        ax.set_xlabel("inference throughput (samples/s)")
+        ax.set_ylabel("error (bench metric)")
+        ax.legend(fontsize=6)
+    return save(fig, path)
+
+
+def bench_scaling(df: pd.DataFrame | None, path: Path) -> bool:
+    if df is None:
+        return False
+    df = df.assign(n=pd.to_numeric(df["n"], errors="coerce"),
+                   seconds_per_eval=pd.to_numeric(df["seconds_per_eval"], errors="coerce")).dropna(
+        subset=["n", "seconds_per_eval"])
+    if df.empty:
+        return False
+    studies = sorted(df["study"].astype(str).unique())[:4]
+    fig, axes = new_figure(ncols=len(studies), width=3.6 * len(studies), height=3.4)
+    for ax, study in zip(axes, studies, strict=True):
+        g = df[df["study"].astype(str) == study]
+        forms = style_index(list(g["formulation"].astype(str)))
+        fws = style_index(list(g["framework"].astype(str)))
+        for (form, fw), h in g.groupby(["formulation", "framework"], sort=True):
+            h = h.sort_values("n")
+            ax.plot(h["n"], h["seconds_per_eval"], color=colour(forms[str(form)]),
+                    marker=MARKERS[fws[str(fw)] % 6], label=f"{form} ({fw})")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ticks_at(ax, g["n"])
+        ax.set_title(study, fontsize=9)
+        ax.set_xlabel("size n (degrees of freedom or grid points)")
+        ax.set_ylabel("seconds per evaluation (s)")
+        ax.legend(fontsize=6)
+    return save(fig, path)
+
+
+def size_metrics(units: list[Unit], metric: str | None) -> dict[str, list[tuple[str, str, int, float]]]:
+    """``{metric: [(model, framework, N, value)]}`` from sized model labels."""
+    out: dict[str, list] = {}
+    if metric:
+        sized = {u.model: SIZE_METRIC.match(u.model) for u in units}
+        bases = {m["base"] for m in sized.values() if m}
+        for u in units:
+            m, value = sized[u.model], u.metric(metric)
+            n_train = (u.result.get("protocol") or {}).get("n_train")
+            if value is None:
+                continue
+            if m:
+                out.setdefault(metric, []).append((m["base"], u.framework, int(m["n"]), value))
+            elif u.model in bases and isinstance(n_train, int):
+                out.setdefault(metric, []).append((u.model, u.framework, n_train, value))
+    return out
+
+
+def data_efficiency(units: list[Unit], path: Path, metric: str | None) -> bool:
+    found = size_metrics(units, metric)
+    if not found:
+        return False
+    bases = list(found)[:3]
+    fig, axes = new_figure(ncols=len(bases), width=3.6 * len(bases), height=3.4)
+    for ax, base in zip(axes, bases, strict=True):
+        rows = pd.DataFrame(found[base], columns=["model", "framework", "n", "value"])
+        models = style_index(list(rows["model"]))
+        fws = style_index(list(rows["framework"]))
+        for (model, fw), g in rows.groupby(["model", "framework"], sort=True):
+            s = g.groupby("n")["value"].agg(["mean", "min", "max"])
+            ax.errorbar(s.index, s["mean"], yerr=[s["mean"] - s["min"], s["max"] - s["mean"]],
+                        color=colour(models[model]), marker=MARKERS[fws[fw] % 6], capsize=2,
+                        label=f"{model} ({fw})")
+        ax.set_xscale("log")
+        ticks_at(ax, rows["n"])
+        log_if_spread(ax, rows["value"], decades=1.0)
+        ax.set_xlabel("training samples N")
+        ax.set_ylabel(base.replace("_", " "))
+        ax.legend(fontsize=7)
+    return save(fig, path)

@@ -1,0 +1,112 @@
+"""Findings: where the LNN paper and its original code disagree (``shared/reference/lnn_original_code.md`` §9).
+
+The suite runs the code's protocol by default and offers the paper's wording as a variant. For each
+finding this module reports which one was run, read from the usable units' ``protocol`` and
+``model_spec`` (any of the finding's ``keys``, searched in nested dicts, plus a generic ``variant``),
+restricted to units of claims whose ``system`` contains one of ``systems`` (all systems if empty).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pandas as pd
+
+from reports.document import NOT_RUN, Para, Section, Table
+from reports.load import Results
+
+
+@dataclass(frozen=True)
+class Finding:
+    title: str
+    paper: str
+    code: str
+    changes: str
+    systems: tuple[str, ...] = ()
+    keys: tuple[str, ...] = ()
+
+
+FINDINGS = [
+    Finding("Relativistic Lagrangian", "L = (1−q̇²)^(−1/2) − 1 + g·q, as printed",
+            "the same non-standard L (physical one is −(1−q̇²)^(1/2) + g·q)",
+            "the printed form is run to match the numbers; the standard one is a variant with p = γq̇",
+            ("relativ",), ("lagrangian", "relativistic_form", "form")),
+    Finding("Initialisation", "σ = 2.2/√n, 0.58·i/√n, n/√n (Appendix C)",
+            "n = max(fan_in, fan_out); output σ = √n; zero biases; LNNs only, not baseline or HNN",
+            "the code's rule is applied to LNNs; baselines and HNNs keep default inits",
+            (), ("init",)),
+    Finding("Loss behind 7.3e-2 / 7.4e-2", "called loss, read as MSE",
+            "per-sample L1 sum |Δq̈1|+|Δq̈2|; LNN value is late training loss (held-out 6.9e-2)",
+            "held-out L1 is the claim metric; MSE is reported alongside", ("double_pendulum",), ("loss",)),
+    Finding("Architectures", "one MLP for both models",
+            "LNN 3×600 softplus, 1 output, custom init; baseline 3×600 ReLU, 2 outputs, default init; "
+            "SR 4×500; wave 3×400",
+            "the code's architectures are used per model", (), ("activation", "hidden")),
+    Finding("Energy metric", "energy error over 40 ICs",
+            "final time t = 100 only, /29.4, ICs near rest (ω < 0.1); baseline over 44 ICs; float32 truth",
+            "final-time and max-over-time both reported, truth in float64", ("double_pendulum",),
+            ("energy_metric", "n_ics", "energy_scale")),
+    Finding("Training vs evaluation states", "not stated",
+            "training ω ∈ [−10, 10]; evaluation ICs start with ω < 0.1",
+            "rollouts probe a small corner of the training distribution", ("double_pendulum",),
+            ("velocity_range", "eval_velocity_range")),
+    Finding("Angle wrapping", "not stated", "angles wrapped to [−π, π): L discontinuous at ±π",
+            "wrapping kept; a sin/cos embedding would be a documented deviation", ("double_pendulum",),
+            ("angle_embedding", "wrap_angles")),
+    Finding("Wave coefficient", "∂²u/∂x² (/dx²)", "second difference divided by 2dx",
+            "the code's /2dx is the default; /dx² is a variant", ("wave",), ("coefficient", "wave_coefficient")),
+    Finding("Wave protocol", "train small grid, test large grid",
+            "10-point periodic grid of white noise, batch 1; test 100 points with a Gaussian pulse; no sparse "
+            "Hessian; plotted energy not conserved by truth either",
+            "same grids; the banded Hessian is a fast-path option", ("wave",), ("grid", "n_train", "n_test")),
+    Finding("Integrator steps", "not stated", "mxstep a no-op in 2020 (unlimited); mxstep=100 in float32 "
+            "corrupts truth", "truth by diffrax in float64 at tight tolerances", (), ("rtol", "solver")),
+    Finding("Precision", "not stated", "everything float32, ground truth included",
+            "truth float64, models float32 by default", (), ("dtype",)),
+    Finding("Relativistic data quirk", "not stated",
+            "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",
+            "the 1 + γ weighting is kept", ("relativ",), ("weighting", "fixed_velocities")),
+    Finding("Hidden wrappers", "not stated", "NaN guards, seed restarts, l2 penalty 1e-6·||θ||²/512",
+            "weight decay kept; non-finite losses are reported as failed units, not restarted silently",
+            (), ("weight_decay", "l2")),
+]
+
+
+def _lookup(d, keys: set[str], prefix: str = "") -> dict[str, str]:
+    out = {}
+    if isinstance(d, dict):
+        for k, v in d.items():
+            name = f"{prefix}{k}"
+            if str(k).lower() in keys and not isinstance(v, dict):
+                out[name] = str(v)
+            out.update(_lookup(v, keys, name + "."))
+    return out
+
+
+def what_ran(res: Results, f: Finding) -> str:
+    claims = [c for c in res.claims if not f.systems or any(
+        s in str(c.get("system", "")).lower() for s in f.systems)]
+    units = [u for c in claims for u in res.usable(c["id"])]
+    if not units:
+        return NOT_RUN
+    keys = {k.lower() for k in f.keys} | {"variant"}
+    seen: dict[str, set[str]] = {}
+    for u in units:
+        for src in ("protocol", "model_spec"):
+            for k, v in _lookup(u.result.get(src), keys).items():
+                seen.setdefault(f"{src}.{k}", set()).add(v)
+    if not seen:
+        return "suite default (code's protocol); not recorded in result files"
+    return "; ".join(f"{k} = {', '.join(sorted(v)[:4])}" for k, v in sorted(seen.items())[:4])
+
+
+def findings_sections(res: Results) -> list[Section]:
+    rows = [{"#": str(i), "finding": f.title, "paper": f.paper, "original code": f.code, "run here": what_ran(res, f),
+             "what it changes": f.changes} for i, f in enumerate(FINDINGS, 1)]
+    s = Section("Findings: paper against original code")
+    s.add(Para("Where the LNN paper and its original code (MilesCranmer/lagrangian_nns) disagree. The suite "
+               "runs the code's protocol by default and offers the paper's wording as a variant; 'run here' "
+               "is read from the protocol and model spec recorded in each unit's result.json."))
+    s.add(Table("Paper against code", pd.DataFrame(rows),
+                ["shared/reference/lnn_original_code.md §9", "units/*/*/*/seed*/result.json (protocol, model_spec)"]))
+    return [s]

@@ -1,0 +1,210 @@
+"""Read and validate a results folder (layout in ``replication/RESULTS.md``); never raises on bad data.
+
+``load_results(root) -> Results``. Every unit folder ``units/<claim>/<framework>/<model>/seed<k>/`` with a
+``result.json`` becomes a :class:`Unit` whose ``status`` is ``"ok"``, ``"failed"`` (the runner's own
+verdict) or ``"corrupt"`` (unreadable JSON, wrong schema, path mismatch, checksum or listed-file sha256
+mismatch; see :mod:`reports.integrity`). Only ``ok`` units feed numbers into the report. Missing files
+leave ``None``/empty fields; problems are collected as human-readable strings in ``Results.problems``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from reports.integrity import verify_unit
+
+BENCH_COLUMNS = {
+    "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
+    "training": ["system", "model", "framework", "mode", "dtype", "batch", "steps_per_s", "samples_per_s"],
+    "rollout": ["system", "solver", "rtol", "kind", "wall_s", "state_err", "energy_err"],
+    "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
+    "ratios": ["operation", "jax", "torch", "ratio", "note"],
+}
+UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One claim x framework x model x seed. ``rel`` is the unit folder relative to the results root."""
+
+    claim: str
+    framework: str
+    model: str
+    seed: str
+    path: Path
+    rel: str
+    status: str
+    reason: str | None = None
+    result: dict = field(default_factory=dict, repr=False)
+
+    def metric(self, name: str) -> float | None:
+        value = (self.result.get("metrics") or {}).get(name)
+        return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+    def table(self, name: str) -> pd.DataFrame | None:
+        """A CSV of this unit (``train_log.csv``, ``rollouts.csv``, ``timeseries.csv``), or None."""
+        path = self.path / name
+        if self.status == "corrupt" or not path.is_file():
+            return None
+        try:
+            return pd.read_csv(path)
+        except (ValueError, OSError):
+            return None
+
+    def arrays(self) -> dict[str, np.ndarray] | None:
+        """The arrays of ``arrays.npz`` (no pickles), or None."""
+        path = self.path / "arrays.npz"
+        if self.status == "corrupt" or not path.is_file():
+            return None
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                return {k: np.asarray(npz[k]) for k in npz.files}
+        except (ValueError, OSError):
+            return None
+
+
+@dataclass
+class Results:
+    root: Path
+    run: dict | None = None
+    claims: list[dict] = field(default_factory=list)
+    units: list[Unit] = field(default_factory=list)
+    verdicts: dict[str, dict] = field(default_factory=dict)
+    verdict_profile: str | None = None
+    units_csv: pd.DataFrame | None = None
+    listed_missing: list[str] = field(default_factory=list)
+    bench: dict[str, pd.DataFrame] = field(default_factory=dict)
+    machine: dict | None = None
+    problems: list[str] = field(default_factory=list)
+
+    def usable(self, claim: str | None = None) -> list[Unit]:
+        return [u for u in self.units if u.status == "ok" and (claim is None or u.claim == claim)]
+
+    def claim_units(self, claim: str) -> list[Unit]:
+        return [u for u in self.units if u.claim == claim]
+
+    @property
+    def frameworks(self) -> list[str]:
+        declared = list((self.run or {}).get("frameworks") or [])
+        seen = sorted({u.framework for u in self.units} - set(declared))
+        return [str(f) for f in declared] + seen
+
+
+def _read_json(path: Path, problems: list[str], root: Path) -> dict | None:
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, OSError) as exc:
+        problems.append(f"{path.relative_to(root)} unreadable: {exc}")
+        return None
+    if not isinstance(data, dict):
+        problems.append(f"{path.relative_to(root)} is not a JSON object")
+        return None
+    return data
+
+
+def _load_unit(root: Path, result_path: Path) -> Unit:
+    unit_dir = result_path.parent
+    rel = unit_dir.relative_to(root).as_posix()
+    parts = unit_dir.relative_to(root / "units").parts
+    claim, fw, model, seed = (list(parts) + ["?"] * 4)[:4]
+    seed = seed.removeprefix("seed")
+    try:
+        result = json.loads(result_path.read_text(encoding="utf-8"))
+        if not isinstance(result, dict):
+            raise ValueError("not a JSON object")
+    except (ValueError, OSError) as exc:
+        return Unit(claim, fw, model, seed, unit_dir, rel, "corrupt", f"result.json unreadable: {exc}")
+    reason = verify_unit(unit_dir, result)
+    if reason is None:
+        missing = [k for k in UNIT_KEYS if k not in result]
+        if missing:
+            reason = "missing keys: " + ", ".join(missing)
+        elif (str(result["claim"]), str(result["framework"]), str(result["model"]), str(result["seed"])) != (
+            claim, fw, model, seed,
+        ) or len(parts) != 4:
+            reason = "folder does not match claim/framework/model/seed in result.json"
+    if reason is not None:
+        return Unit(claim, fw, model, seed, unit_dir, rel, "corrupt", reason, result)
+    status = "ok" if result.get("status") == "ok" else "failed"
+    failure = result.get("failure") or {}
+    why = None if status == "ok" else str(failure.get("kind") or failure.get("message") or result.get("status"))
+    return Unit(claim, fw, model, seed, unit_dir, rel, status, why, result)
+
+
+def _seed_key(seed: str) -> tuple[int, str]:
+    return (int(seed), "") if seed.isdigit() else (1 << 30, seed)
+
+
+def _catalogue(res: Results, claims_json: dict | None) -> list[dict]:
+    claims = []
+    if claims_json is not None:
+        raw = claims_json.get("claims")
+        if isinstance(raw, list):
+            claims = [c for c in raw if isinstance(c, dict) and isinstance(c.get("id"), str)]
+        else:
+            res.problems.append("claims.json has no 'claims' list")
+    known = {c["id"] for c in claims}
+    extra = sorted(({u.claim for u in res.units} | set(res.verdicts)) - known)
+    claims += [{"id": cid, "title": "(not in claims.json)"} for cid in extra]
+    return sorted(claims, key=lambda c: (c.get("number") if isinstance(c.get("number"), int) else 1 << 30, c["id"]))
+
+
+def _load_bench(res: Results) -> None:
+    bench = res.root / "bench"
+    res.machine = _read_json(bench / "machine.json", res.problems, res.root)
+    for name, columns in BENCH_COLUMNS.items():
+        path = bench / f"{name}.csv"
+        if not path.is_file():
+            continue
+        try:
+            df = pd.read_csv(path)
+        except (ValueError, OSError) as exc:
+            res.problems.append(f"bench/{name}.csv unreadable: {exc}")
+            continue
+        missing = [c for c in columns if c not in df.columns]
+        if missing:
+            res.problems.append(f"bench/{name}.csv lacks columns {missing}; not used")
+            continue
+        res.bench[name] = df
+
+
+def load_results(root: str | Path) -> Results:
+    """Read everything under ``root``; a missing or empty folder gives an empty :class:`Results`."""
+    root = Path(root)
+    res = Results(root=root)
+    if not root.is_dir():
+        res.problems.append(f"results folder {root} does not exist")
+        return res
+    res.run = _read_json(root / "run.json", res.problems, root)
+    claims_json = _read_json(root / "claims.json", res.problems, root)
+    verdicts = _read_json(root / "summary" / "verdicts.json", res.problems, root) or {}
+    res.verdict_profile = verdicts.get("profile")
+    for v in verdicts.get("claims") or []:
+        if isinstance(v, dict) and isinstance(v.get("id"), str):
+            res.verdicts[v["id"]] = v
+    units_dir = root / "units"
+    if units_dir.is_dir():
+        found = [_load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))]
+        res.units = sorted(found, key=lambda u: (u.claim, u.framework, u.model, _seed_key(u.seed)))
+    csv_path = root / "summary" / "units.csv"
+    if csv_path.is_file():
+        try:
+            res.units_csv = pd.read_csv(csv_path)
+        except (ValueError, OSError) as exc:
+            res.problems.append(f"summary/units.csv unreadable: {exc}")
+    if res.units_csv is not None and {"claim", "framework", "model", "seed"} <= set(res.units_csv.columns):
+        have = {(u.claim, u.framework, u.model, u.seed) for u in res.units}
+        for row in res.units_csv.itertuples(index=False):
+            key = (str(row.claim), str(row.framework), str(row.model), str(row.seed))
+            if key not in have:
+                res.listed_missing.append("units/{}/{}/{}/seed{}".format(*key))
+    res.claims = _catalogue(res, claims_json)
+    _load_bench(res)
+    return res

@@ -1,0 +1,44 @@
+"""Markdown rendering of a ``list[Section]`` (GitHub-flavoured pipe tables; no tabulate dependency).
+
+Cells are escaped (``|`` becomes ``\\|``, newlines ``<br>``); an empty cell becomes ``"not run"``.
+Figures are embedded with paths relative to the Markdown file.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from reports.document import NOT_RUN, Bullets, Figure, Para, Section, Table
+
+
+def _escape(text) -> str:
+    t = str(text).strip()
+    return (t or NOT_RUN).replace("|", "\\|").replace("\r", "").replace("\n", "<br>")
+
+
+def table_markdown(df: pd.DataFrame) -> str:
+    cols = [_escape(c) for c in df.columns]
+    lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
+    for row in df.itertuples(index=False):
+        lines.append("| " + " | ".join(_escape(v) for v in row) + " |")
+    return "\n".join(lines)
+
+
+def render_markdown(title: str, sections: list[Section]) -> str:
+    out = [f"# {title}", ""]
+    toc = [s for s in sections if s.level == 1]
+    out += [f"- {s.title}" for s in toc] + [""]
+    for s in sections:
+        out += [f"{'#' * (s.level + 1)} {s.title}", ""]
+        for b in s.blocks:
+            if isinstance(b, Para):
+                out += [b.text, ""]
+            elif isinstance(b, Bullets):
+                out += [f"- {item}" for item in b.items] + [""]
+            elif isinstance(b, Table):
+                out += [f"**{b.title}**", "", table_markdown(b.df), ""]
+                if b.note:
+                    out += [f"_{b.note}_", ""]
+            elif isinstance(b, Figure):
+                out += [f"![{b.caption}]({b.path})", "", f"*{b.caption}*", ""]
+    return "\n".join(out).rstrip() + "\n"

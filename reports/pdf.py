@@ -1,0 +1,96 @@
+"""PDF rendering through typst: a ``list[Section]`` becomes ``REPORT.typ``, compiled to ``REPORT.pdf``.
+
+All report text enters the typst source as string literals (``"..."`` with ``\\`` and ``"`` escaped), so
+no report content is ever parsed as typst markup. Tables use a small font scaled down with the number
+of columns, wrap inside their cells and break across pages (portrait throughout: at 6 pt ten columns
+fit). Figures are embedded from ``figures/`` relative to the output folder (the typst root).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from reports.document import Bullets, Figure, Para, Section, Table
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def figure_width(path: Path) -> str:
+    """70 % of the text width for single-panel figures, full width for wide multi-panel ones."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(24)
+        w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+    except OSError:
+        return "70%"
+    if not head.startswith(PNG_SIGNATURE) or h == 0:
+        return "70%"
+    return "100%" if w / h > 2.4 else "70%"
+
+
+PREAMBLE = """#set document(title: {title})
+#set page(paper: "a4", margin: (x: 1.6cm, y: 1.8cm), numbering: "1 / 1")
+#set text(size: 10pt)
+#set par(justify: false)
+#set heading(numbering: "1.1")
+#show heading.where(level: 1, outlined: true): it => {{ pagebreak(weak: true); it }}
+#show table.cell.where(y: 0): strong
+"""
+
+
+def lit(text) -> str:
+    """A typst string literal holding ``text`` verbatim."""
+    s = str(text).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\r", "")
+    s = re.sub(r"[\x00-\x08\x0b-\x1f]", " ", s)
+    return f'"{s}"'
+
+
+def _table(t: Table) -> str:
+    ncol = max(len(t.df.columns), 1)
+    size = 8 if ncol <= 4 else (7 if ncol <= 7 else 6)
+    cells = [lit(c) for c in t.df.columns]
+    for row in t.df.itertuples(index=False):
+        cells += [lit(str(v).strip() or "not run") for v in row]
+    body = (f"#text(size: {size}pt)[#table(columns: {ncol}, inset: 3pt, stroke: 0.4pt + gray, align: left,\n"
+            f"  table.header({', '.join(cells[:ncol])}),\n  {', '.join(cells[ncol:])})]")
+    out = f"#strong({lit(t.title)})\n\n{body}\n"
+    if t.note:
+        out += f"\n#emph({lit(t.note)})\n"
+    return out + "\n"
+
+
+def render_typst(title: str, sections: list[Section], root: Path = Path(".")) -> str:
+    out = [PREAMBLE.format(title=lit(title)),
+           f"#align(center, text(size: 18pt, weight: \"bold\", {lit(title)}))\n",
+           "#outline(depth: 1)\n"]
+    for s in sections:
+        out.append(f"#heading(level: {s.level}, {lit(s.title)})\n")
+        for b in s.blocks:
+            if isinstance(b, Para):
+                out.append(f"#{lit(b.text)}\n")
+            elif isinstance(b, Bullets):
+                out.append("#list(" + ", ".join(lit(i) for i in b.items) + ")\n")
+            elif isinstance(b, Table):
+                out.append(_table(b))
+            elif isinstance(b, Figure):
+                width = figure_width(root / b.path)
+                out.append(f"#figure(image({lit(b.path)}, width: {width}), caption: {lit(b.caption)})\n")
+    return "\n".join(out)
+
+
+def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path, Path]:
+    """Write ``REPORT.typ`` and compile ``REPORT.pdf`` in ``out_dir``; returns both paths."""
+    import typst  # the report extra; imported here so Markdown-only use never needs it
+
+    out_dir = Path(out_dir)
+    typ = out_dir / "REPORT.typ"
+    pdf = out_dir / "REPORT.pdf"
+    typ.write_text(render_typst(title, sections, out_dir), encoding="utf-8")
+    typst.compile(str(typ), output=str(pdf), root=str(out_dir.resolve()))
+    return typ, pdf
+
+
+def page_count(pdf: Path) -> int:
+    """Pages of a typst-written PDF (page objects are not compressed into object streams)."""
+    return len(re.findall(rb"/Type\s*/Page\b", Path(pdf).read_bytes()))

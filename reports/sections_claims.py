@@ -1,0 +1,126 @@
+"""Summary, run-status and per-claim sections (grouped by :mod:`reports.themes`), with their figures.
+
+``summary_sections(res)`` and ``theme_sections(res, out_dir)`` return ``list[Section]``; figures are
+written under ``out_dir/figures/`` as ``<claim>_<kind>.png`` only when their data exist.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from reports import figures as F
+from reports import figures_speed as FS
+from reports.document import NOT_RUN, Figure, Para, Section, Table
+from reports.fmt import cell, num
+from reports.load import Results
+from reports.tables import claim_table, metrics_table, problem_units_table, status_table, summary_table
+from reports.themes import THEMES, assign
+
+RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
+
+
+def slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "claim"
+
+
+def summary_sections(res: Results) -> list[Section]:
+    s = Section("Summary")
+    if not res.claims:
+        s.add(Para("Nothing was run: the results folder holds no claims catalogue, verdicts or units."))
+    n_ok = len(res.usable())
+    s.add(Para(f"{len(res.claims)} claims catalogued; {len(res.units)} units found, {n_ok} usable "
+               f"(status ok, checksums verified). Reproduced values are mean ± sample std over seeds "
+               f"(n = seeds) of each claim's metric, recomputed from the unit files; verdicts are the "
+               f"runner's (summary/verdicts.json)."))
+    s.add(Table("Claims: published against reproduced", summary_table(res),
+                ["claims.json", "units/*/*/*/seed*/result.json", "summary/verdicts.json"]))
+    st = Section("Run status", level=2)
+    st.add(Table("Units per claim and framework", status_table(res), ["units/*/*/*/seed*/result.json"]))
+    bad = problem_units_table(res)
+    if bad is not None:
+        st.add(Para("Corrupt units failed checksum or schema checks and are excluded from every number "
+                    "in this report; failed units (the runner's status) are excluded too."))
+        st.add(Table("Failed, corrupt and missing units", bad, ["units/*/*/*/seed*/result.json",
+                                                                 "summary/units.csv"]))
+    else:
+        st.add(Para("No failed, corrupt or missing units."))
+    if res.problems:
+        st.add(Para("Problems reading the results: " + "; ".join(res.problems) + "."))
+    return [s, st]
+
+
+def _rollout_table(units) -> pd.DataFrame | None:
+    frames = []
+    for u in units:
+        df = u.table("rollouts.csv")
+        if df is not None and len(df):
+            num_cols = [c for c in df.select_dtypes("number").columns if c not in ("traj", "seed")]
+            if num_cols:
+                frames.append(df[num_cols].mean().to_frame().T.assign(model=u.model, framework=u.framework))
+    if not frames:
+        return None
+    all_ = pd.concat(frames, ignore_index=True)
+    mean = all_.groupby(["model", "framework"], sort=False).mean(numeric_only=True)
+    cols = list(mean.columns)[:6]
+    rows = [{"model": m, "framework": fw, **{c: num(r[c]) if pd.notna(r[c]) else "not recorded" for c in cols}}
+            for (m, fw), r in mean.iterrows()]
+    return pd.DataFrame(rows)
+
+
+def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
+    cid = claim["id"]
+    units = res.usable(cid)
+    src = RESULT_FILES.format(claim=cid)
+    s = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}", level=2)
+    s.add(Para(f"{cell(claim.get('title'), 'untitled')} — {cell(claim.get('paper'), 'paper unknown')} "
+               f"{cell(claim.get('section'), '')}. System: {cell(claim.get('system'), 'unknown')}. "
+               f"Metric: {cell(claim.get('metric'), 'unknown')} ({cell(claim.get('metric_label'), 'no label')}). "
+               f"Verdict rule: {cell(claim.get('verdict_rule'), 'not stated')}."))
+    v = res.verdicts.get(cid)
+    if v is not None:
+        s.add(Para(f"Verdict: {cell(v.get('verdict'))}. {cell(v.get('reason'), '')}"))
+    if not units:
+        s.add(Para(f"Result: {NOT_RUN} (no usable unit for this claim)."))
+        return s
+    s.add(Table(f"{cid}: {claim.get('metric', 'metric')} per model and framework", claim_table(res, claim),
+                ["claims.json", src + "result.json"]))
+    mt = metrics_table(res, claim)
+    if mt is not None:
+        s.add(Table(f"{cid}: all recorded metrics (mean ± std over seeds)", mt, [src + "result.json"]))
+    rt = _rollout_table(units)
+    if rt is not None:
+        s.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
+    figs = [
+        ("energy", F.energy_drift, "Energy drift over time against truth (mean over trajectories; "
+                                  "line: mean over seeds, band: seed range)", "timeseries.csv"),
+        ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
+        ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
+        ("decomposition", F.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
+                                                 "(predicted against true)", "arrays.npz"),
+        ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
+         "Data efficiency: error against training samples (bars: seed range)", "result.json"),
+        ("training", F.training_curves, "Training curves (mean over seeds)", "train_log.csv"),
+    ]
+    for kind, fn, caption, file in figs:
+        rel = f"figures/{slug(cid)}_{kind}.png"
+        if fn(units, out_dir / rel):
+            s.add(Figure(rel, f"{cid}: {caption}.", [src + file]))
+    return s
+
+
+def theme_sections(res: Results, out_dir: Path) -> list[Section]:
+    groups = assign(res.claims)
+    out = []
+    for key, title, blurb, _ in THEMES:
+        claims = groups[key]
+        if key == "other" and not claims:
+            continue
+        s = Section(title).add(Para(blurb))
+        if not claims:
+            s.add(Para(f"Result: {NOT_RUN} (no claim of this kind in claims.json)."))
+        out.append(s)
+        out.extend(claim_section(res, c, out_dir) for c in claims)
+    return out

@@ -1,0 +1,85 @@
+"""Speed-against-error and cross-framework-agreement sections.
+
+Speed: per claim, every usable unit as a point (training throughput or time against the claim metric),
+the cheapest-model table, and from the speed study (``bench/*.csv``, when present) the inference
+speed-error plane, the cheapest model per system, training/rollout/scaling tables and figures.
+Agreement: per claim and model, framework means, their relative difference, and the largest per-seed
+difference, plus ``bench/ratios.csv``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from reports import figures_speed as FS
+from reports.compare import TOLERANCE, bench_cheapest_table, cheapest_table, cross_framework_table
+from reports.document import NOT_RUN, Figure, Para, Section, Table
+from reports.fmt import cell
+from reports.load import Results
+from reports.sections_claims import slug
+
+BENCH_TABLE_ROWS = 40
+
+
+def _bench_table(df: pd.DataFrame) -> pd.DataFrame:
+    return df.head(BENCH_TABLE_ROWS).map(cell).astype(str)
+
+
+def speed_sections(res: Results, out_dir: Path) -> list[Section]:
+    s = Section("Speed against error")
+    s.add(Para("Each point is one unit (claim x framework x model x seed): training throughput (or training "
+               "time) against the claim's metric; colour per model, marker per framework. Lower error and "
+               "higher throughput are better."))
+    any_fig = False
+    for claim in res.claims:
+        metric = claim.get("metric")
+        rel = f"figures/{slug(claim['id'])}_speed_error.png"
+        if metric and FS.speed_error(res.usable(claim["id"]), metric, out_dir / rel):
+            any_fig = True
+            s.add(Figure(rel, f"{claim['id']}: speed against {metric}.",
+                         [f"units/{claim['id']}/<framework>/<model>/seed<k>/result.json"]))
+    if not any_fig:
+        s.add(Para(f"Units with throughput and error: {NOT_RUN}."))
+    cheap = cheapest_table(res)
+    if cheap is not None:
+        s.add(Table(f"Cheapest model within {TOLERANCE:g}x of the best error, per claim", cheap,
+                    ["units/*/*/*/seed*/result.json"],
+                    note="Cost: mean training throughput over seeds (samples/s; else training time)."))
+    else:
+        s.add(Para(f"Cheapest model per system: {NOT_RUN}."))
+    b = Section("Speed study (lagbench bench)", level=2)
+    if not res.bench and res.machine is None:
+        b.add(Para(f"Speed study: {NOT_RUN} (no bench/ files)."))
+    if FS.bench_speed_error(res.bench.get("inference"), out_dir / "figures/bench_inference.png"):
+        b.add(Figure("figures/bench_inference.png", "Inference throughput against error per system "
+                     "(colour: model/formulation; marker: framework).", ["bench/inference.csv"]))
+    bc = bench_cheapest_table(res)
+    if bc is not None:
+        b.add(Table(f"Cheapest model within {TOLERANCE:g}x of the best inference error, per system", bc,
+                    ["bench/inference.csv"]))
+    if FS.bench_scaling(res.bench.get("scaling"), out_dir / "figures/bench_scaling.png"):
+        b.add(Figure("figures/bench_scaling.png", "Cost per evaluation against size, per formulation.",
+                     ["bench/scaling.csv"]))
+    for name, title in (("training", "Training throughput"), ("rollout", "Rollout cost and error per solver")):
+        if name in res.bench:
+            b.add(Table(title, _bench_table(res.bench[name]), [f"bench/{name}.csv"]))
+    return [s, b]
+
+
+def agreement_sections(res: Results) -> list[Section]:
+    s = Section("Cross-framework agreement")
+    fws = res.frameworks
+    table = cross_framework_table(res)
+    if table is None:
+        s.add(Para(f"Comparison across frameworks: {NOT_RUN} (frameworks found: "
+                   f"{', '.join(fws) if fws else 'none'})."))
+    else:
+        s.add(Para(f"Each framework against {fws[0]}: the same protocol, initial parameters and batch order, "
+                   "so differences come from floating-point order of operations and library kernels."))
+        s.add(Table("Claim metric per framework", table, ["units/*/*/*/seed*/result.json"]))
+    if "ratios" in res.bench:
+        s.add(Table("JAX against PyTorch speed per operation", _bench_table(res.bench["ratios"]),
+                    ["bench/ratios.csv"]))
+    return [s]

@@ -1,0 +1,162 @@
+"""Per-claim tables (pandas DataFrames of strings) computed from usable units only.
+
+Numbers are recomputed here from the unit ``result.json`` files (corrupt and failed units excluded), so
+they match the units actually listed; verdicts come from ``summary/verdicts.json``. A claim with no
+usable unit reads ``"not run"`` in every cell that would hold a number.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from reports.document import NOT_RUN
+from reports.fmt import cell, num, stat, summarise
+from reports.load import Results, Unit
+
+
+def claim_models(res: Results, claim: dict) -> list[str]:
+    declared = [str(m) for m in claim.get("models") or []]
+    seen = sorted({u.model for u in res.claim_units(claim["id"])} - set(declared))
+    return declared + seen
+
+
+def values(units: list[Unit], metric: str | None) -> dict:
+    """``{framework: {model: {"mean", "std", "n"}}}`` of ``metric`` over seeds of usable units."""
+    out: dict[str, dict[str, dict]] = {}
+    if not metric:
+        return out
+    groups: dict[tuple[str, str], list[float]] = {}
+    for u in units:
+        if u.status == "ok":
+            groups.setdefault((u.framework, u.model), []).append(u.metric(metric))
+    for (fw, model), vals in groups.items():
+        s = summarise(vals)
+        if s["n"]:
+            out.setdefault(fw, {})[model] = s
+    return out
+
+
+def published_text(claim: dict) -> str:
+    pub = claim.get("published")
+    if not isinstance(pub, dict) or not pub:
+        return "none published"
+    return "\n".join(f"{m}: {num(v) if v is not None else 'none published'}" for m, v in pub.items())
+
+
+def verdict_text(res: Results, claim: dict) -> str:
+    v = res.verdicts.get(claim["id"])
+    usable = res.usable(claim["id"])
+    if v is None:
+        text = NOT_RUN if not usable else "not judged (no verdict in summary/verdicts.json)"
+    else:
+        text = cell(v.get("verdict"), "not judged")
+        by_fw = v.get("by_framework") or {}
+        if isinstance(by_fw, dict) and len(set(map(str, by_fw.values()))) > 1:
+            text += " (" + ", ".join(f"{fw}: {x}" for fw, x in by_fw.items()) + ")"
+    corrupt = sum(u.status == "corrupt" for u in res.claim_units(claim["id"]))
+    if corrupt:
+        text += f"; {corrupt} corrupt unit{'s' if corrupt > 1 else ''} excluded"
+    return text
+
+
+def profile_text(res: Results, claim: dict) -> str:
+    profiles = sorted({str(u.result.get("profile")) for u in res.usable(claim["id"]) if u.result.get("profile")})
+    return ", ".join(profiles) if profiles else NOT_RUN
+
+
+def summary_table(res: Results) -> pd.DataFrame:
+    """One row per claim: paper, section, published, reproduced per framework, verdict, profile."""
+    frameworks = res.frameworks or ["any framework"]
+    rows = []
+    for claim in res.claims:
+        vals = values(res.claim_units(claim["id"]), claim.get("metric"))
+        row = {
+            "#": cell(claim.get("number"), "–"),
+            "claim": claim["id"],
+            "paper": cell(claim.get("paper"), "unknown"),
+            "section": cell(claim.get("section"), "unknown"),
+            "metric": cell(claim.get("metric"), "unknown"),
+            "published": published_text(claim),
+        }
+        for fw in frameworks:
+            per = vals.get(fw, {})
+            models = [m for m in claim_models(res, claim) if m in per]
+            row[f"reproduced ({fw})"] = "\n".join(f"{m}: {stat(**per[m])}" for m in models) or NOT_RUN
+        row["verdict"] = verdict_text(res, claim)
+        row["profile"] = profile_text(res, claim)
+        rows.append(row)
+    return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN], "verdict": [NOT_RUN]})
+
+
+def claim_table(res: Results, claim: dict) -> pd.DataFrame:
+    """Rows: models; columns: published value and the claim metric per framework (mean ± std (n))."""
+    vals = values(res.claim_units(claim["id"]), claim.get("metric"))
+    pub = claim.get("published") if isinstance(claim.get("published"), dict) else {}
+    rows = []
+    for model in claim_models(res, claim):
+        row = {"model": model, "published": num(pub[model]) if pub.get(model) is not None else "none published"}
+        for fw in res.frameworks or ["any framework"]:
+            per = vals.get(fw, {}).get(model)
+            row[fw] = stat(**per) if per else NOT_RUN
+        rows.append(row)
+    return pd.DataFrame(rows) if rows else pd.DataFrame({"model": [NOT_RUN]})
+
+
+def metric_names(units: list[Unit]) -> list[str]:
+    names: dict[str, None] = {}
+    for u in units:
+        for k, v in (u.result.get("metrics") or {}).items():
+            if u.metric(k) is not None or v is None:
+                names.setdefault(k, None)
+    return list(names)
+
+
+def metrics_table(res: Results, claim: dict, max_metrics: int = 7) -> pd.DataFrame | None:
+    """Rows: (model, framework); columns: every recorded metric (mean ± std), first ``max_metrics``."""
+    units = res.usable(claim["id"])
+    names = metric_names(units)
+    if claim.get("metric") in names:
+        names.remove(claim["metric"])
+        names.insert(0, claim["metric"])
+    names = names[:max_metrics]
+    if not names:
+        return None
+    rows = []
+    for model in claim_models(res, claim):
+        for fw in res.frameworks:
+            group = [u for u in units if u.model == model and u.framework == fw]
+            if not group:
+                continue
+            row = {"model": model, "framework": fw, "n": str(len(group))}
+            for name in names:
+                s = summarise([u.metric(name) for u in group])
+                row[name] = stat(s["mean"], s["std"]) if s["n"] else "not recorded"
+            rows.append(row)
+    return pd.DataFrame(rows) if rows else None
+
+
+def status_table(res: Results) -> pd.DataFrame:
+    """Rows: claims; columns: per framework ``ok/failed/corrupt`` unit counts."""
+    rows = []
+    for claim in res.claims:
+        row = {"claim": claim["id"]}
+        for fw in res.frameworks or ["any framework"]:
+            us = [u for u in res.claim_units(claim["id"]) if u.framework == fw]
+            if not us:
+                row[fw] = NOT_RUN
+                continue
+            counts = {s: sum(u.status == s for u in us) for s in ("ok", "failed", "corrupt")}
+            row[fw] = ", ".join(f"{n} {s}" for s, n in counts.items() if n)
+        rows.append(row)
+    return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN]})
+
+
+def problem_units_table(res: Results) -> pd.DataFrame | None:
+    rows = [
+        {"unit": u.rel, "status": u.status, "reason": cell(u.reason, "unknown")}
+        for u in res.units
+        if u.status != "ok"
+    ]
+    rows += [{"unit": p, "status": "missing", "reason": "listed in summary/units.csv, no result.json"}
+             for p in res.listed_missing]
+    return pd.DataFrame(rows) if rows else None

@@ -1,0 +1,65 @@
+"""Torque datasets for the two-link arm (DeLaN): smooth joint trajectories, exact torques.
+
+``arm_dataset(kind="train", n_traj=16, n_points=200, seed=0, *, duration=4.0, cache=True,
+**params) -> dict`` of float64 arrays: "t" (n_points,), "q", "qdot", "qddot", "tau"
+(n_traj, n_points, 2) and "energy" (n_traj, n_points).
+
+Each joint follows q_j(t) = c_j + sum_k a_jk sin(2 pi f_jk t + phi_jk), so q, qdot, qddot are
+analytic; tau = ``inverse_dynamics(q, qdot, qddot)`` of ``systems.get("two_link_arm", **params)``.
+The two families differ in shape, so "test" probes extrapolation:
+
+- "train": 3 components per joint, frequencies U[0.2, 0.7) Hz, amplitudes U[0.2, 0.6) / k
+  (decaying with the component index k = 1..3), offsets c ~ U[-pi/2, pi/2);
+- "test": 2 components per joint in a higher band, frequencies U[0.8, 1.3) Hz, equal
+  amplitudes U[0.3, 0.5), offsets c ~ U[-pi/4, pi/4) (faster motions, larger velocities and
+  accelerations than anything in "train").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+FAMILIES = {
+    "train": {"k": 3, "f": (0.2, 0.7), "a": (0.2, 0.6), "decay": True, "c": np.pi / 2},
+    "test": {"k": 2, "f": (0.8, 1.3), "a": (0.3, 0.5), "decay": False, "c": np.pi / 4},
+}
+
+
+def _trajectories(kind: str, n_traj: int, t: np.ndarray, rng: np.random.Generator):
+    fam = FAMILIES[kind]
+    k = fam["k"]
+    f = rng.uniform(*fam["f"], (n_traj, 2, k))
+    a = rng.uniform(*fam["a"], (n_traj, 2, k))
+    if fam["decay"]:
+        a = a / np.arange(1, k + 1)
+    phi = rng.uniform(0.0, 2 * np.pi, (n_traj, 2, k))
+    c = rng.uniform(-fam["c"], fam["c"], (n_traj, 2))
+    w = 2 * np.pi * f
+    arg = w[:, None] * t[None, :, None, None] + phi[:, None]  # (B, T, 2, k)
+    q = c[:, None] + np.sum(a[:, None] * np.sin(arg), axis=-1)
+    qdot = np.sum((a * w)[:, None] * np.cos(arg), axis=-1)
+    qddot = -np.sum((a * w**2)[:, None] * np.sin(arg), axis=-1)
+    return q, qdot, qddot
+
+
+def arm_dataset(kind: str = "train", n_traj: int = 16, n_points: int = 200, seed: int = 0, *,
+                duration: float = 4.0, cache: bool = True, **params) -> dict:
+    """Trajectory family ``kind`` ("train" | "test") with exact torques; see the module docstring."""
+    from systems.datasets import _key, cached
+    from systems.registry import get
+
+    if kind not in FAMILIES:
+        raise ValueError(f"unknown arm trajectory family {kind!r}; valid: {', '.join(FAMILIES)}")
+    if n_traj < 1 or n_points < 2 or duration <= 0:
+        raise ValueError("arm_dataset needs n_traj >= 1, n_points >= 2 and duration > 0")
+    s = get("two_link_arm", **params)
+
+    def make():
+        t = np.linspace(0.0, float(duration), int(n_points))
+        q, qdot, qddot = _trajectories(kind, int(n_traj), t, np.random.default_rng(seed))
+        tau = s.inverse_dynamics(q, qdot, qddot)
+        return {"t": t, "q": q, "qdot": qdot, "qddot": qddot, "tau": tau, "energy": s.energy(q, qdot)}
+
+    key = _key("arm", s, family=kind, n_traj=int(n_traj), n_points=int(n_points), seed=int(seed),
+               duration=float(duration))
+    return cached(key, make, cache)

@@ -1,0 +1,51 @@
+"""Relativistic particle (m = c = 1) in a uniform field g, two Lagrangians (LNN section 5).
+
+- ``relativistic``: the paper's and code's L = (1 - qdot^2)^(-1/2) - 1 + g q, giving
+  qddot = g (1 - qdot^2)^(5/2) / (1 + 2 qdot^2) and p = qdot (1 - qdot^2)^(-3/2);
+- ``relativistic_standard``: the physical L = -(1 - qdot^2)^(1/2) + g q, giving
+  qddot = g (1 - qdot^2)^(3/2) and p = gamma qdot.
+
+Both require |qdot| < 1 (checked on concrete inputs). The field g is a parameter that the
+original protocol draws per sample: ``sample_states`` returns "g" (n,), to be passed back as
+``acceleration(q, qdot, g=g)``. Distribution (LNN code): q ~ U[-10, 10], g ~ N(0, 10^2),
+qdot = 0.99999 tanh(2 N(0, 1)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from systems.definition import Definition, coordinates, param
+from systems.library._sampling import unknown
+
+
+def _sampler(n, rng, params, distribution):
+    if distribution != "default":
+        raise unknown(distribution, ["default"])
+    q = rng.uniform(-10.0, 10.0, (n, 1))
+    g = rng.normal(0.0, 10.0, n)
+    qdot = 0.99999 * np.tanh(2.0 * rng.normal(0.0, 1.0, (n, 1)))
+    return {"q": q, "qdot": qdot, "g": g}
+
+
+def _build(name: str, standard: bool) -> Definition:
+    q, v = coordinates(["x"])
+    p = {"g": param("g", 1.0, "real")}
+    g = p["g"][0]
+    if standard:
+        lag = -sp.sqrt(1 - v[0] ** 2) + g * q[0]
+        text = "L = -(1 - qdot^2)^(1/2) + g q (standard)"
+    else:
+        lag = (1 - v[0] ** 2) ** sp.Rational(-1, 2) - 1 + g * q[0]
+        text = "L = (1 - qdot^2)^(-1/2) - 1 + g q (the LNN paper's)"
+    return Definition(name, q, v, lag, p, _sampler, max_speed=1.0,
+                      description=f"relativistic particle in a uniform field, {text}")
+
+
+def build_relativistic() -> Definition:
+    return _build("relativistic", standard=False)
+
+
+def build_relativistic_standard() -> Definition:
+    return _build("relativistic_standard", standard=True)

@@ -1,0 +1,21 @@
+"""Fixtures: hand-made result files (see result_fixtures.py) and one report built from them per session."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from result_fixtures import write_results
+
+
+@pytest.fixture(scope="session")
+def results_dir(tmp_path_factory) -> Path:
+    return write_results(tmp_path_factory.mktemp("results"))
+
+
+@pytest.fixture(scope="session")
+def built(results_dir, tmp_path_factory) -> dict:
+    from reports import build_report
+
+    out = tmp_path_factory.mktemp("report")
+    return build_report(results_dir, out)

@@ -1,0 +1,113 @@
+"""The built report: every claim row, "not run", corrupt exclusion, figures, PDF, no heavy imports."""
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from result_fixtures import CLAIMS, CORRUPT, NOT_RUN_CLAIM, write_json
+
+from reports import build_report
+from reports.pdf import page_count
+
+HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication"]
+
+
+def summary_rows(md: str) -> dict[str, list[str]]:
+    block = md.split("**Claims: published against reproduced**", 1)[1].split("\n\n")[1]
+    rows = [r.strip("|").split(" | ") for r in block.splitlines()[2:]]
+    return {r[1].strip(): [c.strip() for c in r] for r in rows}
+
+
+def test_markdown_has_every_claim_row_and_not_run(built):
+    md = built["markdown"].read_text()
+    rows = summary_rows(md)
+    assert set(rows) == {c[0] for c in CLAIMS}
+    assert all(rows[NOT_RUN_CLAIM][i] == "not run" for i in (6, 7, 8, 9))
+    assert rows["dp_energy"][8] == "reproduced"
+    for line in md.splitlines():
+        if line.startswith("|"):
+            cells = re.split(r"(?<!\\)\|", line.strip())[1:-1]
+            assert all(c.strip() for c in cells), line
+    for section in ("Double pendulum", "Relativistic", "Wave equation", "DeLaN", "Initialisation",
+                    "Speed against error", "Cross-framework agreement", "Findings", "Environment"):
+        assert f"## {section}" in md
+
+
+def test_corrupt_unit_is_listed_and_excluded(built):
+    md = built["markdown"].read_text()
+    rel = "units/{}/{}/{}/seed{}".format(*CORRUPT)
+    assert f"| {rel} | corrupt | result.json checksum mismatch |" in md
+    assert "999" not in md
+    torch_cell = summary_rows(md)["dp_loss"][7]
+    assert "lnn:" in torch_cell and "(n=2)" in torch_cell.split("<br>")[0]
+
+
+def test_figures_written_and_referenced(built):
+    figs = built["figures"]
+    names = {p.name for p in figs}
+    for name in ("dp_energy_energy.png", "dp_energy_trajectory.png", "wave_lgn_spacetime.png",
+                 "delan_arm_decomposition.png", "delan_arm_data_efficiency.png", "init_study_training.png",
+                 "dp_loss_speed_error.png", "bench_inference.png", "bench_scaling.png"):
+        assert name in names
+    md = built["markdown"].read_text()
+    typ = built["typst"].read_text()
+    for p in figs:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert f"(figures/{p.name})" in md and f'"figures/{p.name}"' in typ
+    assert not any("activation_study" in n for n in names)
+
+
+def test_pdf_opens_with_expected_pages_and_text(built):
+    pdf = built["pdf"]
+    data = pdf.read_bytes()
+    assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF")
+    # each level-1 section starts a page, after the title/contents page
+    level1 = built["markdown"].read_text().count("\n## ")
+    assert page_count(pdf) >= level1 + 1 > 10
+    assert b"/FontFile" in data and data.count(b"/Subtype /Image") + data.count(b"/Subtype/Image") >= len(
+        built["figures"])
+    typ = built["typst"].read_text()
+    for cid, *_ in CLAIMS:
+        assert f'"{cid}"' in typ
+
+
+def test_claims_only_reads_not_run_everywhere(tmp_path):
+    from result_fixtures import claim_record
+
+    res = tmp_path / "res"
+    write_json(res / "claims.json", {"schema": 1, "claims": [claim_record(c) for c in CLAIMS]})
+    paths = build_report(res, tmp_path / "out", pdf=False)
+    rows = summary_rows(paths["markdown"].read_text())
+    assert set(rows) == {c[0] for c in CLAIMS}
+    assert all(r[-1] == "not run" and r[-2] == "not run" for r in rows.values())
+    assert paths["figures"] == []
+
+
+def test_empty_results_dir_says_nothing_was_run(tmp_path):
+    paths = build_report(tmp_path / "empty", tmp_path / "out")
+    md = paths["markdown"].read_text()
+    assert "Nothing was run" in md
+    assert paths["pdf"].read_bytes().startswith(b"%PDF-") and page_count(paths["pdf"]) > 1
+
+
+def test_report_imports_no_training_code(results_dir, tmp_path):
+    small = tmp_path / "res"
+    for name in ("run.json", "claims.json"):
+        small.mkdir(exist_ok=True)
+        shutil.copy(results_dir / name, small / name)
+    shutil.copytree(results_dir / "units" / "dp_energy", small / "units" / "dp_energy")
+    code = (
+        "import sys, json, reports\n"
+        f"p = reports.build_report({str(small)!r}, {str(tmp_path / 'out')!r})\n"
+        f"print(json.dumps([m for m in {HEAVY!r} if any(k == m or k.startswith(m + '.') for k in sys.modules)]))\n"
+        "print(len(p['figures']))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=Path(__file__).parents[2])
+    loaded, nfig = out.stdout.strip().splitlines()[-2:]
+    assert json.loads(loaded) == []
+    assert int(nfig) >= 3
+    assert re.search(r"%PDF-", (tmp_path / "out" / "REPORT.pdf").read_bytes()[:8].decode())
