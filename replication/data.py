@@ -64,7 +64,9 @@ def recipe_iid(protocol, n, rng):
     name = protocol.data.removesuffix("_iid")
     params = tuple(sorted(protocol.system_params))
     s, st = _states(name, params, n, rng)
-    kw = {k: v for k, v in st.items() if k not in ("q", "qdot")}
+    fixed = dict(params)
+    kw = {k: v for k, v in st.items() if k not in ("q", "qdot") and k not in fixed}
+    st = {k: v for k, v in st.items() if k in ("q", "qdot") or k in kw}
     qddot = s.acceleration(st["q"], st["qdot"], backend="numpy", **kw)
     extra = np.stack([kw[k] for k in sorted(kw)], -1) if kw else None
     weight = None

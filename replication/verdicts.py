@@ -44,12 +44,12 @@ def claim_verdict(claim, df: pd.DataFrame) -> dict:
             st = _stats(g[claim.metric]) if claim.metric in g else None
             if st:
                 vals[label] = st
+            # a model whose units all ran but left no finite value (every rollout diverged) is the worst
             if claim.verdict_metrics:
                 ms = [_stats(g[m]) if m in g else None for m in claim.verdict_metrics]
-                if all(ms):
-                    inputs[label] = tuple(m["mean"] for m in ms)
-            elif st:
-                inputs[label] = st["mean"]
+                inputs[label] = tuple(m["mean"] if m else math.inf for m in ms)
+            else:
+                inputs[label] = st["mean"] if st else math.inf
         verdict, reason = claim.verdict(inputs)
         entry["by_framework"][fw] = verdict
         entry["values"][fw] = vals

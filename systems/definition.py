@@ -11,6 +11,8 @@
 - ``options``: structural (non-symbolic) choices that built the Lagrangian (e.g. wave ``n``);
 - ``local_coupling``, ``actuated``: declared structure (the rest is derived);
 - ``max_speed``: if set, every |qdot| must be below it (relativistic particle: 1);
+- ``validate``: optional ``validate(params: dict) -> None`` raising ValueError on
+  non-physical combinations of bound parameters (e.g. a centre of mass beyond its link);
 - ``sampler``: ``sampler(n, rng, params, distribution) -> dict`` of float64 arrays
   ("q", "qdot" of shape (n, dof) and any per-sample parameter of shape (n,)).
 """
@@ -41,6 +43,7 @@ class Definition:
     actuated: bool = False
     max_speed: float | None = None
     description: str = ""
+    validate: Callable | None = None
 
     @property
     def dof(self) -> int:
@@ -99,13 +102,4 @@ def planar_kinetic(points, masses, q, qdot) -> sp.Expr:
         for (ra, aa), wa in zip(terms, rates, strict=True):
             for (rb, ab), wb in zip(terms, rates, strict=True):
                 total += m / 2 * ra * rb * wa * wb * sp.cos(aa - ab)
-    return total
-
-
-def kinetic_from_positions(positions, masses, q, qdot) -> sp.Expr:
-    """T = sum_k m_k/2 |d/dt r_k|^2 for point masses at ``positions`` (lists of coordinate exprs)."""
-    total = sp.Integer(0)
-    for r, m in zip(positions, masses, strict=True):
-        v = [sum(sp.diff(c, qi) * vi for qi, vi in zip(q, qdot, strict=True)) for c in r]
-        total += m / 2 * sum(vc**2 for vc in v)
     return total

@@ -6,7 +6,7 @@ generalised forces Q(q, qdot) and joint torques tau, the equations of motion are
 
 - ``hessian``, ``mixed``, ``rhs`` (b = dL/dq - A qdot + Q + tau), ``acceleration`` (closed form
   when H is diagonal or dof <= 2, otherwise ``None``: callers solve H qddot = b numerically);
-- ``energy`` = qdot . p - L, ``momentum`` = p;
+- ``energy`` = qdot . p - L, ``momentum`` = p, ``momentum_rate`` = dp/dt = dL/dq + Q;
 - ``structure``: quadratic_kinetic (L = qdot^T M(q) qdot / 2 - V(q) exactly), separable
   (L = f(qdot) + g(q)), plus the definition's declared local_coupling and actuated;
 - for quadratic kinetic energy: ``gravity`` g(q) = dV/dq, ``coriolis`` c(q, qdot) with
@@ -104,6 +104,11 @@ class Derivation:
             sol = h.adjugate() * sp.Matrix(b)
             return [sol[i] / det for i in range(self.d.dof)]
         return None
+
+    @functools.cached_property
+    def momentum_rate(self) -> list:
+        """dp/dt = dL/dq + Q (with tau = 0): the HNN target in canonical coordinates."""
+        return [g + f for g, f in zip(self.grad_q, self.forces, strict=True)]
 
     @functools.cached_property
     def energy(self) -> sp.Expr:

@@ -5,7 +5,8 @@ axis of size ``dof`` and leading batch axes ``(...)``, and returns that backend'
 input's float dtype (float32 stays float32; anything else is float64):
 
 - ``acceleration(q, qdot, backend, tau=None, **overrides)`` -> (..., dof)
-- ``energy(q, qdot, ...)`` -> (...,);  ``canonical_momentum(q, qdot, ...)`` -> (..., dof)
+- ``energy(q, qdot, ...)`` -> (...,);  ``canonical_momentum(q, qdot, ...)`` -> (..., dof);
+  ``canonical_momentum_rate(q, qdot, ...)`` -> (..., dof): dp/dt (unforced), HNN's target
 - ``velocity_hessian(q, qdot, ...)`` -> (..., dof, dof)  (d2L/dqdot2, defined for every system)
 - ``mass_matrix(q, ...)`` -> (..., dof, dof); ``gravity(q, ...)`` -> (..., dof);
   ``coriolis(q, qdot, ...)`` -> (..., dof); ``coriolis_matrix(q, qdot, ...)`` -> (..., dof, dof):
@@ -52,6 +53,7 @@ def _output(dv: Derivation, what: str) -> tuple:
     table = {
         "energy": lambda: ("scalar", dv.energy),
         "momentum": lambda: ("vector", dv.momentum),
+        "momentum_rate": lambda: ("vector", dv.momentum_rate),
         "velocity_hessian": lambda: ("matrix", dv.hessian),
         "mass_matrix": lambda: ("matrix", dv.mass_matrix),
         "gravity": lambda: ("vector", dv.gravity),
@@ -133,6 +135,8 @@ class System:
         self.definition = definition
         defaults = {k: default for k, (_, default, _) in definition.params.items()}
         self._params = {**defaults, **check_params(definition, values)}
+        if definition.validate is not None:
+            definition.validate(self._params)
 
     # --- description -----------------------------------------------------------------
     name = property(lambda self: self.definition.name)
@@ -207,6 +211,10 @@ class System:
     def canonical_momentum(self, q, qdot, backend: str = "numpy", **overrides):
         """p = dL/dqdot, shape (..., dof)."""
         return self._call("momentum", backend, {"q": q, "qdot": qdot}, overrides)
+
+    def canonical_momentum_rate(self, q, qdot, backend: str = "numpy", **overrides):
+        """dp/dt = dL/dq + Q along the unforced motion, shape (..., dof)."""
+        return self._call("momentum_rate", backend, {"q": q, "qdot": qdot}, overrides)
 
     def velocity_hessian(self, q, qdot, backend: str = "numpy", **overrides):
         """d2L/dqdot2, shape (..., dof, dof); defined for every system."""

@@ -1,4 +1,6 @@
 """The JAX model base: an equinox Module holding exactly the parameter dict and the static spec.
+Public model methods are wrapped in eqx.filter_jit (compiled once per spec and input shape; they
+inline under an outer jit or grad).
 
 `Model(params, spec)`: params is {key: jax.Array} in the `models.params` layout, spec a ModelSpec.
 Input checks raise ValueError (shape) / TypeError (dtype) naming what was expected and what came.

@@ -5,6 +5,7 @@ q, qdot (..., dof), extra (..., extra_inputs) or None -> (..., n_out), n_out = d
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax.numpy as jnp
 
 from models.jax.base import Model
@@ -12,6 +13,7 @@ from models.jax.mlp import mlp, mlp_input, wrap_angles
 
 
 class Baseline(Model):
+    @eqx.filter_jit
     def acceleration(self, q, qdot, extra=None):
         """MLP output (..., n_out)."""
         self._check_state(q, qdot, extra)

@@ -10,6 +10,7 @@ Shapes: q, qdot, qddot, tau (..., dof); M (..., dof, dof); V, L (...,).
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -41,21 +42,25 @@ class DeLaN(Model):
     def _potential(self, q):
         return self._heads(q)[1]
 
+    @eqx.filter_jit
     def mass_matrix(self, q):
         """M(q) (..., dof, dof), symmetric positive definite."""
         self._check("q", q, self.spec.dof)
         return self._mass(q)
 
+    @eqx.filter_jit
     def potential(self, q):
         """V(q) (...,)."""
         self._check("q", q, self.spec.dof)
         return self._potential(q)
 
+    @eqx.filter_jit
     def gravity(self, q):
         """g = dV/dq (..., dof)."""
         self._check("q", q, self.spec.dof)
         return jax.grad(lambda a: jnp.sum(self._potential(a)))(q)
 
+    @eqx.filter_jit
     def coriolis(self, q, qdot):
         """c = Mdot qdot - 1/2 d(qdot^T M qdot)/dq (..., dof)."""
         self._check_state(q, qdot)
@@ -63,11 +68,13 @@ class DeLaN(Model):
         quad = jax.grad(lambda a: jnp.sum(qdot * _mv(self._mass(a), qdot)))(q)
         return _mv(m_dot, qdot) - 0.5 * quad
 
+    @eqx.filter_jit
     def inverse_dynamics(self, q, qdot, qddot):
         """tau = M qddot + c + g (..., dof)."""
         self._check("qddot", qddot, self.spec.dof, like=q)
         return _mv(self.mass_matrix(q), qddot) + self.coriolis(q, qdot) + self.gravity(q)
 
+    @eqx.filter_jit
     def acceleration(self, q, qdot, extra=None):
         """Forward model qddot = M^-1 (tau - c - g) (..., dof), tau = extra (zero if None)."""
         self._check_state(q, qdot)
@@ -80,6 +87,7 @@ class DeLaN(Model):
         """(acceleration (..., dof), 0): M is positive definite, no fallback."""
         return self.acceleration(q, qdot, extra), jnp.zeros((), dtype=jnp.int64)
 
+    @eqx.filter_jit
     def lagrangian(self, q, qdot, extra=None):
         """L = 1/2 qdot^T M qdot - V (...,)."""
         self._check_state(q, qdot)

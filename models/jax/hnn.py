@@ -5,6 +5,7 @@ extra (..., extra_inputs) or None is fed to the MLP but not differentiated. angl
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
@@ -17,11 +18,13 @@ class HNN(Model):
         z = mlp_input(self.spec, [wrap_angles(self.spec, x), y, *self._parts(extra)])
         return mlp(self.params, z, self.spec)[..., 0]
 
+    @eqx.filter_jit
     def hamiltonian(self, x, y, extra=None):
         """H (...,)."""
         self._check_state(x, y, extra)
         return self._hamiltonian(x, y, extra)
 
+    @eqx.filter_jit
     def time_derivative(self, x, y, extra=None):
         """(xdot, ydot) = (dH/dy, -dH/dx), each (..., dof)."""
         self._check_state(x, y, extra)

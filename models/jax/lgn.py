@@ -8,20 +8,27 @@ Accelerations by spec.formulation:
   "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r); its band comes from
             one reverse pass pushed forward along <= 8r+1 coloured tangents plus the one mixed-term
             tangent (`models.graph.band_coloring`), and the system is solved in O(n) by
-            `models.jax.banded`. Samples whose solve is not finite take the dense pinv result and are
+            `models.jax.banded`. Samples whose solve is not finite take pinv of the dense Hessian and are
             counted. Grids with n < 4r + 1 use the dense path.
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 from jax import lax
 
-from models.graph import band_coloring, band_from_colours, banded_supported, cyclic_band_layout, periodic_neighbours
+from models.graph import (
+    band_coloring,
+    band_from_colours,
+    banded_supported,
+    cyclic_band_layout,
+    periodic_neighbours,
+)
 from models.jax.banded import solve_cyclic_banded
 from models.jax.base import Model
-from models.jax.lnn import euler_lagrange_info, paper_terms, pinv_solve
+from models.jax.lnn import euler_lagrange_info, fast_terms, pinv_solve
 from models.jax.mlp import mlp, mlp_input, wrap_angles
 
 
@@ -54,7 +61,7 @@ def banded_euler_lagrange_info(L_fn, q, qdot, r):
     def fallback():
         safe = jnp.where(bad[:, None, None], jnp.asarray(_identity_band(n, r), band.dtype), band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
-        return jnp.where(bad[:, None], pinv_solve(*paper_terms(L_fn, qf, qdf)), x_safe)
+        return jnp.where(bad[:, None], pinv_solve(*fast_terms(L_fn, qf, qdf)), x_safe)
     x = lax.cond(jnp.any(bad), fallback, lambda: x)
     return x.reshape(*batch, n), jnp.sum(bad)
 
@@ -65,11 +72,13 @@ class LGN(Model):
         x = mlp_input(self.spec, [wrap_angles(self.spec, q)[..., nb], qdot[..., nb]])
         return jnp.sum(mlp(self.params, x, self.spec)[..., 0], axis=-1)
 
+    @eqx.filter_jit
     def lagrangian(self, q, qdot, extra=None):
         """L (...,) for q, qdot (..., n)."""
         self._check_state(q, qdot, extra, width=q.shape[-1])
         return self._lagrangian(q, qdot)
 
+    @eqx.filter_jit
     def acceleration_info(self, q, qdot, extra=None):
         """(qddot (..., n), n_fallback) with spec.formulation."""
         self._check_state(q, qdot, extra, width=q.shape[-1])

@@ -17,6 +17,7 @@ Mirrored line for line by `models.torch.lnn`.
 """
 from __future__ import annotations
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jax import lax
@@ -112,16 +113,19 @@ class LNN(Model):
         x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
 
+    @eqx.filter_jit
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""
         self._check_state(q, qdot, extra)
         return self._lagrangian(q, qdot, extra)
 
+    @eqx.filter_jit
     def velocity_hessian(self, q, qdot, extra=None):
         """(..., dof, dof)."""
         self._check_state(q, qdot, extra)
         return velocity_hessian(self._lagrangian, q, qdot, extra if self.spec.extra_inputs else None)
 
+    @eqx.filter_jit
     def acceleration_info(self, q, qdot, extra=None):
         """(qddot (..., dof), n_fallback) with spec.formulation."""
         self._check_state(q, qdot, extra)

@@ -1,8 +1,6 @@
 """build(spec, params) -> the PyTorch model of spec.kind; to_params(model) -> the NumPy layout."""
 from __future__ import annotations
 
-import numpy as np
-
 from models.params import check_params
 from models.spec import ModelSpec
 from models.torch.baseline import Baseline

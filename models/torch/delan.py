@@ -13,9 +13,9 @@ from __future__ import annotations
 import torch
 from torch.func import grad, jvp
 
+from models.params import tril_selection
 from models.torch.base import Model
 from models.torch.mlp import ACT, linear, mlp, mlp_input, wrap_angles
-from models.params import tril_selection
 
 
 def _mv(m, v):

@@ -8,7 +8,7 @@ Accelerations by spec.formulation:
   "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r); its band comes from
             one reverse pass pushed forward along <= 8r+1 coloured tangents plus the one mixed-term
             tangent (`models.graph.band_coloring`), and the system is solved in O(n) by
-            `models.torch.banded`. Samples whose solve is not finite take the dense pinv result and are
+            `models.torch.banded`. Samples whose solve is not finite take pinv of the dense Hessian and are
             counted. Grids with n < 4r + 1 use the dense path.
 """
 from __future__ import annotations
@@ -17,10 +17,16 @@ import numpy as np
 import torch
 from torch.func import grad, jvp, vmap
 
-from models.graph import band_coloring, band_from_colours, banded_supported, cyclic_band_layout, periodic_neighbours
+from models.graph import (
+    band_coloring,
+    band_from_colours,
+    banded_supported,
+    cyclic_band_layout,
+    periodic_neighbours,
+)
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
-from models.torch.lnn import euler_lagrange_info, paper_terms, pinv_solve
+from models.torch.lnn import euler_lagrange_info, fast_terms, pinv_solve
 from models.torch.mlp import mlp, mlp_input, wrap_angles
 
 
@@ -53,7 +59,7 @@ def banded_euler_lagrange_info(L_fn, q, qdot, r):
     if bool(torch.any(bad)):
         safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype), band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
-        x = torch.where(bad[:, None], pinv_solve(*paper_terms(L_fn, qf, qdf)), x_safe)
+        x = torch.where(bad[:, None], pinv_solve(*fast_terms(L_fn, qf, qdf)), x_safe)
     return x.reshape(*batch, n), torch.sum(bad)
 
 

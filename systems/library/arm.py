@@ -12,7 +12,6 @@ generalised forces of the joints: M(q) qddot + c(q, qdot) + g(q) = tau - frictio
 from __future__ import annotations
 
 import numpy as np
-import sympy as sp
 
 from systems.definition import Definition, coordinates, param, planar_kinetic, planar_position
 from systems.library._sampling import unknown
@@ -38,5 +37,10 @@ def build_two_link_arm() -> Definition:
             raise unknown(distribution, ["default"])
         return {"q": rng.uniform(-np.pi, np.pi, (n, 2)), "qdot": rng.uniform(-3.0, 3.0, (n, 2))}
 
+    def validate(values):
+        for i in (1, 2):
+            if values[f"lc{i}"] > values[f"l{i}"]:
+                raise ValueError(f"two_link_arm: lc{i} (centre of mass) must not exceed l{i} (link length)")
+
     return Definition("two_link_arm", q, v, lag, p, sampler, forces=(-b * v[0], -b * v[1]),
-                      actuated=True, description="planar 2-link arm with joint torques")
+                      actuated=True, validate=validate, description="planar 2-link arm with joint torques")

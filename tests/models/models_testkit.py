@@ -57,13 +57,12 @@ def to_torch(x: dict) -> dict:
 
 def jax_loss_and_grads(spec, params, x):
     """(prediction, {key: dloss/dparam}) with loss = mean over samples of sum |pred - target|."""
-    xj = to_jax(x)
-
-    def loss(model):
+    def loss(model, xj):
         pred = predict(model, spec.kind, xj, jnp.concatenate)
         return jnp.mean(jnp.sum(jnp.abs(pred - xj["target"]), axis=-1)), pred
 
-    (_, pred), grads = eqx.filter_value_and_grad(loss, has_aux=True)(models.jax.build(spec, params))
+    step = eqx.filter_jit(eqx.filter_value_and_grad(loss, has_aux=True))
+    (_, pred), grads = step(models.jax.build(spec, params), to_jax(x))
     return np.asarray(pred), {k: np.asarray(v) for k, v in grads.params.items()}
 
 

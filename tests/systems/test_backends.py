@@ -12,7 +12,8 @@ CASES = [(n, {}) for n in systems.names()] + [("wave", {"variant": "textbook", "
 
 
 def _methods(s):
-    out = ["acceleration", "energy", "canonical_momentum", "velocity_hessian", "inverse_dynamics"]
+    out = ["acceleration", "energy", "canonical_momentum", "canonical_momentum_rate", "velocity_hessian",
+           "inverse_dynamics"]
     if s.structure["quadratic_kinetic"]:
         out += ["mass_matrix", "gravity", "coriolis", "coriolis_matrix"]
     return out

@@ -34,3 +34,15 @@ def test_structure_and_defaults():
     # the LNN energy scale 29.4 = m1 g l1 + m2 g (l1 + l2) is the potential of the upright state
     top = s.energy(np.array([np.pi, np.pi]), np.zeros(2))
     np.testing.assert_allclose(top, 29.4, rtol=1e-14)
+
+
+def test_momentum_rate_is_the_time_derivative_of_momentum():
+    from systems.trajectories import integrate
+
+    s = systems.get("double_pendulum")
+    st = s.sample_states(3, 2)
+    t = np.array([0.0, 1e-4, 2e-4])
+    q, qdot = integrate(s, st["q"], st["qdot"], t)
+    p = s.canonical_momentum(q, qdot)
+    fd = (p[:, 2] - p[:, 0]) / 2e-4
+    np.testing.assert_allclose(fd, s.canonical_momentum_rate(q[:, 1], qdot[:, 1]), rtol=1e-6, atol=1e-6)

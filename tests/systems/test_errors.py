@@ -23,6 +23,7 @@ def test_unknown_name_lists_valid_names():
     ("double_pendulum", {"m1": -1.0}, "m1.*> 0"),
     ("double_pendulum", {"l2": 0.0}, "l2.*> 0"),
     ("two_link_arm", {"friction": -0.1}, "friction.*>= 0"),
+    ("two_link_arm", {"lc2": 0.5}, "lc2.*must not exceed l2"),
     ("pendulum", {"mass": 1.0}, "valid parameters: friction, g, l, m"),
     ("wave", {"n": 2}, "n >= 3"),
     ("wave", {"variant": "exact"}, "code, textbook"),

@@ -18,6 +18,7 @@ def test_acceleration_and_momentum(name, standard):
     mom = s.canonical_momentum(q, qdot, g=g)
     np.testing.assert_allclose(mom[:, 0], closed_form.relativistic_momentum(qdot[:, 0], standard),
                                rtol=1e-10, atol=0)
+    np.testing.assert_allclose(s.canonical_momentum_rate(q, qdot, g=g)[:, 0], g, rtol=1e-14)
 
 
 def test_sampler_follows_the_original_protocol():

@@ -1,4 +1,4 @@
-"""Shared fixtures for the systems tests: the default cache is kept per session in a temp dir
+"""Shared fixtures for every test: the default cache is kept per session in a temp dir
 unless LAGBENCH_CACHE is set (tox sets it), so repeated runs reuse generated code."""
 
 import os

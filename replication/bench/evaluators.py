@@ -1,0 +1,128 @@
+"""q-double-dot evaluators: one callable per (model, framework, dtype), and the error against truth.
+
+`make_evaluator(framework, model_or_system, kind, dtype) -> Evaluator`:
+  `ev.prepare(q, qdot)` converts float64 NumPy (B, d) states to the framework's arrays (outside timing);
+  `ev.run(args)` blocks until q-double-dot (B, d) is computed (what is timed);
+  `ev.numpy(args)` returns it as float64 NumPy (for the error column).
+Models: "lnn" / "lgn" / "delan" (tau = 0) / "baseline" use `.acceleration`; "hnn" is used on the
+non-canonical (q, qdot) (its second output is q-double-dot); "truth" is the SymPy-generated system
+(`System.acceleration` with backend numpy | jax | torch). JAX calls are `jax.jit` of the model passed as
+an argument (the weights are inputs of the compiled program, not folded constants), compiled ahead of
+time per shape; PyTorch runs eagerly under `torch.no_grad()` (torch.func inside still differentiates).
+`median_rel_error(pred, true)`: median over samples of |pred - true| / |true| (Euclidean norms).
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import torch
+
+import models.jax
+import models.torch
+
+
+def median_rel_error(pred, true) -> float:
+    num = np.linalg.norm(np.asarray(pred, np.float64) - true, axis=-1)
+    den = np.maximum(np.linalg.norm(true, axis=-1), 1e-300)
+    return float(np.median(num / den))
+
+
+def _qddot(obj, kind, q, qdot):
+    if kind == "hnn":
+        return obj.time_derivative(q, qdot)[1]
+    return obj.acceleration(q, qdot)
+
+
+class JaxEvaluator:
+    framework = "jax"
+
+    def __init__(self, model, kind, dtype):
+        self.model, self.kind, self.dtype = model, kind, jnp.dtype(dtype)
+        self._fn = jax.jit(lambda m, q, qd: _qddot(m, kind, q, qd))
+        self._compiled = {}
+
+    def prepare(self, q, qdot):
+        return jnp.asarray(q, self.dtype), jnp.asarray(qdot, self.dtype)
+
+    def compiled(self, args):
+        key = tuple(a.shape for a in args)
+        if key not in self._compiled:
+            self._compiled[key] = self._fn.lower(self.model, *args).compile()
+        return self._compiled[key]
+
+    def run(self, args):
+        return jax.block_until_ready(self.compiled(args)(self.model, *args))
+
+    def numpy(self, args):
+        return np.asarray(self.run(args), np.float64)
+
+    def flops(self, args) -> float | None:
+        """FLOPs of one call from XLA's compiled cost analysis (None if unavailable)."""
+        cost = self.compiled(args).cost_analysis()
+        if isinstance(cost, list | tuple):
+            cost = cost[0] if cost else None
+        return float(cost["flops"]) if cost and "flops" in cost else None
+
+
+class TruthJax(JaxEvaluator):
+    def __init__(self, system, dtype):
+        self.model, self.kind, self.dtype = None, "truth", jnp.dtype(dtype)
+        self._fn = jax.jit(lambda _, q, qd: system.acceleration(q, qd, backend="jax"))
+        self._compiled = {}
+
+
+class TorchEvaluator:
+    framework = "torch"
+
+    def __init__(self, model, kind, dtype):
+        self.model, self.kind, self.dtype = model, kind, getattr(torch, dtype)
+
+    def prepare(self, q, qdot):
+        return torch.as_tensor(q, dtype=self.dtype), torch.as_tensor(qdot, dtype=self.dtype)
+
+    def _call(self, args):
+        with torch.no_grad():
+            return _qddot(self.model, self.kind, *args)
+
+    def run(self, args):
+        return self._call(args)
+
+    def numpy(self, args):
+        return self._call(args).detach().numpy().astype(np.float64)
+
+
+class TruthTorch(TorchEvaluator):
+    def __init__(self, system, dtype):
+        self.system, self.kind, self.dtype = system, "truth", getattr(torch, dtype)
+
+    def _call(self, args):
+        with torch.no_grad():
+            return self.system.acceleration(*args, backend="torch")
+
+
+class TruthNumpy:
+    framework = "numpy"
+
+    def __init__(self, system, dtype):
+        self.system, self.kind, self.dtype = system, "truth", np.dtype(dtype)
+
+    def prepare(self, q, qdot):
+        return np.asarray(q, self.dtype), np.asarray(qdot, self.dtype)
+
+    def run(self, args):
+        return self.system.acceleration(*args, backend="numpy")
+
+    def numpy(self, args):
+        return np.asarray(self.run(args), np.float64)
+
+
+def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="float32", system=None):
+    """An evaluator for a model (spec + NumPy params) or, with kind="truth", for `system`."""
+    if kind == "truth":
+        return {"jax": TruthJax, "torch": TruthTorch, "numpy": TruthNumpy}[framework](system, dtype)
+    if framework == "jax":
+        return JaxEvaluator(models.jax.build(spec, params), spec.kind, spec.dtype)
+    if framework == "torch":
+        return TorchEvaluator(models.torch.build(spec, params), spec.kind, spec.dtype)
+    raise ValueError(f"unknown framework {framework!r}; valid: jax, torch (numpy for truth only)")

@@ -1,0 +1,127 @@
+"""Inference study: q-double-dot throughput and error for every model x framework x formulation.
+
+`inference_cases(sizes) -> list[Case]` and `run_case(case, states, min_time) -> list[row]`; a row is
+{system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden}.
+Systems: the double pendulum (every kind but the graph network, plus the SymPy ground truth as model
+"truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid (LGN dense vs banded, and
+truth). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
+large; that is expected. `trained_cases(out)` adds double-pendulum models found as checkpoints under
+OUT/units/<claim>/<framework>/<model>/seed0/ (source "trained:<claim>"), evaluated in their own
+framework and dtype, which gives the error column its meaning. Error (one per case, on the largest
+batch's states, shared by its rows): median of |q''_pred - q''_true| / |q''_true| against float64 NumPy
+ground truth on the same states. Batches below `timing.SMALL_BATCH` run PyTorch on one thread (latency
+on one core; two threads on shared cores spend more time at barriers than in arithmetic).
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import systems
+from models import ModelSpec, init_params
+from replication.bench.evaluators import make_evaluator, median_rel_error
+from replication.bench.timing import SMALL_BATCH, best_time, torch_threads
+
+WAVE_N = 64
+DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
+            ("baseline", "-"))
+WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
+
+
+@dataclass
+class Case:
+    system: str
+    system_kw: dict
+    model: str
+    formulation: str
+    framework: str
+    dtype: str
+    batches: tuple
+    spec: ModelSpec | None = None
+    params: dict | None = None
+    source: str = "random_init"
+    extra: dict = field(default_factory=dict)
+
+
+def model_spec(kind: str, formulation: str, dof: int, hidden: tuple, dtype: str, **kw) -> ModelSpec:
+    """The study's spec of a kind: softplus, the LNN paper's empirical init; the baseline ReLU + Xavier (the
+    LNN paper's baseline); DeLaN softplus + Xavier (the empirical init's sqrt(n) output scale makes a
+    random DeLaN mass matrix singular in float32)."""
+    act, init = ("relu", "xavier") if kind == "baseline" else ("softplus", "cranmer2020")
+    init = "xavier" if kind == "delan" else init
+    form = formulation if kind in ("lnn", "lgn") else "fast"
+    return ModelSpec(kind=kind, dof=dof, hidden=tuple(hidden), activation=act, init=init, dtype=dtype,
+                     formulation=form, **kw)
+
+
+def _frameworks(kind):
+    return ("numpy", "jax", "torch") if kind == "truth" else ("jax", "torch")
+
+
+def inference_cases(sizes) -> list[Case]:
+    cases = []
+    plan = (("double_pendulum", {}, 2, DP_KINDS, sizes.hidden),
+            ("wave", {"n": WAVE_N}, WAVE_N, WAVE_KINDS, sizes.lgn_hidden))
+    for system, kw, dof, kinds, hidden in plan:
+        for kind, form in kinds:
+            for dtype in sizes.dtypes:
+                spec = None if kind == "truth" else model_spec(kind, form, dof, hidden, dtype)
+                params = None if spec is None else init_params(spec, seed=0)
+                for fw in _frameworks(kind):
+                    cases.append(Case(system, kw, kind, form, fw, dtype, sizes.batches, spec, params,
+                                      extra={"hidden": "x".join(map(str, hidden)) if spec else ""}))
+    return cases
+
+
+def trained_cases(out: Path, batches: tuple) -> list[Case]:
+    """Double-pendulum checkpoints of a previous `lagbench run` in OUT/units (seed 0 only)."""
+    from replication.results import load_npz
+
+    cases = []
+    for res_path in sorted(Path(out).glob("units/*/*/*/seed0/result.json")):
+        try:
+            res = json.loads(res_path.read_text())
+        except (OSError, ValueError):
+            continue
+        data = str((res.get("protocol") or {}).get("data", ""))
+        ckpt = res_path.parent / "checkpoint.npz"
+        if res.get("status") != "ok" or "model_spec" not in res or not data.startswith("double_pendulum") \
+                or (res.get("protocol") or {}).get("task", "acceleration") != "acceleration" or not ckpt.is_file():
+            continue
+        spec = ModelSpec.from_dict(res["model_spec"])
+        if spec.dof != 2 or spec.extra_inputs:
+            continue
+        fw = res.get("framework", res_path.parts[-4])
+        cases.append(Case("double_pendulum", {}, spec.kind, spec.formulation if spec.kind == "lnn" else "-",
+                          fw, spec.dtype, batches, spec, load_npz(ckpt), source=f"trained:{res.get('claim')}",
+                          extra={"hidden": "x".join(map(str, spec.hidden))}))
+    return cases
+
+
+def states_for(system: str, kw: dict, n: int, seed: int = 0) -> dict:
+    """n states of the system's default distribution and their float64 ground-truth accelerations."""
+    s = systems.get(system, **kw)
+    st = s.sample_states(n, np.random.default_rng(seed))
+    return {"q": st["q"], "qdot": st["qdot"], "qddot": s.acceleration(st["q"], st["qdot"], backend="numpy")}
+
+
+def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
+    s = systems.get(case.system, **case.system_kw) if case.model == "truth" else None
+    ev = make_evaluator(case.framework, case.spec, case.params, kind="truth" if s else case.model,
+                        dtype=case.dtype, system=s)
+    n_err = max(case.batches)
+    err = median_rel_error(ev.numpy(ev.prepare(states["q"][:n_err], states["qdot"][:n_err])),
+                           states["qddot"][:n_err])
+    rows = []
+    for b in case.batches:
+        args = ev.prepare(states["q"][:b], states["qdot"][:b])
+        with torch_threads(1 if b < SMALL_BATCH else None):
+            ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape)
+            dt = best_time(lambda a=args: ev.run(a), min_time=min_time)
+        rows.append({"system": case.system, "model": case.model, "formulation": case.formulation,
+                     "framework": case.framework, "dtype": case.dtype, "batch": int(b),
+                     "samples_per_s": b / dt, "error": err, "source": case.source, **case.extra})
+    return rows

@@ -1,0 +1,103 @@
+"""Timing helpers and the size presets of the speed study.
+
+`best_time(fn, min_time, min_reps, max_reps) -> seconds`: calls `fn()` (which must block until its
+result is ready) repeatedly and returns the FASTEST call. On shared cores noise only ever slows a call
+down, so the minimum is the most reproducible estimate; every figure of the study is a throughput or a
+ratio of two such minima taken in the same run, never an absolute timing compared across runs.
+`jax_ready(fn)` / `torch_ready(fn)` wrap a framework call so that it blocks and returns nothing.
+`Sizes`: what the tiny / quick / full studies measure.
+"""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import jax
+
+
+def best_time(fn, min_time: float = 0.3, min_reps: int = 2, max_reps: int = 50) -> float:
+    """Fastest wall time of fn() over at least min_reps calls, more while the total is under min_time."""
+    best, total, reps = float("inf"), 0.0, 0
+    while reps < min_reps or (total < min_time and reps < max_reps):
+        t0 = time.perf_counter()
+        fn()
+        dt = time.perf_counter() - t0
+        best, total, reps = min(best, dt), total + dt, reps + 1
+    return best
+
+
+def jax_ready(fn, *args):
+    """A no-argument callable that runs fn(*args) and blocks on the result."""
+    return lambda: jax.block_until_ready(fn(*args))
+
+
+def torch_ready(fn, *args):
+    import torch
+
+    def run():
+        with torch.no_grad():
+            fn(*args)
+    return run
+
+
+SMALL_BATCH = 256  # below this, PyTorch runs on one thread (see torch_threads)
+
+
+@contextmanager
+def torch_threads(n: int | None):
+    """Temporarily set PyTorch's intra-op threads (None: leave as is)."""
+    import torch
+
+    old = torch.get_num_threads()
+    if n is not None:
+        torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(old)
+
+
+@dataclass(frozen=True)
+class Sizes:
+    """The study's sizes. The fast/paper ratios and the roofline always use 3 x 600 (but tiny)."""
+
+    name: str
+    hidden: tuple                  # inference-plane MLP (quick: the quick profile's 3 x 128)
+    batches: tuple                 # inference batch sizes
+    dtypes: tuple
+    lgn_hidden: tuple
+    lgn_n: tuple                   # LGN scaling grid sizes
+    chain_d: tuple                 # LNN fast vs paper scaling degrees of freedom
+    chain_batch: int
+    ratio_batch: int               # the fast/paper target batch (4096)
+    ratio_hidden: tuple            # the fast/paper target MLP (3 x 600), also the chain scaling's
+    ratio_dofs: tuple
+    train_hidden: tuple
+    train_batch: int
+    train_steps: int
+    rollout_rtols: tuple
+    rollout_dts: tuple
+    rollout_t_end: float
+    rollout_ics: int
+    min_time: float
+    torch_compile: bool
+    structure_batch: int
+
+
+TINY = Sizes("tiny", hidden=(16, 16), batches=(1, 64), dtypes=("float32",), lgn_hidden=(8, 8),
+             lgn_n=(16, 32), chain_d=(1, 2), chain_batch=16, ratio_batch=64, ratio_hidden=(16, 16), ratio_dofs=(2,),
+             train_hidden=(16, 16), train_batch=32, train_steps=3, rollout_rtols=(1e-6,),
+             rollout_dts=(0.01,), rollout_t_end=1.0, rollout_ics=2, min_time=0.0, torch_compile=False,
+             structure_batch=64)
+QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("float32", "float64"),
+              lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024), chain_d=(1, 2, 4, 8, 16), chain_batch=256,
+              ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), train_hidden=(600, 600, 600), train_batch=512,
+              train_steps=3, rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003),
+              rollout_t_end=10.0, rollout_ics=8, min_time=0.2, torch_compile=True, structure_batch=1024)
+FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), dtypes=("float32", "float64"),
+             lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024, 4096), chain_d=(1, 2, 4, 8, 16, 32),
+             chain_batch=512, ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), train_hidden=(600, 600, 600),
+             train_batch=512, train_steps=10, rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12),
+             rollout_dts=(0.01, 0.003, 0.001), rollout_t_end=20.0, rollout_ics=16, min_time=1.0,
+             torch_compile=True, structure_batch=4096)

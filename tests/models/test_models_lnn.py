@@ -1,0 +1,139 @@
+"""The Euler-Lagrange routine: exact Lagrangians recover known accelerations in both formulations and
+frameworks, fast equals paper where the velocity Hessian is well conditioned, and singular Hessians
+take the counted pinv fallback without letting a NaN out."""
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+import torch
+from models_testkit import assert_rel, make_inputs, spec_params, to_jax, to_torch
+
+import models.jax
+import models.jax.lnn as jlnn
+import models.torch
+import models.torch.lnn as tlnn
+
+G = 9.8
+
+
+class _JittedEL:
+    """models.jax.lnn with euler_lagrange(_info) compiled (eqx.filter_jit): faster tests."""
+    euler_lagrange_info = staticmethod(eqx.filter_jit(jlnn.euler_lagrange_info))
+    euler_lagrange = staticmethod(eqx.filter_jit(jlnn.euler_lagrange))
+
+
+FW = {"jax": (_JittedEL, jnp, jnp.asarray), "torch": (tlnn, torch, torch.tensor)}
+
+
+def double_pendulum_lagrangian(xp):
+    """m1 = m2 = l1 = l2 = 1 (the LNN code's physics.py), angles from the downward vertical."""
+    def lagrangian(q, qdot):
+        t1, t2, w1, w2 = q[..., 0], q[..., 1], qdot[..., 0], qdot[..., 1]
+        kinetic = w1 ** 2 + 0.5 * w2 ** 2 + w1 * w2 * xp.cos(t1 - t2)
+        return kinetic + 2 * G * xp.cos(t1) + G * xp.cos(t2)
+    return lagrangian
+
+
+def assencio_acceleration(q, qdot):
+    """The closed form of the original code's analytical_fn (reference section 2), NumPy."""
+    t1, t2, w1, w2 = q[..., 0], q[..., 1], qdot[..., 0], qdot[..., 1]
+    a1, a2 = 0.5 * np.cos(t1 - t2), np.cos(t1 - t2)
+    f1 = -0.5 * w2 ** 2 * np.sin(t1 - t2) - G * np.sin(t1)
+    f2 = w1 ** 2 * np.sin(t1 - t2) - G * np.sin(t2)
+    return np.stack([(f1 - a1 * f2) / (1 - a1 * a2), (f2 - a2 * f1) / (1 - a1 * a2)], axis=-1)
+
+
+def _states(batch=32, d=2, seed=0):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(0, 2 * np.pi, (batch, d)), rng.uniform(-10, 10, (batch, d))
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+@pytest.mark.parametrize("formulation", ["fast", "paper"])
+def test_exact_double_pendulum_lagrangian_recovers_the_closed_form(fw, formulation):
+    lnn, xp, arr = FW[fw]
+    q, qdot = _states()
+    got, n_bad = lnn.euler_lagrange_info(double_pendulum_lagrangian(xp), arr(q), arr(qdot), formulation)
+    assert_rel(np.asarray(got), assencio_acceleration(q, qdot), "float64", "double pendulum", factor=10)
+    assert int(n_bad) == 0
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+def test_free_fall_gives_minus_g_appendix_b(fw):
+    lnn, xp, arr = FW[fw]
+    q, qdot = _states(batch=5)
+    free_fall = lambda q, qd: 0.5 * xp.sum(qd ** 2, -1) - G * q[..., 0]  # noqa: E731
+    for formulation in ("fast", "paper"):
+        got = np.asarray(lnn.euler_lagrange(free_fall, arr(q), arr(qdot), formulation))
+        np.testing.assert_allclose(got, np.tile([-G, 0.0], (5, 1)), atol=1e-12)
+
+
+def test_system_registry_accelerations_if_available():
+    systems = pytest.importorskip("systems")
+    if not hasattr(systems, "get"):
+        pytest.skip("systems.get not available yet")
+    q, qdot = _states()
+    truth = systems.get("double_pendulum").acceleration(q, qdot, backend="numpy")
+    got = tlnn.euler_lagrange(double_pendulum_lagrangian(torch), torch.tensor(q), torch.tensor(qdot), "fast")
+    assert_rel(got.numpy(), truth, "float64", "systems double pendulum", factor=10)
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+def test_fast_equals_paper_where_the_hessian_is_well_conditioned(fw):
+    spec, params = spec_params(kind="lnn", dof=3, dtype="float64", init="xavier")
+    x = make_inputs(spec, batch=24, seed=5)
+    build, conv = (models.jax.build, to_jax) if fw == "jax" else (models.torch.build, to_torch)
+    model, xs = build(spec, params), conv(x)
+    L = model.lagrangian
+    fast, n_bad = FW[fw][0].euler_lagrange_info(L, xs["q"], xs["qdot"], "fast")
+    paper = FW[fw][0].euler_lagrange(L, xs["q"], xs["qdot"], "paper")
+    hess = np.asarray(model.velocity_hessian(xs["q"], xs["qdot"]).tolist())
+    good = np.linalg.cond(hess) < 1e6
+    assert good.sum() >= 12 and int(n_bad) == 0
+    assert_rel(np.asarray(fast.tolist())[good], np.asarray(paper.tolist())[good], "float64", "fast vs paper", factor=100)
+
+
+def _half_singular(xp):
+    """L = 1/2 q1 qdot1^2 + 1/2 qdot2^2 - 1/2 q2^2: the Hessian diag(q1, 1) is singular where q1 = 0."""
+    return lambda q, qd: 0.5 * q[..., 0] * qd[..., 0] ** 2 + 0.5 * qd[..., 1] ** 2 - 0.5 * q[..., 1] ** 2
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+def test_singular_hessians_are_counted_and_take_pinv(fw):
+    lnn, xp, arr = FW[fw]
+    q, qdot = _states(batch=8, seed=7)
+    q[[1, 4, 6], 0] = 0.0
+    fast, n_bad = lnn.euler_lagrange_info(_half_singular(xp), arr(q), arr(qdot), "fast")
+    paper = lnn.euler_lagrange(_half_singular(xp), arr(q), arr(qdot), "paper")
+    assert int(n_bad) == 3
+    fast, paper = np.asarray(fast.tolist()), np.asarray(paper.tolist())
+    assert np.all(np.isfinite(fast))
+    assert_rel(fast, paper, "float64", "fallback equals pinv", factor=100)
+    np.testing.assert_allclose(fast[[1, 4, 6], 0], 0.0)     # pinv drops the null direction
+    np.testing.assert_allclose(fast[:, 1], -q[:, 1])         # the regular coordinate is exact
+
+
+def test_fallback_gradients_stay_finite():
+    q, qdot = _states(batch=6, seed=8)
+    q[2, 0] = 0.0
+
+    def jax_loss(a):
+        L = lambda q, qd: a * _half_singular(jnp)(q, qd)  # noqa: E731
+        return jnp.sum(jlnn.euler_lagrange(L, jnp.asarray(q), jnp.asarray(qdot)))
+    assert np.isfinite(float(jax.jit(jax.grad(jax_loss))(1.5)))
+    a = torch.tensor(1.5, dtype=torch.float64, requires_grad=True)
+    L = lambda q, qd: a * _half_singular(torch)(q, qd)  # noqa: E731
+    tlnn.euler_lagrange(L, torch.tensor(q), torch.tensor(qdot)).sum().backward()
+    assert torch.isfinite(a.grad)
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+def test_relu_lnn_has_a_zero_hessian_everywhere_and_every_sample_falls_back(fw):
+    spec, params = spec_params(kind="lnn", dof=2, dtype="float64", activation="relu")
+    x = make_inputs(spec, batch=10)
+    build, conv = (models.jax.build, to_jax) if fw == "jax" else (models.torch.build, to_torch)
+    xs = conv(x)
+    qddot, n_bad = build(spec, params).acceleration_info(xs["q"], xs["qdot"])
+    assert int(n_bad) == 10
+    assert np.all(np.isfinite(np.asarray(qddot.tolist())))
