@@ -6,6 +6,10 @@
     import models.jax, models.torch
     mj, mt = models.jax.build(spec, params), models.torch.build(spec, params)
 """
+import os as _os
+
+_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # busy-waiting OpenMP threads stall a loaded CPU (CONTRIBUTING)
+
 from models.activations import ACTIVATIONS
 from models.init import init_params
 from models.params import check_params, layer_table, param_shapes

@@ -9,6 +9,10 @@ See ``systems.system`` for the methods of a ``System`` and their shapes,
 ``systems.trajectories`` for diffrax integration and ``systems.datasets`` for cached datasets.
 Importing this package enables JAX float64 (``jax_enable_x64``).
 """
+import os as _os
+
+_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # busy-waiting OpenMP threads stall a loaded CPU (CONTRIBUTING)
+
 
 from systems import backends  # noqa: F401  (enables jax x64)
 from systems.derive import NotQuadraticError

@@ -12,8 +12,18 @@ import torch
 
 from models.params import n_layers
 
+def softplus(x):
+    """log(1 + e^x) as logaddexp(x, 0) computes it, but with derivatives of every order finite:
+    torch's logaddexp double-backward is NaN for large negative x (JAX's is 0). Each branch only
+    sees inputs of the sign it is valid for, so the unselected branch's gradient is 0, not NaN."""
+    pos = x > 0
+    zero = torch.zeros_like(x)
+    return torch.where(pos, x + torch.log1p(torch.exp(-torch.where(pos, x, zero))),
+                       torch.log1p(torch.exp(torch.where(pos, zero, x))))
+
+
 ACT = {
-    "softplus": lambda x: torch.logaddexp(x, torch.zeros_like(x)),
+    "softplus": softplus,
     "relu": lambda x: torch.clamp(x, min=0.0),
     "relu2": lambda x: torch.clamp(x, min=0.0) ** 2,
     "relu3": lambda x: torch.clamp(x, min=0.0) ** 3,

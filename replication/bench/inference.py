@@ -3,14 +3,13 @@
 `inference_cases(sizes) -> list[Case]` and `run_case(case, states, min_time) -> list[row]`; a row is
 {system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden}.
 Systems: the double pendulum (every kind but the graph network, plus the SymPy ground truth as model
-"truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid (LGN dense vs banded, and
-truth). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
+"truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid of `sizes.wave_n` points (LGN dense vs banded, and
+truth; batches capped at `GRID_NODES` // n states). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
 large; that is expected. `trained_cases(out)` adds double-pendulum models found as checkpoints under
 OUT/units/<claim>/<framework>/<model>/seed0/ (source "trained:<claim>"), evaluated in their own
 framework and dtype, which gives the error column its meaning. Error (one per case, on the largest
 batch's states, shared by its rows): median of |q''_pred - q''_true| / |q''_true| against float64 NumPy
-ground truth on the same states. Batches below `timing.SMALL_BATCH` run PyTorch on one thread (latency
-on one core; two threads on shared cores spend more time at barriers than in arithmetic).
+ground truth on the same states.
 """
 from __future__ import annotations
 
@@ -23,9 +22,9 @@ import numpy as np
 import systems
 from models import ModelSpec, init_params
 from replication.bench.evaluators import make_evaluator, median_rel_error
-from replication.bench.timing import SMALL_BATCH, best_time, torch_threads
+from replication.bench.timing import best_time
 
-WAVE_N = 64
+GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dense path holds n + 1 tangents)
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
             ("baseline", "-"))
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
@@ -63,15 +62,16 @@ def _frameworks(kind):
 
 def inference_cases(sizes) -> list[Case]:
     cases = []
-    plan = (("double_pendulum", {}, 2, DP_KINDS, sizes.hidden),
-            ("wave", {"n": WAVE_N}, WAVE_N, WAVE_KINDS, sizes.lgn_hidden))
-    for system, kw, dof, kinds, hidden in plan:
+    wave_batches = tuple(sorted({min(b, GRID_NODES // sizes.wave_n) for b in sizes.batches}))
+    plan = (("double_pendulum", {}, 2, DP_KINDS, sizes.hidden, sizes.batches),
+            ("wave", {"n": sizes.wave_n}, sizes.wave_n, WAVE_KINDS, sizes.lgn_hidden, wave_batches))
+    for system, kw, dof, kinds, hidden, batches in plan:
         for kind, form in kinds:
             for dtype in sizes.dtypes:
                 spec = None if kind == "truth" else model_spec(kind, form, dof, hidden, dtype)
                 params = None if spec is None else init_params(spec, seed=0)
                 for fw in _frameworks(kind):
-                    cases.append(Case(system, kw, kind, form, fw, dtype, sizes.batches, spec, params,
+                    cases.append(Case(system, kw, kind, form, fw, dtype, batches, spec, params,
                                       extra={"hidden": "x".join(map(str, hidden)) if spec else ""}))
     return cases
 
@@ -118,9 +118,8 @@ def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
     rows = []
     for b in case.batches:
         args = ev.prepare(states["q"][:b], states["qdot"][:b])
-        with torch_threads(1 if b < SMALL_BATCH else None):
-            ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape)
-            dt = best_time(lambda a=args: ev.run(a), min_time=min_time)
+        ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape)
+        dt = best_time(lambda a=args: ev.run(a), min_time=min_time)
         rows.append({"system": case.system, "model": case.model, "formulation": case.formulation,
                      "framework": case.framework, "dtype": case.dtype, "batch": int(b),
                      "samples_per_s": b / dt, "error": err, "source": case.source, **case.extra})

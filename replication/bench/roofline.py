@@ -23,7 +23,7 @@ from models.jax.mlp import mlp as jmlp
 from models.torch.mlp import mlp as tmlp
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import model_spec
-from replication.bench.timing import best_time, torch_threads
+from replication.bench.timing import best_time
 
 WARMUP_BATCH = 64
 
@@ -42,12 +42,11 @@ def fast_paper_rows(sizes, dof: int) -> list[dict]:
         for fw in ("jax", "torch"):
             ev = make_evaluator(fw, spec, params)
             args = ev.prepare(q, qd)
-            with torch_threads(None):
-                if fw == "torch":
-                    ev.run(ev.prepare(q[:WARMUP_BATCH], qd[:WARMUP_BATCH]))
-                else:
-                    ev.compiled(args)
-                dt = best_time(lambda ev=ev, args=args: ev.run(args), min_time=sizes.min_time, min_reps=2)
+            if fw == "torch":
+                ev.run(ev.prepare(q[:WARMUP_BATCH], qd[:WARMUP_BATCH]))
+            else:
+                ev.compiled(args)
+            dt = best_time(lambda ev=ev, args=args: ev.run(args), min_time=sizes.min_time, min_reps=2)
             flops = ev.flops(args) / sizes.ratio_batch if fw == "jax" else float("nan")
             rows.append({"dof": dof, "framework": fw, "formulation": form, "batch": sizes.ratio_batch,
                          "seconds": dt, "samples_per_s": sizes.ratio_batch / dt, "flops_per_sample": flops,

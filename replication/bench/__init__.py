@@ -1,0 +1,125 @@
+"""The speed study: `run_bench(out, quick=True, tiny=False)` writes OUT/bench/ (what `lagbench bench` calls).
+
+Files (all CSV with a header row, written atomically; columns beyond these are extras the report may
+ignore):
+  machine.json    cpu, cores, gpu (or null), platform, thread settings, versions, commit, date, preset
+  inference.csv   system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden
+                  (`replication.bench.inference`)
+  training.csv    system, model, framework, mode, dtype, batch, steps_per_s, samples_per_s, hidden
+                  (`replication.bench.training`)
+  rollout.csv     system, solver, rtol, kind, wall_s, state_err, energy_err, dt, n_ics, t_end
+                  (`replication.bench.rollout`)
+  scaling.csv     study, formulation, framework, n, seconds_per_eval, samples_per_s, batch
+  scaling_fit.csv study, formulation, framework, exponent, n_min, n_max   (`replication.bench.scaling`)
+  fast_paper.csv  dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample, gflops
+  matmul.csv      dof, framework, rows, seconds, gflops                    (`replication.bench.roofline`)
+  structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
+  ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
+  targets.json    the issue's numeric targets, each with the measured values and met: true/false
+Presets (`replication.bench.timing`): quick (default), full (`quick=False`), tiny (`tiny=True` or the
+environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). Every figure is a throughput or a
+ratio within this one run; numbers from different machines (machine.json) are never to be mixed.
+PyTorch runs with `TORCH_THREADS` (1) intra-op threads: on two shared cores its OpenMP pool at 2 threads
+ran 10-100x slower than on 1 (threads waiting at barriers while other processes hold the cores); JAX
+keeps XLA's defaults (the thread settings are recorded in machine.json).
+"""
+from __future__ import annotations
+
+import datetime as dt
+import os
+from pathlib import Path
+
+import pandas as pd
+import torch
+from tqdm.auto import tqdm
+
+from replication import environment
+from replication.bench import inference as INF
+from replication.bench import roofline, rollout, scaling, structure, tables, training
+from replication.bench.timing import FULL, QUICK, TINY, TORCH_THREADS
+from replication.results import write_csv, write_json
+
+__all__ = ["run_bench"]
+
+
+def machine(sizes) -> dict:
+    return {**environment.hardware(), "versions": environment.versions(), "commit": environment.commit(),
+            "date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"), "preset": sizes.name,
+            "torch_threads": TORCH_THREADS, "jax_threads": "XLA default",
+            "xla_flags": os.environ.get("XLA_FLAGS", ""), "torch_config": torch.__config__.parallel_info()
+            .splitlines()[:6]}
+
+
+def _write(bench: Path, name: str, rows: list[dict]) -> None:
+    write_csv(bench / f"{name}.csv", pd.DataFrame(rows))
+
+
+def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True) -> dict:
+    """Run the study into OUT/bench/; returns the targets dict (also written as targets.json)."""
+    if tiny is None:
+        tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
+    sizes = TINY if tiny else (QUICK if quick else FULL)
+    out = Path(out)
+    bench = out / "bench"
+    bench.mkdir(parents=True, exist_ok=True)
+    write_json(bench / "machine.json", machine(sizes))
+    old_threads = torch.get_num_threads()
+    torch.set_num_threads(TORCH_THREADS)
+    try:
+        return _run(out, bench, sizes, progress)
+    finally:
+        torch.set_num_threads(old_threads)
+
+
+def _run(out: Path, bench: Path, sizes, progress: bool) -> dict:
+    notes: list[str] = [f"PyTorch on {TORCH_THREADS} intra-op thread(s); JAX with XLA's default threads"]
+    cases = INF.inference_cases(sizes) + INF.trained_cases(out, (1, max(sizes.batches)))
+    sc_cases = list(scaling.lgn_cases(sizes)) + list(scaling.chain_cases(sizes))
+    total = (len(cases) + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
+             + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases())
+    bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
+    try:
+        inf_rows, states = [], {}
+        for c in cases:
+            key = (c.system, tuple(sorted(c.system_kw.items())))
+            if key not in states:
+                states[key] = INF.states_for(c.system, c.system_kw, max(sizes.batches))
+            bar.set_postfix_str(f"{c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}")
+            try:
+                inf_rows += INF.run_case(c, states[key], sizes.min_time)
+            except Exception as exc:  # a model that cannot run is a result, not the end of the study
+                notes.append(f"inference {c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}: "
+                             f"{type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}")
+            bar.update(1)
+        _write(bench, "inference", inf_rows)
+        bar.set_postfix_str("training")
+        train_rows = training.training_rows(sizes, notes, bar)
+        _write(bench, "training", train_rows)
+        bar.set_postfix_str("rollouts")
+        _write(bench, "rollout", rollout.rollout_rows(sizes, bar))
+        sc_rows = []
+        for c in sc_cases:
+            bar.set_postfix_str(f"scaling {c[0]} {c[1]} {c[2]} n={c[3]}")
+            sc_rows.append(scaling.run_scaling_case(c, sizes))
+            bar.update(1)
+        fit = scaling.fit_exponents(sc_rows)
+        _write(bench, "scaling", sc_rows)
+        _write(bench, "scaling_fit", fit)
+        fp_rows, mm_rows = [], []
+        for d in sizes.ratio_dofs:
+            bar.set_postfix_str(f"fast vs paper d={d}")
+            fp_rows += roofline.fast_paper_rows(sizes, d)
+            bar.update(1)
+            mm_rows += roofline.matmul_rows(sizes, d)
+            bar.update(1)
+        _write(bench, "fast_paper", fp_rows)
+        _write(bench, "matmul", mm_rows)
+        bar.set_postfix_str("structure")
+        _write(bench, "structure", structure.structure_rows(sizes, inf_rows, bar))
+    finally:
+        bar.close()
+    ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes)
+    _write(bench, "ratios", ratios)
+    targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows)
+    write_json(bench / "targets.json", {"preset": sizes.name, "targets": targets})
+    return targets

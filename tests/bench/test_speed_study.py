@@ -1,0 +1,82 @@
+"""The speed study end to end in its tiny preset (seconds): every bench file exists with the documented
+columns, throughputs are finite and positive, and the report's loader accepts the files. No timing is
+asserted (speed figures are ratios within one run; see replication/bench)."""
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from replication.bench import run_bench
+
+COLUMNS = {
+    "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
+    "training": ["system", "model", "framework", "mode", "dtype", "batch", "steps_per_s", "samples_per_s"],
+    "rollout": ["system", "solver", "rtol", "kind", "wall_s", "state_err", "energy_err"],
+    "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
+    "scaling_fit": ["study", "formulation", "framework", "exponent"],
+    "ratios": ["operation", "jax", "torch", "ratio", "note"],
+    "structure": ["system", "quadratic_kinetic", "separable", "local_coupling", "structured_model",
+                  "general_model", "speedup"],
+    "fast_paper": ["dof", "framework", "formulation", "samples_per_s", "flops_per_sample"],
+    "matmul": ["dof", "framework", "gflops"],
+}
+POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples_per_s"],
+            "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"],
+            "fast_paper": ["samples_per_s"], "matmul": ["gflops"]}
+
+
+@pytest.fixture(scope="module")
+def bench_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench")
+    targets = run_bench(out, tiny=True, progress=False)
+    return out, targets
+
+
+@pytest.mark.parametrize("name", sorted(COLUMNS))
+def test_csv_columns_and_throughputs(bench_dir, name):
+    out, _ = bench_dir
+    df = pd.read_csv(out / "bench" / f"{name}.csv")
+    assert not df.empty
+    assert [c for c in COLUMNS[name] if c not in df.columns] == []
+    for col in POSITIVE.get(name, []):
+        v = df[col].to_numpy(float)
+        assert np.all(np.isfinite(v)) and np.all(v > 0), f"{name}.{col}: {v}"
+
+
+def test_inference_covers_every_model_and_framework(bench_dir):
+    out, _ = bench_dir
+    df = pd.read_csv(out / "bench" / "inference.csv")
+    got = set(zip(df["model"], df["formulation"], df["framework"], strict=True))
+    for model, form in [("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"),
+                        ("lgn", "dense"), ("lgn", "banded")]:
+        assert {(model, form, "jax"), (model, form, "torch")} <= got
+    assert {("truth", "sympy", fw) for fw in ("numpy", "jax", "torch")} <= got
+    assert np.all(np.isfinite(df["error"].to_numpy(float)))
+    truth = df[(df["model"] == "truth")]
+    assert truth["error"].max() < 1e-4  # float32 ground truth against float64
+
+
+def test_rollout_has_chaos_floor_and_rk4(bench_dir):
+    out, _ = bench_dir
+    df = pd.read_csv(out / "bench" / "rollout.csv")
+    assert (df["kind"] == "chaos_floor").sum() == 1
+    assert "rk4" in set(df["solver"])
+
+
+def test_machine_and_targets(bench_dir):
+    out, targets = bench_dir
+    m = json.loads((out / "bench" / "machine.json").read_text())
+    assert {"cpu", "cores", "gpu", "versions", "date"} <= set(m)
+    assert "fast_over_paper_d2" in targets and "training_samples_per_s" in targets
+    assert json.loads((out / "bench" / "targets.json").read_text())["preset"] == "tiny"
+
+
+def test_report_loader_accepts_bench_files(bench_dir):
+    from reports.load import load_results
+
+    out, _ = bench_dir
+    res = load_results(out)
+    assert {"inference", "training", "rollout", "scaling", "ratios"} <= set(res.bench)
+    assert not [p for p in res.problems if "bench/" in p]
+    assert res.machine is not None
