@@ -16,7 +16,7 @@ MODELS = (ModelEntry("delan_relativistic", _delan, hidden=W, overrides=REL),
 _base = Protocol(data="charged_magnetic_iid", steps=20, batch=32, n_train=640, n_heldout=512, loss="l1",
                  lr=1e-3, schedule="onecycle", log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=2000, batch=256, n_train=256 * 200, n_heldout=10_000, log_every=50),
+             "quick": _base.replace(steps=1500, batch=256, n_train=256 * 200, n_heldout=10_000, log_every=50),
              "paper": _base.replace(steps=100_000, batch=512, n_train=512 * 1000, n_heldout=100_000, log_every=1000)}
 
 

@@ -25,7 +25,7 @@ _base = Protocol(data="double_pendulum_iid", steps=20, batch=32, n_train=640, n_
 
 PROTOCOLS = {
     "smoke": _base,
-    "quick": _base.replace(steps=3000, batch=256, n_train=256 * 500, n_heldout=20_000, log_every=50),
+    "quick": _base.replace(steps=2000, batch=256, n_train=256 * 500, n_heldout=20_000, log_every=50),
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
 
