@@ -88,7 +88,16 @@ def recipe_arm(protocol, n, rng, kind="train"):
 RECIPES = {"iid": recipe_iid, "arm": recipe_arm}
 
 
+def recipe_file(protocol, n, rng, kind="train"):
+    """A user's data file (see `replication.userdata`): the train or held-out rows, as a batch dict."""
+    from replication.userdata import split_rows
+
+    return split_rows(protocol.data.removeprefix("file:"), protocol.task, kind)
+
+
 def recipe_for(protocol):
+    if protocol.data.startswith("file:"):
+        return recipe_file
     if protocol.data.endswith("_iid"):
         return recipe_iid
     if protocol.data.startswith("two_link_arm"):
@@ -98,6 +107,8 @@ def recipe_for(protocol):
 
 def heldout(protocol, **kw) -> dict:
     """The fixed held-out set of a protocol (the same for every seed and model)."""
+    if protocol.data.startswith("file:"):
+        kw = {"kind": "heldout", **kw}
     return recipe_for(protocol)(protocol, protocol.n_heldout, np.random.default_rng(HELDOUT_SEED), **kw)
 
 
