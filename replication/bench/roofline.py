@@ -45,7 +45,7 @@ def fast_paper_rows(sizes, dof: int) -> list[dict]:
             if fw == "torch":
                 ev.run(ev.prepare(q[:WARMUP_BATCH], qd[:WARMUP_BATCH]))
             else:
-                ev.compiled(args)
+                ev.run(args)
             dt = best_time(lambda ev=ev, args=args: ev.run(args), min_time=sizes.min_time, min_reps=2)
             flops = ev.flops(args) / sizes.ratio_batch if fw == "jax" else float("nan")
             rows.append({"dof": dof, "framework": fw, "formulation": form, "batch": sizes.ratio_batch,

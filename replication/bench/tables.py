@@ -110,8 +110,9 @@ def targets(ratios, scaling_fit, scaling, inference, training) -> dict:
                                                    "met": bool(max(inf_ratios) <= 1.5)}
     for r in scaling_fit:
         if r["study"] == "lgn_grid" and r["formulation"] == "banded":
-            t[f"lgn_banded_exponent_{r['framework']}"] = {"exponent": r["exponent"], "target": 1.1,
-                                                        "met": bool(r["exponent"] <= 1.1)}
+            t[f"lgn_banded_exponent_{r['framework']}_{r.get('fit_range', 'all')}"] = {
+                "exponent": r["exponent"], "n_min": r.get("n_min"), "n_max": r.get("n_max"), "target": 1.1,
+                "met": bool(r["exponent"] <= 1.1)}
     for fw in ("jax", "torch"):
         ns = [r["n"] for r in scaling if r["study"] == "lgn_grid" and r["framework"] == fw]
         n = 1024 if 1024 in ns else (max(ns) if ns else None)

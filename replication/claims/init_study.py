@@ -11,7 +11,7 @@ W = {"smoke": dp.SMOKE_W, "quick": (64, 64, 64), "paper": dp.PAPER_W}
 MODELS = tuple(ModelEntry(f"lnn_init-{i}", {"kind": "lnn", "activation": "softplus", "init": i,
                                              "angle_wrap": True}, hidden=W) for i in INITS)
 PROTOCOLS = {"smoke": dp.PROTOCOLS["smoke"],
-             "quick": dp.PROTOCOLS["quick"].replace(steps=500, n_train=256 * 400, n_heldout=10_000),
+             "quick": dp.PROTOCOLS["quick"].replace(steps=1000, n_heldout=10_000),
              "paper": dp.PROTOCOLS["paper"].replace(steps=40_000)}
 
 
