@@ -33,10 +33,8 @@ def _from_csv(path):
 
 def _from_npz(path):
     try:
-        with np.load(path) as z:
+        with np.load(path, allow_pickle=False) as z:
             return {k: np.asarray(z[k], dtype=np.float64) for k in z.files if k in (*REQUIRED, "tau")}
-    except ValueError:
-        raise
     except Exception as e:
         raise ValueError(f"{path}: cannot read as .npz ({e})") from e
 

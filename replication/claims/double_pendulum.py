@@ -32,6 +32,8 @@ PROTOCOLS = {
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
 
+SEEDS = {"smoke": 1, "quick": 2, "paper": 3}
+
 # energy evaluation: initial conditions released near rest (velocities U[0, 0.1)), rolled out to T
 EVAL = {
     "smoke": {"n_ics": 3, "t_end": 2.0, "n_t": 21, "dt": 0.01, "energy_scale": 29.4},

@@ -13,5 +13,5 @@ CLAIM = Claim(
     metric="energy_err_final", metric_label="|E_pred(T) - E_true(T)| / 29.4, mean over initial conditions",
     published={"lnn": 0.0043, "baseline": 0.0736},
     verdict_rule="lnn * 3 < baseline (partly: lnn < baseline)", verdict=ratio_rule("lnn", "baseline", 3.0),
-    eval_config=dp.EVAL,
+    eval_config=dp.EVAL, seeds=dp.SEEDS,
 )

@@ -22,4 +22,5 @@ CLAIM = Claim(
     metric="heldout_l1", metric_label="held-out per-sample L1 of q-double-dot (sum over 2 components)",
     published={"lnn": 7.3e-2, "baseline": 7.4e-2},
     verdict_rule="lnn / baseline within [1/3, 3] (partly: within 10x)", verdict=_similar,
+    seeds=dp.SEEDS,
 )
