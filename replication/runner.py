@@ -44,13 +44,31 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
     return units
 
 
+def is_current(unit, out) -> bool:
+    """True if the unit's folder holds a verified result of this very protocol and model spec. A verified
+    result of another protocol or spec (the claim was edited) is kept, renamed `superseded-<time>-seed<k>`,
+    and the unit is rerun: nothing finished is lost or silently overwritten."""
+    folder = unit.folder(out)
+    try:
+        d = R.load_result(folder)
+    except R.CorruptResult:
+        return False
+    if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict():
+        return True
+    stamp = env.now().replace(":", "").replace("-", "")
+    folder.rename(folder.with_name(f"superseded-{stamp}-{folder.name}"))
+    log.warning("%s: its result was made under another protocol or spec; kept as superseded-%s-%s and rerun",
+                unit.name, stamp, folder.name)
+    return False
+
+
 def estimate_seconds(units, out) -> float:
     """Time 3 training steps of each distinct configuration (after one to compile) and scale up."""
     from replication.training import run_training
 
     seen, total = {}, 0.0
     for u in units:
-        if not u.entry.train or R.is_finished(u.folder(out)):
+        if not u.entry.train or is_current(u, out):
             continue
         p, spec = u.protocol(), u.spec()
         key = (u.framework, spec, p.replace(steps=1))
@@ -77,7 +95,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
               f"({env.hardware()['cpu']}, GPU: {env.hardware()['gpu']}); it resumes if interrupted.", flush=True)
         manifest["estimated_train_s"] = est
     R.write_json(out / "run.json", manifest)
-    todo = [u for u in units if not R.is_finished(u.folder(out))]
+    todo = [u for u in units if not is_current(u, out)]
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     failures, t0 = [], time.perf_counter()
     bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)

@@ -54,3 +54,18 @@ def test_corrupt_result_is_detected_and_rerun(tmp_path):
     (f.parent / "train_log.csv").write_text("truncated")
     run(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"], progress=False)
     assert R.is_finished(f.parent) and _metrics(tmp_path) == good
+
+
+def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatch):
+    from replication.claims import get
+
+    kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
+              progress=False)
+    run(**kw)
+    claim = get("dp_loss")
+    monkeypatch.setitem(claim.protocols, "smoke", claim.protocols["smoke"].replace(steps=7))
+    run(**kw)
+    (new,) = tmp_path.glob("units/dp_loss/jax/baseline/seed0/result.json")
+    assert R.load_result(new.parent)["train_steps"] == 7
+    (old,) = tmp_path.glob("units/dp_loss/jax/baseline/superseded-*-seed0/result.json")
+    assert R.load_result(old.parent)["train_steps"] == 20
