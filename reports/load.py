@@ -191,7 +191,9 @@ def load_results(root: str | Path) -> Results:
             res.verdicts[v["id"]] = v
     units_dir = root / "units"
     if units_dir.is_dir():
-        found = [_load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))]
+        # results superseded by a later protocol (folders "superseded-<time>-seed<k>") are history, not units
+        found = [_load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))
+                 if not p.parent.name.startswith("superseded-")]
         res.units = sorted(found, key=lambda u: (u.claim, u.framework, u.model, _seed_key(u.seed)))
     csv_path = root / "summary" / "units.csv"
     if csv_path.is_file():
