@@ -92,6 +92,8 @@ def eval_heldout(ctx) -> Evaluation:
         _, n_fb = m.acceleration_info(batch["q"], batch["qdot"], batch.get("extra"))
         out.counters["hessian_fallbacks"] = int(n_fb)
         out.counters["hessian_fallback_fraction"] = float(n_fb) / len(batch["q"])
+        eig = np.linalg.eigvalsh(m.velocity_hessian(batch["q"], batch["qdot"], batch.get("extra")))
+        out.counters["hessian_indefinite_fraction"] = float(np.mean((eig[:, 0] < 0) & (eig[:, -1] > 0)))
     return out
 
 

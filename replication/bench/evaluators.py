@@ -52,8 +52,7 @@ class JaxEvaluator:
         return self._compiled[key]
 
     def run(self, args):
-        # the jitted function (C++ dispatch fast path; compiles on its first call per shape), not the
-        # AOT `compiled` object, whose Python-side call costs ~100 us more per call
+        # the jitted function (compiles on its first call per shape; the AOT object costs the same per call)
         return jax.block_until_ready(self._fn(self.model, *args))
 
     def numpy(self, args):
