@@ -23,10 +23,12 @@ def heldout_errors(pred, target, weight=None) -> dict:
 
 
 def bounded_relative_error(z_pred, z_true):
+    """In [0, 1]; a diverged (non-finite) prediction counts as 1, the bound."""
     num = np.linalg.norm(z_pred - z_true, axis=-1)
     den = np.linalg.norm(z_pred, axis=-1) + np.linalg.norm(z_true, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / den, 0.0)
+        err = np.where(den > 0, num / den, 0.0)
+    return np.where(np.isfinite(num) & np.isfinite(den), err, 1.0)
 
 
 def geometric_mean_over_time(err, floor=1e-16):

@@ -36,7 +36,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
             n = seeds if max(claim.seeds.values()) > 1 else 1
         for entry in claim.models:
-            if models and entry.label not in models:
+            if (models and entry.label not in models) or profile not in entry.profiles:
                 continue
             for fw in frameworks:
                 for seed in range(n):

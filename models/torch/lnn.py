@@ -1,6 +1,7 @@
 """Euler-Lagrange accelerations of any scalar L(q, qdot), and the LNN model (PyTorch, torch.func).
 
-Mirrors `models.jax.lnn` line for line (see its docstring for the formulations and the fallback).
+Mirrors `models.jax.lnn` line for line (see its docstring for the formulations and the fallback), except
+that `LNN`'s own fast terms come from the hand-written MLP derivatives (`models.torch.mlp_derivatives`).
 `euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None) -> (qddot (..., d), n_fallback)`,
 `euler_lagrange(...) -> qddot`, `velocity_hessian(L_fn, q, qdot, extra) -> (..., d, d)`.
 Outputs stay differentiable w.r.t. tensors L_fn closes over (the nn.Parameters): loss.backward() works.
@@ -13,6 +14,7 @@ from torch.func import grad, hessian, jacrev, jvp, vmap
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
 from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 def _dtype_name(x) -> str:
@@ -87,9 +89,13 @@ def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):
         return pinv_solve(hess, rhs).reshape(*batch, d), torch.zeros((), dtype=torch.int64)
     if formulation != "fast":
         raise ValueError(f"unknown formulation {formulation!r}; valid: fast, paper")
-    hess, rhs = fast_terms(L_fn, qf, qdf, ef)
+    return _solved(*fast_terms(L_fn, qf, qdf, ef), batch)
+
+
+def _solved(hess, rhs, batch):
+    """The fast formulation's solve of flat (H (B, d, d), rhs (B, d)): (qddot (*batch, d), n_fallback)."""
     x, n_bad = solve_with_fallback(hess, rhs)
-    return x.reshape(*batch, d), n_bad
+    return x.reshape(*batch, hess.shape[-1]), n_bad
 
 
 def euler_lagrange(L_fn, q, qdot, formulation="fast", extra=None):
@@ -105,11 +111,29 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
 
 
 class LNN(Model):
-    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None."""
+    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None.
+
+    The fast formulation and velocity_hessian differentiate the model's own MLP by hand
+    (`models.torch.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, faster."""
 
     def _lagrangian(self, q, qdot, extra=None):
         x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
+
+    def _fast_terms(self, q, qdot, extra=None):
+        """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
+        MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
+        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
+        spec, (n, d) = self.spec, q.shape
+        x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
+        scale = (torch.ones(x.shape[-1], dtype=x.dtype) if spec.input_scale is None
+                 else torch.tensor(spec.input_scale, dtype=x.dtype))
+        s_q, s_qd = scale[:d], scale[d:2 * d]
+        tangents = torch.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
+        tangents[:, :d, d:2 * d] = torch.diag(s_qd)
+        tangents[:, d, :d] = qdot * s_q
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
+        return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
 
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""
@@ -119,13 +143,18 @@ class LNN(Model):
     def velocity_hessian(self, q, qdot, extra=None):
         """(..., dof, dof)."""
         self._check_state(q, qdot, extra)
-        return velocity_hessian(self._lagrangian, q, qdot, extra if self.spec.extra_inputs else None)
+        d, extra = q.shape[-1], extra if self.spec.extra_inputs else None
+        hess, _ = self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None))
+        return hess.reshape(*q.shape, d)
 
     def acceleration_info(self, q, qdot, extra=None):
         """(qddot (..., dof), n_fallback) with spec.formulation."""
         self._check_state(q, qdot, extra)
         extra = extra if self.spec.extra_inputs else None
-        return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+        if self.spec.formulation != "fast":
+            return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+        d = q.shape[-1]
+        return _solved(*self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None)), q.shape[:-1])
 
     def acceleration(self, q, qdot, extra=None):
         """qddot (..., dof)."""

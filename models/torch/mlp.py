@@ -12,6 +12,7 @@ import torch
 
 from models.params import n_layers
 
+
 def softplus(x):
     """log(1 + e^x) as logaddexp(x, 0) computes it, but with derivatives of every order finite:
     torch's logaddexp double-backward is NaN for large negative x (JAX's is 0). Each branch only

@@ -25,7 +25,6 @@ keeps XLA's defaults (the thread settings are recorded in machine.json).
 """
 from __future__ import annotations
 
-import datetime as dt
 import os
 from pathlib import Path
 
@@ -35,7 +34,7 @@ from tqdm.auto import tqdm
 
 from replication import environment
 from replication.bench import inference as INF
-from replication.bench import roofline, rollout, scaling, structure, tables, training
+from replication.bench import rollout, roofline, scaling, structure, tables, training
 from replication.bench.timing import FULL, QUICK, TINY, TORCH_THREADS
 from replication.results import write_csv, write_json
 
@@ -44,7 +43,7 @@ __all__ = ["run_bench"]
 
 def machine(sizes) -> dict:
     return {**environment.hardware(), "versions": environment.versions(), "commit": environment.commit(),
-            "date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"), "preset": sizes.name,
+            "date": environment.now(), "preset": sizes.name,
             "torch_threads": TORCH_THREADS, "jax_threads": "XLA default",
             "xla_flags": os.environ.get("XLA_FLAGS", ""), "torch_config": torch.__config__.parallel_info()
             .splitlines()[:6]}
@@ -108,10 +107,10 @@ def _run(out: Path, bench: Path, sizes, progress: bool) -> dict:
         fp_rows, mm_rows = [], []
         for d in sizes.ratio_dofs:
             bar.set_postfix_str(f"fast vs paper d={d}")
-            fp_rows += roofline.fast_paper_rows(sizes, d)
-            bar.update(1)
-            mm_rows += roofline.matmul_rows(sizes, d)
-            bar.update(1)
+            fp, mm = roofline.roofline_rows(sizes, d)
+            fp_rows += fp
+            mm_rows += mm
+            bar.update(2)
         _write(bench, "fast_paper", fp_rows)
         _write(bench, "matmul", mm_rows)
         bar.set_postfix_str("structure")

@@ -1,7 +1,7 @@
 """The fast/paper targets and the matmul roofline, at the paper's architecture.
 
-`roofline_rows(sizes, dof) -> (fast_paper rows, matmul rows)`. fast/paper: the LNN (`sizes.ratio_hidden` softplus, empirical init, float32, batch
-`sizes.ratio_batch`) timed in both formulations and both frameworks -> rows {dof, framework,
+`roofline_rows(sizes, dof) -> (fast_paper rows, matmul rows)`.
+fast/paper: the LNN (`sizes.ratio_hidden` softplus, empirical init, float32, batch `sizes.ratio_batch`) timed in both formulations and both frameworks -> rows {dof, framework,
 formulation, batch, seconds, samples_per_s, flops_per_sample (JAX only: XLA's compiled cost analysis),
 gflops (JAX only)}.
 matmul: the attainable rate: a plain MLP forward of the same layer shapes
@@ -32,11 +32,11 @@ def _states(batch, d, seed=0):
     return rng.uniform(-np.pi, np.pi, (batch, d)), rng.uniform(-10, 10, (batch, d))
 
 
-def interleaved_best(fns: dict, reps: int) -> dict:
+def interleaved_best(fns: dict, reps: int, warm_up: bool = True) -> dict:
     """{name: fastest time} over `reps` rounds that call every fn once in turn (after one warm-up call
-    each): a slow drift in how much CPU other processes leave us hits every fn alike, so their ratios
-    stay fair on shared cores."""
-    for fn in fns.values():
+    each if warm_up): a slow drift in how much CPU other processes leave us hits every fn alike, so their
+    ratios stay fair on shared cores."""
+    for fn in fns.values() if warm_up else ():
         fn()
     best = {k: float("inf") for k in fns}
     for _ in range(reps):
@@ -78,7 +78,8 @@ def roofline_rows(sizes, dof: int) -> tuple[list[dict], list[dict]]:
         argss = {f: ev.prepare(q, qd) for f, ev in evs.items()}
         fns = {f: (lambda ev=ev, a=argss[f]: ev.run(a)) for f, ev in evs.items()}
         fns["matmul"] = _plain_mlp(fw, specs["fast"], params, n_rows)
-        best = interleaved_best(fns, sizes.ratio_reps)
+        # JAX compiles on its first call; eager PyTorch needs no warm-up (a 25 s call at d = 16)
+        best = interleaved_best(fns, sizes.ratio_reps, warm_up=fw == "jax")
         for f, ev in evs.items():
             flops = ev.flops(argss[f]) / sizes.ratio_batch if fw == "jax" else float("nan")
             fp.append({"dof": dof, "framework": fw, "formulation": f, "batch": sizes.ratio_batch,

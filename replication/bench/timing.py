@@ -73,6 +73,7 @@ class Sizes:
     ratio_batch: int               # the fast/paper target batch (4096)
     ratio_hidden: tuple            # the fast/paper target MLP (3 x 600), also the chain scaling's
     ratio_dofs: tuple
+    ratio_reps: int                # interleaved rounds of the fast/paper/matmul timing
     train_hidden: tuple
     train_batch: int
     train_steps: int
@@ -87,19 +88,22 @@ class Sizes:
     wave_n: int                    # grid of the wave inference rows
 
 
-TINY = Sizes("tiny", hidden=(16, 16), batches=(1, 64), dtypes=("float32",), lgn_hidden=(8, 8),
-             lgn_n=(16, 32), chain_d=(1, 2), chain_batch=16, ratio_batch=64, ratio_hidden=(16, 16), ratio_dofs=(2,),
-             train_hidden=(16, 16), train_batch=32, train_steps=3, rollout_solvers=("tsit5",), rollout_rtols=(1e-6,),
-             rollout_dts=(0.01,), rollout_t_end=1.0, rollout_ics=2, min_time=0.0, torch_compile=False,
-             structure_batch=64, wave_n=16)
+_SOLVERS = ("tsit5", "dopri5", "dopri8")
+TINY = Sizes("tiny", hidden=(16, 16), batches=(8,), dtypes=("float32",), lgn_hidden=(8, 8),
+             lgn_n=(16, 32), chain_d=(1, 2), chain_batch=16, ratio_batch=64, ratio_hidden=(16, 16),
+             ratio_dofs=(2,), ratio_reps=1, train_hidden=(16, 16), train_batch=32, train_steps=3,
+             rollout_solvers=("tsit5",), rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0,
+             rollout_ics=2, min_time=0.0, torch_compile=False, structure_batch=64, wave_n=16)
 QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("float32", "float64"),
               lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024), chain_d=(1, 2, 4, 8, 16), chain_batch=256,
-              ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), train_hidden=(600, 600, 600), train_batch=512,
-              train_steps=3, rollout_solvers=("tsit5", "dopri5", "dopri8"), rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003),
-              rollout_t_end=10.0, rollout_ics=8, min_time=0.2, torch_compile=True, structure_batch=1024, wave_n=32)
+              ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=2,
+              train_hidden=(600, 600, 600), train_batch=512, train_steps=3, rollout_solvers=_SOLVERS,
+              rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003), rollout_t_end=10.0,
+              rollout_ics=8, min_time=0.2, torch_compile=True, structure_batch=1024, wave_n=32)
 FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), dtypes=("float32", "float64"),
              lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024, 4096), chain_d=(1, 2, 4, 8, 16, 32),
-             chain_batch=512, ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), train_hidden=(600, 600, 600),
-             train_batch=512, train_steps=10, rollout_solvers=("tsit5", "dopri5", "dopri8"), rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12),
-             rollout_dts=(0.01, 0.003, 0.001), rollout_t_end=20.0, rollout_ics=16, min_time=1.0,
-             torch_compile=True, structure_batch=4096, wave_n=64)
+             chain_batch=512, ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=3,
+             train_hidden=(600, 600, 600), train_batch=512, train_steps=10, rollout_solvers=_SOLVERS,
+             rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12), rollout_dts=(0.01, 0.003, 0.001),
+             rollout_t_end=20.0, rollout_ics=16, min_time=1.0, torch_compile=True, structure_batch=4096,
+             wave_n=64)

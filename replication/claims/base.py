@@ -22,13 +22,15 @@ class ModelEntry:
     """One model of a claim. `spec` holds ModelSpec fields except dof and dtype (taken from the system
     and the protocol); `hidden` may map a profile to widths; `overrides` change the claim's protocol
     for this model (another data recipe, task, loss, learning rate, pool size...), optionally per
-    profile as {profile: {...}}; `train=False` marks a model evaluated without training."""
+    profile as {profile: {...}}; `train=False` marks a model evaluated without training; `profiles` limits
+    the profiles the model runs in."""
 
     label: str
     spec: dict
     hidden: dict | tuple = ()
     overrides: dict = field(default_factory=dict)
     train: bool = True
+    profiles: tuple = PROFILES   # the profiles this model runs in
 
     def widths(self, profile: str) -> tuple:
         h = self.hidden.get(profile, ()) if isinstance(self.hidden, dict) else self.hidden

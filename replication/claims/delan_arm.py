@@ -19,8 +19,8 @@ def _models():
     out = [ModelEntry("delan", _delan, hidden=W), ModelEntry("ff", _ff, hidden=W)]
     for n in sorted({n for v in SIZES.values() for n in v}):
         prof = {p: {"n_train": n, "batch": min(n, 256)} for p, v in SIZES.items() if n in v}
-        out.append(ModelEntry(f"delan_n{n}", _delan, hidden=W, overrides=prof))
-        out.append(ModelEntry(f"ff_n{n}", _ff, hidden=W, overrides=prof))
+        out.append(ModelEntry(f"delan_n{n}", _delan, hidden=W, overrides=prof, profiles=tuple(prof)))
+        out.append(ModelEntry(f"ff_n{n}", _ff, hidden=W, overrides=prof, profiles=tuple(prof)))
     return tuple(out)
 
 
@@ -28,7 +28,7 @@ MODELS = _models()
 _base = Protocol(data="two_link_arm", task="inverse_dynamics", steps=20, batch=32, n_train=512, n_heldout=512,
                  loss="mse", lr=5e-4, schedule="constant", l2=1e-5, log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=2000, batch=256, n_train=4096, n_heldout=4000, log_every=50),
+             "quick": _base.replace(steps=3000, batch=256, n_train=4096, n_heldout=4000, log_every=50, lr=1e-3),
              "paper": _base.replace(steps=40_000, batch=512, n_train=2459, n_heldout=4000, log_every=500)}
 
 

@@ -16,8 +16,8 @@ _base = Protocol(data="wave_iid", system_params=(("n", 10), ("variant", "code"))
 PROTOCOLS = {"smoke": _base,
              "quick": _base.replace(steps=1000, batch=32, n_train=32 * 500, n_heldout=5000, log_every=50),
              "paper": _base.replace(steps=500_000, batch=1, n_train=5000, n_heldout=20_000, log_every=5000)}
-EVAL = {"smoke": {"n_big": 100, "t_end": 1.0, "n_t": 11, "dt": 0.01},
-        "quick": {"n_big": 100, "t_end": 30.0, "n_t": 301, "dt": 0.01},
+EVAL = {"smoke": {"n_big": 100, "t_end": 1.0, "n_t": 11, "dt": 0.05},
+        "quick": {"n_big": 100, "t_end": 10.0, "n_t": 101, "dt": 0.05},
         "paper": {"n_big": 100, "t_end": 300.0, "n_t": 1500, "dt": 0.01}}
 
 

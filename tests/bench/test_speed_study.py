@@ -7,7 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from models import ModelSpec, init_params
 from replication.bench import run_bench
+from replication.results import write_npz
 
 COLUMNS = {
     "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
@@ -26,9 +28,21 @@ POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples
             "fast_paper": ["samples_per_s"], "matmul": ["gflops"]}
 
 
+def _fake_trained_unit(out):
+    """A double-pendulum unit as `lagbench run` leaves it: result.json with model_spec + checkpoint.npz."""
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
+    unit = out / "units" / "dp_loss" / "jax" / "lnn" / "seed0"
+    unit.mkdir(parents=True)
+    write_npz(unit / "checkpoint.npz", init_params(spec, seed=3))
+    (unit / "result.json").write_text(json.dumps({
+        "claim": "dp_loss", "framework": "jax", "model": "lnn", "seed": 0, "status": "ok",
+        "model_spec": spec.to_dict(), "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+
+
 @pytest.fixture(scope="module")
 def bench_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("bench")
+    _fake_trained_unit(out)
     targets = run_bench(out, tiny=True, progress=False)
     return out, targets
 
@@ -55,6 +69,8 @@ def test_inference_covers_every_model_and_framework(bench_dir):
     assert np.all(np.isfinite(df["error"].to_numpy(float)))
     truth = df[(df["model"] == "truth")]
     assert truth["error"].max() < 1e-4  # float32 ground truth against float64
+    trained = df[df["source"] == "trained:dp_loss"]
+    assert set(trained["framework"]) == {"jax"} and set(trained["hidden"].astype(str)) == {"8"}
 
 
 def test_rollout_has_chaos_floor_and_rk4(bench_dir):
