@@ -77,3 +77,9 @@ def cyclic_band_layout(n: int, r: int) -> dict:
     out["row_border"] = band_gather(border[:, None] + 0 * interior[None, :], interior[None, :] + 0 * border[:, None], n, w)
     out["border"] = band_gather(border[:, None] + 0 * border[None, :], border[None, :] + 0 * border[:, None], n, w)
     return out
+
+
+def band_columns(n: int, width: int) -> np.ndarray:
+    """(n, 2w+1) column index of each band entry: band[:, i, k] = H[i, cols[i, k]]."""
+    w = (width - 1) // 2
+    return (np.arange(n)[:, None] + np.arange(width)[None, :] - w) % n

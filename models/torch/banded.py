@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import torch
 
+from models.graph import band_columns
+
 
 def _gather(band, triple):
     rows, cols, mask = triple
@@ -30,8 +32,31 @@ def block_tridiagonal_solve(diag, lower, upper, rhs):
     return torch.stack(xs, dim=1)
 
 
+class _ImplicitSolve(torch.autograd.Function):
+    """Implicit gradient of the solve (see models.jax.banded.solve_cyclic_banded)."""
+
+    @staticmethod
+    def forward(ctx, band, rhs, layout):
+        x = _solve(band, rhs, layout)
+        ctx.save_for_backward(band, x)
+        ctx.layout = layout
+        return x
+
+    @staticmethod
+    def backward(ctx, xbar):
+        band, x = ctx.saved_tensors
+        lam = _solve(band, xbar, ctx.layout)
+        cols = torch.as_tensor(band_columns(x.shape[-1], band.shape[-1]))
+        return -lam[:, :, None] * x[:, cols], lam, None
+
+
 def solve_cyclic_banded(band, rhs, layout):
-    """x (B, n) with H x = rhs, H given by its cyclic band (B, n, 2w+1)."""
+    """x (B, n) with H x = rhs for a symmetric H given by its cyclic band (B, n, 2w+1); differentiated
+    implicitly (mirrors models.jax.banded.solve_cyclic_banded)."""
+    return _ImplicitSolve.apply(band, rhs, layout)
+
+
+def _solve(band, rhs, layout):
     m, w, nb = layout["m"], layout["w"], layout["nb"]
     bsz, ni = rhs.shape[0], layout["m"] * layout["w"]
     col_border = _gather(band, layout["col_border"])

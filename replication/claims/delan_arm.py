@@ -28,7 +28,7 @@ MODELS = _models()
 _base = Protocol(data="two_link_arm", task="inverse_dynamics", steps=20, batch=32, n_train=512, n_heldout=512,
                  loss="mse", lr=5e-4, schedule="constant", l2=1e-5, log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=3000, batch=256, n_train=4096, n_heldout=4000, log_every=50, lr=1e-3),
+             "quick": _base.replace(steps=2000, batch=256, n_train=4096, n_heldout=4000, log_every=50, lr=1e-3),
              "paper": _base.replace(steps=40_000, batch=512, n_train=2459, n_heldout=4000, log_every=500)}
 
 

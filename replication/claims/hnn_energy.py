@@ -41,4 +41,5 @@ CLAIM = Claim(
     metric="energy_err_max", metric_label="max_t |E_pred - E_true|, mean over initial states",
     published={m.label: None for m in MODELS},
     verdict_rule="hnn * 3 < baseline on both systems (partly: on one)", verdict=_verdict, eval_config=EVAL,
+    seeds={"smoke": 1, "quick": 2, "paper": 3},
 )

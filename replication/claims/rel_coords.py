@@ -50,4 +50,5 @@ CLAIM = Claim(
     metric="heldout_l1_qddot", metric_label="held-out (1+gamma)-weighted L1 of q-double-dot",
     published={"lnn": 7.86e-4, "hnn_qqdot": 0.4096, "hnn_qp": 2.40e-4},
     verdict_rule="hnn_qqdot > 10 x max(lnn, hnn_qp) (partly: merely the worst)", verdict=_verdict,
+    seeds={"smoke": 1, "quick": 2, "paper": 3},
 )
