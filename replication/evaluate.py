@@ -16,7 +16,12 @@ import pandas as pd
 import systems
 import systems.trajectories
 from replication import data as datamod
-from replication.metrics import bounded_relative_error, energy_errors, geometric_mean_over_time, heldout_errors
+from replication.metrics import (
+    bounded_relative_error,
+    energy_errors,
+    geometric_mean_over_time,
+    heldout_errors,
+)
 from replication.objective import predict
 from replication.rollout import hamiltonian_field, lagrangian_field, rollout
 

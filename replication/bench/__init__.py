@@ -61,9 +61,9 @@ def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool 
     out = Path(out)
     bench = out / "bench"
     bench.mkdir(parents=True, exist_ok=True)
-    write_json(bench / "machine.json", machine(sizes))
     old_threads = torch.get_num_threads()
     torch.set_num_threads(TORCH_THREADS)
+    write_json(bench / "machine.json", machine(sizes))
     try:
         return _run(out, bench, sizes, progress)
     finally:

@@ -4,7 +4,8 @@
 note}`: jax and torch are throughputs (samples/s, steps/s for training, GFLOP/s for the roofline rows);
 ratio = jax / torch (above 1: JAX faster). A ratio beyond 2x either way carries a reason in `note`.
 Also rows for the fast/paper speedups (jax, torch = each framework's fast/paper ratio; ratio empty),
-the fast LNN's achieved GFLOP/s, the attainable (plain MLP forward) GFLOP/s and the achieved fraction.
+the fast LNN's achieved GFLOP/s (XLA's FLOP count for both frameworks), the attainable (matrix products)
+GFLOP/s and the achieved fraction.
 `targets(...) -> dict` checks the issue's numeric targets against these rows.
 """
 from __future__ import annotations
@@ -73,12 +74,12 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes) -> list[d
         mm = {fw: _get(matmul, "gflops", dof=d, framework=fw) for fw in ("jax", "torch")}
         flops = _get(fastpaper, "flops_per_sample", dof=d, framework="jax", formulation="fast")
         ach = {fw: flops * _get(fastpaper, dof=d, framework=fw, formulation="fast") / 1e9 for fw in mm}
-        out.append(_row(f"matmul roofline: plain MLP forward d={d} (GFLOP/s)", mm["jax"], mm["torch"]))
+        out.append(_row(f"matmul roofline: matrix products of the layer shapes d={d} (GFLOP/s)", mm["jax"], mm["torch"]))
         out.append(_row(f"fast LNN achieved d={d} (GFLOP/s; {flops:.3g} FLOP/sample from XLA cost analysis)",
                         ach["jax"], ach["torch"]))
         out.append({"operation": f"fast LNN fraction of roofline d={d}", "jax": ach["jax"] / mm["jax"],
                     "torch": ach["torch"] / mm["torch"], "ratio": np.nan,
-                    "note": "target >= 0.8 (JAX); each framework against its own plain-MLP rate"})
+                    "note": "target >= 0.8 (JAX); each framework against its own matrix-product rate"})
     out += [{"operation": "note", "jax": np.nan, "torch": np.nan, "ratio": np.nan, "note": n} for n in notes]
     return out
 

@@ -1,6 +1,16 @@
 """The ten claims of the SPEC, by id, in the SPEC's order."""
-from replication.claims import (activation_study, appendix_b, delan_arm, delan_table1, dp_energy, dp_loss,
-                                hnn_energy, init_study, rel_coords, wave_lgn)
+from replication.claims import (
+    activation_study,
+    appendix_b,
+    delan_arm,
+    delan_table1,
+    dp_energy,
+    dp_loss,
+    hnn_energy,
+    init_study,
+    rel_coords,
+    wave_lgn,
+)
 from replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
 
 _ALL = (dp_loss, dp_energy, rel_coords, wave_lgn, appendix_b, init_study, activation_study, delan_table1,

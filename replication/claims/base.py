@@ -8,8 +8,8 @@ framework, returning (verdict, reason)).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 from replication.protocol import Protocol
 

@@ -26,7 +26,7 @@ def test_twenty_steps_agree(case):
     b = run_training("torch", spec, protocol, seed=3)
     assert a.failure is None and b.failure is None
     assert len(a.log) == len(b.log) == 20
-    for ra, rb in zip(a.log, b.log):
+    for ra, rb in zip(a.log, b.log, strict=True):
         assert ra["step"] == rb["step"] and ra["lr"] == rb["lr"]
         np.testing.assert_allclose(ra["loss"], rb["loss"], rtol=1e-8, err_msg=f"loss at step {ra['step']}")
         np.testing.assert_allclose(ra["grad_norm"], rb["grad_norm"], rtol=1e-8, err_msg=f"grad at step {ra['step']}")
