@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from pathlib import Path
 
 
 def _csv(s):
@@ -41,7 +42,7 @@ def cmd_report(args):
 
     paths = reports.build_report(args.results, args.out)
     for k, v in paths.items():
-        print(f"{k}: {v}")
+        print(f"{k}: {len(v)} files in {Path(args.out) / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
 
 def cmd_fit(args):
