@@ -73,8 +73,8 @@ def _matmul_chain(framework, params, n_layers, n_rows, n_in):
 
 
 def roofline_rows(sizes, dof: int) -> tuple[list[dict], list[dict]]:
-    """(fast/paper rows, matmul rows) for one dof; per framework the paper LNN, the fast LNN and the plain
-    MLP forward are timed interleaved (`interleaved_best`, `sizes.ratio_reps` rounds)."""
+    """(fast/paper rows, matmul rows) for one dof; per framework the paper LNN, the fast LNN and the matrix
+    products are timed interleaved (`interleaved_best`, `sizes.ratio_reps` rounds)."""
     q, qd = _states(sizes.ratio_batch, dof)
     specs = {f: model_spec("lnn", f, dof, sizes.ratio_hidden, "float32") for f in ("paper", "fast")}
     params = init_params(specs["fast"], seed=0)  # the same MLP layout and weights for both formulations
