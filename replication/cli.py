@@ -35,6 +35,9 @@ def cmd_run(args):
                   progress=not args.quiet)
     for c in summary["claims"]:
         print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
+    for e in summary.get("errors", []):
+        print(f"lagbench: error in unit {e} (no result written; a rerun retries it)", file=sys.stderr)
+    return 1 if summary.get("errors") else 0
 
 
 def cmd_report(args):
@@ -103,12 +106,12 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     try:
-        args.func(args)
+        code = args.func(args)
     except (KeyError, ValueError, FileNotFoundError) as e:
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
         print(f"lagbench: error: {msg}", file=sys.stderr)
         return 2
-    return 0
+    return code or 0
 
 
 if __name__ == "__main__":

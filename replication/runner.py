@@ -97,7 +97,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     R.write_json(out / "run.json", manifest)
     todo = [u for u in units if not is_current(u, out)]
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
-    failures, t0 = [], time.perf_counter()
+    failures, errors, t0 = [], [], time.perf_counter()
     bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
     for u in bar:
         bar.set_postfix_str(u.name)
@@ -110,12 +110,19 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
             last["step"] = row["step"]
             inner.set_postfix(loss=f"{row['loss']:.3g}")
 
-        d = run_unit(u, out, on_log=on_log)
-        inner.close()
+        try:
+            d = run_unit(u, out, on_log=on_log)
+        except Exception as e:  # noqa: BLE001 - one unit's error must not lose the rest of the run
+            log.exception("%s failed", u.name)
+            errors.append(f"{u.name}: {type(e).__name__}: {e}")
+            continue
+        finally:
+            inner.close()
         if d["status"] != "ok":
             failures.append(f"{u.name}: {d['failure']['message']}")
     summary = write_summary(out, profile)
     manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
-                    units_run=len(todo), failures=failures)
+                    units_run=len(todo), failures=failures, errors=errors)
     R.write_json(out / "run.json", manifest)
+    summary = dict(summary, errors=errors)
     return summary

@@ -15,13 +15,20 @@ def _gather(band, triple):
     return torch.where(torch.as_tensor(mask), band[:, torch.as_tensor(rows), torch.as_tensor(cols)], 0.0)
 
 
+def _solve_or_nan(a, b):
+    """torch.linalg.solve without raising: a singular block gives NaN (as JAX does), left to the
+    caller's counted fallback."""
+    x, info = torch.linalg.solve_ex(a, b)
+    return torch.where((info != 0)[:, None, None], torch.full_like(x, float("nan")), x)
+
+
 def block_tridiagonal_solve(diag, lower, upper, rhs):
     """diag, lower, upper (B, m, w, w) (lower[:, 0] = upper[:, -1] = 0), rhs (B, m, w, k) -> (B, m, w, k)."""
     w, m = diag.shape[-1], diag.shape[1]
     c_prev, f_prev, cs, fs = torch.zeros_like(diag[:, 0]), torch.zeros_like(rhs[:, 0]), [], []
     for b in range(m):
         d, lo, up, r = diag[:, b], lower[:, b], upper[:, b], rhs[:, b]
-        sol = torch.linalg.solve(d - lo @ c_prev, torch.cat([up, r - lo @ f_prev], dim=-1))
+        sol = _solve_or_nan(d - lo @ c_prev, torch.cat([up, r - lo @ f_prev], dim=-1))
         c_prev, f_prev = sol[..., :w], sol[..., w:]
         cs.append(c_prev)
         fs.append(f_prev)
@@ -66,5 +73,5 @@ def _solve(band, rhs, layout):
     z, x_border = z_all[..., 0], z_all[..., 1:]
     row_border = _gather(band, layout["row_border"])
     schur = _gather(band, layout["border"]) - row_border @ x_border
-    y = torch.linalg.solve(schur, (rhs[:, ni:] - (row_border @ z[..., None])[..., 0])[..., None])[..., 0]
+    y = _solve_or_nan(schur, (rhs[:, ni:] - (row_border @ z[..., None])[..., 0])[..., None])[..., 0]
     return torch.cat([z - (x_border @ y[..., None])[..., 0], y], dim=-1)
