@@ -80,7 +80,7 @@ def test_public_api_gives_a_clean_error_or_a_correct_result(name, batch, extra_d
     s = systems.get(name)
     dof = s.dof + extra_dim
     rng = np.random.default_rng(seed)
-    q = rng.uniform(-3, 3, (*batch, dof)) if dof > 0 else np.zeros(batch)
+    q = rng.uniform(-3, 3, (*batch, max(dof, 0)))
     qdot = rng.uniform(-0.9, 0.9, q.shape)
     fn = getattr(s, method)
     if extra_dim != 0:
