@@ -23,6 +23,11 @@ ACT = {
 }
 
 
+def act_and_slope(name: str, a):
+    """(act(a), act'(a)), each shaped like a: the activation and its elementwise slope (one jvp)."""
+    return jax.jvp(ACT[name], (a,), (jnp.ones_like(a),))
+
+
 def linear(params: dict, prefix: str, x):
     """x (..., in) -> (..., out)."""
     return x @ params[f"{prefix}.weight"].T + params[f"{prefix}.bias"]
