@@ -13,14 +13,41 @@ import torch
 from models.params import n_layers
 
 
+class _Softplus(torch.autograd.Function):
+    """softplus(a) = logaddexp(a, 0) in one op whose derivative is the given s = sigmoid(a), itself part
+    of the graph: every higher derivative is sigmoid's, finite everywhere (torch's own logaddexp
+    double-backward is NaN for large negative a; JAX's is 0). Reverse, forward (jvp) and vmap all work,
+    so the Hessians of `models.torch.lnn` / `lgn` go through it; half the ops of a where-based form."""
+    generate_vmap_rule = True
+
+    @staticmethod
+    def forward(a, s):
+        return torch.logaddexp(a, torch.zeros((), dtype=a.dtype))
+
+    @staticmethod
+    def setup_context(ctx, inputs, output):
+        ctx.save_for_backward(inputs[1])
+        ctx.save_for_forward(inputs[1])
+
+    @staticmethod
+    def backward(ctx, grad):
+        (s,) = ctx.saved_tensors
+        return grad * s, None
+
+    @staticmethod
+    def jvp(ctx, a_t, s_t):
+        (s,) = ctx.saved_tensors
+        return a_t * s
+
+
+def softplus_given_sigmoid(x, s):
+    """softplus(x), with s = sigmoid(x) already computed (see `_Softplus`)."""
+    return _Softplus.apply(x, s)
+
+
 def softplus(x):
-    """log(1 + e^x) as logaddexp(x, 0) computes it, but with derivatives of every order finite:
-    torch's logaddexp double-backward is NaN for large negative x (JAX's is 0). Each branch only
-    sees inputs of the sign it is valid for, so the unselected branch's gradient is 0, not NaN."""
-    pos = x > 0
-    zero = torch.zeros_like(x)
-    return torch.where(pos, x + torch.log1p(torch.exp(-torch.where(pos, x, zero))),
-                       torch.log1p(torch.exp(torch.where(pos, zero, x))))
+    """log(1 + e^x) with derivatives of every order finite (see `_Softplus`)."""
+    return _Softplus.apply(x, torch.sigmoid(x))
 
 
 ACT = {

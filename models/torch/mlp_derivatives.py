@@ -18,29 +18,12 @@ from __future__ import annotations
 import torch
 
 from models.params import n_layers
-
-
-class _SoftplusGivenSigmoid(torch.autograd.Function):
-    """softplus(a) = logaddexp(a, 0) in one op, its derivative the given s = sigmoid(a) (part of the
-    graph, so every higher derivative is sigmoid's: finite, unlike torch's logaddexp double-backward)."""
-
-    @staticmethod
-    def forward(a, s):
-        return torch.logaddexp(a, torch.zeros((), dtype=a.dtype))
-
-    @staticmethod
-    def setup_context(ctx, inputs, output):
-        ctx.save_for_backward(inputs[1])
-
-    @staticmethod
-    def backward(ctx, grad):
-        (s,) = ctx.saved_tensors
-        return grad * s, None
+from models.torch.mlp import softplus_given_sigmoid
 
 
 def _softplus(a):
     s = torch.sigmoid(a)
-    return _SoftplusGivenSigmoid.apply(a, s), s, torch.addcmul(s, s, s, value=-1.0)
+    return softplus_given_sigmoid(a, s), s, torch.addcmul(s, s, s, value=-1.0)
 
 
 def _relu(a):
