@@ -8,6 +8,7 @@ Shapes: trajectories (B, T, k); energies (B, T).
 - energy: `energy_errors(E_pred, E_true, scale)` -> |E_pred - E_true| / scale at the final step and
   the max over time, each averaged over trajectories (diverged trajectories count as +inf in the max
   and are reported separately).
+Arrays of the wrong rank, mismatched shapes or no samples raise ValueError naming the problem.
 """
 from __future__ import annotations
 
@@ -16,14 +17,28 @@ import numpy as np
 from replication.objective import loss_value
 
 
+def _same_shape(what: str, a, b, ndim: int, min_len=(1,)):
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    if a.shape != b.shape or a.ndim != ndim or any(n < m for n, m in zip(a.shape, min_len, strict=False)):
+        raise ValueError(f"{what}: expected two arrays of the same shape with {ndim} dimensions and at least "
+                         f"{min_len} entries along the first axes; got {a.shape} and {b.shape}")
+    return a, b
+
+
 def heldout_errors(pred, target, weight=None) -> dict:
     pred, target = np.asarray(pred, np.float64), np.asarray(target, np.float64)
+    pred, target = _same_shape("heldout_errors (pred, target)", pred, target, max(pred.ndim, 1), (1, 1))
     w = None if weight is None else np.asarray(weight, np.float64)
+    if w is not None and w.shape != pred.shape[:1]:
+        raise ValueError(f"heldout_errors: weight must have shape {pred.shape[:1]}, got {w.shape}")
     return {"l1": float(loss_value(pred, target, w, "l1")), "mse": float(loss_value(pred, target, w, "mse"))}
 
 
 def bounded_relative_error(z_pred, z_true):
     """In [0, 1]; a diverged (non-finite) prediction counts as 1, the bound."""
+    z_pred, z_true = np.asarray(z_pred), np.asarray(z_true)
+    if z_pred.shape != z_true.shape or z_pred.ndim < 1:
+        raise ValueError(f"bounded_relative_error: shapes must match (..., k); got {z_pred.shape} and {z_true.shape}")
     num = np.linalg.norm(z_pred - z_true, axis=-1)
     den = np.linalg.norm(z_pred, axis=-1) + np.linalg.norm(z_true, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -32,12 +47,18 @@ def bounded_relative_error(z_pred, z_true):
 
 
 def geometric_mean_over_time(err, floor=1e-16):
-    e = np.asarray(err)[:, 1:]
+    e = np.asarray(err)
+    if e.ndim != 2 or e.shape[1] < 2:
+        raise ValueError(f"geometric_mean_over_time: expected errors (B, T) with T >= 2; got shape {e.shape}")
+    e = e[:, 1:]
     return np.exp(np.mean(np.log(np.maximum(e, floor)), axis=1))
 
 
 def energy_errors(E_pred, E_true, scale) -> dict:
-    d = np.abs(np.asarray(E_pred) - np.asarray(E_true)) / scale
+    E_pred, E_true = _same_shape("energy_errors (E_pred, E_true)", E_pred, E_true, 2, (0, 1))
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"energy_errors: scale must be positive and finite, got {scale!r}")
+    d = np.abs(E_pred - E_true) / scale
     diverged = ~np.all(np.isfinite(d), axis=1)
     ok = ~diverged
     final = float(np.mean(d[ok, -1])) if ok.any() else float("nan")

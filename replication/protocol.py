@@ -11,6 +11,8 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
+import numbers
 from dataclasses import dataclass, field
 
 LOSSES = ("l1", "mse", "l1_gamma")
@@ -67,13 +69,13 @@ class Protocol:
         for name, valid in checks:
             if getattr(self, name) not in valid:
                 raise ValueError(f"unknown {name} {getattr(self, name)!r}; valid: {', '.join(valid)}")
-        for name in ("steps", "batch", "n_train", "n_heldout"):
-            if int(getattr(self, name)) < 1:
+        for name in ("steps", "batch", "n_train", "n_heldout", "lr_step_every", "log_every"):
+            if not _positive_integer(getattr(self, name)):
                 raise ValueError(f"protocol {name} must be a positive integer, got {getattr(self, name)!r}")
         if self.batch > self.n_train:
             raise ValueError(f"batch {self.batch} exceeds the training pool n_train={self.n_train}")
-        if not self.lr > 0:
-            raise ValueError(f"learning rate must be positive, got {self.lr}")
+        if not (_real(self.lr) and math.isfinite(self.lr) and self.lr > 0):
+            raise ValueError(f"learning rate must be positive and finite, got {self.lr!r}")
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
@@ -93,3 +95,12 @@ class Protocol:
         """A short stable hash of everything in the protocol."""
         blob = json.dumps(self.to_dict(), sort_keys=True, default=str).encode()
         return hashlib.sha256(blob).hexdigest()[:16]
+
+
+def _real(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _positive_integer(v) -> bool:
+    """An int (or an integral finite float, as JSON may give) >= 1."""
+    return _real(v) and math.isfinite(v) and v == int(v) and v >= 1

@@ -11,9 +11,12 @@
 from __future__ import annotations
 
 import math
+import numbers
 
 
 def learning_rate(protocol, step: int) -> float:
+    if not (isinstance(step, numbers.Real) and math.isfinite(step) and step >= 0):
+        raise ValueError(f"the step must be a finite number >= 0, got {step!r}")
     lr = float(protocol.lr)
     if protocol.schedule == "constant":
         return lr

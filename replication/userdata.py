@@ -27,7 +27,10 @@ def _from_csv(path):
         cols = sorted((c for c in df.columns if c.startswith(name) and c[len(name):].isdigit()),
                       key=lambda c: int(c[len(name):]))
         if cols:
-            out[name] = df[cols].to_numpy(dtype=np.float64)
+            try:
+                out[name] = df[cols].to_numpy(dtype=np.float64)
+            except (TypeError, ValueError) as e:
+                raise ValueError(f"{path}: columns {', '.join(cols)} are not all numbers ({e})") from e
     return out
 
 

@@ -1,12 +1,13 @@
 """Ground-truth trajectories: diffrax in float64 on the generated JAX equations of motion.
 
 ``integrate(system, q0, qdot0, t, *, rtol=1e-12, atol=1e-12, solver="dopri8", tau=None,
-max_steps=2**20, **param_overrides) -> (q, qdot)``
+max_steps=2**20, return_steps=False, **param_overrides) -> (q, qdot) [+ steps]``
 
 - ``q0``, ``qdot0``: (B, dof) or (dof,); ``t``: 1D strictly increasing grid of T times
   (the first is the initial time);
 - returns float64 NumPy arrays (B, T, dof) (or (T, dof) for 1D inputs), states saved at ``t``;
-- ``solver``: one of ``SOLVERS`` ("tsit5", "dopri5", "dopri8"), adaptive step with a PID
+- ``solver``: one of ``SOLVERS`` ("tsit5", "dopri5", "dopri8" explicit; "kvaerno5" implicit, L-stable,
+  for dissipative stiff systems; ``systems.stiffness.pick_solver`` chooses), adaptive step with a PID
   controller at (rtol, atol) that also steps onto every time in ``t`` (saved states are step
   values, not dense-output interpolants); each trajectory gets its own step sizes (vmap over B);
 - ``tau``: constant generalised forces (dof,) or (B, dof), or a JAX-traceable ``tau(t) -> (dof,)``;
@@ -26,7 +27,8 @@ import numpy as np
 from systems import backends  # noqa: F401  (x64)
 from systems.system import System
 
-SOLVERS = {"tsit5": diffrax.Tsit5, "dopri5": diffrax.Dopri5, "dopri8": diffrax.Dopri8}
+SOLVERS = {"tsit5": diffrax.Tsit5, "dopri5": diffrax.Dopri5, "dopri8": diffrax.Dopri8,
+           "kvaerno5": diffrax.Kvaerno5}
 _COMPILED: dict = {}
 
 
@@ -55,7 +57,7 @@ def _solver_fn(system: System, solver: str, rtol: float, atol: float, max_steps:
             stepsize_controller=diffrax.PIDController(rtol=rtol, atol=atol, step_ts=ts),
             max_steps=max_steps,
         )
-        return sol.ys
+        return sol.ys, sol.stats["num_steps"]
 
     fn = jax.jit(jax.vmap(solve_one, in_axes=(0, None, 0, 0)))
     _COMPILED[key] = fn
@@ -63,8 +65,10 @@ def _solver_fn(system: System, solver: str, rtol: float, atol: float, max_steps:
 
 
 def integrate(system: System, q0, qdot0, t, *, rtol: float = 1e-12, atol: float = 1e-12,
-              solver: str = "dopri8", tau=None, max_steps: int = 2**20, **param_overrides):
-    """Integrate ``system`` from (q0, qdot0) and return (q, qdot) at the times ``t``."""
+              solver: str = "dopri8", tau=None, max_steps: int = 2**20, return_steps: bool = False,
+              **param_overrides):
+    """Integrate ``system`` from (q0, qdot0) and return (q, qdot) at the times ``t``
+    (and the accepted steps per trajectory, (B,) or an int for 1D input, if ``return_steps``)."""
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver {solver!r}; valid: {', '.join(SOLVERS)}")
     q0, qdot0 = np.asarray(q0, dtype=np.float64), np.asarray(qdot0, dtype=np.float64)
@@ -90,13 +94,17 @@ def integrate(system: System, q0, qdot0, t, *, rtol: float = 1e-12, atol: float 
     tau_arr = np.zeros((b, dof)) if tau is None or tau_fn is not None else np.asarray(tau, dtype=np.float64)
     tau_arr = np.broadcast_to(tau_arr, (b, dof))
     if ts.size == 1:
-        ys = np.concatenate([q0, qdot0], axis=-1)[:, None, :]
+        ys, steps = np.concatenate([q0, qdot0], axis=-1)[:, None, :], np.zeros(b, dtype=np.int64)
     else:
         fn = _solver_fn(system, solver, float(rtol), float(atol), int(max_steps), tau_fn)
         y0 = jnp.asarray(np.concatenate([q0, qdot0], axis=-1))
         try:
-            ys = np.asarray(fn(y0, jnp.asarray(ts), params, jnp.asarray(tau_arr)))
+            ys, steps = fn(y0, jnp.asarray(ts), params, jnp.asarray(tau_arr))
+            ys, steps = np.asarray(ys), np.asarray(steps)
         except Exception as err:  # diffrax reports step-limit and NaN failures as runtime errors
             raise RuntimeError(f"integration of {system.name!r} failed: {err}") from err
     q, qdot = ys[..., :dof], ys[..., dof:]
-    return (q[0], qdot[0]) if single else (q, qdot)
+    out = (q[0], qdot[0]) if single else (q, qdot)
+    if return_steps:
+        return (*out, int(steps[0]) if single else steps)
+    return out

@@ -1,4 +1,4 @@
-"""The ten claims of the SPEC, by id, in the SPEC's order."""
+"""The ten claims of the SPEC, by id, in the SPEC's order, then the hard-case claims (11: precision)."""
 from replication.claims import (
     activation_study,
     appendix_b,
@@ -8,13 +8,14 @@ from replication.claims import (
     dp_loss,
     hnn_energy,
     init_study,
+    precision,
     rel_coords,
     wave_lgn,
 )
 from replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
 
 _ALL = (dp_loss, dp_energy, rel_coords, wave_lgn, appendix_b, init_study, activation_study, delan_table1,
-        delan_arm, hnn_energy)
+        delan_arm, hnn_energy, precision)
 CLAIMS = {m.CLAIM.id: m.CLAIM for m in sorted(_ALL, key=lambda m: m.CLAIM.number)}
 
 
