@@ -3,11 +3,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import pandas as pd
+
+LOG_COLUMNS = ["step", "loss", "grad_norm", "lr", "wall_s"]   # then any `hessian_probe` columns
+
 
 @dataclass
 class TrainOutcome:
     params: dict            # last good parameters, init_params layout (NumPy)
-    log: list               # rows: step, loss, grad_norm, lr, wall_s
+    log: list               # rows: step, loss, grad_norm, lr, wall_s [, hessian_probe.COLUMNS]
     failure: dict | None    # None, or {"kind", "step", "message"}
     train_time_s: float
     steps_done: int
@@ -23,3 +27,10 @@ def nonfinite_failure(step: int, loss: float, gnorm: float) -> dict:
     return {"kind": f"non_finite_{what}", "step": int(step),
             "message": f"non-finite {what} at step {step} (loss={loss}, grad_norm={gnorm}); "
                        f"kept the parameters from before step {step}"}
+
+
+def log_frame(log: list) -> pd.DataFrame:
+    """The train log as the train_log.csv table: LOG_COLUMNS first, then the probe columns present."""
+    df = pd.DataFrame(log)
+    extra = [c for c in df.columns if c not in LOG_COLUMNS]
+    return df.reindex(columns=LOG_COLUMNS + extra)

@@ -2,8 +2,8 @@
 
 `train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome` runs `protocol.steps`
 Adam steps (optax.scale_by_adam, scaled by the learning rate the neutral schedule gives for the
-step), records loss and global gradient norm every `log_every` steps (and at step 0 and the last),
-and stops at the first non-finite loss or gradient, keeping the parameters from before that step.
+step), records loss and global gradient norm every `log_every` steps (and at step 0 and the last;
+for LNN/LGN also the velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops at the first non-finite loss or gradient, keeping the parameters from before that step.
 """
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ import numpy as np
 import optax
 
 import models.jax
+from replication import hessian_probe
 from replication.objective import loss_value, predict
 from replication.outcome import TrainOutcome, nonfinite_failure
 from replication.schedules import learning_rate
@@ -51,12 +52,31 @@ def make_step(spec, protocol):
     return opt, step
 
 
+def make_probe(spec, protocol):
+    """batch -> the `hessian_probe` columns (None for models without a velocity Hessian)."""
+    if not hessian_probe.wanted(spec, protocol):
+        return None
+
+    @eqx.filter_jit
+    def look(model, batch):
+        q, qdot, extra = batch["q"], batch["qdot"], batch.get("extra")
+        hess = model.velocity_hessian(q, qdot, extra) if hasattr(model, "velocity_hessian") else None
+        return (*model.acceleration_info(q, qdot, extra), hess)
+
+    def run(model, batch):
+        qdd, n_fb, hess = look(model, batch)
+        return hessian_probe.probe(np.asarray(qdd), int(n_fb), None if hess is None else np.asarray(hess),
+                                   protocol.dtype)
+    return run
+
+
 def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
     dtype = jnp.dtype(protocol.dtype)
     model = models.jax.build(spec, params)
     opt, step = make_step(spec, protocol)
+    look = make_probe(spec, protocol)
     opt_state = opt.init(eqx.filter(model, eqx.is_inexact_array))
-    log, failure, t0 = [], None, time.perf_counter()
+    log, failure, t0, t_probe = [], None, time.perf_counter(), 0.0
     for k in range(protocol.steps):
         lr = learning_rate(protocol, k)
         batch = _to_jax(stream.batch(k), dtype)
@@ -67,10 +87,15 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
             break
         model, opt_state = new_model, new_state
         if k % protocol.log_every == 0 or k == protocol.steps - 1:
-            row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr, "wall_s": time.perf_counter() - t0}
+            row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr,
+                   "wall_s": time.perf_counter() - t0 - t_probe}
+            if look is not None:
+                tp = time.perf_counter()
+                row.update(look(model, batch))
+                t_probe += time.perf_counter() - tp
             log.append(row)
             if on_log:
                 on_log(row)
-    wall = time.perf_counter() - t0
+    wall = time.perf_counter() - t0 - t_probe
     return TrainOutcome(params=models.jax.to_params(model), log=log, failure=failure, train_time_s=wall,
                         steps_done=k + 1 if failure is None else k, batch=protocol.batch)

@@ -16,7 +16,7 @@ import pandas as pd
 from models import init_params
 from replication import results as R
 from replication.data import BatchStream
-from replication.outcome import TrainOutcome
+from replication.outcome import TrainOutcome, log_frame
 
 log = logging.getLogger("lagbench")
 
@@ -53,8 +53,7 @@ def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutc
                             steps_done=meta["steps_done"], batch=meta["batch"])
     outcome = run_training(framework, spec, protocol, seed, on_log=on_log)
     files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
-             "train_log.csv": R.write_csv(folder / "train_log.csv", pd.DataFrame(
-                 outcome.log, columns=["step", "loss", "grad_norm", "lr", "wall_s"]))}
+             "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
                                           "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},

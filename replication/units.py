@@ -5,14 +5,14 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import pandas as pd
-
 from models import ModelSpec
 from replication import environment as env
+from replication import hessian_probe
 from replication import results as R
 from replication.adapters import adapter
 from replication.evaluate import Context, system_of
 from replication.evaluations import EVALUATIONS
+from replication.outcome import log_frame
 from replication.training import train_cached
 
 
@@ -50,8 +50,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
     if unit.entry.train:
         outcome = train_cached(out, unit.framework, spec, protocol, unit.seed, on_log=on_log)
         failure, params = outcome.failure, outcome.params
-        files["train_log.csv"] = R.write_csv(folder / "train_log.csv", pd.DataFrame(
-            outcome.log, columns=["step", "loss", "grad_norm", "lr", "wall_s"]))
+        files["train_log.csv"] = R.write_csv(folder / "train_log.csv", log_frame(outcome.log))
         files["checkpoint.npz"] = R.write_npz(folder / "checkpoint.npz", params)
     else:
         params = None
@@ -67,7 +66,8 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
     record = {
         "schema": R.SCHEMA, "claim": unit.claim.id, "framework": unit.framework, "model": unit.entry.label,
         "seed": unit.seed, "profile": unit.profile, "status": "ok" if failure is None else "failed",
-        "failure": failure, "metrics": ev.metrics, "counters": ev.counters, "model_spec": spec.to_dict(),
+        "failure": failure, "metrics": ev.metrics, "counters": {**ev.counters, **(hessian_probe.summarize(outcome.log) if outcome else {})},
+        "model_spec": spec.to_dict(),
         "protocol": protocol.to_dict(), "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
         "train_time_s": outcome.train_time_s if outcome else 0.0,
         "train_steps": outcome.steps_done if outcome else 0,

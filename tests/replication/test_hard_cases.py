@@ -5,6 +5,7 @@ import pytest
 
 import systems
 from models import ModelSpec, init_params
+from replication import hessian_probe
 from replication.protocol import Protocol
 from replication.training import run_training
 
@@ -36,6 +37,29 @@ def test_fresh_lnn_has_indefinite_velocity_hessians_and_says_so():
     assert 0.25 < indefinite < 0.6, indefinite
     qdd, n_fb = m.acceleration_info(jnp.asarray(st["q"]), jnp.asarray(st["qdot"]))
     assert np.all(np.isfinite(np.asarray(qdd)))  # indefinite is not singular: solved, not silently NaN
+
+
+def test_probe_tells_indefinite_from_singular():
+    hess = np.array([np.diag([1.0, 2.0]), np.diag([-1.0, 2.0]), np.diag([1e-9, 1.0])])
+    row = hessian_probe.probe(np.array([[1.0, -7.0]] * 3), 2, hess, "float32")
+    assert row == {"hessian_fallbacks": 2, "qddot_max_abs": 7.0, "hessian_indefinite_fraction": 1 / 3,
+                   "hessian_singular_fraction": 1 / 3}
+    summary = hessian_probe.summarize([row, {**row, "hessian_fallbacks": 1}])
+    assert summary["train_hessian_fallbacks_total"] == 3 and summary["train_hessian_indefinite_fraction_max"] == 1 / 3
+
+
+def test_training_logs_the_hessian_health_alike_in_both_frameworks():
+    """Float64, same init and batches: the probe sees the same Hessians in JAX and PyTorch at every
+    logged step, and the fraction is the measured one of a freshly initialised LNN (well above 0)."""
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(64, 64), dtype="float64", angle_wrap=True)
+    p = Protocol(data="double_pendulum_iid", steps=6, batch=64, n_train=640, lr=1e-3, schedule="constant",
+                 log_every=2, dtype="float64")
+    logs = {fw: run_training(fw, spec, p, seed=0).log for fw in ("jax", "torch")}
+    for col in hessian_probe.COLUMNS:
+        a, b = [np.array([r[col] for r in logs[fw]]) for fw in ("jax", "torch")]
+        np.testing.assert_allclose(a, b, rtol=1e-6, err_msg=col)
+    frac = [r["hessian_indefinite_fraction"] for r in logs["jax"]]
+    assert len(frac) == 4 and all(0.0 < f <= 1.0 for f in frac), frac
 
 
 @pytest.mark.parametrize("dtype, rtol", [(np.float64, 1e-9), (np.float32, 2e-3)])

@@ -56,4 +56,6 @@ def test_report_builds_from_real_smoke_results(smoke_results, tmp_path):
     md = paths["markdown"].read_text()
     for cid in CLAIMS:
         assert cid in md
+    health = md.split("**Velocity-Hessian health per unit**")[1].split("\n## ")[0]
+    assert "| dp_loss | jax | lnn |" in health and "| dp_loss | torch | lnn |" in health  # logged in training
     assert paths["pdf"].read_bytes()[:4] == b"%PDF"
