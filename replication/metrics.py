@@ -7,7 +7,7 @@ Shapes: trajectories (B, T, k); energies (B, T).
   (B, T); `geometric_mean_over_time` of it per trajectory (B,), skipping t = 0 where it is 0.
 - energy: `energy_errors(E_pred, E_true, scale)` -> |E_pred - E_true| / scale at the final step and
   the max over time, each averaged over trajectories (diverged trajectories count as +inf in the max
-  and are reported separately).
+  and are reported separately), and the median final error over all trajectories (diverged = +inf).
 Arrays of the wrong rank, mismatched shapes or no samples raise ValueError naming the problem.
 """
 from __future__ import annotations
@@ -63,5 +63,8 @@ def energy_errors(E_pred, E_true, scale) -> dict:
     ok = ~diverged
     final = float(np.mean(d[ok, -1])) if ok.any() else float("nan")
     mx = float(np.mean(np.max(d[ok], axis=1))) if ok.any() else float("nan")
-    return {"energy_err_final": final, "energy_err_max": mx, "n_diverged": int(diverged.sum()),
+    # the median over every trajectory (a diverged one counts as +inf): robust to one blown-up rollout
+    median = float(np.median(np.where(diverged, np.inf, d[:, -1]))) if len(d) else float("nan")
+    return {"energy_err_final": final, "energy_err_final_median": median, "energy_err_max": mx,
+            "n_diverged": int(diverged.sum()),
             "n_trajectories": int(d.shape[0])}
