@@ -52,28 +52,12 @@ def system_of(protocol, **extra):
     return systems.get(name, **{**dict(protocol.system_params), **extra})
 
 
-@lru_cache(maxsize=8)
-def _momentum_jacobians(name, params):
-    """NumPy callables (dp/dq, dp/dqdot) of the system's canonical momentum, from SymPy."""
-    import sympy as sp
-
-    s = systems.get(name, **dict(params))
-    qs, vs = list(s.q_symbols), list(s.qdot_symbols)
-    p = sp.Matrix([sp.diff(s.lagrangian, v) for v in vs])
-    subs = {x: s.params[x.name] for x in s.lagrangian.free_symbols if x.name in s.params}
-    jq, jv = (sp.lambdify(qs + vs, p.jacobian(x).subs(subs), "numpy") for x in (qs, vs))
-    return jq, jv
-
-
 def pdot_to_qddot(protocol, q, qdot, pdot):
-    """q-double-dot from pdot along the motion: pdot = dp/dq qdot + dp/dqdot qdd."""
-    jq, jv = _momentum_jacobians(protocol.data.removesuffix("_iid"), tuple(sorted(protocol.system_params)))
-    args = [*np.moveaxis(q, -1, 0), *np.moveaxis(qdot, -1, 0)]
-    n, d = q.shape
-    Jq = np.broadcast_to(np.moveaxis(np.asarray(jq(*args), dtype=float), (0, 1), (-2, -1)), (n, d, d))
-    Jv = np.broadcast_to(np.moveaxis(np.asarray(jv(*args), dtype=float), (0, 1), (-2, -1)), (n, d, d))
-    rhs = pdot - np.einsum("nij,nj->ni", Jq, qdot)
-    return np.linalg.solve(Jv, rhs[..., None])[..., 0]
+    """q-double-dot from a predicted pdot along the motion, pdot = dp/dq qdot + dp/dqdot qdd: with the
+    truth's own rate r = dp/dq qdot + dp/dqdot qdd_true, qdd = qdd_true + (d2L/dqdot2)^-1 (pdot - r)."""
+    s = system_of(protocol)
+    gap = (pdot - s.canonical_momentum_rate(q, qdot))[..., None]
+    return s.acceleration(q, qdot) + np.linalg.solve(s.velocity_hessian(q, qdot), gap)[..., 0]
 
 
 def eval_heldout(ctx) -> Evaluation:
