@@ -13,7 +13,8 @@
            is not finite) the sample takes the paper's pinv result and is counted in n_fallback.
            Indefinite but well-conditioned H are solved exactly (pinv would give the same).
 `euler_lagrange(...)` returns qddot only; `velocity_hessian(L_fn, q, qdot, extra)` -> (..., d, d).
-Mirrored line for line by `models.torch.lnn`.
+Mirrored line for line by `models.torch.lnn`; in both, `LNN`'s own fast terms come from the hand-written
+MLP derivatives (`models.jax.mlp_derivatives`), the generic `fast_terms` serves any other L_fn.
 """
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ from jax import lax
 
 from models.jax.base import Model
 from models.jax.mlp import mlp, mlp_input, wrap_angles
+from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
 from models.numerics import pinv_rtol, rcond_min
 
 
@@ -107,11 +109,30 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
 
 
 class LNN(Model):
-    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None."""
+    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None.
+
+    The fast formulation and velocity_hessian differentiate the model's own MLP by hand
+    (`models.jax.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, fewer FLOPs
+    (XLA's forward-over-reverse also pushes the d + 1 tangents back through the network)."""
 
     def _lagrangian(self, q, qdot, extra=None):
         x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
+
+    def _fast_terms(self, q, qdot, extra=None):
+        """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
+        MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
+        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
+        spec, (n, d) = self.spec, q.shape
+        x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
+        scale = (jnp.ones(x.shape[-1], dtype=x.dtype) if spec.input_scale is None
+                 else jnp.asarray(spec.input_scale, dtype=x.dtype))
+        s_q, s_qd = scale[:d], scale[d:2 * d]
+        tangents = jnp.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
+        tangents = tangents.at[:, :d, d:2 * d].set(jnp.diag(s_qd))
+        tangents = tangents.at[:, d, :d].set(qdot * s_q)
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
+        return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
 
     @eqx.filter_jit
     def lagrangian(self, q, qdot, extra=None):
@@ -123,14 +144,20 @@ class LNN(Model):
     def velocity_hessian(self, q, qdot, extra=None):
         """(..., dof, dof)."""
         self._check_state(q, qdot, extra)
-        return velocity_hessian(self._lagrangian, q, qdot, extra if self.spec.extra_inputs else None)
+        d, extra = q.shape[-1], extra if self.spec.extra_inputs else None
+        hess, _ = self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None))
+        return hess.reshape(*q.shape, d)
 
     @eqx.filter_jit
     def acceleration_info(self, q, qdot, extra=None):
         """(qddot (..., dof), n_fallback) with spec.formulation."""
         self._check_state(q, qdot, extra)
         extra = extra if self.spec.extra_inputs else None
-        return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+        if self.spec.formulation != "fast":
+            return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+        d = q.shape[-1]
+        x, n_bad = solve_with_fallback(*self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None)))
+        return x.reshape(*q.shape[:-1], d), n_bad
 
     def acceleration(self, q, qdot, extra=None):
         """qddot (..., dof)."""

@@ -28,6 +28,13 @@ def act_and_slope(name: str, a):
     return jax.jvp(ACT[name], (a,), (jnp.ones_like(a),))
 
 
+def act_derivs(name: str, a):
+    """(act(a), act'(a), act''(a)), each shaped like a, by nested elementwise jvp."""
+    ones = jnp.ones_like(a)
+    (f, s1), (_, s2) = jax.jvp(lambda b: act_and_slope(name, b), (a,), (ones,))
+    return f, s1, s2
+
+
 def linear(params: dict, prefix: str, x):
     """x (..., in) -> (..., out)."""
     return x @ params[f"{prefix}.weight"].T + params[f"{prefix}.bias"]

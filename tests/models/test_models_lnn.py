@@ -137,3 +137,20 @@ def test_relu_lnn_has_a_zero_hessian_everywhere_and_every_sample_falls_back(fw):
     qddot, n_bad = build(spec, params).acceleration_info(xs["q"], xs["qdot"])
     assert int(n_bad) == 10
     assert np.all(np.isfinite(np.asarray(qddot.tolist())))
+
+
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+@pytest.mark.parametrize("activation, extra, scale", [("softplus", 0, None), ("tanh", 2, [0.5, 2.0, 1.5, 0.3, 1.0, 1.0]),
+                                                      ("relu3", 0, [1.0, 2.0, 0.5, 3.0])])
+def test_hand_written_fast_terms_equal_forward_over_reverse(fw, activation, extra, scale):
+    """The LNN's own fast path (`mlp_derivatives`) against the generic `fast_terms` of its Lagrangian."""
+    spec, params = spec_params(kind="lnn", dof=2, dtype="float64", init="xavier", activation=activation,
+                               extra_inputs=extra, input_scale=scale, angle_wrap=True)
+    x = make_inputs(spec, batch=16, seed=3)
+    build, conv, lib = (models.jax.build, to_jax, jlnn) if fw == "jax" else (models.torch.build, to_torch, tlnn)
+    model, xs = build(spec, params), conv(x)
+    e = xs["extra"] if extra else None
+    hand = model._fast_terms(xs["q"], xs["qdot"], e)
+    generic = lib.fast_terms(model._lagrangian, xs["q"], xs["qdot"], e)
+    for a, b, what in zip(hand, generic, ("hessian", "rhs"), strict=True):
+        assert_rel(np.asarray(a.tolist()), np.asarray(b.tolist()), "float64", what)
