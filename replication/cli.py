@@ -63,6 +63,21 @@ def cmd_bench(args):
     run_bench(out=args.out, quick=not args.full)
 
 
+def cmd_stiff(args):
+    from pathlib import Path
+
+    from replication.results import write_csv, write_json
+    from replication.stiff_study import stiff_study
+
+    df = stiff_study(system=args.system)
+    folder = Path(args.out) / "stiff"
+    write_csv(folder / "solvers.csv", df)
+    write_json(folder / "choice.json", {"system": args.system, **{k: (float(v) if isinstance(v, float) else v)
+                                                                    for k, v in df.attrs.items()}})
+    print(df.to_string(index=False))
+    print(f"picked: {df.attrs.get('reason')}; written to {folder}")
+
+
 def build_parser():
     p = argparse.ArgumentParser(prog="lagbench", description="Replication suite for learned Lagrangian and "
                                 "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.")
@@ -99,6 +114,11 @@ def build_parser():
     s.add_argument("--out", default="results/quick")
     s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow)")
     s.set_defaults(func=cmd_bench)
+    s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
+                                     "(writes OUT/stiff/solvers.csv for the report)")
+    s.add_argument("--out", default="results/quick")
+    s.add_argument("--system", default="stiff_chain", help="a system name (default: stiff_chain)")
+    s.set_defaults(func=cmd_stiff)
     return p
 
 

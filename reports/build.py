@@ -20,6 +20,7 @@ from reports.pdf import write_pdf
 from reports.sections_claims import summary_sections, theme_sections
 from reports.sections_hessian import hessian_sections
 from reports.sections_speed import agreement_sections, speed_sections
+from reports.sections_stiff import stiff_sections
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
@@ -31,6 +32,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     sections += speed_sections(res, out_dir)
     sections += agreement_sections(res)
     sections += hessian_sections(res)
+    sections += stiff_sections(res)
     sections += findings_sections(res)
     sections += environment_sections(res, now)
     return sections + sources_sections(res, sections)
