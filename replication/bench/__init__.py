@@ -1,14 +1,22 @@
-"""The speed study: `run_bench(out, quick=True, tiny=False)` writes OUT/bench/ (what `lagbench bench` calls).
+"""The speed study: `run_bench(out, quick=True, tiny=False, trained_from=None)` writes OUT/bench/ (what
+`lagbench bench` calls). Learned-model rollouts take their parameters from the training cache of
+`trained_from` (default OUT: `lagbench bench --out results/quick` uses the quick run's models) and
+otherwise train tiny ones.
 
 Files (all CSV with a header row, written atomically; columns beyond these are extras the report may
 ignore):
   machine.json    cpu, cores, gpu (or null), platform, thread settings, versions, commit, date, preset
-  inference.csv   system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden
-                  (`replication.bench.inference`)
+  inference.csv   system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden,
+                  ops (`replication.bench.inference`)
+  latency.csv     system, model, method, framework, dtype, mode, dispatch, threads, hidden, evals_per_s,
+                  max_abs_diff, ops: DeLaN one-sample calls (`replication.bench.latency`; JAX through
+                  `models.jax.compiled.compile_single`)
   training.csv    system, model, framework, mode, dtype, batch, steps_per_s, samples_per_s, hidden
                   (`replication.bench.training`)
-  rollout.csv     system, solver, rtol, kind, wall_s, state_err, energy_err, dt, n_ics, t_end
-                  (`replication.bench.rollout`)
+  rollout.csv     system, solver, rtol, kind, model, source, wall_s, state_err, energy_err, dt, n_ics, t_end
+                  (`replication.bench.rollout`; kind truth | chaos_floor | learned | learned_tiny)
+  train_target.csv / train_target_log.csv  samples to reach held-out L1 thresholds, per protocol, and the
+                  held-out L1 against samples consumed (`replication.bench.train_target`)
   scaling.csv     study, formulation, framework, n, seconds_per_eval, samples_per_s, batch
   scaling_fit.csv study, formulation, framework, exponent, n_min, n_max   (`replication.bench.scaling`)
   fast_paper.csv  dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample, gflops
@@ -16,6 +24,7 @@ ignore):
   structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
   targets.json    the issue's numeric targets, each with the measured values and met: true/false
+  timings.json    wall seconds of the whole study and per stage
 Presets (`replication.bench.timing`): quick (default), full (`quick=False`), tiny (`tiny=True` or the
 environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). Every figure is a throughput or a
 ratio within this one run; numbers from different machines (machine.json) are never to be mixed.
@@ -26,6 +35,8 @@ keeps XLA's defaults (the thread settings are recorded in machine.json).
 from __future__ import annotations
 
 import os
+import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -34,7 +45,7 @@ from tqdm.auto import tqdm
 
 from replication import environment
 from replication.bench import inference as INF
-from replication.bench import rollout, roofline, scaling, structure, tables, training
+from replication.bench import latency, rollout, roofline, scaling, structure, tables, train_target, training
 from replication.bench.timing import FULL, QUICK, TINY, TORCH_THREADS
 from replication.results import write_csv, write_json
 
@@ -53,8 +64,12 @@ def _write(bench: Path, name: str, rows: list[dict]) -> None:
     write_csv(bench / f"{name}.csv", pd.DataFrame(rows))
 
 
-def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True) -> dict:
-    """Run the study into OUT/bench/; returns the targets dict (also written as targets.json)."""
+def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True,
+              trained_from=None) -> dict:
+    """Run the study into OUT/bench/; returns the targets dict (also written as targets.json).
+
+    trained_from: a results folder whose training cache (trained/jax/...) holds double-pendulum models
+    for the learned rollouts (default OUT itself; where none is found a tiny model is trained)."""
     if tiny is None:
         tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
     sizes = TINY if tiny else (QUICK if quick else FULL)
@@ -65,60 +80,94 @@ def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool 
     torch.set_num_threads(TORCH_THREADS)
     write_json(bench / "machine.json", machine(sizes))
     try:
-        return _run(out, bench, sizes, progress)
+        return _run(out, bench, sizes, progress, Path(trained_from) if trained_from else out)
     finally:
         torch.set_num_threads(old_threads)
 
 
-def _run(out: Path, bench: Path, sizes, progress: bool) -> dict:
+class _Stages:
+    """Wall seconds per stage of the study (written to timings.json)."""
+
+    def __init__(self, bar):
+        self.bar, self.seconds = bar, {}
+
+    @contextmanager
+    def __call__(self, name):
+        self.bar.set_postfix_str(name)
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
+
+
+def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path) -> dict:
     notes: list[str] = [f"PyTorch on {TORCH_THREADS} intra-op thread(s); JAX with XLA's default threads"]
     cases = INF.inference_cases(sizes) + INF.trained_cases(out, (1, max(sizes.batches)))
     sc_cases = list(scaling.lgn_cases(sizes)) + list(scaling.chain_cases(sizes))
-    total = (len(cases) + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
-             + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases())
+    total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
+             + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes))
     bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
+    stage, t_start = _Stages(bar), time.perf_counter()
     try:
-        inf_rows, states = [], {}
-        for c in cases:
-            key = (c.system, tuple(sorted(c.system_kw.items())))
-            if key not in states:
-                states[key] = INF.states_for(c.system, c.system_kw, max(sizes.batches))
-            bar.set_postfix_str(f"{c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}")
-            try:
-                inf_rows += INF.run_case(c, states[key], sizes.min_time)
-            except Exception as exc:  # a model that cannot run is a result, not the end of the study
-                notes.append(f"inference {c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}: "
-                             f"{type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}")
+        with stage("inference"):
+            inf_rows = _inference(cases, sizes, notes, bar)
+            _write(bench, "inference", inf_rows)
+        with stage("single-sample latency"):
+            lat_rows = latency.latency_rows(sizes, notes)
+            _write(bench, "latency", lat_rows)
             bar.update(1)
-        _write(bench, "inference", inf_rows)
-        bar.set_postfix_str("training")
-        train_rows = training.training_rows(sizes, notes, bar)
-        _write(bench, "training", train_rows)
-        bar.set_postfix_str("rollouts")
-        _write(bench, "rollout", rollout.rollout_rows(sizes, bar))
-        sc_rows = []
-        for c in sc_cases:
-            bar.set_postfix_str(f"scaling {c[0]} {c[1]} {c[2]} n={c[3]}")
-            sc_rows.append(scaling.run_scaling_case(c, sizes))
-            bar.update(1)
-        fit = scaling.fit_exponents(sc_rows)
-        _write(bench, "scaling", sc_rows)
-        _write(bench, "scaling_fit", fit)
-        fp_rows, mm_rows = [], []
-        for d in sizes.ratio_dofs:
-            bar.set_postfix_str(f"fast vs paper d={d}")
-            fp, mm = roofline.roofline_rows(sizes, d)
-            fp_rows += fp
-            mm_rows += mm
-            bar.update(2)
-        _write(bench, "fast_paper", fp_rows)
-        _write(bench, "matmul", mm_rows)
-        bar.set_postfix_str("structure")
-        _write(bench, "structure", structure.structure_rows(sizes, inf_rows, bar))
+        with stage("training"):
+            train_rows = training.training_rows(sizes, notes, bar)
+            _write(bench, "training", train_rows)
+        with stage("rollouts"):
+            _write(bench, "rollout", rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes))
+        with stage("scaling"):
+            sc_rows = []
+            for c in sc_cases:
+                bar.set_postfix_str(f"scaling {c[0]} {c[1]} {c[2]} n={c[3]}")
+                sc_rows.append(scaling.run_scaling_case(c, sizes))
+                bar.update(1)
+            fit = scaling.fit_exponents(sc_rows)
+            _write(bench, "scaling", sc_rows)
+            _write(bench, "scaling_fit", fit)
+        with stage("fast vs paper"):
+            fp_rows, mm_rows = [], []
+            for d in sizes.ratio_dofs:
+                fp, mm = roofline.roofline_rows(sizes, d)
+                fp_rows += fp
+                mm_rows += mm
+                bar.update(2)
+            _write(bench, "fast_paper", fp_rows)
+            _write(bench, "matmul", mm_rows)
+        with stage("structure"):
+            _write(bench, "structure", structure.structure_rows(sizes, inf_rows, bar))
+        with stage("train to target"):
+            tt_rows, tt_log = train_target.train_target_rows(sizes, bar)
+            _write(bench, "train_target", tt_rows)
+            _write(bench, "train_target_log", tt_log)
     finally:
         bar.close()
-    ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes)
+        write_json(bench / "timings.json", {"preset": sizes.name, "total_s": time.perf_counter() - t_start,
+                                            "stages_s": stage.seconds})
+    ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes, lat_rows)
     _write(bench, "ratios", ratios)
-    targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows)
+    targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows, lat_rows, tt_rows)
     write_json(bench / "targets.json", {"preset": sizes.name, "targets": targets})
     return targets
+
+
+def _inference(cases, sizes, notes, bar) -> list[dict]:
+    rows, states = [], {}
+    for c in cases:
+        key = (c.system, tuple(sorted(c.system_kw.items())))
+        if key not in states:
+            states[key] = INF.states_for(c.system, c.system_kw, max(sizes.batches))
+        bar.set_postfix_str(f"{c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}")
+        try:
+            rows += INF.run_case(c, states[key], sizes.min_time)
+        except Exception as exc:  # a model that cannot run is a result, not the end of the study
+            notes.append(f"inference {c.system} {c.model}/{c.formulation} {c.framework} {c.dtype}: "
+                         f"{type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}")
+        bar.update(1)
+    return rows

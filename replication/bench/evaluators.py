@@ -7,11 +7,17 @@
 Models: "lnn" / "lgn" / "delan" (tau = 0) / "baseline" use `.acceleration`; "hnn" is used on the
 non-canonical (q, qdot) (its second output is q-double-dot); "truth" is the SymPy-generated system
 (`System.acceleration` with backend numpy | jax | torch). JAX calls are `jax.jit` of the model passed as
-an argument (the weights are inputs of the compiled program, not folded constants), compiled on the
-first call per shape (`flops` compiles ahead of time for XLA's cost analysis); PyTorch runs eagerly under `torch.no_grad()` (torch.func inside still differentiates).
+an argument (the weights are inputs of the compiled program, not folded constants), lowered and
+compiled ahead of time on the first call per shape (the same object serves `flops` and `ops`); PyTorch
+runs eagerly under `torch.no_grad()` (torch.func inside still differentiates).
+`ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
+(fusions, dots, custom calls, ... in the optimised HLO's entry computation), PyTorch the ATen operators
+one call dispatches (counted with a TorchDispatchMode); None for NumPy.
 `median_rel_error(pred, true)`: median over samples of |pred - true| / |true| (Euclidean norms).
 """
 from __future__ import annotations
+
+import re
 
 import jax
 import jax.numpy as jnp
@@ -34,6 +40,32 @@ def _qddot(obj, kind, q, qdot):
     return obj.acceleration(q, qdot)
 
 
+_NOT_KERNELS = {"parameter", "constant", "bitcast", "tuple", "get-tuple-element"}
+
+
+def xla_kernels(compiled) -> int:
+    """Instructions of the optimised entry computation that run code (not parameters, constants, views)."""
+    text = compiled.as_text()
+    entry = text[text.index("ENTRY"):] if "ENTRY" in text else text
+    ops = re.findall(r"=\s*\S+\s+([a-z][\w-]*)\(", entry)
+    return sum(op not in _NOT_KERNELS for op in ops)
+
+
+def torch_ops(fn) -> int:
+    """ATen operators dispatched by one fn() call."""
+    from torch.utils._python_dispatch import TorchDispatchMode
+
+    class Count(TorchDispatchMode):
+        n = 0
+
+        def __torch_dispatch__(self, func, types, args=(), kwargs=None):
+            Count.n += 1
+            return func(*args, **(kwargs or {}))
+    with Count():
+        fn()
+    return Count.n
+
+
 class JaxEvaluator:
     framework = "jax"
 
@@ -52,11 +84,14 @@ class JaxEvaluator:
         return self._compiled[key]
 
     def run(self, args):
-        # the jitted function (compiles on its first call per shape; the AOT object costs the same per call)
-        return jax.block_until_ready(self._fn(self.model, *args))
+        # the ahead-of-time compiled program for this shape (compiled on the first call per shape)
+        return jax.block_until_ready(self.compiled(args)(self.model, *args))
 
     def numpy(self, args):
         return np.asarray(self.run(args), np.float64)
+
+    def ops(self, args) -> int:
+        return xla_kernels(self.compiled(args))
 
     def flops(self, args) -> float | None:
         """FLOPs of one call from XLA's compiled cost analysis (None if unavailable)."""
@@ -92,6 +127,9 @@ class TorchEvaluator:
     def numpy(self, args):
         return self._call(args).detach().numpy().astype(np.float64)
 
+    def ops(self, args) -> int:
+        return torch_ops(lambda: self._call(args))
+
 
 class TruthTorch(TorchEvaluator):
     def __init__(self, system, dtype):
@@ -116,6 +154,9 @@ class TruthNumpy:
 
     def numpy(self, args):
         return np.asarray(self.run(args), np.float64)
+
+    def ops(self, args):
+        return None
 
 
 def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="float32", system=None):

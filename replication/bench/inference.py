@@ -1,7 +1,8 @@
 """Inference study: q-double-dot throughput and error for every model x framework x formulation.
 
 `inference_cases(sizes) -> list[Case]` and `run_case(case, states, min_time) -> list[row]`; a row is
-{system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden}.
+{system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden, ops} (ops:
+kernels per call, `Evaluator.ops`, counted at the smallest batch; the ratio notes use it).
 Systems: the double pendulum (every kind but the graph network, plus the SymPy ground truth as model
 "truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid of `sizes.wave_n` points (LGN dense vs banded, and
 truth; batches capped at `GRID_NODES` // n states). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
@@ -115,12 +116,17 @@ def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
     n_err = max(case.batches)
     err = median_rel_error(ev.numpy(ev.prepare(states["q"][:n_err], states["qdot"][:n_err])),
                            states["qddot"][:n_err])
+    try:
+        ops = ev.ops(ev.prepare(states["q"][:min(case.batches)], states["qdot"][:min(case.batches)]))
+    except Exception:  # a count is a note's detail, never a reason to lose the row
+        ops = None
     rows = []
     for b in case.batches:
         args = ev.prepare(states["q"][:b], states["qdot"][:b])
-        ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape)
+        if b != n_err:
+            ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape); the error call warmed n_err
         dt = best_time(lambda a=args: ev.run(a), min_time=min_time)
         rows.append({"system": case.system, "model": case.model, "formulation": case.formulation,
                      "framework": case.framework, "dtype": case.dtype, "batch": int(b),
-                     "samples_per_s": b / dt, "error": err, "source": case.source, **case.extra})
+                     "samples_per_s": b / dt, "error": err, "source": case.source, "ops": ops, **case.extra})
     return rows

@@ -23,6 +23,7 @@ import torch
 from models import init_params
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import model_spec
+from replication.bench.timing import LONG_CALL_S
 
 
 def _states(batch, d, seed=0):
@@ -33,12 +34,14 @@ def _states(batch, d, seed=0):
 def interleaved_best(fns: dict, reps: int, warm_up: bool = True) -> dict:
     """{name: fastest time} over `reps` rounds that call every fn once in turn (after one warm-up call
     each if warm_up): a slow drift in how much CPU other processes leave us hits every fn alike, so their
-    ratios stay fair on shared cores."""
+    ratios stay fair on shared cores. A fn whose call took LONG_CALL_S or more sits out later rounds."""
     for fn in fns.values() if warm_up else ():
         fn()
     best = {k: float("inf") for k in fns}
     for _ in range(reps):
         for k, fn in fns.items():
+            if LONG_CALL_S <= best[k] < float("inf"):
+                continue
             t0 = time.perf_counter()
             fn()
             best[k] = min(best[k], time.perf_counter() - t0)

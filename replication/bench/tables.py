@@ -2,7 +2,11 @@
 
 `ratio_rows(inference, training, scaling, fastpaper, matmul, notes) -> rows {operation, jax, torch, ratio,
 note}`: jax and torch are throughputs (samples/s, steps/s for training, GFLOP/s for the roofline rows);
-ratio = jax / torch (above 1: JAX faster). A ratio beyond 2x either way carries a reason in `note`.
+ratio = jax / torch (above 1: JAX faster). A ratio beyond 2x either way carries a reason in `note`, made
+from the data: for q'' rows, the call time fitted over the case's batch sizes (fixed per-call cost +
+batch x per-sample cost, per framework; which term makes the difference) and the kernels per call
+(XLA's fused kernels, PyTorch's ATen operators); for other rows the batch, the kind of operation and
+the thread counts.
 Also rows for the fast/paper speedups (jax, torch = each framework's fast/paper ratio; ratio empty),
 the fast LNN's achieved GFLOP/s (XLA's FLOP count for both frameworks), the attainable (matrix products)
 GFLOP/s and the achieved fraction.
@@ -10,35 +14,94 @@ GFLOP/s and the achieved fraction.
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
+
+from replication.bench.timing import TORCH_THREADS
+from replication.bench.train_target import ORIGINAL_SAMPLES, PAPER_L1, TARGET_SAMPLES
 
 FAST_PAPER_TARGET = {2: 1.25, 16: 1.8}
 
 
-def _reason(op: str, ratio: float, batch=None) -> str:
-    if not np.isfinite(ratio) or 0.5 <= ratio <= 2.0:
-        return ""
-    if ratio < 0.5:
-        return "PyTorch faster: its eager kernel (oneDNN/MKL) beats XLA's CPU code for this shape"
-    if batch is not None and batch < 256:
-        return ("small batch: per-call overhead dominates; PyTorch eager dispatches every operator (and "
-                "the torch.func transforms) from Python, JAX runs one compiled XLA program")
-    if "truth" in op:
-        return ("generated SymPy expression: hundreds of elementwise operations, fused into one loop by XLA, "
-                "one kernel each in PyTorch eager")
-    if "paper" in op:
-        return ("torch.func vmap over hessian/jacrev runs the per-sample Jacobians operator by operator "
-                "(batched rules, copies); XLA fuses them")
+def _fit_call_cost(rows) -> dict:
+    """{(system, model, formulation, dtype, framework): (t0 s/call, t1 s/sample)}: the call time
+    b / samples_per_s = t0 + b t1 through the smallest and the largest batch of a case (needs two batch
+    sizes; t1 >= 0, t0 >= 0), so that both ends of the batch range are reproduced exactly."""
+    by: dict = {}
+    for r in rows:
+        by.setdefault((r["system"], r["model"], r["formulation"], r["dtype"], r["framework"]), []).append(r)
+    fit = {}
+    for k, rs in by.items():
+        lo, hi = min(rs, key=lambda r: r["batch"]), max(rs, key=lambda r: r["batch"])
+        if lo["batch"] == hi["batch"]:
+            continue
+        t_lo, t_hi = lo["batch"] / lo["samples_per_s"], hi["batch"] / hi["samples_per_s"]
+        t1 = max((t_hi - t_lo) / (hi["batch"] - lo["batch"]), 0.0)
+        fit[k] = (max(t_lo - lo["batch"] * t1, 0.0), t1)
+    return fit
+
+
+def _count(x) -> str:
+    return "?" if x is None or not np.isfinite(x) else str(int(x))
+
+
+def _us(x) -> str:
+    return f"{x * 1e6:.3g} us"
+
+
+def _inference_note(key, b, j_rate, t_rate, fit, ops) -> str:
+    """Why JAX and PyTorch differ at this batch, from the batch fit and the kernel counts (measured)."""
+    ratio = j_rate / t_rate
+    j, t = fit.get((*key, "jax")), fit.get((*key, "torch"))
+    oj, ot = ops.get((*key, "jax")), ops.get((*key, "torch"))
+    parts = []
+    if j and t:
+        fixed, per = t[0] - j[0], b * (t[1] - j[1])
+        slow = "PyTorch" if ratio > 1 else "JAX"
+        dominant = "fixed per-call cost (dispatch)" if abs(fixed) >= abs(per) else "per-sample compute"
+        parts.append(f"{slow} slower mainly by {dominant}: call = fixed + batch x per-sample through the "
+                     f"smallest and largest batch: fixed JAX {_us(j[0])}, PyTorch {_us(t[0])}; per-sample JAX "
+                     f"{_us(j[1])}, PyTorch {_us(t[1])}")
+    else:  # one batch size: no fit; what the row is says which cost dominates
+        parts.append(_generic_note("q''", ratio, b, b / min(j_rate, t_rate)))
+    if "?" not in (_count(oj), _count(ot)):
+        parts.append(f"kernels per call: XLA {_count(oj)} (fused), PyTorch {_count(ot)} ATen operators")
+    text = "; ".join(parts)
+    return text if "thread" in text else f"{text}; threads: PyTorch {TORCH_THREADS}, XLA default ({os.cpu_count()} cores)"
+
+
+DISPATCH_BOUND_S = 2e-3  # a call shorter than this is mostly per-operator dispatch (~10 us x 100s of ops)
+
+
+def _generic_note(op: str, ratio: float, batch=None, call_s=None) -> str:
+    """Reason for a ratio beyond 2x where no batch fit exists: from the batch, the slower framework's
+    call time (call_s, seconds) and the kind of operation."""
+    what = ("PyTorch faster" if ratio < 1 else "JAX faster") + f" {max(ratio, 1 / ratio):.1f}x"
+    threads = f"PyTorch on {TORCH_THREADS} thread(s), XLA's pool default ({os.cpu_count()} cores)"
     if op.startswith("train"):
-        return "eager autograd and a per-parameter Adam against one fused, compiled XLA step"
-    return ("XLA fuses the elementwise work (softplus and its derivatives in the tangent passes) into the "
-            "matrix products' loops; PyTorch eager runs each operator separately, on 1 thread here")
+        return (f"{what}: eager autograd runs forward and backward operator by operator plus a per-parameter "
+                f"Adam, against one fused, compiled XLA step; {threads}")
+    if op.startswith("matmul") or "GFLOP/s" in op:
+        return f"{what}: matrix products at these shapes; {threads}"
+    at = f"batch {batch}" if batch is not None else "this size"
+    if call_s is not None and call_s < DISPATCH_BOUND_S:
+        return (f"{what}: {at}, the slower call takes {call_s * 1e6:.3g} us: per-call and per-operator "
+                f"dispatch dominates (eager PyTorch dispatches every operator from Python)")
+    if call_s is None and batch is not None and batch < 256:
+        return f"{what}: {at}, small batch: per-call dispatch overhead likely dominates (no call time given)"
+    slow = f" (slower call {call_s:.3g} s)" if call_s is not None else ""
+    return (f"{what}: {at}{slow}, compute-bound: XLA fuses the elementwise work into the products' loops, "
+            f"PyTorch eager runs each operator separately; {threads}")
 
 
-def _row(op, j, t, batch=None, note=""):
+def _row(op, j, t, batch=None, note=None):
+    """j, t: throughputs (per second); with a batch, the slower call time is batch / min(j, t)."""
     r = j / t if (np.isfinite(j) and np.isfinite(t) and t > 0) else np.nan
-    reason = _reason(op, r, batch)
-    return {"operation": op, "jax": j, "torch": t, "ratio": r, "note": "; ".join(x for x in (reason, note) if x)}
+    beyond = np.isfinite(r) and not 0.5 <= r <= 2.0
+    call_s = batch / min(j, t) if batch is not None and beyond else None
+    text = (note if note is not None else _generic_note(op, r, batch, call_s)) if beyond else ""
+    return {"operation": op, "jax": j, "torch": t, "ratio": r, "note": text}
 
 
 def _pairs(rows, keys, value):
@@ -48,19 +111,41 @@ def _pairs(rows, keys, value):
     return {k: v for k, v in got.items() if "jax" in v and "torch" in v}
 
 
-def ratio_rows(inference, training, scaling, fastpaper, matmul, notes) -> list[dict]:
+def _latency_ratios(latency) -> list[dict]:
+    """One row per (method, dtype): the fastest JAX single-sample mode against PyTorch eager."""
     out = []
+    for (meth, dt) in sorted({(r["method"], r["dtype"]) for r in latency}):
+        rs = [r for r in latency if r["method"] == meth and r["dtype"] == dt]
+        jx = [r for r in rs if r["framework"] == "jax"]
+        tc = [r for r in rs if r["framework"] == "torch"]
+        if not jx or not tc:
+            continue
+        j, t = max(jx, key=lambda r: r["evals_per_s"]), tc[0]
+        note = (f"one sample, JAX {j['mode']} ({j['dispatch']} dispatch): {_us(1 / j['evals_per_s'])} per call, "
+                f"{_count(j.get('ops'))} XLA kernels in one dispatch; PyTorch eager: {_us(1 / t['evals_per_s'])} per "
+                f"call, {_count(t.get('ops'))} ATen operators each dispatched from Python")
+        out.append(_row(f"single sample delan {meth} {dt} (evals/s)", j["evals_per_s"], t["evals_per_s"],
+                        batch=1, note=note))
+    return out
+
+
+def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=()) -> list[dict]:
+    out = _latency_ratios(latency)
     inf = [r for r in inference if r.get("source") == "random_init"]
+    fit = _fit_call_cost(inf)
+    ops = {(r["system"], r["model"], r["formulation"], r["dtype"], r["framework"]): r.get("ops") for r in inf}
     for (sy, m, f, dt, b), v in _pairs(inf, ("system", "model", "formulation", "dtype", "batch"),
                                       "samples_per_s").items():
-        out.append(_row(f"q'' {sy} {m}/{f} {dt} batch {b}", v["jax"], v["torch"], batch=b))
+        note = _inference_note((sy, m, f, dt), b, v["jax"], v["torch"], fit, ops) if v["torch"] > 0 else None
+        out.append(_row(f"q'' {sy} {m}/{f} {dt} batch {b}", v["jax"], v["torch"], batch=b, note=note))
     jit = {(r["model"]): r["steps_per_s"] for r in training if r["mode"] == "jit"}
     for r in training:
         if r["framework"] == "torch" and r["model"] in jit:
             out.append(_row(f"train {r['system']} {r['model']} jit vs {r['mode']} batch {r['batch']} (steps/s)",
                             jit[r["model"]], r["steps_per_s"]))
+    batch_of = {(r["study"], r["formulation"], r["n"]): r.get("batch") for r in scaling}
     for (st, f, n), v in _pairs(scaling, ("study", "formulation", "n"), "samples_per_s").items():
-        out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"]))
+        out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"], batch=batch_of.get((st, f, n))))
     for (d, f), v in _pairs(fastpaper, ("dof", "formulation"), "samples_per_s").items():
         out.append(_row(f"q'' lnn/{f} d={d} float32 batch {fastpaper[0]['batch']} (3x600 target)",
                         v["jax"], v["torch"], batch=fastpaper[0]["batch"]))
@@ -91,7 +176,7 @@ def _get(rows, value="samples_per_s", **match):
     return np.nan
 
 
-def targets(ratios, scaling_fit, scaling, inference, training) -> dict:
+def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train_target=()) -> dict:
     byop = {r["operation"]: r for r in ratios}
     t: dict = {}
     for d, tgt in FAST_PAPER_TARGET.items():
@@ -124,9 +209,26 @@ def targets(ratios, scaling_fit, scaling, inference, training) -> dict:
     for fw in ("jax", "torch"):
         dl = {r["batch"]: r["samples_per_s"] for r in inference if r["model"] == "delan" and
               r["framework"] == fw and r["dtype"] == "float32" and r["system"] == "double_pendulum"}
-        if dl:
-            t[f"delan_{fw}"] = {"single_sample_per_s": dl.get(1), "batched": {str(b): v for b, v in dl.items()},
-                                "target_single": 1e4, "met": bool((dl.get(1) or 0) >= 1e4)}
+        single = {f"{r['method']}/{r['mode']}/{r['dispatch']}": r["evals_per_s"] for r in latency
+                  if r["framework"] == fw and r["dtype"] == "float32"}
+        if dl or single:
+            best = max(single.items(), key=lambda kv: kv[1]) if single else (None, dl.get(1) or 0.0)
+            t[f"delan_{fw}"] = {"single_sample_per_s": best[1], "best_mode": best[0], "single_sample": single,
+                                "batched_acceleration": {str(b): v for b, v in dl.items()},
+                                "target_single": 1e4, "met": bool(best[1] >= 1e4),
+                                "met_by": sorted(k for k, v in single.items() if v >= 1e4)}
+    for proto in sorted({r["protocol"] for r in train_target}):
+        rs = sorted((r for r in train_target if r["protocol"] == proto), key=lambda r: -r["threshold"])
+        paper = [r for r in rs if abs(r["threshold"] - PAPER_L1) < 1e-9]
+        hit = bool(paper and np.isfinite(paper[0]["samples_to_reach"])
+                   and paper[0]["samples_to_reach"] <= TARGET_SAMPLES)
+        t[f"train_target_{proto}"] = {
+            "target": f"held-out L1 <= {PAPER_L1:g} within {TARGET_SAMPLES:.0e} samples (a tenth of the original's "
+                      f"{ORIGINAL_SAMPLES:.0e})", "budget": rs[0]["budget"], "hidden": rs[0]["hidden"],
+            "best_l1": rs[0]["best_l1"], "description": rs[0]["description"],
+            "samples_to_reach": {f"{r['threshold']:g}": r["samples_to_reach"] for r in rs},
+            "extrapolated_samples_NOT_MEASURED": {f"{r['threshold']:g}": r["extrapolated_samples"] for r in rs},
+            "met": hit}
     t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}": r["samples_per_s"]
                                    for r in training}
     return t

@@ -14,7 +14,11 @@ from replication.results import write_npz
 COLUMNS = {
     "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
     "training": ["system", "model", "framework", "mode", "dtype", "batch", "steps_per_s", "samples_per_s"],
-    "rollout": ["system", "solver", "rtol", "kind", "wall_s", "state_err", "energy_err"],
+    "rollout": ["system", "solver", "rtol", "kind", "model", "source", "wall_s", "state_err", "energy_err"],
+    "latency": ["model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s", "max_abs_diff"],
+    "train_target": ["protocol", "budget", "threshold", "samples_to_reach", "reached", "extrapolated_samples",
+                     "extrapolation"],
+    "train_target_log": ["protocol", "samples", "heldout_l1"],
     "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
     "scaling_fit": ["study", "formulation", "framework", "exponent"],
     "ratios": ["operation", "jax", "torch", "ratio", "note"],
@@ -24,7 +28,7 @@ COLUMNS = {
     "matmul": ["dof", "framework", "gflops"],
 }
 POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples_per_s"],
-            "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"],
+            "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"], "latency": ["evals_per_s"],
             "fast_paper": ["samples_per_s"], "matmul": ["gflops"]}
 
 
@@ -39,10 +43,23 @@ def _fake_trained_unit(out):
         "model_spec": spec.to_dict(), "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
 
 
+def _fake_training_cache(out):
+    """An LNN in the training cache (OUT/trained/jax/<key>/) as `replication.training` leaves it; the
+    baseline is missing, so the rollout study trains a tiny one."""
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
+    folder = out / "trained" / "jax" / "fakekey"
+    folder.mkdir(parents=True)
+    write_npz(folder / "checkpoint.npz", init_params(spec, seed=4))
+    (folder / "result.json").write_text(json.dumps({
+        "failure": None, "steps_done": 10, "batch": 8, "spec": spec.to_dict(), "seed": 0,
+        "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+
+
 @pytest.fixture(scope="module")
 def bench_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("bench")
     _fake_trained_unit(out)
+    _fake_training_cache(out)
     targets = run_bench(out, tiny=True, progress=False)
     return out, targets
 
@@ -73,11 +90,45 @@ def test_inference_covers_every_model_and_framework(bench_dir):
     assert set(trained["framework"]) == {"jax"} and set(trained["hidden"].astype(str)) == {"8"}
 
 
-def test_rollout_has_chaos_floor_and_rk4(bench_dir):
+def test_rollout_has_chaos_floor_rk4_and_learned_models(bench_dir):
     out, _ = bench_dir
     df = pd.read_csv(out / "bench" / "rollout.csv")
     assert (df["kind"] == "chaos_floor").sum() == 1
     assert "rk4" in set(df["solver"])
+    learned = df[df["kind"].str.startswith("learned")]
+    assert set(zip(learned["model"], learned["kind"], strict=True)) == {("lnn", "learned"),
+                                                                          ("baseline", "learned_tiny")}
+    assert learned[learned["model"] == "lnn"]["source"].str.startswith("trained:fakekey").all()
+
+
+def test_latency_compiled_matches_method_and_is_in_targets(bench_dir):
+    out, targets = bench_dir
+    df = pd.read_csv(out / "bench" / "latency.csv")
+    assert {"method", "compile_single", "compile_single_frozen"} <= set(df[df["framework"] == "jax"]["mode"])
+    assert set(df[df["framework"] == "jax"]["dispatch"]) == {"async", "sync"}
+    assert "eager" in set(df[df["framework"] == "torch"]["mode"])
+    assert df["max_abs_diff"].max() < 1e-4  # float32
+    assert targets["delan_jax"]["best_mode"] and "met" in targets["delan_jax"]
+
+
+def test_train_target_rows(bench_dir):
+    out, targets = bench_dir
+    df = pd.read_csv(out / "bench" / "train_target.csv")
+    assert set(df["protocol"]) == {"original_scaled", "variant"}
+    assert set(df["threshold"]) == {10.0, 3.0, 1.0, 0.3, 0.073}
+    missed = df[~np.isfinite(df["samples_to_reach"].to_numpy(float))]
+    assert missed["reached"].str.startswith("not reached within budget").all()
+    assert df["extrapolation"].str.contains("EXTRAPOLATED").all()
+    assert targets["train_target_variant"]["met"] in (True, False)
+    assert set(targets["train_target_original_scaled"]["samples_to_reach"]) == {"10", "3", "1", "0.3", "0.073"}
+
+
+def test_ratio_notes_explain_every_ratio_beyond_2x(bench_dir):
+    out, _ = bench_dir
+    df = pd.read_csv(out / "bench" / "ratios.csv")
+    r = df["ratio"].to_numpy(float)
+    beyond = np.isfinite(r) & ((r > 2) | (r < 0.5))
+    assert df[beyond]["note"].fillna("").str.len().min() > 20 if beyond.any() else True
 
 
 def test_machine_and_targets(bench_dir):
