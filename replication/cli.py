@@ -60,7 +60,7 @@ def cmd_fit(args):
 def cmd_bench(args):
     from replication.bench import run_bench
 
-    run_bench(out=args.out, quick=not args.full)
+    run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from)
 
 
 def cmd_stiff(args):
@@ -113,6 +113,8 @@ def build_parser():
     s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)")
     s.add_argument("--out", default="results/quick")
     s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow)")
+    s.add_argument("--trained-from", help="results folder whose training cache holds the learned models rolled "
+                                          "out in the solver study (default: --out; else tiny models are trained)")
     s.set_defaults(func=cmd_bench)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
                                      "(writes OUT/stiff/solvers.csv for the report)")

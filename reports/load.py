@@ -24,6 +24,9 @@ BENCH_COLUMNS = {
     "rollout": ["system", "solver", "rtol", "kind", "wall_s", "state_err", "energy_err"],
     "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
     "ratios": ["operation", "jax", "torch", "ratio", "note"],
+    "latency": ["system", "model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"],
+    "train_target": ["protocol", "description", "budget", "threshold", "samples_to_reach", "reached", "best_l1",
+                     "samples_per_s", "extrapolated_samples", "extrapolation"],
 }
 UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
 

@@ -62,10 +62,45 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
     if FS.bench_scaling(res.bench.get("scaling"), out_dir / "figures/bench_scaling.png"):
         b.add(Figure("figures/bench_scaling.png", "Cost per evaluation against size, per formulation.",
                      ["bench/scaling.csv"]))
-    for name, title in (("training", "Training throughput"), ("rollout", "Rollout cost and error per solver")):
+    for name, title in (("training", "Training throughput"), ("rollout", "Rollout cost and error per solver "
+                                                                        "(truth and learned models)")):
         if name in res.bench:
             b.add(Table(title, _bench_table(res.bench[name]), [f"bench/{name}.csv"]))
+    if "latency" in res.bench:
+        cols = ["model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"]
+        b.add(Table("Single-sample latency (online control): evaluations per second, one core",
+                    _bench_table(res.bench["latency"][cols]), ["bench/latency.csv"],
+                    note="compile_single: `models.jax.compiled`, one XLA dispatch per call; frozen: parameters "
+                         "compiled in as constants; sync: JAX's CPU dispatch in the calling thread."))
+    if "train_target" in res.bench:
+        cols = ["protocol", "threshold", "samples_to_reach", "reached", "best_l1", "samples_per_s",
+                "extrapolated_samples"]
+        b.add(Table("Samples to reach held-out L1 thresholds (double-pendulum LNN; paper: 7.3e-2 at ~3e8)",
+                    _bench_table(res.bench["train_target"][cols]), ["bench/train_target.csv"],
+                    note="extrapolated_samples is a power-law extrapolation of the best-so-far curve, not a "
+                         "measurement; 'not reached' rows say within which budget."))
+    targets = _targets_table(res.root / "bench" / "targets.json")
+    if targets is not None:
+        b.add(Table("Speed targets: measured against the target", targets, ["bench/targets.json"]))
     return [s, b]
+
+
+def _targets_table(path: Path) -> pd.DataFrame | None:
+    """One row per target of bench/targets.json: name, met, and its scalar measured values."""
+    import json
+
+    try:
+        targets = json.loads(path.read_text())["targets"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    rows = []
+    for name, t in targets.items():
+        if not isinstance(t, dict):
+            continue
+        values = "; ".join(f"{k} {cell(v)}" for k, v in t.items()
+                           if k != "met" and isinstance(v, int | float | str) and not isinstance(v, bool))
+        rows.append({"target": name, "met": "yes" if t.get("met") else "no", "measured": values})
+    return pd.DataFrame(rows) if rows else None
 
 
 def agreement_sections(res: Results) -> list[Section]:

@@ -144,6 +144,22 @@ def test_report_loader_accepts_bench_files(bench_dir):
 
     out, _ = bench_dir
     res = load_results(out)
-    assert {"inference", "training", "rollout", "scaling", "ratios"} <= set(res.bench)
+    assert {"inference", "training", "rollout", "scaling", "ratios", "latency", "train_target"} <= set(res.bench)
     assert not [p for p in res.problems if "bench/" in p]
     assert res.machine is not None
+
+
+def test_report_speed_section_shows_latency_train_target_and_targets(bench_dir, tmp_path):
+    from reports.sections_speed import speed_sections
+
+    out, _ = bench_dir
+    titles = [b.title for s in speed_sections(load_results_of(out), tmp_path) for b in s.blocks if hasattr(b, "df")]
+    assert any(t.startswith("Single-sample latency") for t in titles)
+    assert any(t.startswith("Samples to reach held-out L1") for t in titles)
+    assert any(t.startswith("Speed targets") for t in titles)
+
+
+def load_results_of(out):
+    from reports.load import load_results
+
+    return load_results(out)
