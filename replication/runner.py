@@ -6,6 +6,7 @@ interrupted run resumes where it stopped and ends with the same numbers as an un
 """
 from __future__ import annotations
 
+import json
 import logging
 import time
 from pathlib import Path
@@ -45,15 +46,18 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
 
 
 def is_current(unit, out) -> bool:
-    """True if the unit's folder holds a verified result of this very protocol and model spec. A verified
-    result of another protocol or spec (the claim was edited) is kept, renamed `superseded-<time>-seed<k>`,
+    """True if the unit's folder holds a verified result of this very protocol, model spec and evaluation
+    config. A verified result of another protocol, spec or evaluation config (the claim was edited) is kept, renamed `superseded-<time>-seed<k>`,
     and the unit is rerun: nothing finished is lost or silently overwritten."""
     folder = unit.folder(out)
     try:
         d = R.load_result(folder)
     except R.CorruptResult:
         return False
-    if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict():
+    cfg = unit.claim.eval_config.get(unit.profile, {})
+    # results written before evaluation configs were recorded carry none: judged on protocol and spec only
+    same_eval = "eval_config" not in d or d["eval_config"] == json.loads(json.dumps(cfg))
+    if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
         return True
     stamp = env.now().replace(":", "").replace("-", "")
     folder.rename(folder.with_name(f"superseded-{stamp}-{folder.name}"))

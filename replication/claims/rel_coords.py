@@ -26,7 +26,7 @@ _base = Protocol(data="relativistic_iid", steps=20, batch=32, n_train=640, n_hel
                  lr=1e-3, schedule="onecycle", lr_start=0.3, log_every=5)
 PROTOCOLS = {
     "smoke": _base,
-    "quick": _base.replace(steps=2000, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50),
+    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50),
     "paper": _base.replace(steps=300_000, batch=512, n_train=512 * 3000, n_heldout=100_000, log_every=1000),
 }
 

@@ -20,7 +20,7 @@ PROTOCOLS = {"smoke": _base,
                                     schedule="step", lr_step_every=700, lr_step_gamma=0.1),
              "paper": _base.replace(steps=500_000, batch=1, n_train=5000, n_heldout=20_000, log_every=5000)}
 EVAL = {"smoke": {"n_big": 100, "t_end": 1.0, "n_t": 11, "dt": 0.05},
-        "quick": {"n_big": 100, "t_end": 10.0, "n_t": 101, "dt": 0.05},
+        "quick": {"n_big": 100, "t_end": 6.0, "n_t": 61, "dt": 0.05},
         "paper": {"n_big": 100, "t_end": 300.0, "n_t": 1500, "dt": 0.01}}
 
 

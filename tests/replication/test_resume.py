@@ -69,3 +69,17 @@ def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatc
     assert R.load_result(new.parent)["train_steps"] == 7
     (old,) = tmp_path.glob("units/dp_loss/jax/baseline/superseded-*-seed0/result.json")
     assert R.load_result(old.parent)["train_steps"] == 20
+
+
+def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
+    from replication.claims import get
+
+    kw = dict(profile="smoke", out=tmp_path, claims=["dp_energy"], frameworks=("jax",), models=["baseline"],
+              progress=False)
+    run(**kw)
+    claim = get("dp_energy")
+    monkeypatch.setitem(claim.eval_config, "smoke", {**claim.eval_config["smoke"], "n_ics": 2})
+    run(**kw)
+    (new,) = tmp_path.glob("units/dp_energy/jax/baseline/seed0/result.json")
+    assert R.load_result(new.parent)["eval_config"]["n_ics"] == 2
+    assert len(list(tmp_path.glob("units/dp_energy/jax/baseline/superseded-*-seed0/result.json"))) == 1
