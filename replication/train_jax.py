@@ -3,7 +3,8 @@
 `train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome` runs `protocol.steps`
 Adam steps (optax.scale_by_adam, scaled by the learning rate the neutral schedule gives for the
 step), records loss and global gradient norm every `log_every` steps (and at step 0 and the last;
-for LNN/LGN also the velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops at the first non-finite loss or gradient, keeping the parameters from before that step.
+for LNN/LGN also the velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops
+at the first non-finite loss or gradient, keeping the parameters from before that step.
 """
 from __future__ import annotations
 
