@@ -13,6 +13,8 @@
            is not finite) the sample takes the paper's pinv result and is counted in n_fallback.
            Indefinite but well-conditioned H are solved exactly (pinv would give the same).
 `euler_lagrange(...)` returns qddot only; `velocity_hessian(L_fn, q, qdot, extra)` -> (..., d, d).
+Large batches are computed in cache-sized row blocks (`models.jax.blocking`; JAX only, eager PyTorch
+gained nothing reliable from it).
 Mirrored line for line by `models.torch.lnn`; in both, `LNN`'s own fast terms come from the hand-written
 MLP derivatives (`models.jax.mlp_derivatives`), the generic `fast_terms` serves any other L_fn.
 """
@@ -24,6 +26,7 @@ import jax.numpy as jnp
 from jax import lax
 
 from models.jax.base import Model
+from models.jax.blocking import in_row_blocks
 from models.jax.mlp import mlp, mlp_input, wrap_angles
 from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
 from models.numerics import pinv_rtol, rcond_min
@@ -87,11 +90,11 @@ def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):
     d, batch = q.shape[-1], q.shape[:-1]
     qf, qdf, ef = _flat(q, d), _flat(qdot, d), _flat(extra, None)
     if formulation == "paper":
-        hess, rhs = paper_terms(L_fn, qf, qdf, ef)
+        hess, rhs = in_row_blocks(lambda a, b, e: paper_terms(L_fn, a, b, e), (qf, qdf, ef), d + 1)
         return pinv_solve(hess, rhs).reshape(*batch, d), jnp.zeros((), jnp.int64)
     if formulation != "fast":
         raise ValueError(f"unknown formulation {formulation!r}; valid: fast, paper")
-    hess, rhs = fast_terms(L_fn, qf, qdf, ef)
+    hess, rhs = in_row_blocks(lambda a, b, e: fast_terms(L_fn, a, b, e), (qf, qdf, ef), d + 1)
     x, n_bad = solve_with_fallback(hess, rhs)
     return x.reshape(*batch, d), n_bad
 
@@ -134,6 +137,11 @@ class LNN(Model):
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
         return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
 
+    def _blocked_terms(self, q, qdot, extra):
+        """`_fast_terms` on the flattened batch, in cache-sized row blocks (`models.jax.blocking`)."""
+        d = q.shape[-1]
+        return in_row_blocks(self._fast_terms, (_flat(q, d), _flat(qdot, d), _flat(extra, None)), d + 1)
+
     @eqx.filter_jit
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""
@@ -145,7 +153,7 @@ class LNN(Model):
         """(..., dof, dof)."""
         self._check_state(q, qdot, extra)
         d, extra = q.shape[-1], extra if self.spec.extra_inputs else None
-        hess, _ = self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None))
+        hess, _ = self._blocked_terms(q, qdot, extra)
         return hess.reshape(*q.shape, d)
 
     @eqx.filter_jit
@@ -156,7 +164,7 @@ class LNN(Model):
         if self.spec.formulation != "fast":
             return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
         d = q.shape[-1]
-        x, n_bad = solve_with_fallback(*self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None)))
+        x, n_bad = solve_with_fallback(*self._blocked_terms(q, qdot, extra))
         return x.reshape(*q.shape[:-1], d), n_bad
 
     def acceleration(self, q, qdot, extra=None):

@@ -40,6 +40,8 @@ def _qddot(obj, kind, q, qdot):
     return obj.acceleration(q, qdot)
 
 
+FLOPS_ROWS = 16  # at most 2 * the smallest block (`models.jax.blocking.block_size` >= 8): one block
+
 _NOT_KERNELS = {"parameter", "constant", "bitcast", "tuple", "get-tuple-element"}
 
 
@@ -94,11 +96,15 @@ class JaxEvaluator:
         return xla_kernels(self.compiled(args))
 
     def flops(self, args) -> float | None:
-        """FLOPs of one call from XLA's compiled cost analysis (None if unavailable)."""
-        cost = self.compiled(args).cost_analysis()
+        """FLOPs of one call from XLA's compiled cost analysis (None if unavailable). The analysis
+        counts a loop body once, and large batches run in row blocks (`models.jax.blocking`), so the
+        call is costed on its first FLOPS_ROWS samples (never blocked) and scaled to the batch."""
+        n = args[0].shape[0]
+        m = min(n, FLOPS_ROWS)
+        cost = self.compiled(tuple(a[:m] for a in args)).cost_analysis()
         if isinstance(cost, list | tuple):
             cost = cost[0] if cost else None
-        return float(cost["flops"]) if cost and "flops" in cost else None
+        return float(cost["flops"]) * n / m if cost and "flops" in cost else None
 
 
 class TruthJax(JaxEvaluator):
