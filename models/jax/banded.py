@@ -3,15 +3,17 @@
 solve_cyclic_banded(band, rhs, layout): band (B, n, 2w+1) with band[b, i, k] = H[i, (i+k-w) mod n],
 rhs (B, n) -> x (B, n) with H x = rhs; layout = `models.graph.cyclic_band_layout(n, r)`.
 Interior nodes 0 .. m*w-1 form a block-tridiagonal matrix A (blocks w x w), eliminated by block
-Thomas (dense LU with partial pivoting inside each block, none across blocks) with the border columns
-as extra right-hand sides; the border (nb nodes) is then solved from its Schur complement. Cost
-O(n w^2 nb). Non-finite results (a singular pivot block) are left to the caller's fallback.
+cyclic reduction (log2 m levels; dense LU with partial pivoting inside each block, none across blocks)
+with the border columns as extra right-hand sides; the border (nb nodes) is then solved from its Schur
+complement. Cost O(n w^2 nb). Non-finite results (a singular pivot block) are left to the caller's
+fallback. Cyclic reduction replaced a block Thomas sweep (m sequential steps): same cost in JAX up to
+n = 1024, 0.78x at n = 4096; in eager PyTorch, whose every operation has a fixed cost, the sweep made
+the banded LGN grow like n^1.27 (n >= 64), cyclic reduction like n^1.02 (measured, batch 1024 // n).
 """
 from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
-from jax import lax
 
 from models.graph import band_columns
 
@@ -21,27 +23,30 @@ def _gather(band, triple):
     return jnp.where(jnp.asarray(mask), band[:, rows, cols], 0.0)
 
 
+def _shift(a, step):
+    """Blocks moved one place along axis 1, zero-filled: step +1 gives a[j-1] at j, -1 gives a[j+1]."""
+    zero = jnp.zeros_like(a[:, :1])
+    return jnp.concatenate([zero, a[:, :-1]], 1) if step > 0 else jnp.concatenate([a[:, 1:], zero], 1)
+
+
 def block_tridiagonal_solve(diag, lower, upper, rhs):
-    """diag, lower, upper (B, m, w, w) (lower[:, 0] = upper[:, -1] = 0), rhs (B, m, w, k) -> (B, m, w, k)."""
-    w = diag.shape[-1]
-    xs = tuple(jnp.moveaxis(a, 1, 0) for a in (diag, lower, upper, rhs))
-
-    def forward(carry, blk):
-        c_prev, f_prev = carry
-        d, lo, up, r = blk
-        sol = jnp.linalg.solve(d - lo @ c_prev, jnp.concatenate([up, r - lo @ f_prev], axis=-1))
-        return (sol[..., :w], sol[..., w:]), (sol[..., :w], sol[..., w:])
-
-    init = (jnp.zeros_like(xs[0][0]), jnp.zeros_like(xs[3][0]))
-    _, (c, f) = lax.scan(forward, init, xs)
-
-    def backward(x_next, blk):
-        c_b, f_b = blk
-        x = f_b - c_b @ x_next
-        return x, x
-
-    _, x = lax.scan(backward, jnp.zeros_like(f[0]), (c, f), reverse=True)
-    return jnp.moveaxis(x, 0, 1)
+    """diag, lower, upper (B, m, w, w) (lower[:, 0] = upper[:, -1] = 0), rhs (B, m, w, k) -> (B, m, w, k),
+    by block cyclic reduction (see `models.torch.banded.block_tridiagonal_solve`)."""
+    bsz, m, w = diag.shape[0], diag.shape[1], diag.shape[-1]
+    if m == 1:
+        return jnp.linalg.solve(diag[:, 0], rhs[:, 0])[:, None]
+    if m % 2:                                    # append a decoupled identity block (x = 0 there)
+        eye = jnp.broadcast_to(jnp.eye(w, dtype=diag.dtype), (bsz, 1, w, w))
+        zero_w, zero_k = jnp.zeros_like(diag[:, :1]), jnp.zeros_like(rhs[:, :1])
+        return block_tridiagonal_solve(jnp.concatenate([diag, eye], 1), jnp.concatenate([lower, zero_w], 1),
+                                       jnp.concatenate([upper, zero_w], 1), jnp.concatenate([rhs, zero_k], 1))[:, :m]
+    sol = jnp.linalg.solve(diag[:, 1::2], jnp.concatenate([lower[:, 1::2], upper[:, 1::2], rhs[:, 1::2]], -1))
+    a, b, f = sol[..., :w], sol[..., w:2 * w], sol[..., 2 * w:]
+    lo_e, up_e = lower[:, 0::2], upper[:, 0::2]  # even block e = 2j couples to odd j - 1 and odd j
+    x_even = block_tridiagonal_solve(diag[:, 0::2] - up_e @ a - lo_e @ _shift(b, 1), -lo_e @ _shift(a, 1),
+                                     -up_e @ b, rhs[:, 0::2] - up_e @ f - lo_e @ _shift(f, 1))
+    x_odd = f - a @ x_even - b @ _shift(x_even, -1)
+    return jnp.stack([x_even, x_odd], 2).reshape(rhs.shape)
 
 
 def solve_cyclic_banded(band, rhs, layout):
