@@ -13,7 +13,10 @@ Mirrored line for line by `models.jax.delan`. Shapes: q, qdot, qddot, tau
 """
 from __future__ import annotations
 
+from functools import cache
+
 import torch
+from torch.nn.functional import linear as _lin
 
 from models.params import n_layers, tril_selection
 from models.torch.base import Model
@@ -25,9 +28,26 @@ def _mv(m, v):
     return (m @ v[..., None])[..., 0]
 
 
+def _vm(v, m):
+    """v^T m over the second-to-last axis of m: v (..., i), m (..., i, j) -> (..., j)."""
+    return (v[..., None, :] @ m)[..., 0, :]
+
+
+@cache
+def _constant(kind: str, d: int, dtype: torch.dtype, scale: tuple | None = None):
+    """Per-call constants, built once (a tensor built from NumPy costs more than the small products):
+    "tril" the (d(d+1)/2, d*d) assembly matrix S^T (`models.params.tril_selection`), "eye" I_d,
+    "dx" diag(input scale) (the tangents dx/dq_k)."""
+    if kind == "tril":
+        return torch.tensor(tril_selection(d).T, dtype=dtype)
+    if kind == "eye":
+        return torch.eye(d, dtype=dtype)
+    return torch.diag(torch.ones(d, dtype=dtype) if scale is None else torch.tensor(scale, dtype=dtype))
+
+
 def _lower(vec, d):
     """[diag, strictly lower] (..., d(d+1)/2) -> Lc (..., d, d)."""
-    return (vec @ torch.tensor(tril_selection(d), dtype=vec.dtype).T).reshape(*vec.shape[:-1], d, d)
+    return (vec @ _constant("tril", d, vec.dtype)).reshape(*vec.shape[:-1], d, d)
 
 
 class DeLaN(Model):
@@ -44,35 +64,35 @@ class DeLaN(Model):
         its d forward tangents (x = scale * wrap(q), so dx/dq_k = scale_k e_k; wrapping has slope 1)."""
         spec, d, p = self.spec, self.spec.dof, self.params
         x = mlp_input(spec, [wrap_angles(spec, q)])
-        scale = torch.ones(d, dtype=q.dtype) if spec.input_scale is None else \
-            torch.tensor(spec.input_scale, dtype=q.dtype)
-        h, dh = x, torch.diag(scale).expand(*q.shape[:-1], d, d)
+        scale = None if spec.input_scale is None else tuple(spec.input_scale)
+        h, dh = x, _constant("dx", d, q.dtype, scale).expand(*q.shape[:-1], d, d)
         derivs = ACT_DERIVS[spec.activation]
         for i in range(n_layers(spec)):
             a = linear(p, f"mlp.{i}", h)
             h, s1, _ = derivs(a)
-            dh = s1[..., None, :] * (dh @ p[f"mlp.{i}.weight"].T)
+            dh = s1[..., None, :] * _lin(dh, p[f"mlp.{i}.weight"])
         raw = linear(p, "delan_diag", h) + spec.delan_diag_offset
         diag, s1, _ = ACT_DERIVS["softplus"](raw)
-        ddiag = s1[..., None, :] * (dh @ p["delan_diag.weight"].T)
+        ddiag = s1[..., None, :] * _lin(dh, p["delan_diag.weight"])
         if d > 1:
             vec = torch.cat([diag, linear(p, "delan_lower", h)], dim=-1)
-            dvec = torch.cat([ddiag, dh @ p["delan_lower.weight"].T], dim=-1)
+            dvec = torch.cat([ddiag, _lin(dh, p["delan_lower.weight"])], dim=-1)
         else:
             vec, dvec = diag, ddiag
         v = linear(p, "delan_potential", h)[..., 0]
-        return _lower(vec, d), _lower(dvec, d), v, (dh @ p["delan_potential.weight"].T)[..., 0]
+        return _lower(vec, d), _lower(dvec, d), v, _lin(dh, p["delan_potential.weight"])[..., 0]
 
     def _mass_of(self, lc):
-        return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * torch.eye(self.spec.dof, dtype=lc.dtype)
+        return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * _constant("eye", self.spec.dof, lc.dtype)
 
     def _dynamics(self, q, qdot):
         """(M, c, g) at (q, qdot), one trunk pass."""
         lc, dlc, _, g = self._heads_tangents(q)
-        u = _mv(lc.transpose(-1, -2), qdot)                        # Lc^T qdot
-        w = torch.einsum("...kij,...i->...kj", dlc, qdot)          # w_k = dLc_k^T qdot
-        l_dot = torch.einsum("...k,...kij->...ij", qdot, dlc)      # Ldot
-        m_dot_qdot = _mv(l_dot, u) + _mv(lc, torch.einsum("...k,...kj->...j", qdot, w))
+        d = self.spec.dof
+        u = _vm(qdot, lc)                                          # Lc^T qdot
+        w = _vm(qdot[..., None, :], dlc)                           # w_k = dLc_k^T qdot (..., k, j)
+        l_dot = _vm(qdot, dlc.flatten(-2)).unflatten(-1, (d, d))   # Ldot = sum_k qdot_k dLc_k
+        m_dot_qdot = _mv(l_dot, u) + _mv(lc, _vm(qdot, w))
         return self._mass_of(lc), m_dot_qdot - _mv(w, u), g
 
     def mass_matrix(self, q):

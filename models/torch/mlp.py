@@ -62,7 +62,7 @@ ACT = {
 
 def linear(params: dict, prefix: str, x):
     """x (..., in) -> (..., out)."""
-    return x @ params[f"{prefix}.weight"].T + params[f"{prefix}.bias"]
+    return torch.nn.functional.linear(x, params[f"{prefix}.weight"], params[f"{prefix}.bias"])
 
 
 def mlp(params: dict, x, spec, prefix: str = "mlp", final_linear: bool = True):
