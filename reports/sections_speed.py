@@ -70,8 +70,10 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
         cols = ["model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"]
         b.add(Table("Single-sample latency (online control): evaluations per second, one core",
                     _bench_table(res.bench["latency"][cols]), ["bench/latency.csv"],
-                    note="compile_single: `models.jax.compiled`, one XLA dispatch per call; frozen: parameters "
-                         "compiled in as constants; sync: JAX's CPU dispatch in the calling thread."))
+                    note="compile_single: JAX `models.jax.compiled`, one XLA dispatch per call; PyTorch "
+                         "`models.torch.compiled` (torch.export + AOTInductor, parameters as constants), one call "
+                         "into a compiled library; frozen: parameters compiled in as constants; sync: JAX's CPU "
+                         "dispatch in the calling thread."))
     if "train_target" in res.bench:
         cols = ["protocol", "threshold", "samples_to_reach", "reached", "best_l1", "samples_per_s",
                 "extrapolated_samples"]

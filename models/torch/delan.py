@@ -13,8 +13,6 @@ Mirrored line for line by `models.jax.delan`. Shapes: q, qdot, qddot, tau
 """
 from __future__ import annotations
 
-from functools import cache
-
 import torch
 from torch.nn.functional import linear as _lin
 
@@ -33,39 +31,39 @@ def _vm(v, m):
     return (v[..., None, :] @ m)[..., 0, :]
 
 
-@cache
-def _constant(kind: str, d: int, dtype: torch.dtype, scale: tuple | None = None):
-    """Per-call constants, built once (a tensor built from NumPy costs more than the small products):
-    "tril" the (d(d+1)/2, d*d) assembly matrix S^T (`models.params.tril_selection`), "eye" I_d,
-    "dx" diag(input scale) (the tangents dx/dq_k)."""
-    if kind == "tril":
-        return torch.tensor(tril_selection(d).T, dtype=dtype)
-    if kind == "eye":
-        return torch.eye(d, dtype=dtype)
-    return torch.diag(torch.ones(d, dtype=dtype) if scale is None else torch.tensor(scale, dtype=dtype))
-
-
-def _lower(vec, d):
-    """[diag, strictly lower] (..., d(d+1)/2) -> Lc (..., d, d)."""
-    return (vec @ _constant("tril", d, vec.dtype)).reshape(*vec.shape[:-1], d, d)
+def _lower(vec, tril):
+    """[diag, strictly lower] (..., d(d+1)/2) -> Lc (..., d, d); tril = S^T (`models.params.tril_selection`)."""
+    d = int(round(tril.shape[-1] ** 0.5))
+    return (vec @ tril).reshape(*vec.shape[:-1], d, d)
 
 
 class DeLaN(Model):
+    def __init__(self, spec, params):
+        """Per-call constants are built once, as non-persistent buffers (a tensor built from NumPy costs
+        more than the small products; buffers, unlike a module-level cache, are also what torch.export
+        captures): "tril" the (d(d+1)/2, d*d) assembly matrix S^T, "eye" I_d, "dx" diag(input scale),
+        the tangents dx/dq_k."""
+        super().__init__(spec, params)
+        d, dtype = spec.dof, getattr(torch, spec.dtype)
+        scale = torch.ones(d, dtype=dtype) if spec.input_scale is None else torch.tensor(spec.input_scale, dtype=dtype)
+        self.register_buffer("tril", torch.tensor(tril_selection(d).T, dtype=dtype), persistent=False)
+        self.register_buffer("eye", torch.eye(d, dtype=dtype), persistent=False)
+        self.register_buffer("dx", torch.diag(scale), persistent=False)
+
     def _heads(self, q):
         """(Lc (..., d, d), V (...,)) from the trunk on q (no derivatives)."""
         spec, d = self.spec, self.spec.dof
         h = mlp(self.params, mlp_input(spec, [wrap_angles(spec, q)]), spec, final_linear=False)
         diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
-        return _lower(torch.cat(parts, dim=-1), d), linear(self.params, "delan_potential", h)[..., 0]
+        return _lower(torch.cat(parts, dim=-1), self.tril), linear(self.params, "delan_potential", h)[..., 0]
 
     def _heads_tangents(self, q):
         """(Lc (..., d, d), dLc (..., d_k, d, d) = dLc/dq_k, V (...,), dV/dq (..., d)): the trunk with
         its d forward tangents (x = scale * wrap(q), so dx/dq_k = scale_k e_k; wrapping has slope 1)."""
         spec, d, p = self.spec, self.spec.dof, self.params
         x = mlp_input(spec, [wrap_angles(spec, q)])
-        scale = None if spec.input_scale is None else tuple(spec.input_scale)
-        h, dh = x, _constant("dx", d, q.dtype, scale).expand(*q.shape[:-1], d, d)
+        h, dh = x, self.dx.expand(*q.shape[:-1], d, d)
         derivs = ACT_DERIVS[spec.activation]
         for i in range(n_layers(spec)):
             a = linear(p, f"mlp.{i}", h)
@@ -80,10 +78,10 @@ class DeLaN(Model):
         else:
             vec, dvec = diag, ddiag
         v = linear(p, "delan_potential", h)[..., 0]
-        return _lower(vec, d), _lower(dvec, d), v, _lin(dh, p["delan_potential.weight"])[..., 0]
+        return _lower(vec, self.tril), _lower(dvec, self.tril), v, _lin(dh, p["delan_potential.weight"])[..., 0]
 
     def _mass_of(self, lc):
-        return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * _constant("eye", self.spec.dof, lc.dtype)
+        return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * self.eye
 
     def _dynamics(self, q, qdot):
         """(M, c, g) at (q, qdot), one trunk pass."""

@@ -6,7 +6,9 @@ evals_per_s, max_abs_diff, ops}`: evaluations per second of ONE sample (inputs o
 blocked on), for method "inverse_dynamics" (q, qdot, qddot) -> tau and "acceleration" (q, qdot) -> qddot.
 Modes: JAX "method" (the model's eqx.filter_jit method, as a user calls it), "compile_single" and
 "compile_single_frozen" (`models.jax.compiled.compile_single`, parameters as arguments / as constants);
-PyTorch "eager" (the method under torch.no_grad). max_abs_diff: largest |difference| against the model
+PyTorch "eager" (the method under torch.no_grad) and, where `sizes.torch_compile` (not the tiny preset: 15-40 s
+of compiling per method), "compile_single" (`models.torch.compiled.compile_single`: torch.export +
+AOTInductor, parameters as constants; ops None). max_abs_diff: largest |difference| against the model
 method on the same sample (0 for the method itself); ops: XLA kernels of the compiled program, or the
 ATen operators of one PyTorch call (None for the eqx method).
 Each dispatch setting runs in a fresh Python process (`python -m replication.bench.latency`), because
@@ -70,10 +72,11 @@ def _jax_fns(spec, params, method, x):
     return fns, diffs, ops
 
 
-def _torch_fns(spec, params, method, x):
+def _torch_fns(spec, params, method, x, aot: bool):
     import torch
 
     import models.torch
+    from models.torch.compiled import compile_single
 
     m = models.torch.build(spec, params)
     xs = [torch.as_tensor(v, dtype=getattr(torch, spec.dtype)) for v in x]
@@ -82,10 +85,16 @@ def _torch_fns(spec, params, method, x):
     def run():
         with torch.no_grad():
             return call(*xs)
-    return {"eager": run}, {"eager": 0.0}, {"eager": torch_ops(run)}
+    fns, diffs, ops = {"eager": run}, {"eager": 0.0}, {"eager": torch_ops(run)}
+    if aot:
+        f = compile_single(m, method)
+        diffs["compile_single"] = float((f(*xs) - run()).abs().max())
+        fns["compile_single"], ops["compile_single"] = (lambda: f(*xs)), None
+    return fns, diffs, ops
 
 
-def measure(hidden: tuple, dtypes: tuple, seconds: float, sync: bool, methods: tuple = METHODS) -> list[dict]:
+def measure(hidden: tuple, dtypes: tuple, seconds: float, sync: bool, methods: tuple = METHODS,
+            torch_aot: bool = False) -> list[dict]:
     """The rows of one process (call with a fresh interpreter: `sync` must be set before JAX starts)."""
     from models.jax.compiled import async_dispatch, use_sync_dispatch
 
@@ -106,7 +115,7 @@ def measure(hidden: tuple, dtypes: tuple, seconds: float, sync: bool, methods: t
             x = [rng.uniform(-1, 1, 2) for _ in range(3 if method == "inverse_dynamics" else 2)]
             fws = [("jax", *_jax_fns(spec, params, method, x))]
             if sync:
-                fws.append(("torch", *_torch_fns(spec, params, method, x)))
+                fws.append(("torch", *_torch_fns(spec, params, method, x, torch_aot)))
             for fw, fns, diffs, ops in fws:
                 for mode, rate in interleaved_rates(fns, seconds).items():
                     rows.append({"system": "double_pendulum", "model": "delan", "method": method,
@@ -124,7 +133,7 @@ def latency_rows(sizes, notes: list | None = None) -> list[dict]:
     for sync in (False, True):
         arg = json.dumps({"hidden": list(sizes.hidden), "dtypes": list(sizes.latency_dtypes),
                           "seconds": sizes.latency_s, "sync": sync,
-                          "methods": list(sizes.latency_methods)})
+                          "methods": list(sizes.latency_methods), "torch_aot": sizes.torch_compile})
         root = str(Path(__file__).resolve().parents[2])  # the project root, for an uninstalled checkout
         env = {**os.environ, "XLA_FLAGS": f"{os.environ.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(),
                "OMP_NUM_THREADS": "1",
@@ -143,4 +152,5 @@ def latency_rows(sizes, notes: list | None = None) -> list[dict]:
 
 if __name__ == "__main__":
     a = json.loads(sys.argv[1])
-    print(json.dumps(measure(tuple(a["hidden"]), tuple(a["dtypes"]), a["seconds"], a["sync"], tuple(a["methods"]))))
+    print(json.dumps(measure(tuple(a["hidden"]), tuple(a["dtypes"]), a["seconds"], a["sync"], tuple(a["methods"]),
+                             a.get("torch_aot", False))))
