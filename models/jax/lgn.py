@@ -28,6 +28,7 @@ from models.graph import (
 )
 from models.jax.banded import solve_cyclic_banded
 from models.jax.base import Model
+from models.jax.blocking import in_row_blocks
 from models.jax.lnn import euler_lagrange_info, fast_terms, pinv_solve
 from models.jax.mlp import mlp, mlp_input, wrap_angles
 
@@ -61,7 +62,9 @@ def banded_euler_lagrange_info(L_fn, q, qdot, r):
     def fallback():
         safe = jnp.where(bad[:, None, None], jnp.asarray(_identity_band(n, r), band.dtype), band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
-        return jnp.where(bad[:, None], pinv_solve(*fast_terms(L_fn, qf, qdf)), x_safe)
+        # the dense terms in cache-sized row blocks: XLA reserves this branch's memory on every call
+        dense = in_row_blocks(lambda a, b: fast_terms(L_fn, a, b), (qf, qdf), n + 1)
+        return jnp.where(bad[:, None], pinv_solve(*dense), x_safe)
     x = lax.cond(jnp.any(bad), fallback, lambda: x)
     return x.reshape(*batch, n), jnp.sum(bad)
 
