@@ -4,8 +4,12 @@ check_input(spec, name, x, width, like=None): x must be (..., width) (any width 
 spec.dtype, and have the batch shape of `like`. check_state(spec, q, qdot, extra, width=None): the
 (q, qdot[, extra]) triple of a model call. Shape problems raise ValueError, dtype problems TypeError,
 each naming what was expected and what came.
+n_required_inputs(fn): required positional arguments of an unbound model method, less `self` (how
+many inputs `compile_single` compiles for, in both frameworks).
 """
 from __future__ import annotations
+
+import inspect
 
 
 def _dtype_name(x) -> str:
@@ -34,3 +38,10 @@ def check_state(spec, q, qdot, extra=None, width=None):
         check_input(spec, "extra", extra, spec.extra_inputs, like=q)
     elif extra is not None:
         raise ValueError(f"{spec.kind}: got extra inputs but spec.extra_inputs == 0")
+
+
+def n_required_inputs(fn) -> int:
+    """Required positional arguments of an unbound method, less `self`."""
+    sig = inspect.signature(inspect.unwrap(fn))
+    return -1 + sum(p.default is inspect.Parameter.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+               for p in sig.parameters.values())

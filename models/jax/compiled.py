@@ -31,10 +31,11 @@ before the first JAX array is created: the CPU client reads the flag once, when 
 from __future__ import annotations
 
 import dataclasses
-import inspect
 
 import jax
 import jax.numpy as jnp
+
+from models.checks import n_required_inputs
 
 __all__ = ["CompiledMethod", "async_dispatch", "compile_single", "use_sync_dispatch"]
 
@@ -57,13 +58,6 @@ class CompiledMethod:
         return cost[0] if isinstance(cost, list | tuple) and cost else cost
 
 
-def _n_required(fn) -> int:
-    """Required positional arguments of an unbound method, less `self`."""
-    sig = inspect.signature(inspect.unwrap(fn))
-    return -1 + sum(p.default is inspect.Parameter.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
-               for p in sig.parameters.values())
-
-
 def compile_single(model, method: str = "inverse_dynamics", dtype=None, batch: int | None = None,
                    n_inputs: int | None = None, width: int | None = None, freeze: bool = False,
                    compiler_options: dict | None = None) -> CompiledMethod:
@@ -77,7 +71,7 @@ def compile_single(model, method: str = "inverse_dynamics", dtype=None, batch: i
     keys = sorted(model.params)
     leaves = [jnp.asarray(model.params[k], dtype) for k in keys]
     cls = type(model)
-    n = _n_required(getattr(cls, method)) if n_inputs is None else int(n_inputs)
+    n = n_required_inputs(getattr(cls, method)) if n_inputs is None else int(n_inputs)
     shape = (spec.dof if width is None else width,)
     shape = shape if batch is None else (int(batch), *shape)
     example = [jax.ShapeDtypeStruct(shape, dtype) for _ in range(n)]

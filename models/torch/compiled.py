@@ -20,12 +20,13 @@ raises a ValueError naming the input.
 """
 from __future__ import annotations
 
-import inspect
 import os
 import tempfile
 import warnings
 
 import torch
+
+from models.checks import n_required_inputs
 
 __all__ = ["CompiledMethod", "compile_single"]
 
@@ -56,20 +57,13 @@ class CompiledMethod:
         return self.runner(*inputs)
 
 
-def _n_required(fn) -> int:
-    """Required positional arguments of an unbound method, less `self`."""
-    sig = inspect.signature(inspect.unwrap(fn))
-    return -1 + sum(p.default is inspect.Parameter.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
-               for p in sig.parameters.values())
-
-
 def compile_single(model, method: str = "inverse_dynamics", batch: int | None = None,
                    n_inputs: int | None = None, width: int | None = None) -> CompiledMethod:
     """Compile `getattr(model, method)` ahead of time for inputs of shape (width,) or (batch, width)."""
     spec = model.spec
     if not callable(getattr(model, method, None)):
         raise ValueError(f"{spec.kind} model has no method {method!r}")
-    n = _n_required(getattr(type(model), method)) if n_inputs is None else int(n_inputs)
+    n = n_required_inputs(getattr(type(model), method)) if n_inputs is None else int(n_inputs)
     shape = (spec.dof if width is None else width,)
     shape = shape if batch is None else (int(batch), *shape)
     dtype = getattr(torch, spec.dtype)
