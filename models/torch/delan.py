@@ -31,10 +31,9 @@ def _vm(v, m):
     return (v[..., None, :] @ m)[..., 0, :]
 
 
-def _lower(vec, tril):
+def _lower(vec, tril, d):
     """[diag, strictly lower] (..., d(d+1)/2) -> Lc (..., d, d); tril = S^T (`models.params.tril_selection`)."""
-    d = int(round(tril.shape[-1] ** 0.5))
-    return (vec @ tril).reshape(*vec.shape[:-1], d, d)
+    return (vec @ tril).unflatten(-1, (d, d))
 
 
 class DeLaN(Model):
@@ -56,7 +55,7 @@ class DeLaN(Model):
         h = mlp(self.params, mlp_input(spec, [wrap_angles(spec, q)]), spec, final_linear=False)
         diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
-        return _lower(torch.cat(parts, dim=-1), self.tril), linear(self.params, "delan_potential", h)[..., 0]
+        return _lower(torch.cat(parts, dim=-1), self.tril, d), linear(self.params, "delan_potential", h)[..., 0]
 
     def _heads_tangents(self, q):
         """(Lc (..., d, d), dLc (..., d_k, d, d) = dLc/dq_k, V (...,), dV/dq (..., d)): the trunk with
@@ -78,7 +77,7 @@ class DeLaN(Model):
         else:
             vec, dvec = diag, ddiag
         v = linear(p, "delan_potential", h)[..., 0]
-        return _lower(vec, self.tril), _lower(dvec, self.tril), v, _lin(dh, p["delan_potential.weight"])[..., 0]
+        return _lower(vec, self.tril, d), _lower(dvec, self.tril, d), v, _lin(dh, p["delan_potential.weight"])[..., 0]
 
     def _mass_of(self, lc):
         return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * self.eye
