@@ -1,5 +1,5 @@
 """models.torch.compiled.compile_single (torch.export + AOTInductor): the compiled library gives the model
-method's numbers (float64) and refuses inputs of another shape or dtype with a message naming them.
+method's numbers (float64), for contiguous and strided inputs alike, and refuses inputs of another shape or dtype with a message naming them.
 Compiling takes 15-40 s, so the default run compiles once; the batched/tau case is marked slow."""
 import numpy as np
 import pytest
@@ -27,6 +27,10 @@ def test_delan_inverse_dynamics_matches_method_and_checks_inputs():
         got = f(*xs)
         assert got.shape == want.shape
         np.testing.assert_allclose(got.numpy(), want.numpy(), rtol=0, atol=1e-12)
+    strided = torch.tensor(RNG.uniform(-2, 2, (3, 4)))[:, ::2]  # views that are not contiguous
+    with torch.no_grad():
+        want = m.inverse_dynamics(*strided)
+    np.testing.assert_allclose(f(*strided).numpy(), want.numpy(), rtol=0, atol=1e-12)
     with pytest.raises(ValueError, match=r"input 0: compiled for a \(2,\) torch.float64"):
         f(torch.zeros(3, dtype=torch.float64), *xs[1:])
     with pytest.raises(ValueError, match="input 1.*float32"):
