@@ -1,7 +1,9 @@
-"""Single-sample model calls compiled ahead of time (PyTorch): one call = one compiled C++ function.
+"""Model calls compiled ahead of time (PyTorch): one call = one compiled C++ function.
 
     f = compile_single(model, method="inverse_dynamics", batch=None, n_inputs=None, width=None)
     tau = f(q, qdot, qddot)          # torch tensors, each (dof,) (or (batch, dof)) -> a tensor, e.g. (dof,)
+    g = compile_batched(fn, n_inputs=2, width=2, dtype="float32")
+    qddot = g(q, qdot)               # any batch: (B, width) each; fn(*inputs) a torch function or Module
 
 The PyTorch mirror of `models.jax.compiled.compile_single(..., freeze=True)`. Eager PyTorch pays a fixed
 dispatch cost for every ATen operator (4-10 us here); DeLaN's inverse dynamics on one sample is ~115
@@ -16,10 +18,14 @@ Costs and requirements: compiling takes 15-40 s and needs a C++ compiler (gcc; w
 CPU). The compiled kernels use OpenMP: for a one-core control loop set OMP_NUM_THREADS=1 before the
 process starts (measured: DeLaN 3 x 128 one-sample inverse dynamics 12.3k calls/s with it, 6.5k without,
 eager 1.0-1.3k). Inputs must already have the compiled shape and dtype (torch tensors); anything else
-raises a ValueError naming the input.
+raises a ValueError naming the input. `compile_batched` exports with a dynamic batch dimension (one
+library for every batch size; the speed study's "aoti" mode); code that fixes the batch size while
+tracing fails there with torch's constraint error, and `compile_batched(..., batch=B)` compiles it for
+that one batch size instead.
 """
 from __future__ import annotations
 
+import inspect
 import os
 import tempfile
 import warnings
@@ -29,7 +35,9 @@ from torch.utils._pytree import tree_flatten, tree_unflatten
 
 from models.checks import n_required_inputs
 
-__all__ = ["CompiledMethod", "compile_single"]
+__all__ = ["CompiledMethod", "compile_batched", "compile_single"]
+
+MAX_BATCH = 1 << 20  # the largest batch a dynamic-batch library accepts
 
 
 class _Method(torch.nn.Module):
@@ -42,7 +50,8 @@ class _Method(torch.nn.Module):
 
 
 class CompiledMethod:
-    """A model method compiled for fixed input shapes; `f(*inputs)` runs it (one call into the library).
+    """A function compiled for fixed input shapes (None in in_shape[0]: any batch size); `f(*inputs)` runs
+    it (one call into the library).
 
     The call goes straight to the package's loader (`runner.loader.run(list)`) and rebuilds the output
     with its tree spec: the package's own `__call__` flattens and checks the inputs as a pytree first,
@@ -53,19 +62,67 @@ class CompiledMethod:
         self.runner, self.method, self.in_shape, self.dtype, self.n_inputs = runner, method, in_shape, dtype, n_inputs
         self._run, self._out_spec = runner.loader.run, out_spec
         self._single = out_spec.is_leaf()
+        self._dynamic = bool(in_shape) and in_shape[0] is None
+
+    def _fits(self, x) -> bool:
+        if not isinstance(x, torch.Tensor) or x.dtype != self.dtype:
+            return False
+        if self._dynamic:
+            return x.dim() == len(self.in_shape) and 1 <= x.shape[0] <= MAX_BATCH and x.shape[1:] == self.in_shape[1:]
+        return x.shape == self.in_shape
 
     def __call__(self, *inputs):
         if len(inputs) != self.n_inputs:
             raise ValueError(f"{self.method} was compiled for {self.n_inputs} inputs, got {len(inputs)}")
         xs = []
         for i, x in enumerate(inputs):
-            if not isinstance(x, torch.Tensor) or x.shape != self.in_shape or x.dtype != self.dtype:
+            if not self._fits(x):
                 got = (f"{tuple(x.shape)} {x.dtype}" if isinstance(x, torch.Tensor) else type(x).__name__)
-                raise ValueError(f"{self.method} input {i}: compiled for a {self.in_shape} {self.dtype} tensor, "
-                                 f"got {got}")
+                want = "(batch, " + ", ".join(map(str, self.in_shape[1:])) + ")" if self._dynamic else self.in_shape
+                raise ValueError(f"{self.method} input {i}: compiled for a {want} {self.dtype} tensor, got {got}")
             xs.append(x if x.is_contiguous() else x.contiguous())  # the kernels index memory densely
         out = self._run(xs)
         return out[0] if self._single else tree_unflatten(out, self._out_spec)
+
+
+class _Fn(torch.nn.Module):
+    def __init__(self, fn):
+        super().__init__()
+        self.fn = fn
+
+    def forward(self, *xs):
+        return self.fn(*xs)
+
+
+def _package(module, example, dynamic_shapes=None):
+    """(AOTI runner, output tree spec) of module(*example), exported and compiled in a scratch folder."""
+    with tempfile.TemporaryDirectory(prefix="lagbench_aoti_") as tmp, torch.no_grad(), warnings.catch_warnings():
+        # torch's own deprecation notices from inside export (nothing a caller can act on)
+        warnings.simplefilter("ignore", FutureWarning)
+        program = torch.export.export(module.eval(), example, dynamic_shapes=dynamic_shapes)
+        path = torch._inductor.aoti_compile_and_package(program, package_path=os.path.join(tmp, "fn.pt2"))
+        runner = torch._inductor.aoti_load_package(path)
+        out_spec = tree_flatten(module(*example))[1]
+    return runner, out_spec
+
+
+def compile_batched(fn, n_inputs: int, width: int, dtype: str = "float32", batch: int | None = None,
+                    name: str = "fn") -> CompiledMethod:
+    """Compile fn(*inputs), each input (B, width), for every batch size B (batch=None) or for B = batch."""
+    if n_inputs < 1 or width < 1:
+        raise ValueError(f"compile_batched needs n_inputs >= 1 and width >= 1, got {n_inputs}, {width}")
+    dt = getattr(torch, dtype)
+    module = fn if isinstance(fn, torch.nn.Module) else _Fn(fn)
+    if batch is None:
+        dim = torch.export.Dim("batch", min=1, max=MAX_BATCH)
+        example = tuple(torch.zeros(8, width, dtype=dt) for _ in range(n_inputs))  # 0 and 1 would specialise
+        dims = tuple({0: dim} for _ in range(n_inputs))
+        varargs = any(p.kind is p.VAR_POSITIONAL for p in inspect.signature(module.forward).parameters.values())
+        runner, out_spec = _package(module, example, (dims,) if varargs else dims)
+        return CompiledMethod(runner, name, (None, width), dt, n_inputs, out_spec)
+    example = tuple(torch.zeros(int(batch), width, dtype=dt) for _ in range(n_inputs))
+    runner, out_spec = _package(module, example)
+    return CompiledMethod(runner, name, (int(batch), width), dt, n_inputs, out_spec)
 
 
 def compile_single(model, method: str = "inverse_dynamics", batch: int | None = None,
@@ -79,11 +136,5 @@ def compile_single(model, method: str = "inverse_dynamics", batch: int | None = 
     shape = shape if batch is None else (int(batch), *shape)
     dtype = getattr(torch, spec.dtype)
     example = tuple(torch.zeros(shape, dtype=dtype) for _ in range(n))
-    with tempfile.TemporaryDirectory(prefix="lagbench_aoti_") as tmp, torch.no_grad(), warnings.catch_warnings():
-        # torch's own deprecation notices from inside export (nothing a caller can act on)
-        warnings.simplefilter("ignore", FutureWarning)
-        program = torch.export.export(_Method(model, method).eval(), example)
-        path = torch._inductor.aoti_compile_and_package(program, package_path=os.path.join(tmp, f"{method}.pt2"))
-        runner = torch._inductor.aoti_load_package(path)
-        out_spec = tree_flatten(getattr(model, method)(*example))[1]
+    runner, out_spec = _package(_Method(model, method), example)
     return CompiledMethod(runner, method, shape, dtype, n, out_spec)

@@ -75,7 +75,10 @@ def solve_with_fallback(hess, rhs):
     bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
     safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype), hess)
     x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
-    if bool(torch.any(bad)):
+    if torch.compiler.is_exporting():  # no Python branch on data in an exported graph
+        x = torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], pinv_solve(h, r), y),
+                       lambda h, r, b, y: y.clone(), (hess, rhs, bad, x))
+    elif bool(torch.any(bad)):
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
     return x, torch.sum(bad)
 

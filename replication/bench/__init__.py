@@ -30,7 +30,10 @@ environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). Every figur
 ratio within this one run; numbers from different machines (machine.json) are never to be mixed.
 PyTorch runs with `TORCH_THREADS` (1) intra-op threads: on two shared cores its OpenMP pool at 2 threads
 ran 10-100x slower than on 1 (threads waiting at barriers while other processes hold the cores); JAX
-keeps XLA's defaults (the thread settings are recorded in machine.json).
+keeps XLA's defaults (the thread settings are recorded in machine.json). The inference rows are the
+exception: each PyTorch row is timed at 1 thread and at all cores and keeps the faster (its `threads`
+column), so that at large batches PyTorch is not held to half the cores XLA uses; PyTorch compiled
+ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`) has its own rows beside eager.
 """
 from __future__ import annotations
 
@@ -102,7 +105,8 @@ class _Stages:
 
 
 def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path) -> dict:
-    notes: list[str] = [f"PyTorch on {TORCH_THREADS} intra-op thread(s); JAX with XLA's default threads"]
+    notes: list[str] = [f"PyTorch on {TORCH_THREADS} intra-op thread(s) (inference rows: the faster of "
+                        f"{' and '.join(map(str, INF.TORCH_THREAD_CHOICES))}); JAX with XLA's default threads"]
     cases = INF.inference_cases(sizes) + INF.trained_cases(out, (1, max(sizes.batches)))
     sc_cases = list(scaling.lgn_cases(sizes)) + list(scaling.chain_cases(sizes))
     total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)

@@ -69,7 +69,7 @@ def torch_ops(fn) -> int:
 
 
 class JaxEvaluator:
-    framework = "jax"
+    framework, mode = "jax", "jit"
 
     def __init__(self, model, kind, dtype):
         self.model, self.kind, self.dtype = model, kind, jnp.dtype(dtype)
@@ -115,7 +115,7 @@ class TruthJax(JaxEvaluator):
 
 
 class TorchEvaluator:
-    framework = "torch"
+    framework, mode = "torch", "eager"
 
     def __init__(self, model, kind, dtype):
         self.model, self.kind, self.dtype = model, kind, getattr(torch, dtype)
@@ -146,8 +146,35 @@ class TruthTorch(TorchEvaluator):
             return self.system.acceleration(*args, backend="torch")
 
 
+class _Qddot(torch.nn.Module):
+    """q-double-dot of a PyTorch model as a module (the model a submodule: its tensors export as constants)."""
+
+    def __init__(self, model, kind):
+        super().__init__()
+        self.model, self.kind = model, kind
+
+    def forward(self, q, qdot):
+        return _qddot(self.model, self.kind, q, qdot)
+
+
+class TorchAotEvaluator(TorchEvaluator):
+    mode = "aoti"
+
+    def __init__(self, fn, width, dtype, kind):
+        from models.torch.compiled import compile_batched
+
+        self.kind, self.dtype = kind, getattr(torch, dtype)
+        self._fn = compile_batched(fn, 2, width, dtype, name=f"{kind} q''")
+
+    def _call(self, args):
+        return self._fn(*args)
+
+    def ops(self, args):
+        return None  # one call into the compiled library
+
+
 class TruthNumpy:
-    framework = "numpy"
+    framework, mode = "numpy", "numpy"
 
     def __init__(self, system, dtype):
         self.system, self.kind, self.dtype = system, "truth", np.dtype(dtype)
@@ -165,8 +192,20 @@ class TruthNumpy:
         return None
 
 
-def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="float32", system=None):
-    """An evaluator for a model (spec + NumPy params) or, with kind="truth", for `system`."""
+def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="float32", system=None,
+                   mode: str | None = None):
+    """An evaluator for a model (spec + NumPy params) or, with kind="truth", for `system`; mode "aoti"
+    (PyTorch only) compiles it ahead of time, otherwise each framework's default (jit, eager)."""
+    if mode == "aoti":
+        if framework != "torch":
+            raise ValueError(f"mode 'aoti' is PyTorch's; got framework {framework!r}")
+        if kind == "truth":
+            return TorchAotEvaluator(lambda q, qd: system.acceleration(q, qd, backend="torch"), system.dof,
+                                     dtype, "truth")
+        return TorchAotEvaluator(_Qddot(models.torch.build(spec, params), spec.kind), spec.dof, spec.dtype,
+                                 spec.kind)
+    if mode not in (None, "jit", "eager", "numpy"):
+        raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti")
     if kind == "truth":
         return {"jax": TruthJax, "torch": TruthTorch, "numpy": TruthNumpy}[framework](system, dtype)
     if framework == "jax":

@@ -1,8 +1,13 @@
 """Inference study: q-double-dot throughput and error for every model x framework x formulation.
 
 `inference_cases(sizes) -> list[Case]` and `run_case(case, states, min_time) -> list[row]`; a row is
-{system, model, formulation, framework, dtype, batch, samples_per_s, error, source, hidden, ops} (ops:
-kernels per call, `Evaluator.ops`, counted at the smallest batch; the ratio notes use it).
+{system, model, formulation, framework, mode, threads, dtype, batch, samples_per_s, error, source, hidden,
+ops} (ops: kernels per call, `Evaluator.ops`, counted at the smallest batch; the ratio notes use it).
+mode: "jit" (JAX), "eager" or "aoti" (PyTorch compiled ahead of time, `evaluators.TorchAotEvaluator`; the
+double-pendulum kinds in AOT_KINDS, where `sizes.torch_compile`), "numpy". threads: PyTorch rows are
+timed at each of TORCH_THREAD_CHOICES intra-op threads (1 and all cores) and keep the faster (the column
+says which: on shared cores a 2-thread pool can lose 10-100x to other processes' load, idle it wins at
+large batches); JAX rows run XLA's default pool ("default").
 Systems: the double pendulum (every kind but the graph network, plus the SymPy ground truth as model
 "truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid of `sizes.wave_n` points (LGN dense vs banded, and
 truth; batches capped at `GRID_NODES` // n states). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
@@ -15,6 +20,7 @@ ground truth on the same states.
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,12 +29,14 @@ import numpy as np
 import systems
 from models import ModelSpec, init_params
 from replication.bench.evaluators import make_evaluator, median_rel_error
-from replication.bench.timing import best_time
+from replication.bench.timing import best_time, torch_threads
 
 GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dense path holds n + 1 tangents)
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
             ("baseline", "-"))
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
+AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("delan", "-"), ("baseline", "-"))  # export + AOTI work
+TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
 
 
 @dataclass
@@ -44,6 +52,7 @@ class Case:
     params: dict | None = None
     source: str = "random_init"
     extra: dict = field(default_factory=dict)
+    mode: str | None = None  # None: the framework's default (jit, eager); "aoti": PyTorch compiled
 
 
 def model_spec(kind: str, formulation: str, dof: int, hidden: tuple, dtype: str, **kw) -> ModelSpec:
@@ -71,9 +80,12 @@ def inference_cases(sizes) -> list[Case]:
             for dtype in sizes.dtypes:
                 spec = None if kind == "truth" else model_spec(kind, form, dof, hidden, dtype)
                 params = None if spec is None else init_params(spec, seed=0)
+                extra = {"hidden": "x".join(map(str, hidden)) if spec else ""}
                 for fw in _frameworks(kind):
-                    cases.append(Case(system, kw, kind, form, fw, dtype, batches, spec, params,
-                                      extra={"hidden": "x".join(map(str, hidden)) if spec else ""}))
+                    cases.append(Case(system, kw, kind, form, fw, dtype, batches, spec, params, extra=extra))
+                if sizes.torch_compile and system == "double_pendulum" and (kind, form) in AOT_KINDS:
+                    cases.append(Case(system, kw, kind, form, "torch", dtype, batches, spec, params, extra=extra,
+                                      mode="aoti"))
     return cases
 
 
@@ -109,10 +121,22 @@ def states_for(system: str, kw: dict, n: int, seed: int = 0) -> dict:
     return {"q": st["q"], "qdot": st["qdot"], "qddot": s.acceleration(st["q"], st["qdot"], backend="numpy")}
 
 
+def _timed(ev, args, min_time) -> tuple[float, object]:
+    """(fastest call seconds, threads): PyTorch at each of TORCH_THREAD_CHOICES, the faster kept."""
+    if ev.framework != "torch":
+        return best_time(lambda: ev.run(args), min_time=min_time), "default"
+    best = (float("inf"), None)
+    for n in TORCH_THREAD_CHOICES:
+        with torch_threads(n):
+            ev.run(args)  # the pool at this size
+            best = min(best, (best_time(lambda: ev.run(args), min_time=min_time), n))
+    return best
+
+
 def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
     s = systems.get(case.system, **case.system_kw) if case.model == "truth" else None
     ev = make_evaluator(case.framework, case.spec, case.params, kind="truth" if s else case.model,
-                        dtype=case.dtype, system=s)
+                        dtype=case.dtype, system=s, mode=case.mode)
     n_err = max(case.batches)
     err = median_rel_error(ev.numpy(ev.prepare(states["q"][:n_err], states["qdot"][:n_err])),
                            states["qddot"][:n_err])
@@ -125,8 +149,9 @@ def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
         args = ev.prepare(states["q"][:b], states["qdot"][:b])
         if b != n_err:
             ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape); the error call warmed n_err
-        dt = best_time(lambda a=args: ev.run(a), min_time=min_time)
+        dt, threads = _timed(ev, args, min_time)
         rows.append({"system": case.system, "model": case.model, "formulation": case.formulation,
-                     "framework": case.framework, "dtype": case.dtype, "batch": int(b),
-                     "samples_per_s": b / dt, "error": err, "source": case.source, "ops": ops, **case.extra})
+                     "framework": case.framework, "mode": ev.mode, "threads": threads, "dtype": case.dtype,
+                     "batch": int(b), "samples_per_s": b / dt, "error": err, "source": case.source, "ops": ops,
+                     **case.extra})
     return rows

@@ -1,0 +1,55 @@
+"""models.torch.compiled.compile_batched: one AOTInductor library for every batch size gives the eager
+numbers (float64) at batch sizes other than the one it was traced with, keeps the Euler-Lagrange
+fallback (torch.cond under export: pinv where the velocity Hessian is singular) and refuses inputs of
+another width or dtype. Each compile takes 10-25 s: one in the default run, the model case is slow."""
+import numpy as np
+import pytest
+import torch
+
+import models.torch
+from models import ModelSpec, init_params
+from models.torch.compiled import compile_batched
+
+RNG = np.random.default_rng(3)
+
+
+def _lnn(**kw):
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64", init="xavier", formulation="fast", **kw)
+    return spec, init_params(spec, seed=2)
+
+
+def test_any_batch_size_and_the_singular_fallback():
+    """An LNN blind to qdot (first-layer velocity weights zero): its velocity Hessian is 0, every sample
+    takes the pinv branch (q'' = pinv(0) rhs = 0); without that branch the guarded solve would return rhs."""
+    spec, params = _lnn()
+    params["mlp.0.weight"][:, 2:] = 0.0
+    m = models.torch.build(spec, params)
+    f = compile_batched(m.acceleration, n_inputs=2, width=2, dtype="float64", name="acceleration")
+    for b in (1, 5, 37):
+        q, qdot = (torch.tensor(RNG.uniform(-2, 2, (b, 2))) for _ in range(2))
+        with torch.no_grad():
+            want, n_bad = m.acceleration_info(q, qdot)
+            rhs = m._fast_terms(q, qdot)[1]
+        assert int(n_bad) == b and rhs.abs().min() > 0
+        got = f(q, qdot)
+        np.testing.assert_allclose(got.numpy(), want.numpy(), rtol=0, atol=1e-12)
+        np.testing.assert_allclose(got.numpy(), 0.0, atol=1e-12)
+    with pytest.raises(ValueError, match=r"input 1: compiled for a \(batch, 2\) torch.float64"):
+        f(q, torch.zeros(3, 3, dtype=torch.float64))
+    with pytest.raises(ValueError, match="input 0.*float32"):
+        f(q.float(), qdot)
+    with pytest.raises(ValueError, match="n_inputs >= 1"):
+        compile_batched(m.acceleration, n_inputs=0, width=2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["delan", "lnn"])
+def test_model_acceleration_any_batch(kind):
+    spec = ModelSpec(kind=kind, dof=2, hidden=(16, 16), dtype="float64", init="xavier")
+    m = models.torch.build(spec, init_params(spec, seed=2))
+    f = compile_batched(m.acceleration, n_inputs=2, width=2, dtype="float64")
+    for b in (1, 64):
+        q, qdot = (torch.tensor(RNG.uniform(-1, 1, (b, 2))) for _ in range(2))
+        with torch.no_grad():
+            want = m.acceleration(q, qdot)
+        np.testing.assert_allclose(f(q, qdot).numpy(), want.numpy(), rtol=1e-10, atol=1e-12)
