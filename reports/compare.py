@@ -106,7 +106,8 @@ def bench_cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataF
         pick = ok.loc[ok["samples_per_s"].idxmax()] if len(ok) else best
 
         def name(r):
-            return f"{r['model']}/{r['formulation']} ({r['framework']}, {r['dtype']})"
+            mode = "/aoti" if r.get("mode") == "aoti" else ""
+            return f"{r['model']}/{r['formulation']} ({r['framework']}{mode}, {r['dtype']})"
 
         rows.append({"system": str(system), "best error": f"{name(best)}: {num(best['error'])}",
                      "cheapest within tolerance": f"{name(pick)}: {num(pick['error'])}",

@@ -12,7 +12,8 @@ from replication.bench import run_bench
 from replication.results import write_npz
 
 COLUMNS = {
-    "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
+    "inference": ["system", "model", "formulation", "framework", "mode", "threads", "dtype", "batch", "samples_per_s",
+                  "error"],
     "training": ["system", "model", "framework", "mode", "dtype", "batch", "steps_per_s", "samples_per_s"],
     "rollout": ["system", "solver", "rtol", "kind", "model", "source", "wall_s", "state_err", "energy_err"],
     "latency": ["model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s", "max_abs_diff"],
