@@ -2,7 +2,7 @@
 
 Contract: ``namespace(backend)`` returns the dict of names the generated source expects
 (``sin``, ``cos``, ``sqrt``, ``Abs``, ``pi``, and the helpers ``_stack``, ``_solve``), built once per backend.
-``as_array(x, backend, dtype)`` converts an input to that backend (keeping float32/float64,
+``broadcast_shapes(shapes, backend)`` is the common batch shape, ``as_array(x, backend, dtype)`` converts an input to that backend (keeping float32/float64,
 promoting anything else to float64); ``is_concrete(x)`` says whether values can be inspected
 (False for a JAX tracer inside ``jit``/``vmap``). Importing this module enables JAX x64.
 PyTorch is imported lazily, on first use of the "torch" backend.
@@ -93,6 +93,19 @@ def is_concrete(x) -> bool:
 def max_abs(x) -> float:
     """Largest |x| as a Python float (x concrete)."""
     return float(np.max(np.abs(_to_numpy(x)))) if np.size(_to_numpy(x)) else 0.0
+
+
+def broadcast_shapes(shapes, backend: str) -> tuple:
+    """The common batch shape (ValueError if none). PyTorch's own rule keeps symbolic sizes symbolic,
+    so a function of it exports with a dynamic batch (NumPy's would fix them to the traced example)."""
+    if backend != "torch":
+        return np.broadcast_shapes(*shapes)
+    import torch
+
+    try:
+        return tuple(torch.broadcast_shapes(*shapes))
+    except RuntimeError as err:
+        raise ValueError(str(err)) from err
 
 
 def zeros(shape, backend: str, dtype: str):

@@ -183,7 +183,7 @@ class System:
         shapes = [tuple(x.shape[:-1]) for x in conv.values() if x is not None]
         shapes += [tuple(p.shape) for p in params if not isinstance(p, float)]
         try:
-            batch = np.broadcast_shapes(*shapes)
+            batch = backends.broadcast_shapes(shapes, backend)
         except ValueError as err:
             raise ValueError(f"{self.name}.{what}: batch shapes {shapes} do not broadcast") from err
         self._check_speed(conv.get("qdot"), what)

@@ -9,7 +9,12 @@ non-canonical (q, qdot) (its second output is q-double-dot); "truth" is the SymP
 (`System.acceleration` with backend numpy | jax | torch). JAX calls are `jax.jit` of the model passed as
 an argument (the weights are inputs of the compiled program, not folded constants), lowered and
 compiled ahead of time on the first call per shape (the same object serves `flops` and `ops`); PyTorch
-runs eagerly under `torch.no_grad()` (torch.func inside still differentiates).
+runs eagerly under `torch.no_grad()` (torch.func inside still differentiates), or with mode="aoti"
+through `models.torch.compiled.compile_batched` (torch.export + AOTInductor: one library for every
+batch size, compiled when the evaluator is made, 10-25 s; its kernels are generated for the intra-op
+thread count at that time, the study's 1). Not every model exports: the HNN (torch.func.grad) and the
+paper-formulation LNN (torch.func.hessian) fail inside torch.export, which raises; the study records
+that as a note. `ev.mode`: "jit", "eager", "aoti", "numpy".
 `ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
 (fusions, dots, custom calls, ... in the optimised HLO's entry computation), PyTorch the ATen operators
 one call dispatches (counted with a TorchDispatchMode); None for NumPy.
@@ -147,41 +152,16 @@ class TruthTorch(TorchEvaluator):
             return self.system.acceleration(*args, backend="torch")
 
 
-class _Qddot(torch.nn.Module):
-    """q-double-dot of a PyTorch model as a module (the model a submodule: its tensors export as constants)."""
-
-    def __init__(self, model, kind):
-        super().__init__()
-        self.model, self.kind = model, kind
-
-    def forward(self, q, qdot):
-        return _qddot(self.model, self.kind, q, qdot)
-
-
 class TorchAotEvaluator(TorchEvaluator):
-    """PyTorch through `compile_batched`: one library for every batch size, or, where the traced code fixes
-    the batch size (torch.export's "specialized it to be a constant"; the SymPy-generated ground truth
-    does), one library per batch size, compiled on its first call."""
+    """PyTorch through `compile_batched`: one library for every batch size, compiled when made."""
     mode = "aoti"
 
     def __init__(self, fn, width, dtype, kind):
-        self.fn, self.width, self.dtype_name, self.kind, self.dtype = fn, width, dtype, kind, getattr(torch, dtype)
-        self._per_batch = {}
-        try:
-            self._any = compile_batched(fn, 2, width, dtype, name=f"{kind} q''")
-        except Exception as exc:
-            if "specialized it to be a constant" not in str(exc):
-                raise
-            self._any = None
+        self.kind, self.dtype = kind, getattr(torch, dtype)
+        self._fn = compile_batched(fn, 2, width, dtype, name=f"{kind} q''")
 
     def _call(self, args):
-        if self._any is not None:
-            return self._any(*args)
-        b = args[0].shape[0]
-        if b not in self._per_batch:
-            self._per_batch[b] = compile_batched(self.fn, 2, self.width, self.dtype_name, batch=b,
-                                                 name=f"{self.kind} q''")
-        return self._per_batch[b](*args)
+        return self._fn(*args)
 
     def ops(self, args):
         return None  # one call into the compiled library
@@ -216,8 +196,8 @@ def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="flo
         if kind == "truth":
             return TorchAotEvaluator(lambda q, qd: system.acceleration(q, qd, backend="torch"), system.dof,
                                      dtype, "truth")
-        return TorchAotEvaluator(_Qddot(models.torch.build(spec, params), spec.kind), spec.dof, spec.dtype,
-                                 spec.kind)
+        model = models.torch.build(spec, params)
+        return TorchAotEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind)
     if mode not in (None, "jit", "eager", "numpy"):
         raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti")
     if kind == "truth":
