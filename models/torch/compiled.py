@@ -40,15 +40,6 @@ __all__ = ["CompiledMethod", "compile_batched", "compile_single"]
 MAX_BATCH = 1 << 20  # the largest batch a dynamic-batch library accepts
 
 
-class _Method(torch.nn.Module):
-    def __init__(self, model, method):
-        super().__init__()
-        self.model, self.method = model, method
-
-    def forward(self, *xs):
-        return getattr(self.model, self.method)(*xs)
-
-
 class CompiledMethod:
     """A function compiled for fixed input shapes (None in in_shape[0]: any batch size); `f(*inputs)` runs
     it (one call into the library).
@@ -86,6 +77,9 @@ class CompiledMethod:
 
 
 class _Fn(torch.nn.Module):
+    """A function (a bound model method, a closure) as the module torch.export takes; the tensors it
+    reaches are captured as constants."""
+
     def __init__(self, fn):
         super().__init__()
         self.fn = fn
@@ -136,5 +130,5 @@ def compile_single(model, method: str = "inverse_dynamics", batch: int | None = 
     shape = shape if batch is None else (int(batch), *shape)
     dtype = getattr(torch, spec.dtype)
     example = tuple(torch.zeros(shape, dtype=dtype) for _ in range(n))
-    runner, out_spec = _package(_Method(model, method), example)
+    runner, out_spec = _package(_Fn(getattr(model, method)), example)
     return CompiledMethod(runner, method, shape, dtype, n, out_spec)
