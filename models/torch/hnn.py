@@ -2,14 +2,17 @@
 
 x, y (..., dof) are canonical (q, p), or deliberately non-canonical (q, qdot) to replicate the failure;
 extra (..., extra_inputs) or None is fed to the MLP but not differentiated. angle_wrap wraps x.
+The gradient is the MLP's hand-written reverse pass (`models.torch.mlp_derivatives`), not torch.func:
+same values, plain differentiable ops (training backpropagates through it), and it goes through
+torch.export (`models.torch.compiled`), which torch.func.grad does not.
 """
 from __future__ import annotations
 
 import torch
-from torch.func import grad
 
 from models.torch.base import Model
 from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 class HNN(Model):
@@ -25,5 +28,10 @@ class HNN(Model):
     def time_derivative(self, x, y, extra=None):
         """(xdot, ydot) = (dH/dy, -dH/dx), each (..., dof)."""
         self._check_state(x, y, extra)
-        dh_dx, dh_dy = grad(lambda a, b: torch.sum(self._hamiltonian(a, b, extra)), argnums=(0, 1))(x, y)
-        return dh_dy, -dh_dx
+        spec, d = self.spec, x.shape[-1]
+        z = mlp_input(spec, [wrap_angles(spec, x), y, *self._parts(extra)])  # wrap has derivative 1
+        g, _ = input_grad_and_tangent_hessian(self.params, z.reshape(-1, z.shape[-1]), None, spec)
+        if spec.input_scale is not None:
+            g = g * torch.tensor(spec.input_scale, dtype=g.dtype)
+        g = g.reshape(*z.shape[:-1], z.shape[-1])
+        return g[..., d:2 * d], -g[..., :d]

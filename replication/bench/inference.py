@@ -4,7 +4,7 @@
 {system, model, formulation, framework, mode, threads, dtype, batch, samples_per_s, error, source, hidden,
 ops} (ops: kernels per call, `Evaluator.ops`, counted at the smallest batch; the ratio notes use it).
 mode: "jit" (JAX), "eager" or "aoti" (PyTorch compiled ahead of time, `evaluators.TorchAotEvaluator`; the
-double-pendulum kinds in AOT_KINDS, where `sizes.torch_compile`), "numpy". threads: PyTorch rows are
+kinds in AOT_KINDS, both systems' truths included, where `sizes.torch_compile`), "numpy". threads: PyTorch rows are
 timed at each of TORCH_THREAD_CHOICES intra-op threads (1 and all cores) and keep the faster (the column
 says which: on shared cores a 2-thread pool can lose 10-100x to other processes' load, idle it wins at
 large batches); JAX rows run XLA's default pool ("default").
@@ -35,7 +35,8 @@ GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dens
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
             ("baseline", "-"))
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
-AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("delan", "-"), ("baseline", "-"))  # export + AOTI work
+# kinds that export (torch.export + AOTInductor); the paper LNN and the dense LGN differentiate with torch.func
+AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"))
 TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
 
 
@@ -83,7 +84,7 @@ def inference_cases(sizes) -> list[Case]:
                 extra = {"hidden": "x".join(map(str, hidden)) if spec else ""}
                 for fw in _frameworks(kind):
                     cases.append(Case(system, kw, kind, form, fw, dtype, batches, spec, params, extra=extra))
-                if sizes.torch_compile and system == "double_pendulum" and (kind, form) in AOT_KINDS:
+                if sizes.torch_compile and (kind, form) in AOT_KINDS:
                     cases.append(Case(system, kw, kind, form, "torch", dtype, batches, spec, params, extra=extra,
                                       mode="aoti"))
     return cases

@@ -24,11 +24,12 @@ CASES = [
     ("lnn", {"formulation": "paper"}),
     ("lnn", {"formulation": "fast", "extra_inputs": 1, "angle_wrap": True, "input_scale": (0.5, 2.0, 1.5, 0.1, 2.0)}),
     ("hnn", {"activation": "tanh"}),
+    ("hnn", {"extra_inputs": 1, "angle_wrap": True, "input_scale": (0.5, 2.0, 1.5, 0.1, 2.0)}),
     ("delan", {"init": "xavier"}),
     ("lgn", {"formulation": "banded", "dof": 7}),
     ("lgn", {"formulation": "dense", "dof": 7}),
 ]
-FLOAT32 = [0, 2, 5, 6]
+FLOAT32 = [0, 2, 5, 7]
 
 
 def _check(kind, kw, dtype):
