@@ -1,15 +1,20 @@
-"""Lagrangian graph network on a periodic 1D grid (PyTorch, torch.func): L = sum_i density(q_nb(i), qdot_nb(i)).
+"""Lagrangian graph network on a periodic 1D grid (PyTorch): L = sum_i density(q_nb(i), qdot_nb(i)).
 
 q, qdot (..., n) with any n at call time (a model trained at n = 10 runs at n = 100). The density MLP
 sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs) gathered by `models.graph.periodic_neighbours`.
 Accelerations by spec.formulation:
   "dense":  full n x n Hessian (forward-over-reverse) + solve with the counted pinv fallback (`lnn`).
   "paper":  the original code's full Hessian, full mixed Jacobian and pinv (`lnn`, "paper").
-  "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r); its band comes from
-            one reverse pass pushed forward along <= 8r+1 coloured tangents plus the one mixed-term
-            tangent (`models.graph.band_coloring`), and the system is solved in O(n) by
-            `models.torch.banded`. Samples whose solve is not finite take pinv of the dense Hessian and are
-            counted. Grids with n < 4r + 1 use the dense path.
+  "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r), solved in O(n) by
+            `models.torch.banded`. Samples whose solve is not finite take pinv of the same matrix made
+            dense and are counted. Grids with n < 4r + 1 use the dense path.
+            `banded_terms(L_fn, ...)` gets the band of any L_fn by one reverse pass pushed forward along
+            <= 8r+1 coloured tangents plus the mixed-term tangent (`models.graph.band_coloring`), as the
+            JAX mirror does. `LGN` itself differentiates its density MLP by hand at every node instead
+            (`models.torch.mlp_derivatives`; k = 2r+1 velocity tangents and one mixed tangent per node,
+            the node terms shifted into place): same values, plain torch ops, so the banded LGN goes
+            through torch.export (`models.torch.compiled`; the fallback is a torch.cond there), which
+            torch.func does not.
 """
 from __future__ import annotations
 
@@ -19,6 +24,7 @@ from torch.func import grad, jvp, vmap
 
 from models.graph import (
     band_coloring,
+    band_columns,
     band_from_colours,
     banded_supported,
     cyclic_band_layout,
@@ -26,8 +32,9 @@ from models.graph import (
 )
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
-from models.torch.lnn import euler_lagrange_info, fast_terms, pinv_solve
+from models.torch.lnn import euler_lagrange_info, pinv_solve
 from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 def banded_terms(L_fn, q, qdot, r):
@@ -47,20 +54,49 @@ def _identity_band(n, r):
     return np.eye(1, 4 * r + 1, 2 * r)[0][None, :].repeat(n, 0)
 
 
-def banded_euler_lagrange_info(L_fn, q, qdot, r):
-    """(qddot (..., n), n_fallback) by the banded path; see the module doc."""
-    n, batch = q.shape[-1], q.shape[:-1]
-    qf, qdf = q.reshape(-1, n), qdot.reshape(-1, n)
-    band, rhs = banded_terms(L_fn, qf, qdf, r)
+def dense_from_band(band):
+    """The (B, n, n) matrix of a cyclic band (B, n, 2w+1) (n >= 2w+1: no two band entries share a place)."""
+    bsz, n, width = band.shape
+    cols = band_columns(n, width)
+    flat = torch.as_tensor((np.arange(n)[:, None] * n + cols).reshape(-1))
+    return torch.zeros((bsz, n * n), dtype=band.dtype).index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
+
+
+def banded_solve_info(band, rhs, r):
+    """Flat band (B, n, 4r+1), rhs (B, n): (x (B, n), n_fallback). Samples whose banded solve is not
+    finite take pinv of the dense matrix (counted); they are solved again on an identity band first, so
+    no NaN reaches the gradient. Under torch.export the fallback is a torch.cond (no Python branch on
+    data in an exported graph)."""
+    n = rhs.shape[-1]
     layout = cyclic_band_layout(n, r)
     x = solve_cyclic_banded(band, rhs, layout)
     bad = ~torch.all(torch.isfinite(x.detach()), dim=-1)
 
-    if bool(torch.any(bad)):
+    def fallback(band, rhs, bad, x):
         safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype), band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
-        x = torch.where(bad[:, None], pinv_solve(*fast_terms(L_fn, qf, qdf)), x_safe)
-    return x.reshape(*batch, n), torch.sum(bad)
+        return torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
+
+    if torch.compiler.is_exporting():  # inference only: pinv on the bad samples (a data-dependent count)
+        idx = torch.nonzero(bad).squeeze(1)
+        x = x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
+    elif bool(torch.any(bad)):
+        x = fallback(band, rhs, bad, x)
+    return x, torch.sum(bad)
+
+
+def banded_euler_lagrange_info(L_fn, q, qdot, r):
+    """(qddot (..., n), n_fallback) by the banded path of any L_fn (`banded_terms`); see the module doc."""
+    n, batch = q.shape[-1], q.shape[:-1]
+    x, n_bad = banded_solve_info(*banded_terms(L_fn, q.reshape(-1, n), qdot.reshape(-1, n), r), r)
+    return x.reshape(*batch, n), n_bad
+
+
+def _band_sum(r):
+    """(k*k, 4r+1) 0/1: node term (a, b) (velocity slots of neighbours i+a-r, i+b-r) -> band column 2r+b-a."""
+    k = 2 * r + 1
+    a, b = np.divmod(np.arange(k * k), k)
+    return np.eye(4 * r + 1)[2 * r + b - a]
 
 
 class LGN(Model):
@@ -68,6 +104,30 @@ class LGN(Model):
         nb = torch.as_tensor(periodic_neighbours(q.shape[-1], self.spec.lgn_radius))
         x = mlp_input(self.spec, [wrap_angles(self.spec, q)[..., nb], qdot[..., nb]])
         return torch.sum(mlp(self.params, x, self.spec)[..., 0], dim=-1)
+
+    def _banded_terms(self, q, qdot):
+        """On flat (B, n): (band (B, n, 4r+1), rhs = dL/dq - J qdot (B, n)), as `banded_terms` gives them.
+        Node i's density sees x_i = scale * [q_nb(i), qdot_nb(i)] (k = 2r+1 neighbours i+a-r); its MLP
+        gradient g_i and its Gram G_i (tangents: s_qd[a] e_(k+a) for each a, and s_q * qdot_nb(i) in the
+        q slots) give every term: node i adds G_i[a, b] to H[i+a-r, i+b-r] (band column 2r+b-a),
+        G_i[a, k] to (J qdot)[i+a-r] and s_q[b] g_i[b] to dL/dq[i+b-r]. Gathering node j-a+r for slot a
+        at row j moves them all into place."""
+        spec, (bsz, n), r = self.spec, q.shape, self.spec.lgn_radius
+        k = 2 * r + 1
+        nb = torch.as_tensor(periodic_neighbours(n, r))
+        x = mlp_input(spec, [wrap_angles(spec, q)[..., nb], qdot[..., nb]]).reshape(bsz * n, 2 * k)
+        scale = (torch.ones(2 * k, dtype=x.dtype) if spec.input_scale is None
+                 else torch.tensor(spec.input_scale, dtype=x.dtype))
+        s_q, s_qd = scale[:k], scale[k:]
+        tangents = torch.zeros((bsz * n, k + 1, 2 * k), dtype=x.dtype)
+        tangents[:, :k, k:] = torch.diag(s_qd)
+        tangents[:, k, :k] = qdot[..., nb].reshape(bsz * n, k) * s_q
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
+        g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]], -1)
+        src, slot = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n), torch.arange(k)
+        moved = g[:, src, slot]                  # (B, n, k, k + 2): [j, a] = node j-a+r's slot-a terms
+        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ torch.as_tensor(_band_sum(r), dtype=x.dtype)
+        return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)
 
     def lagrangian(self, q, qdot, extra=None):
         """L (...,) for q, qdot (..., n)."""
@@ -79,7 +139,9 @@ class LGN(Model):
         self._check_state(q, qdot, extra, width=q.shape[-1])
         form, n, r = self.spec.formulation, q.shape[-1], self.spec.lgn_radius
         if form in ("banded", "fast") and banded_supported(n, r):
-            return banded_euler_lagrange_info(self._lagrangian, q, qdot, r)
+            band, rhs = self._banded_terms(q.reshape(-1, n), qdot.reshape(-1, n))
+            x, n_bad = banded_solve_info(band, rhs, r)
+            return x.reshape(q.shape), n_bad
         return euler_lagrange_info(self._lagrangian, q, qdot, "paper" if form == "paper" else "fast")
 
     def acceleration(self, q, qdot, extra=None):

@@ -52,13 +52,20 @@ def paper_terms(L_fn, q, qdot, extra=None):
     return vmap(one)(q, qdot, extra)
 
 
-def pinv_solve(hess, rhs):
-    """pinv(H) rhs per sample, H (B, d, d), rhs (B, d), rtol = 10 d eps."""
+def pinv_solve(hess, rhs, by_svd=False):
+    """pinv(H) rhs per sample, H (B, d, d), rhs (B, d), rtol = 10 d eps. by_svd: the same from
+    torch.linalg.svd by hand (singular values <= rtol * largest dropped, as pinv does): no gradient
+    (1/s of a dropped value is inf), but it exports for a data-dependent B, which pinv does not."""
     rtol = pinv_rtol(_dtype_name(hess), hess.shape[-1])
     # torch's SVD raises on non-finite input where JAX returns NaN: give NaN for those samples too
     finite = torch.isfinite(hess).flatten(-2).all(-1)
     safe = torch.where(finite[..., None, None], hess, torch.zeros_like(hess))
-    x = (torch.linalg.pinv(safe, rtol=rtol) @ rhs[..., None])[..., 0]
+    if by_svd:
+        u, sv, vh = torch.linalg.svd(safe)
+        inv = torch.where(sv > rtol * sv[..., :1], 1.0 / sv, torch.zeros_like(sv))
+        x = (vh.mT @ (inv[..., None] * (u.mT @ rhs[..., None])))[..., 0]
+    else:
+        x = (torch.linalg.pinv(safe, rtol=rtol) @ rhs[..., None])[..., 0]
     return torch.where(finite[..., None], x, torch.full_like(x, float("nan")))
 
 

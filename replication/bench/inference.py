@@ -36,7 +36,7 @@ DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"),
             ("baseline", "-"))
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
 # kinds that export (torch.export + AOTInductor); the paper LNN and the dense LGN differentiate with torch.func
-AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"))
+AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"), ("lgn", "banded"))
 TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
 
 

@@ -1,8 +1,8 @@
 """models.torch.compiled.compile_batched: one AOTInductor library for every batch size gives the eager
 numbers (float64) at batch sizes other than the one it was traced with, keeps the Euler-Lagrange
 fallback (torch.cond under export: pinv where the velocity Hessian is singular) and refuses inputs of
-another width or dtype; the HNN (hand-written gradient) exports too. Each compile takes 10-25 s: two in
-the default run, the model case is slow."""
+another width or dtype; the HNN and the banded LGN (hand-written derivatives) export too. Each compile
+takes 10-25 s: three in the default run, the model case is slow."""
 import numpy as np
 import pytest
 import torch
@@ -69,3 +69,20 @@ def test_hnn_exports_and_matches_the_autograd_gradient():
         xdot, ydot = f(x.detach(), y.detach())
         np.testing.assert_allclose(xdot.numpy(), dh_dy.numpy(), rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(ydot.numpy(), -dh_dx.numpy(), rtol=1e-12, atol=1e-12)
+
+
+def test_banded_lgn_exports_and_keeps_its_fallback():
+    """The banded LGN (hand-written node derivatives, O(n) solve) exports; under export its fallback
+    takes pinv on the gathered bad samples only. A batch with one non-finite state: the good samples
+    equal eager, the bad one is NaN (as in eager), also at batch 1."""
+    spec = ModelSpec(kind="lgn", dof=10, hidden=(16, 16), dtype="float64", init="xavier", formulation="banded")
+    m = models.torch.build(spec, init_params(spec, seed=2))
+    f = compile_batched(m.acceleration, n_inputs=2, width=10, dtype="float64", name="acceleration")
+    for b in (1, 6):
+        q, qdot = (torch.tensor(RNG.uniform(-1, 1, (b, 10))) for _ in range(2))
+        if b > 1:
+            q[2, 4] = float("nan")
+        with torch.no_grad():
+            want, n_bad = m.acceleration_info(q, qdot)
+        assert int(n_bad) == (b > 1)
+        np.testing.assert_allclose(f(q, qdot).numpy(), want.numpy(), rtol=1e-10, atol=1e-12)  # NaN == NaN
