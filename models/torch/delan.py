@@ -8,7 +8,8 @@ Jacobians propagated forward as the DeLaN paper does), no autograd graph of its 
   dLc_k = dLc/dq_k, Ldot = sum_k qdot_k dLc_k, u = Lc^T qdot, w_k = dLc_k^T qdot,
   Mdot qdot = Ldot u + Lc (Ldot^T qdot),  1/2 d(qdot^T M qdot)/dq_k = w_k . u,
   c = Mdot qdot - 1/2 d(qdot^T M qdot)/dq,  g = dV/dq.
-Mirrored line for line by `models.jax.delan`. Shapes: q, qdot, qddot, tau
+Mirrored line for line by `models.jax.delan`, except that under torch.export the forward model solves
+by `spd_solve_unrolled` (dof <= 8; same numbers, it compiles to fused kernels). Shapes: q, qdot, qddot, tau
 (..., dof); M (..., dof, dof); V, L (...,).
 """
 from __future__ import annotations
@@ -29,6 +30,26 @@ def _mv(m, v):
 def _vm(v, m):
     """v^T m over the second-to-last axis of m: v (..., i), m (..., i, j) -> (..., j)."""
     return (v[..., None, :] @ m)[..., 0, :]
+
+
+def spd_solve_unrolled(m, b):
+    """m^-1 b for symmetric positive definite m (..., d, d), b (..., d), by a Cholesky factorisation and
+    two substitutions written out over the d rows: elementwise ops on the batch only. Used under
+    torch.export: AOTInductor fuses these into its kernels, while torch.linalg.solve there becomes a call
+    through its slow proxy executor (DeLaN one-sample acceleration 9.9k calls/s with it, measured)."""
+    d = m.shape[-1]
+    lo = [[None] * d for _ in range(d)]
+    for j in range(d):
+        lo[j][j] = torch.sqrt(m[..., j, j] - sum(lo[j][k] ** 2 for k in range(j)))
+        for i in range(j + 1, d):
+            lo[i][j] = (m[..., i, j] - sum(lo[i][k] * lo[j][k] for k in range(j))) / lo[j][j]
+    y = []
+    for i in range(d):
+        y.append((b[..., i] - sum(lo[i][k] * y[k] for k in range(i))) / lo[i][i])
+    x = [None] * d
+    for i in reversed(range(d)):
+        x[i] = (y[i] - sum(lo[k][i] * x[k] for k in range(i + 1, d))) / lo[i][i]
+    return torch.stack(x, dim=-1)
 
 
 def _lower(vec, tril, d):
@@ -125,6 +146,8 @@ class DeLaN(Model):
         tau = torch.zeros_like(q) if extra is None else extra
         self._check("tau (extra)", tau, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
+        if torch.compiler.is_exporting() and self.spec.dof <= 8:
+            return spd_solve_unrolled(m, tau - c - g)
         return torch.linalg.solve(m, (tau - c - g)[..., None])[..., 0]
 
     def acceleration_info(self, q, qdot, extra=None):

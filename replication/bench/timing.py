@@ -115,7 +115,7 @@ QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("
               ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=2,
               train_hidden=(600, 600, 600), train_batch=512, train_steps=3, rollout_solvers=_SOLVERS,
               rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003), rollout_t_end=10.0,
-              rollout_ics=8, min_time=0.05, torch_compile=True, structure_batch=1024, wave_n=32, latency_s=0.3,
+              rollout_ics=8, min_time=0.05, torch_compile=True, structure_batch=1024, wave_n=32, latency_s=2.0,
               target_budget=500_000, target_hidden=(64, 64, 64))
 FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), dtypes=("float32", "float64"),
              lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024, 4096), chain_d=(1, 2, 4, 8, 16, 32),

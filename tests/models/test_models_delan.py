@@ -1,6 +1,7 @@
 """DeLaN: the mass matrix is symmetric positive definite for random parameters and inputs; the
 inverse and forward models invert each other and agree with the Euler-Lagrange equation of L."""
 import numpy as np
+import pytest
 import torch
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -36,3 +37,17 @@ def test_forward_and_inverse_models_are_consistent_with_euler_lagrange():
                "DeLaN terms vs Euler-Lagrange of its L", factor=100)
     c = model.coriolis(q, torch.zeros_like(qdot))
     assert torch.all(c == 0)
+
+
+@pytest.mark.parametrize("d", [1, 2, 5, 8])
+def test_unrolled_spd_solve_matches_linalg_solve(d):
+    """`spd_solve_unrolled` (what the exported DeLaN acceleration uses) against torch.linalg.solve on
+    random SPD matrices with a leading batch shape."""
+    from models.torch.delan import spd_solve_unrolled
+
+    rng = np.random.default_rng(d)
+    a = torch.tensor(rng.normal(size=(2, 3, d, d)))
+    m = a @ a.transpose(-1, -2) + 0.1 * torch.eye(d, dtype=torch.float64)
+    b = torch.tensor(rng.normal(size=(2, 3, d)))
+    want = torch.linalg.solve(m, b[..., None])[..., 0]
+    np.testing.assert_allclose(spd_solve_unrolled(m, b).numpy(), want.numpy(), rtol=1e-9, atol=1e-9)
