@@ -88,13 +88,21 @@ class _Fn(torch.nn.Module):
         return self.fn(*xs)
 
 
-def _package(module, example, dynamic_shapes=None):
+# For compile_single: inductor's pass that writes matrix products with one row (static shapes, CPU) as
+# fused elementwise code instead of a call into ATen's mm. A one-sample DeLaN makes ~20 such calls, each
+# a few us of overhead (inverse dynamics 18k -> 25k calls/s, measured). Not for compile_batched: the pass
+# fails on the data-dependent sizes of the banded LGN's export (torch 2.13).
+_ONE_ROW_MM_AS_ELEMENTWISE = {"post_grad_fusion_options": {"decompose_mm_pass": {}}}
+
+
+def _package(module, example, dynamic_shapes=None, inductor_configs=None):
     """(AOTI runner, output tree spec) of module(*example), exported and compiled in a scratch folder."""
     with tempfile.TemporaryDirectory(prefix="lagbench_aoti_") as tmp, torch.no_grad(), warnings.catch_warnings():
         # torch's own deprecation notices from inside export (nothing a caller can act on)
         warnings.simplefilter("ignore", FutureWarning)
         program = torch.export.export(module.eval(), example, dynamic_shapes=dynamic_shapes)
-        path = torch._inductor.aoti_compile_and_package(program, package_path=os.path.join(tmp, "fn.pt2"))
+        path = torch._inductor.aoti_compile_and_package(program, package_path=os.path.join(tmp, "fn.pt2"),
+                                                        inductor_configs=inductor_configs)
         runner = torch._inductor.aoti_load_package(path)
         out_spec = tree_flatten(module(*example))[1]
     return runner, out_spec
@@ -130,5 +138,5 @@ def compile_single(model, method: str = "inverse_dynamics", batch: int | None = 
     shape = shape if batch is None else (int(batch), *shape)
     dtype = getattr(torch, spec.dtype)
     example = tuple(torch.zeros(shape, dtype=dtype) for _ in range(n))
-    runner, out_spec = _package(_Fn(getattr(model, method)), example)
+    runner, out_spec = _package(_Fn(getattr(model, method)), example, inductor_configs=_ONE_ROW_MM_AS_ELEMENTWISE)
     return CompiledMethod(runner, method, shape, dtype, n, out_spec)
