@@ -13,8 +13,7 @@ Accelerations by spec.formulation:
             JAX mirror does. `LGN` itself differentiates its density MLP by hand at every node instead
             (`models.torch.mlp_derivatives`; k = 2r+1 velocity tangents and one mixed tangent per node,
             the node terms shifted into place): same values, plain torch ops, so the banded LGN goes
-            through torch.export (`models.torch.compiled`; the fallback is a torch.cond there), which
-            torch.func does not.
+            through torch.export (`models.torch.compiled`), which torch.func does not.
 """
 from __future__ import annotations
 
@@ -65,8 +64,9 @@ def dense_from_band(band):
 def banded_solve_info(band, rhs, r):
     """Flat band (B, n, 4r+1), rhs (B, n): (x (B, n), n_fallback). Samples whose banded solve is not
     finite take pinv of the dense matrix (counted); they are solved again on an identity band first, so
-    no NaN reaches the gradient. Under torch.export the fallback is a torch.cond (no Python branch on
-    data in an exported graph)."""
+    no NaN reaches the gradient. Under torch.export (inference) the bad samples are gathered and only
+    they take pinv: an exported graph has no Python branch on data, and a torch.cond here fixed the
+    batch size to >= 2 (torch 2.13)."""
     n = rhs.shape[-1]
     layout = cyclic_band_layout(n, r)
     x = solve_cyclic_banded(band, rhs, layout)

@@ -13,8 +13,9 @@ runs eagerly under `torch.no_grad()` (torch.func inside still differentiates), o
 through `models.torch.compiled.compile_batched` (torch.export + AOTInductor: one library for every
 batch size, compiled when the evaluator is made, 10-25 s; its kernels are generated for the intra-op
 thread count at that time, the study's 1). Not every model exports: what differentiates with torch.func
-(the paper-formulation LNN's hessian, the LGN's forward-over-reverse) fails inside torch.export (torch
-2.13), which raises. The HNN, the fast LNN and DeLaN differentiate their MLPs by hand and export. `ev.mode`: "jit", "eager", "aoti", "numpy".
+(the paper-formulation LNN's hessian, the dense LGN's forward-over-reverse) fails inside torch.export
+(torch 2.13), which raises. The fast LNN, the HNN, DeLaN and the banded LGN differentiate their MLPs by
+hand and export. `ev.mode`: "jit", "eager", "aoti", "numpy".
 `ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
 (fusions, dots, custom calls, ... in the optimised HLO's entry computation), PyTorch the ATen operators
 one call dispatches (counted with a TorchDispatchMode); None for NumPy.

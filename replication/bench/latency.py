@@ -41,8 +41,10 @@ def interleaved_rates(fns: dict, seconds: float, calls: int = CALLS, slice_s: fl
     """{name: calls per second}: the fastest window of `calls` calls per fn. The fns take turns, each
     running windows for `slice_s` seconds (at least one) per turn, so every fn gets the same share of
     time and a fast fn many windows. With one window per turn, the fast compiled fns got as few windows
-    as eager had (3-6), and the best of so few, on this shared machine, was far from the best of many:
-    PyTorch compile_single 8-12k calls/s beside eager against 16-18k alone (measured, DeLaN 3 x 128)."""
+    as eager had (3-6), and on this shared machine the best of so few was far from the best of many:
+    PyTorch compile_single 11-12k calls/s beside eager against 16-18k alone, 0.3 s each (measured, DeLaN
+    3 x 128). Load bursts here last about as long as 0.3 s, so `seconds` should be 2 or more: 3 s gave
+    18.6-18.8k in every repeat."""
     best = dict.fromkeys(fns, float("inf"))
     for f in fns.values():
         f()
