@@ -154,3 +154,20 @@ def test_hand_written_fast_terms_equal_forward_over_reverse(fw, activation, extr
     generic = lib.fast_terms(model._lagrangian, xs["q"], xs["qdot"], e)
     for a, b, what in zip(hand, generic, ("hessian", "rhs"), strict=True):
         assert_rel(np.asarray(a.tolist()), np.asarray(b.tolist()), "float64", what)
+
+
+def test_pinv_solve_by_svd_matches_pinv():
+    """pinv_solve(..., by_svd=True) (the banded LGN's exported fallback) equals the torch.linalg.pinv
+    form: full-rank, rank-deficient (dropped singular values), zero and non-finite matrices."""
+    from models.torch.lnn import pinv_solve
+
+    rng = np.random.default_rng(5)
+    u = torch.tensor(rng.normal(size=(4, 6, 3)))
+    h = torch.stack([u[0] @ u[0].T + torch.eye(6, dtype=torch.float64),   # full rank
+                     u[1] @ u[1].T,                                     # rank 3
+                     torch.zeros(6, 6, dtype=torch.float64),
+                     torch.full((6, 6), float("nan"), dtype=torch.float64)])
+    rhs = torch.tensor(rng.normal(size=(4, 6)))
+    want, got = pinv_solve(h, rhs), pinv_solve(h, rhs, by_svd=True)
+    np.testing.assert_allclose(got.numpy(), want.numpy(), rtol=1e-9, atol=1e-9)
+    assert torch.isnan(got[3]).all() and (got[2] == 0).all()
