@@ -72,24 +72,14 @@ def banded_solve_info(band, rhs, r):
     x = solve_cyclic_banded(band, rhs, layout)
     bad = ~torch.all(torch.isfinite(x.detach()), dim=-1)
 
-    def fallback(band, rhs, bad, x):
-        safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype), band)
-        x_safe = solve_cyclic_banded(safe, rhs, layout)
-        return torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
-
     if torch.compiler.is_exporting():  # inference only: pinv on the bad samples (a data-dependent count)
         idx = torch.nonzero(bad).squeeze(1)
         x = x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
     elif bool(torch.any(bad)):
-        x = fallback(band, rhs, bad, x)
+        safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype), band)
+        x_safe = solve_cyclic_banded(safe, rhs, layout)
+        x = torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
     return x, torch.sum(bad)
-
-
-def banded_euler_lagrange_info(L_fn, q, qdot, r):
-    """(qddot (..., n), n_fallback) by the banded path of any L_fn (`banded_terms`); see the module doc."""
-    n, batch = q.shape[-1], q.shape[:-1]
-    x, n_bad = banded_solve_info(*banded_terms(L_fn, q.reshape(-1, n), qdot.reshape(-1, n), r), r)
-    return x.reshape(*batch, n), n_bad
 
 
 def _band_sum(r):
