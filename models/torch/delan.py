@@ -19,7 +19,7 @@ from torch.nn.functional import linear as _lin
 
 from models.params import n_layers, tril_selection
 from models.torch.base import Model
-from models.torch.mlp import ACT, linear, mlp, mlp_input, wrap_angles
+from models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import ACT_DERIVS
 
 
@@ -65,7 +65,7 @@ class DeLaN(Model):
         the tangents dx/dq_k."""
         super().__init__(spec, params)
         d, dtype = spec.dof, getattr(torch, spec.dtype)
-        scale = torch.ones(d, dtype=dtype) if spec.input_scale is None else torch.tensor(spec.input_scale, dtype=dtype)
+        scale = input_scale(spec, d, dtype)
         self.register_buffer("tril", torch.tensor(tril_selection(d).T, dtype=dtype), persistent=False)
         self.register_buffer("eye", torch.eye(d, dtype=dtype), persistent=False)
         self.register_buffer("dx", torch.diag(scale), persistent=False)

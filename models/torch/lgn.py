@@ -32,7 +32,7 @@ from models.graph import (
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
 from models.torch.lnn import euler_lagrange_info, pinv_solve
-from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
@@ -106,8 +106,7 @@ class LGN(Model):
         k = 2 * r + 1
         nb = torch.as_tensor(periodic_neighbours(n, r))
         x = mlp_input(spec, [wrap_angles(spec, q)[..., nb], qdot[..., nb]]).reshape(bsz * n, 2 * k)
-        scale = (torch.ones(2 * k, dtype=x.dtype) if spec.input_scale is None
-                 else torch.tensor(spec.input_scale, dtype=x.dtype))
+        scale = input_scale(spec, 2 * k, x.dtype)
         s_q, s_qd = scale[:k], scale[k:]
         tangents = torch.zeros((bsz * n, k + 1, 2 * k), dtype=x.dtype)
         tangents[:, :k, k:] = torch.diag(s_qd)

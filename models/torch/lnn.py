@@ -13,7 +13,7 @@ from torch.func import grad, hessian, jacrev, jvp, vmap
 
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
-from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
@@ -136,8 +136,7 @@ class LNN(Model):
         tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
         spec, (n, d) = self.spec, q.shape
         x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
-        scale = (torch.ones(x.shape[-1], dtype=x.dtype) if spec.input_scale is None
-                 else torch.tensor(spec.input_scale, dtype=x.dtype))
+        scale = input_scale(spec, x.shape[-1], x.dtype)
         s_q, s_qd = scale[:d], scale[d:2 * d]
         tangents = torch.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
         tangents[:, :d, d:2 * d] = torch.diag(s_qd)
