@@ -19,8 +19,8 @@ ignore):
                   held-out L1 against samples consumed (`replication.bench.train_target`)
   scaling.csv     study, formulation, framework, n, seconds_per_eval, samples_per_s, batch
   scaling_fit.csv study, formulation, framework, exponent, n_min, n_max   (`replication.bench.scaling`)
-  fast_paper.csv  dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample, gflops
-  matmul.csv      dof, framework, rows, seconds, gflops                    (`replication.bench.roofline`)
+  fast_paper.csv  dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample, gflops, threads
+  matmul.csv      dof, framework, rows, seconds, gflops, threads           (`replication.bench.roofline`)
   structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
   targets.json    the issue's numeric targets, each with the measured values and met: true/false
@@ -31,8 +31,8 @@ ratio within this one run; numbers from different machines (machine.json) are ne
 PyTorch runs with `TORCH_THREADS` (1) intra-op threads: on two shared cores its OpenMP pool at 2 threads
 ran 10-100x slower than on 1 (threads waiting at barriers while other processes hold the cores); JAX
 keeps XLA's defaults (the thread settings are recorded in machine.json). The inference rows are the
-exception: each PyTorch row is timed at 1 thread and at all cores and keeps the faster (its `threads`
-column), so that at large batches PyTorch is not held to half the cores XLA uses; PyTorch compiled
+exception, and so are the fast/paper and matmul rows: each PyTorch row is timed at 1 thread and at all
+cores and keeps the faster (its `threads` column), so that at large batches PyTorch is not held to half the cores XLA uses; PyTorch compiled
 ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`) has its own rows beside eager.
 """
 from __future__ import annotations

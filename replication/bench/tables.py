@@ -87,11 +87,14 @@ def _inference_note(key, b, j_rate, t_rate, fit, ops, how="") -> str:
 DISPATCH_BOUND_S = 2e-3  # a call shorter than this is mostly per-operator dispatch (~10 us x 100s of ops)
 
 
-def _generic_note(op: str, ratio: float, batch=None, call_s=None) -> str:
+def _generic_note(op: str, ratio: float, batch=None, call_s=None, torch_threads=None) -> str:
     """Reason for a ratio beyond 2x where no batch fit exists: from the batch, the slower framework's
-    call time (call_s, seconds) and the kind of operation."""
+    call time (call_s, seconds) and the kind of operation. torch_threads: the PyTorch row's own thread
+    count where it chose one (else the study's TORCH_THREADS)."""
     what = ("PyTorch faster" if ratio < 1 else "JAX faster") + f" {max(ratio, 1 / ratio):.1f}x"
-    threads = f"PyTorch on {TORCH_THREADS} thread(s), XLA's pool default ({os.cpu_count()} cores)"
+    chosen = " (the faster of 1 and all cores)" if torch_threads is not None else ""
+    threads = (f"PyTorch on {TORCH_THREADS if torch_threads is None else torch_threads} thread(s){chosen}, "
+               f"XLA's pool default ({os.cpu_count()} cores)")
     if op.startswith("train"):
         return (f"{what}: eager autograd runs forward and backward operator by operator plus a per-parameter "
                 f"Adam, against one fused, compiled XLA step; {threads}")
@@ -108,12 +111,12 @@ def _generic_note(op: str, ratio: float, batch=None, call_s=None) -> str:
             f"PyTorch eager runs each operator separately; {threads}")
 
 
-def _row(op, j, t, batch=None, note=None):
+def _row(op, j, t, batch=None, note=None, torch_threads=None):
     """j, t: throughputs (per second); with a batch, the slower call time is batch / min(j, t)."""
     r = j / t if (np.isfinite(j) and np.isfinite(t) and t > 0) else np.nan
     beyond = np.isfinite(r) and not 0.5 <= r <= 2.0
     call_s = batch / min(j, t) if batch is not None and beyond else None
-    text = (note if note is not None else _generic_note(op, r, batch, call_s)) if beyond else ""
+    text = (note if note is not None else _generic_note(op, r, batch, call_s, torch_threads)) if beyond else ""
     return {"operation": op, "jax": j, "torch": t, "ratio": r, "note": text}
 
 
@@ -170,7 +173,8 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
         out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"], batch=batch_of.get((st, f, n))))
     for (d, f), v in _pairs(fastpaper, ("dof", "formulation"), "samples_per_s").items():
         out.append(_row(f"q'' lnn/{f} d={d} float32 batch {fastpaper[0]['batch']} (3x600 target)",
-                        v["jax"], v["torch"], batch=fastpaper[0]["batch"]))
+                        v["jax"], v["torch"], batch=fastpaper[0]["batch"],
+                        torch_threads=_threads_of(fastpaper, dof=d, framework="torch", formulation=f)))
     for d in sorted({r["dof"] for r in fastpaper}):
         sp = {fw: _get(fastpaper, dof=d, framework=fw, formulation="fast") /
               _get(fastpaper, dof=d, framework=fw, formulation="paper") for fw in ("jax", "torch")}
@@ -181,14 +185,25 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
         mm = {fw: _get(matmul, "gflops", dof=d, framework=fw) for fw in ("jax", "torch")}
         flops = _get(fastpaper, "flops_per_sample", dof=d, framework="jax", formulation="fast")
         ach = {fw: flops * _get(fastpaper, dof=d, framework=fw, formulation="fast") / 1e9 for fw in mm}
-        out.append(_row(f"matmul roofline: matrix products of the layer shapes d={d} (GFLOP/s)", mm["jax"], mm["torch"]))
+        out.append(_row(f"matmul roofline: matrix products of the layer shapes d={d} (GFLOP/s)", mm["jax"], mm["torch"],
+                        torch_threads=_threads_of(matmul, dof=d, framework="torch")))
         out.append(_row(f"fast LNN achieved d={d} (GFLOP/s; {flops:.3g} FLOP/sample from XLA cost analysis)",
-                        ach["jax"], ach["torch"]))
+                        ach["jax"], ach["torch"],
+                        torch_threads=_threads_of(fastpaper, dof=d, framework="torch", formulation="fast")))
         out.append({"operation": f"fast LNN fraction of roofline d={d}", "jax": ach["jax"] / mm["jax"],
                     "torch": ach["torch"] / mm["torch"], "ratio": np.nan,
                     "note": "target >= 0.8 (JAX); each framework against its own matrix-product rate"})
     out += [{"operation": "note", "jax": np.nan, "torch": np.nan, "ratio": np.nan, "note": n} for n in notes]
     return out
+
+
+def _threads_of(rows, **match):
+    """The `threads` a matching row chose (int), or None where it has none (results from before the column)."""
+    for r in rows:
+        if all(r.get(k) == v for k, v in match.items()) and r.get("threads") not in (None, "") \
+                and np.isfinite(float(r["threads"])):
+            return int(float(r["threads"]))
+    return None
 
 
 def _get(rows, value="samples_per_s", **match):

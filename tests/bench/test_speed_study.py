@@ -9,6 +9,7 @@ import pytest
 
 from models import ModelSpec, init_params
 from replication.bench import run_bench
+from replication.bench.inference import TORCH_THREAD_CHOICES
 from replication.results import write_npz
 
 COLUMNS = {
@@ -25,8 +26,8 @@ COLUMNS = {
     "ratios": ["operation", "jax", "torch", "ratio", "note"],
     "structure": ["system", "quadratic_kinetic", "separable", "local_coupling", "structured_model",
                   "general_model", "speedup"],
-    "fast_paper": ["dof", "framework", "formulation", "samples_per_s", "flops_per_sample"],
-    "matmul": ["dof", "framework", "gflops"],
+    "fast_paper": ["dof", "framework", "formulation", "samples_per_s", "flops_per_sample", "threads"],
+    "matmul": ["dof", "framework", "gflops", "threads"],
 }
 POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples_per_s"],
             "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"], "latency": ["evals_per_s"],
@@ -89,6 +90,14 @@ def test_inference_covers_every_model_and_framework(bench_dir):
     assert truth["error"].max() < 1e-4  # float32 ground truth against float64
     trained = df[df["source"] == "trained:dp_loss"]
     assert set(trained["framework"]) == {"jax"} and set(trained["hidden"].astype(str)) == {"8"}
+
+
+def test_fast_paper_and_matmul_torch_rows_record_their_thread_count(bench_dir):
+    out, _ = bench_dir
+    for name in ("fast_paper", "matmul"):
+        df = pd.read_csv(out / "bench" / f"{name}.csv")
+        assert set(df.loc[df["framework"] == "jax", "threads"]) == {"default"}
+        assert set(df.loc[df["framework"] == "torch", "threads"].astype(int)) <= set(TORCH_THREAD_CHOICES)
 
 
 def test_rollout_has_chaos_floor_rk4_and_learned_models(bench_dir):
