@@ -128,10 +128,11 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path) -> d
             _write(bench, "rollout", rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes))
         with stage("scaling"):
             sc_rows = []
-            for c in sc_cases:
-                bar.set_postfix_str(f"scaling {c[0]} {c[1]} {c[2]} n={c[3]}")
-                sc_rows.append(scaling.run_scaling_case(c, sizes))
-                bar.update(1)
+            for group in scaling.scaling_groups(sc_cases):
+                st, form, fw = group[0][:3]
+                bar.set_postfix_str(f"scaling {st} {form} {fw} n={','.join(str(c[3]) for c in group)}")
+                sc_rows += scaling.run_scaling_group(group, sizes)
+                bar.update(len(group))
             fit = scaling.fit_exponents(sc_rows)
             _write(bench, "scaling", sc_rows)
             _write(bench, "scaling_fit", fit)

@@ -8,6 +8,8 @@ Studies (rows {study, formulation, framework, n, batch, seconds_per_eval, sample
   "lnn_chain": the LNN (`sizes.ratio_hidden`, softplus) on d = n degrees of freedom (the pendulum chain's
                state shape; random normal states, the cost does not depend on the values), "fast" vs
                "paper", batch `sizes.chain_batch`.
+`scaling_groups(cases)`, `run_scaling_group(group, sizes) -> rows`: the sizes of one study, formulation
+and framework are timed interleaved (round by round), so that other processes' load does not bend the fit.
 `fit_exponents(rows)` -> rows {study, formulation, framework, exponent, fit_range, n_min, n_max}: the
 least-squares slope of log(seconds_per_eval) on log(n) over all measured sizes (fit_range "all") and
 without the smallest size ("n>=N": the asymptotic trend; the banded target is an exponent <= 1.1).
@@ -21,22 +23,40 @@ import numpy as np
 from models import init_params
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import model_spec
-from replication.bench.timing import LONG_CALL_S, best_time
+from replication.bench.timing import LONG_CALL_S
 
 MAX_DENSE_N = 2048
 FRAMEWORKS = ("jax", "torch")
 
 
-def _time_eval(spec, framework, n, batch, min_time, seed=0):
+def _prepared(spec, framework, n, batch, seed=0):
+    """(a no-argument call of the evaluator on batch random normal states, its first call's seconds)."""
     ev = make_evaluator(framework, spec, init_params(spec, seed=0))
     rng = np.random.default_rng(seed)
     args = ev.prepare(rng.normal(size=(batch, n)), rng.normal(size=(batch, n)))
     t0 = time.perf_counter()
     ev.run(args)  # JAX: compiles; eager PyTorch: already a representative call
-    first = time.perf_counter() - t0
-    if framework == "torch" and first >= LONG_CALL_S:
-        return first
-    return best_time(lambda: ev.run(args), min_time=min_time, min_reps=2)
+    return (lambda: ev.run(args)), time.perf_counter() - t0
+
+
+def time_interleaved(fns: dict, first: dict, budget_s: float, max_rounds: int = 50) -> dict:
+    """{name: fastest seconds}: rounds that call every fn once in turn (at least 2 rounds, more while the
+    rounds' total is under budget_s), so that a burst of load from other processes hits one size in one
+    round, not one size for all of its calls. A fn whose timed call, or whose `first` (seconds: an earlier
+    representative call, 0 where there was none), took LONG_CALL_S or more sits out further rounds."""
+    best = {k: (first[k] if first[k] >= LONG_CALL_S else float("inf")) for k in fns}
+    spent, rounds = 0.0, 0
+    while rounds < 2 or (spent < budget_s and rounds < max_rounds):
+        live = [k for k in fns if best[k] < LONG_CALL_S or best[k] == float("inf")]
+        if not live:
+            break
+        for k in live:
+            t0 = time.perf_counter()
+            fns[k]()
+            dt = time.perf_counter() - t0
+            best[k], spent = min(best[k], dt), spent + dt
+        rounds += 1
+    return best
 
 
 def lgn_cases(sizes):
@@ -55,15 +75,33 @@ def chain_cases(sizes):
                 yield ("lnn_chain", form, fw, d, sizes.chain_batch)
 
 
-def run_scaling_case(case, sizes) -> dict:
-    study, form, fw, n, batch = case
+def _spec(case, sizes):
+    study, form, _, n, _ = case
     if study == "lgn_grid":
-        spec = model_spec("lgn", form, n, sizes.lgn_hidden, "float32", lgn_radius=1)
-    else:
-        spec = model_spec("lnn", form, n, sizes.ratio_hidden, "float32")
-    dt = _time_eval(spec, fw, n, batch, sizes.min_time)
-    return {"study": study, "formulation": form, "framework": fw, "n": int(n), "batch": int(batch),
-            "seconds_per_eval": dt / batch, "samples_per_s": batch / dt}
+        return model_spec("lgn", form, n, sizes.lgn_hidden, "float32", lgn_radius=1)
+    return model_spec("lnn", form, n, sizes.ratio_hidden, "float32")
+
+
+def run_scaling_group(cases, sizes) -> list[dict]:
+    """Rows for cases of one (study, formulation, framework) at several n, timed interleaved
+    (`time_interleaved`, `sizes.scaling_s` seconds of rounds per case): the fitted exponent compares the
+    sizes with each other, so load from other processes must not fall on one size alone."""
+    fns, first = {}, {}
+    for c in cases:
+        fns[c], t = _prepared(_spec(c, sizes), c[2], c[3], c[4])
+        first[c] = t if c[2] == "torch" else 0.0  # JAX's first call compiled
+    best = time_interleaved(fns, first, sizes.scaling_s * len(cases))
+    return [{"study": st, "formulation": form, "framework": fw, "n": int(n), "batch": int(batch),
+             "seconds_per_eval": best[c] / batch, "samples_per_s": batch / best[c]}
+            for c in cases for st, form, fw, n, batch in [c]]
+
+
+def scaling_groups(cases) -> list[list]:
+    """cases grouped by (study, formulation, framework), in first-seen order."""
+    groups: dict = {}
+    for c in cases:
+        groups.setdefault(c[:3], []).append(c)
+    return list(groups.values())
 
 
 def _slope(n, t):

@@ -100,6 +100,7 @@ class Sizes:
     latency_methods: tuple = ("inverse_dynamics", "acceleration")
     target_budget: int = 0         # samples per protocol of the train-to-target study (0: skip it)
     target_hidden: tuple = (64, 64, 64)
+    scaling_s: float = 0.5         # seconds of interleaved timing rounds per scaling case (`replication.bench.scaling`)
     rollout_learned: bool = True   # roll out learned double-pendulum models in the solver study
 
 
@@ -109,7 +110,7 @@ TINY = Sizes("tiny", hidden=(16, 16), batches=(8,), dtypes=("float32",), lgn_hid
              ratio_dofs=(2,), ratio_reps=1, train_hidden=(16, 16), train_batch=32, train_steps=3,
              rollout_solvers=("tsit5",), rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0,
              rollout_ics=2, min_time=0.0, torch_compile=False, structure_batch=64, wave_n=16, latency_s=0.02,
-             latency_methods=("inverse_dynamics",), target_budget=2048, target_hidden=(8, 8))
+             latency_methods=("inverse_dynamics",), target_budget=2048, target_hidden=(8, 8), scaling_s=0.0)
 QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("float32", "float64"),
               lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024), chain_d=(1, 4, 16), chain_batch=256,
               ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=2,

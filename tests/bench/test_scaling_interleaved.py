@@ -1,0 +1,32 @@
+"""The scaling study times the sizes of one group round by round (no timing asserted: calls are counted)."""
+from replication.bench.scaling import scaling_groups, time_interleaved
+from replication.bench.timing import LONG_CALL_S
+
+
+def _counting(names):
+    calls = {k: 0 for k in names}
+
+    def make(k):
+        def fn():
+            calls[k] += 1
+        return fn
+    return {k: make(k) for k in names}, calls
+
+
+def test_every_size_is_called_once_per_round_and_a_long_first_call_sits_out():
+    fns, calls = _counting(["n16", "n64", "n1024"])
+    best = time_interleaved(fns, {"n16": 0.0, "n64": 0.0, "n1024": LONG_CALL_S + 1.0}, budget_s=0.0)
+    assert calls == {"n16": 2, "n64": 2, "n1024": 0}  # at least two rounds; the long one is not repeated
+    assert best["n1024"] == LONG_CALL_S + 1.0 and 0 <= best["n16"] < LONG_CALL_S
+
+
+def test_rounds_stop_at_max_rounds_within_budget():
+    fns, calls = _counting(["a", "b"])
+    time_interleaved(fns, {"a": 0.0, "b": 0.0}, budget_s=1e9, max_rounds=7)
+    assert calls == {"a": 7, "b": 7}
+
+
+def test_groups_keep_study_formulation_and_framework_together():
+    cases = [("lgn_grid", "dense", "jax", 16, 64), ("lgn_grid", "dense", "torch", 16, 64),
+             ("lgn_grid", "dense", "jax", 64, 16), ("lnn_chain", "fast", "jax", 1, 256)]
+    assert scaling_groups(cases) == [[cases[0], cases[2]], [cases[1]], [cases[3]]]
