@@ -255,7 +255,7 @@ def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train
                                 "batched_acceleration": {str(b): v for b, v in dl.items()},
                                 "target_single": 1e4, "met": bool(best[1] >= 1e4),
                                 "met_by": sorted(k for k, v in single.items() if v >= 1e4)}
-    for proto in sorted({r["protocol"] for r in train_target}):
+    for proto in sorted({r["protocol"] for r in train_target if r.get("model", "lnn") == "lnn"}):
         rs = sorted((r for r in train_target if r["protocol"] == proto), key=lambda r: -r["threshold"])
         paper = [r for r in rs if abs(r["threshold"] - PAPER_L1) < 1e-9]
         hit = bool(paper and np.isfinite(paper[0]["samples_to_reach"])
@@ -264,6 +264,7 @@ def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train
             "target": f"held-out L1 <= {PAPER_L1:g} within {TARGET_SAMPLES:.0e} samples (a tenth of the original's "
                       f"{ORIGINAL_SAMPLES:.0e})", "budget": rs[0]["budget"], "hidden": rs[0]["hidden"],
             "best_l1": rs[0]["best_l1"], "description": rs[0]["description"],
+            "hessian_rel_err": rs[0].get("hessian_rel_err", float("nan")),
             "samples_to_reach": {f"{r['threshold']:g}": r["samples_to_reach"] for r in rs},
             "extrapolated_samples_NOT_MEASURED": {f"{r['threshold']:g}": r["extrapolated_samples"] for r in rs},
             "met": hit}

@@ -16,7 +16,17 @@ study runs both protocols for the same `sizes.target_budget` samples and reports
       at 0.3 stayed at 52: leaving the plateau is seed-dependent). At 5e5 samples a constant 3e-3 for
       two thirds diverged after 1.5e5 samples (L1 17 -> 95); decaying every quarter: 16.1, stable;
       1e-3 for two thirds: 20.5.
-Both use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`.
+Both use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
+them, for reference (not a target row):
+  "baseline_reference": the claim's plain MLP baseline (ReLU, Glorot init, q'' straight out) on the
+      variant's protocol and inputs: what the same samples buy when no Euler-Lagrange solve is learned.
+
+Why the LNN stalls, measured: `hessian_rel_err` is the median over the held-out states of
+||H - c H_true||_F / ||c H_true||_F, H the final model's velocity Hessian d2L/dqdot2, H_true the system's
+(the mass matrix), c one least-squares scale for the whole set (L is defined up to a constant factor and
+a total time derivative; neither changes c H_true). Near 0: the LNN found the true Lagrangian up to those
+symmetries; order 1: its accelerations come from some other Lagrangian (the inverse problem admits many),
+whose Euler-Lagrange equations only partly fit. NaN for the baseline.
 
 The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_step`, `data.BatchStream`,
 `schedules.learning_rate`, `objective`); this module only adds a held-out evaluation every
@@ -25,8 +35,8 @@ The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_
 `data.heldout(protocol)` (`sizes` decides its size).
 
 `train_target_rows(sizes, progress) -> (rows, log)`:
-  rows {protocol, description, hidden, budget, threshold, samples_to_reach, reached, best_l1, final_l1,
-        samples_per_s, wall_s, extrapolated_samples, extrapolation}: samples_to_reach is the first
+  rows {protocol, model, description, hidden, budget, threshold, samples_to_reach, reached, best_l1,
+        final_l1, hessian_rel_err, samples_per_s, wall_s, extrapolated_samples, extrapolation}: samples_to_reach is the first
         evaluation at or below the threshold (NaN: "not reached within budget <N>" in `reached`);
         extrapolated_samples is NOT measured: a power law L1 = a * samples^b fitted to the best-so-far
         held-out L1 over the last half of the evaluations, solved for the threshold (`_extrapolate`; NaN:
@@ -43,6 +53,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import models.jax
+import systems
 from models import ModelSpec, init_params
 from replication import train_jax
 from replication.claims.double_pendulum import MODELS, PROTOCOLS
@@ -62,7 +73,7 @@ VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 3e-3, 0.3
 
 
 def protocols(budget: int, n_heldout: int) -> dict:
-    """{name: (Protocol, description, spec overrides)} for a budget in samples."""
+    """{name: (Protocol, description, spec overrides, model label)} for a budget in samples."""
     paper = PROTOCOLS["paper"]
     pool = min(paper.n_train, max(paper.batch, budget // paper.batch * paper.batch))
     orig = paper.replace(steps=max(budget // paper.batch, 2), n_train=pool, n_heldout=n_heldout, log_every=10**9)
@@ -71,11 +82,30 @@ def protocols(budget: int, n_heldout: int) -> dict:
                                      n_heldout=n_heldout, lr=VARIANT_LR, schedule="step",
                                      lr_step_every=max(steps // 4, 1), lr_step_gamma=0.1, log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}
+    var_text = (f"batch {var.batch}, {var.lr:g} then x{var.lr_step_gamma:g} every {var.lr_step_every} of "
+                f"{var.steps} steps, l2 {var.l2:.3g}; MLP input velocities scaled by {VELOCITY_SCALE:g}")
     return {"original_scaled": (orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
-                                      f"{orig.steps} steps, l2 {orig.l2:.3g}", {}),
-            "variant": (var, f"batch {var.batch}, {var.lr:g} then x{var.lr_step_gamma:g} every "
-                             f"{var.lr_step_every} of {var.steps} steps, l2 {var.l2:.3g}; MLP input velocities "
-                             f"scaled by {VELOCITY_SCALE:g}", scale)}
+                                      f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
+            "variant": (var, var_text, scale, "lnn"),
+            "baseline_reference": (var, f"the MLP baseline on the variant's protocol: {var_text}", scale,
+                                   "baseline")}
+
+
+def hessian_rel_err(model, spec, protocol) -> float:
+    """Median over the held-out states of ||H - c H_true||_F / ||c H_true||_F (module doc); NaN for models
+    without a velocity Hessian."""
+    if spec.kind != "lnn":
+        return float("nan")
+    data = heldout(protocol)
+    q, qd = (jnp.asarray(data[k], protocol.dtype) for k in ("q", "qdot"))
+    h = np.asarray(model.velocity_hessian(q, qd), float)
+    h_true = np.asarray(systems.get("double_pendulum", **dict(protocol.system_params))
+                        .velocity_hessian(data["q"], data["qdot"]), float)
+    c = float(np.sum(h * h_true) / np.sum(h_true * h_true))
+    if not (np.isfinite(c) and c != 0.0):
+        return float("nan")
+    return float(np.median(np.linalg.norm(h - c * h_true, axis=(-2, -1))
+                           / np.linalg.norm(c * h_true, axis=(-2, -1))))
 
 
 def _heldout_l1(spec, protocol):
@@ -88,8 +118,9 @@ def _heldout_l1(spec, protocol):
     return lambda model: float(l1(model))
 
 
-def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> list[dict]:
-    """Train from seed-0 init for protocol.steps; held-out L1 at N_EVALS evenly spaced steps and the last."""
+def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> tuple[list[dict], object]:
+    """Train from seed-0 init for protocol.steps: (log with the held-out L1 at N_EVALS evenly spaced steps and
+    the last, the final model: the last one with a finite loss)."""
     model = models.jax.build(spec, init_params(spec, seed=seed))
     opt, step = train_jax.make_step(spec, protocol)
     state = opt.init(eqx.filter(model, eqx.is_inexact_array))
@@ -113,7 +144,7 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> list[di
         if (k + 1) % every == 0 or k == protocol.steps - 1:
             log.append({"protocol": name, "step": k + 1, "samples": (k + 1) * protocol.batch, "lr": lr,
                         "train_loss": loss, "heldout_l1": evaluate(model), "wall_s": wall})
-    return log
+    return log, model
 
 
 def _extrapolate(samples, l1, threshold) -> float:
@@ -136,7 +167,7 @@ def _extrapolate(samples, l1, threshold) -> float:
     return float(n) if n <= EXTRAPOLATION_CAP else np.inf
 
 
-def summarise(name, description, spec, protocol, log) -> list[dict]:
+def summarise(name, description, spec, protocol, log, h_err=float("nan")) -> list[dict]:
     s = np.array([r["samples"] for r in log], float)
     v = np.array([r["heldout_l1"] for r in log], float)
     wall = log[-1]["wall_s"]
@@ -144,11 +175,11 @@ def summarise(name, description, spec, protocol, log) -> list[dict]:
     for thr in THRESHOLDS:
         hit = np.nonzero(v <= thr)[0]
         budget = protocol.steps * protocol.batch
-        rows.append({"protocol": name, "description": description, "hidden": "x".join(map(str, spec.hidden)),
+        rows.append({"protocol": name, "model": spec.kind, "description": description, "hidden": "x".join(map(str, spec.hidden)),
                      "budget": budget, "threshold": thr,
                      "samples_to_reach": float(s[hit[0]]) if hit.size else np.nan,
                      "reached": "yes" if hit.size else f"not reached within budget {budget}",
-                     "best_l1": float(np.nanmin(v)), "final_l1": float(v[-1]),
+                     "best_l1": float(np.nanmin(v)), "final_l1": float(v[-1]), "hessian_rel_err": h_err,
                      "samples_per_s": (s[-1] - protocol.batch) / wall if wall > 0 else np.nan, "wall_s": wall,
                      "extrapolated_samples": _extrapolate(s, v, thr),
                      "extrapolation": "EXTRAPOLATED, not measured: power law fitted to the last half of the "
@@ -159,19 +190,19 @@ def summarise(name, description, spec, protocol, log) -> list[dict]:
 def train_target_rows(sizes, progress=None) -> tuple[list[dict], list[dict]]:
     if not sizes.target_budget:
         return [], []
-    entry = next(m for m in MODELS if m.label == "lnn")
     rows, logs = [], []
-    for name, (proto, desc, over) in protocols(sizes.target_budget, HELDOUT.get(sizes.name, 4096)).items():
+    for name, (proto, desc, over, label) in protocols(sizes.target_budget, HELDOUT.get(sizes.name, 4096)).items():
+        entry = next(m for m in MODELS if m.label == label)
         spec = ModelSpec(dof=2, hidden=tuple(sizes.target_hidden), dtype=proto.dtype, **{**entry.spec, **over})
         if progress:
             progress.set_postfix_str(f"train to target: {name}")
-        log = run_protocol(name, spec, proto)
+        log, model = run_protocol(name, spec, proto)
         logs += log
-        rows += summarise(name, desc, spec, proto, log)
+        rows += summarise(name, desc, spec, proto, log, hessian_rel_err(model, spec, proto))
         if progress:
             progress.update(1)
     return rows, logs
 
 
 def n_cases(sizes) -> int:
-    return 2 if sizes.target_budget else 0
+    return 3 if sizes.target_budget else 0

@@ -124,7 +124,12 @@ def test_latency_compiled_matches_method_and_is_in_targets(bench_dir):
 def test_train_target_rows(bench_dir):
     out, targets = bench_dir
     df = pd.read_csv(out / "bench" / "train_target.csv")
-    assert set(df["protocol"]) == {"original_scaled", "variant"}
+    assert set(df["protocol"]) == {"original_scaled", "variant", "baseline_reference"}
+    assert set(df.loc[df["protocol"] == "baseline_reference", "model"]) == {"baseline"}
+    lnn = df[df["model"] == "lnn"]
+    assert np.all(np.isfinite(lnn["hessian_rel_err"].to_numpy(float)))
+    assert np.all(np.isnan(df.loc[df["model"] == "baseline", "hessian_rel_err"].to_numpy(float)))
+    assert "train_target_baseline_reference" not in targets  # a reference, not a target
     assert set(df["threshold"]) == {10.0, 3.0, 1.0, 0.3, 0.073}
     missed = df[~np.isfinite(df["samples_to_reach"].to_numpy(float))]
     assert missed["reached"].str.startswith("not reached within budget").all()
