@@ -113,7 +113,7 @@ TINY = Sizes("tiny", hidden=(16, 16), batches=(8,), dtypes=("float32",), lgn_hid
              latency_methods=("inverse_dynamics",), target_budget=2048, target_hidden=(8, 8), scaling_s=0.0)
 QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("float32", "float64"),
               lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024), chain_d=(1, 4, 16), chain_batch=256,
-              ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=2,
+              ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=4,
               train_hidden=(600, 600, 600), train_batch=512, train_steps=3, rollout_solvers=_SOLVERS,
               rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003), rollout_t_end=10.0,
               rollout_ics=8, min_time=0.05, torch_compile=True, structure_batch=1024, wave_n=32, latency_s=2.0,
