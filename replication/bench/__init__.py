@@ -32,8 +32,8 @@ PyTorch runs with `TORCH_THREADS` (1) intra-op threads: on two shared cores its 
 ran 10-100x slower than on 1 (threads waiting at barriers while other processes hold the cores); JAX
 keeps XLA's defaults (the thread settings are recorded in machine.json). The inference rows are the
 exception, and so are the fast/paper and matmul rows: each PyTorch row is timed at 1 thread and at all
-cores and keeps the faster (its `threads` column), so that at large batches PyTorch is not held to half the cores XLA uses; PyTorch compiled
-ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`) has its own rows beside eager.
+cores and keeps the faster (its `threads` column), so that at large batches PyTorch is not held to half
+the cores XLA uses; PyTorch compiled ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`) has its own rows beside eager.
 """
 from __future__ import annotations
 
