@@ -2,8 +2,8 @@
 
 `roofline_rows(sizes, dof) -> (fast_paper rows, matmul rows)`.
 fast/paper: the LNN (`sizes.ratio_hidden` softplus, empirical init, float32, batch `sizes.ratio_batch`)
-timed in both formulations and both frameworks -> rows {dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample (JAX only: XLA's compiled cost analysis),
-gflops (JAX only), threads}.
+timed in both formulations and both frameworks -> rows {dof, framework, formulation, batch, seconds,
+samples_per_s, flops_per_sample (JAX only: XLA's compiled cost analysis), gflops (JAX only), threads}.
 matmul: the attainable rate: the chain of matrix products of the same layer shapes (2d -> hidden -> 1,
 a ReLU between) on batch * (d + 1) rows (the width of the fast formulation's batched
 tangent products), FLOPs = 2 * sum(in * out) * rows (matrix products only) -> rows {dof, framework,
