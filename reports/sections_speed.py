@@ -23,8 +23,10 @@ from reports.sections_claims import slug
 BENCH_TABLE_ROWS = 40
 
 
-def _bench_table(df: pd.DataFrame) -> pd.DataFrame:
-    return df.head(BENCH_TABLE_ROWS).map(cell).astype(str)
+def _bench_table(df: pd.DataFrame, missing: str | None = None) -> pd.DataFrame:
+    """The first BENCH_TABLE_ROWS rows as text; NaN reads "not run" unless a `missing` text says what it means."""
+    fmt = cell if missing is None else (lambda x: cell(x, missing))
+    return df.head(BENCH_TABLE_ROWS).map(fmt).astype(str)
 
 
 def speed_sections(res: Results, out_dir: Path) -> list[Section]:
@@ -79,9 +81,10 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
         cols = [c for c in ["protocol", "model", "threshold", "samples_to_reach", "reached", "best_l1",
                             "hessian_rel_err", "samples_per_s", "extrapolated_samples"] if c in tt.columns]
         b.add(Table("Samples to reach held-out L1 thresholds (double-pendulum LNN; paper: 7.3e-2 at ~3e8)",
-                    _bench_table(tt[cols]), ["bench/train_target.csv"],
+                    _bench_table(tt[cols], missing="-"), ["bench/train_target.csv"],
                     note="extrapolated_samples is a power-law extrapolation of the best-so-far curve, not a "
-                         "measurement; 'not reached' rows say within which budget. baseline_reference: the plain "
+                         "measurement ('-': reached, or a flat curve; inf: beyond 1000 x 3e8 samples); "
+                         "samples_to_reach '-': not reached, the 'reached' column says within which budget. baseline_reference: the plain "
                          "MLP on the variant's protocol, for scale. hessian_rel_err: median relative distance of "
                          "the final LNN's velocity Hessian from the true mass matrix times one best scale "
                          "(0: the true Lagrangian up to its symmetries)."))

@@ -172,6 +172,10 @@ def test_report_speed_section_shows_latency_train_target_and_targets(bench_dir, 
     assert any(t.startswith("Single-sample latency") for t in titles)
     assert any(t.startswith("Samples to reach held-out L1") for t in titles)
     assert any(t.startswith("Speed targets") for t in titles)
+    tt = next(b.df for s in speed_sections(load_results_of(out), tmp_path) for b in s.blocks
+              if hasattr(b, "df") and b.title.startswith("Samples to reach"))
+    assert {"baseline_reference", "variant"} <= set(tt["protocol"]) and "hessian_rel_err" in tt.columns
+    assert not (tt == "not run").any().any()  # NaN there means "not reached" or "no extrapolation": "-"
 
 
 def load_results_of(out):
