@@ -84,8 +84,8 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                     _bench_table(tt[cols], missing="-"), ["bench/train_target.csv"],
                     note="extrapolated_samples is a power-law extrapolation of the best-so-far curve, not a "
                          "measurement ('-': reached, or a flat curve; inf: beyond 1000 x 3e8 samples); "
-                         "samples_to_reach '-': not reached, the 'reached' column says within which budget. baseline_reference: the plain "
-                         "MLP on the variant's protocol, for scale. hessian_rel_err: median relative distance of "
+                         "samples_to_reach '-': not reached, the 'reached' column says within which budget. "
+                         "baseline_reference: the plain MLP on the variant's protocol, for scale. hessian_rel_err: median relative distance of "
                          "the final LNN's velocity Hessian from the true mass matrix times one best scale "
                          "(0: the true Lagrangian up to its symmetries)."))
     targets = _targets_table(res.root / "bench" / "targets.json")
