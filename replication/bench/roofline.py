@@ -16,8 +16,6 @@ computed in `replication.bench.tables`.
 """
 from __future__ import annotations
 
-import time
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -26,29 +24,12 @@ import torch
 from models import init_params
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import TORCH_THREAD_CHOICES, model_spec
-from replication.bench.timing import LONG_CALL_S, torch_threads
+from replication.bench.timing import interleaved_best, torch_threads
 
 
 def _states(batch, d, seed=0):
     rng = np.random.default_rng(seed)
     return rng.uniform(-np.pi, np.pi, (batch, d)), rng.uniform(-10, 10, (batch, d))
-
-
-def interleaved_best(fns: dict, reps: int, warm_up: bool = True) -> dict:
-    """{name: fastest time} over `reps` rounds that call every fn once in turn (after one warm-up call
-    each if warm_up): a slow drift in how much CPU other processes leave us hits every fn alike, so their
-    ratios stay fair on shared cores. A fn whose call took LONG_CALL_S or more sits out later rounds."""
-    for fn in fns.values() if warm_up else ():
-        fn()
-    best = {k: float("inf") for k in fns}
-    for _ in range(reps):
-        for k, fn in fns.items():
-            if LONG_CALL_S <= best[k] < float("inf"):
-                continue
-            t0 = time.perf_counter()
-            fn()
-            best[k] = min(best[k], time.perf_counter() - t0)
-    return best
 
 
 def _matmul_chain(framework, params, n_layers, n_rows, n_in):
@@ -82,18 +63,20 @@ def _best_over_threads(fns: dict, reps: int, framework: str) -> dict:
     """{name: (fastest seconds, threads)}: JAX once (its first call compiles: warmed up); PyTorch once per
     thread count in TORCH_THREAD_CHOICES (eager: no warm-up, a d = 16 paper call takes 15 s), faster kept."""
     if framework == "jax":
-        return {k: (t, "default") for k, t in interleaved_best(fns, reps, warm_up=True).items()}
+        for fn in fns.values():
+            fn()
+        return {k: (t, "default") for k, t in interleaved_best(fns, min_rounds=reps).items()}
     best = {k: (float("inf"), None) for k in fns}
     for n in TORCH_THREAD_CHOICES:
         with torch_threads(n):
-            for k, t in interleaved_best(fns, reps, warm_up=False).items():
+            for k, t in interleaved_best(fns, min_rounds=reps).items():
                 best[k] = min(best[k], (t, n))
     return best
 
 
 def roofline_rows(sizes, dof: int) -> tuple[list[dict], list[dict]]:
     """(fast/paper rows, matmul rows) for one dof; per framework the paper LNN, the fast LNN and the matrix
-    products are timed interleaved (`interleaved_best`, `sizes.ratio_reps` rounds)."""
+    products are timed interleaved (`timing.interleaved_best`, `sizes.ratio_reps` rounds)."""
     q, qd = _states(sizes.ratio_batch, dof)
     specs = {f: model_spec("lnn", f, dof, sizes.ratio_hidden, "float32") for f in ("paper", "fast")}
     params = init_params(specs["fast"], seed=0)  # the same MLP layout and weights for both formulations

@@ -23,7 +23,7 @@ import numpy as np
 from models import init_params
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import model_spec
-from replication.bench.timing import LONG_CALL_S
+from replication.bench.timing import interleaved_best
 
 MAX_DENSE_N = 2048
 FRAMEWORKS = ("jax", "torch")
@@ -37,26 +37,6 @@ def _prepared(spec, framework, n, batch, seed=0):
     t0 = time.perf_counter()
     ev.run(args)  # JAX: compiles; eager PyTorch: already a representative call
     return (lambda: ev.run(args)), time.perf_counter() - t0
-
-
-def time_interleaved(fns: dict, first: dict, budget_s: float, max_rounds: int = 50) -> dict:
-    """{name: fastest seconds}: rounds that call every fn once in turn (at least 2 rounds, more while the
-    rounds' total is under budget_s), so that a burst of load from other processes hits one size in one
-    round, not one size for all of its calls. A fn whose timed call, or whose `first` (seconds: an earlier
-    representative call, 0 where there was none), took LONG_CALL_S or more sits out further rounds."""
-    best = {k: (first[k] if first[k] >= LONG_CALL_S else float("inf")) for k in fns}
-    spent, rounds = 0.0, 0
-    while rounds < 2 or (spent < budget_s and rounds < max_rounds):
-        live = [k for k in fns if best[k] < LONG_CALL_S or best[k] == float("inf")]
-        if not live:
-            break
-        for k in live:
-            t0 = time.perf_counter()
-            fns[k]()
-            dt = time.perf_counter() - t0
-            best[k], spent = min(best[k], dt), spent + dt
-        rounds += 1
-    return best
 
 
 def lgn_cases(sizes):
@@ -84,13 +64,13 @@ def _spec(case, sizes):
 
 def run_scaling_group(cases, sizes) -> list[dict]:
     """Rows for cases of one (study, formulation, framework) at several n, timed interleaved
-    (`time_interleaved`, `sizes.scaling_s` seconds of rounds per case): the fitted exponent compares the
+    (`timing.interleaved_best`, `sizes.scaling_s` seconds of rounds per case): the fitted exponent compares the
     sizes with each other, so load from other processes must not fall on one size alone."""
     fns, first = {}, {}
     for c in cases:
         fns[c], t = _prepared(_spec(c, sizes), c[2], c[3], c[4])
         first[c] = t if c[2] == "torch" else 0.0  # JAX's first call compiled
-    best = time_interleaved(fns, first, sizes.scaling_s * len(cases))
+    best = interleaved_best(fns, budget_s=sizes.scaling_s * len(cases), first=first)
     return [{"study": st, "formulation": form, "framework": fw, "n": int(n), "batch": int(batch),
              "seconds_per_eval": best[c] / batch, "samples_per_s": batch / best[c]}
             for c in cases for st, form, fw, n, batch in [c]]

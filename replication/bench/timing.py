@@ -5,11 +5,14 @@ result is ready) repeatedly and returns the FASTEST call (one call if it takes L
 shared cores noise only ever slows a call down, so the minimum is the most reproducible estimate; every
 figure of the study is a throughput or a ratio of two such minima taken in the same run, never an
 absolute timing compared across runs.
+`interleaved_best(fns, min_rounds, budget_s, max_rounds, first) -> {name: seconds}`: the fastest call of
+each of several fns timed round by round (every fn once per round), for figures compared with each other
+(fast/paper/matmul, the sizes of a scaling fit).
 `jax_ready(fn)` / `torch_ready(fn)` wrap a framework call so that it blocks and returns nothing.
 `Sizes`: what the tiny / quick / full studies measure. Wall time on the 2 shared cores of the
-development machine (timings.json, 2026-11): tiny 76 s, quick 345 s (of which 140 s are the single-sample
-latency, learned-rollout and train-to-target stages); both up to 1.5x more while another process holds
-the cores. Full: not timed here.
+development machine (timings.json, 2026-11-22): quick 962 s (inference 411 s with its AOTInductor
+compiles, fast vs paper 143 s, rollouts 124 s, train to target 108 s, scaling 78 s, latency 73 s); up to
+1.5x more while another process holds the cores. Full: not timed here.
 """
 from __future__ import annotations
 
@@ -33,6 +36,29 @@ def best_time(fn, min_time: float = 0.3, min_reps: int = 2, max_reps: int = 50) 
         best, total, reps = min(best, dt), total + dt, reps + 1
         if dt >= LONG_CALL_S:
             break
+    return best
+
+
+def interleaved_best(fns: dict, min_rounds: int = 2, budget_s: float = 0.0, max_rounds: int = 50,
+                     first: dict | None = None) -> dict:
+    """{name: fastest seconds} over rounds that call every fn once in turn: at least min_rounds, more while
+    the rounds' total is under budget_s (at most max_rounds). A slow drift or a burst in how much CPU other
+    processes leave us then hits every fn alike, so ratios and fitted exponents stay fair on shared cores.
+    A fn whose timed call, or whose `first` (seconds of an earlier representative call, where there was
+    one), took LONG_CALL_S or more sits out further rounds."""
+    first = first or {}
+    best = {k: (first[k] if first.get(k, 0.0) >= LONG_CALL_S else float("inf")) for k in fns}
+    spent, rounds = 0.0, 0
+    while rounds < min_rounds or (spent < budget_s and rounds < max_rounds):
+        live = [k for k in fns if best[k] < LONG_CALL_S or best[k] == float("inf")]
+        if not live:
+            break
+        for k in live:
+            t0 = time.perf_counter()
+            fns[k]()
+            dt = time.perf_counter() - t0
+            best[k], spent = min(best[k], dt), spent + dt
+        rounds += 1
     return best
 
 

@@ -1,6 +1,7 @@
-"""The scaling study times the sizes of one group round by round (no timing asserted: calls are counted)."""
-from replication.bench.scaling import scaling_groups, time_interleaved
-from replication.bench.timing import LONG_CALL_S
+"""Interleaved timing rounds (the scaling study's sizes, the roofline's three) and the scaling groups;
+no timing asserted: calls are counted."""
+from replication.bench.scaling import scaling_groups
+from replication.bench.timing import LONG_CALL_S, interleaved_best
 
 
 def _counting(names):
@@ -15,15 +16,21 @@ def _counting(names):
 
 def test_every_size_is_called_once_per_round_and_a_long_first_call_sits_out():
     fns, calls = _counting(["n16", "n64", "n1024"])
-    best = time_interleaved(fns, {"n16": 0.0, "n64": 0.0, "n1024": LONG_CALL_S + 1.0}, budget_s=0.0)
+    best = interleaved_best(fns, first={"n16": 0.0, "n1024": LONG_CALL_S + 1.0})
     assert calls == {"n16": 2, "n64": 2, "n1024": 0}  # at least two rounds; the long one is not repeated
     assert best["n1024"] == LONG_CALL_S + 1.0 and 0 <= best["n16"] < LONG_CALL_S
 
 
 def test_rounds_stop_at_max_rounds_within_budget():
     fns, calls = _counting(["a", "b"])
-    time_interleaved(fns, {"a": 0.0, "b": 0.0}, budget_s=1e9, max_rounds=7)
+    interleaved_best(fns, budget_s=1e9, max_rounds=7)
     assert calls == {"a": 7, "b": 7}
+
+
+def test_min_rounds_without_budget_is_exactly_that_many():
+    fns, calls = _counting(["paper", "fast", "matmul"])
+    interleaved_best(fns, min_rounds=4)
+    assert calls == {"paper": 4, "fast": 4, "matmul": 4}
 
 
 def test_groups_keep_study_formulation_and_framework_together():
