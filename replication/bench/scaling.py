@@ -71,9 +71,12 @@ def run_scaling_group(cases, sizes) -> list[dict]:
         fns[c], t = _prepared(_spec(c, sizes), c[2], c[3], c[4])
         first[c] = t if c[2] == "torch" else 0.0  # JAX's first call compiled
     best = interleaved_best(fns, budget_s=sizes.scaling_s * len(cases), first=first)
-    return [{"study": st, "formulation": form, "framework": fw, "n": int(n), "batch": int(batch),
-             "seconds_per_eval": best[c] / batch, "samples_per_s": batch / best[c]}
-            for c in cases for st, form, fw, n, batch in [c]]
+    rows = []
+    for c in cases:
+        study, form, fw, n, batch = c
+        rows.append({"study": study, "formulation": form, "framework": fw, "n": int(n), "batch": int(batch),
+                     "seconds_per_eval": best[c] / batch, "samples_per_s": batch / best[c]})
+    return rows
 
 
 def scaling_groups(cases) -> list[list]:

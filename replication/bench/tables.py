@@ -199,17 +199,16 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
 
 def _threads_of(rows, **match):
     """The `threads` a matching row chose (int), or None where it has none (results from before the column)."""
-    for r in rows:
-        if all(r.get(k) == v for k, v in match.items()) and r.get("threads") not in (None, "") \
-                and np.isfinite(float(r["threads"])):
-            return int(float(r["threads"]))
-    return None
+    t = _get(rows, "threads", **match)
+    return int(t) if np.isfinite(t) else None
 
 
 def _get(rows, value="samples_per_s", **match):
+    """The first matching row's value as a float; NaN where no row matches or the row has no value."""
     for r in rows:
         if all(r.get(k) == v for k, v in match.items()):
-            return float(r[value])
+            v = r.get(value)
+            return np.nan if v is None or v == "" else float(v)
     return np.nan
 
 
