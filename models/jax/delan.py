@@ -16,7 +16,7 @@ import equinox as eqx
 import jax.numpy as jnp
 
 from models.jax.base import Model
-from models.jax.mlp import ACT, act_and_slope, linear, mlp, mlp_input, wrap_angles
+from models.jax.mlp import ACT, act_and_slope, input_scale, linear, mlp, mlp_input, wrap_angles
 from models.params import n_layers, tril_selection
 
 
@@ -46,8 +46,7 @@ class DeLaN(Model):
         its d forward tangents (x = scale * wrap(q), so dx/dq_k = scale_k e_k; wrapping has slope 1)."""
         spec, d, p = self.spec, self.spec.dof, self.params
         x = mlp_input(spec, [wrap_angles(spec, q)])
-        scale = jnp.ones(d, dtype=q.dtype) if spec.input_scale is None else \
-            jnp.asarray(spec.input_scale, dtype=q.dtype)
+        scale = input_scale(spec, d, q.dtype)
         h, dh = x, jnp.broadcast_to(jnp.diag(scale), (*q.shape[:-1], d, d))
         for i in range(n_layers(spec)):
             h, s1 = act_and_slope(spec.activation, linear(p, f"mlp.{i}", h))

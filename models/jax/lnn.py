@@ -27,7 +27,7 @@ from jax import lax
 
 from models.jax.base import Model
 from models.jax.blocking import in_row_blocks
-from models.jax.mlp import mlp, mlp_input, wrap_angles
+from models.jax.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
 from models.numerics import pinv_rtol, rcond_min
 
@@ -128,8 +128,7 @@ class LNN(Model):
         tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
         spec, (n, d) = self.spec, q.shape
         x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
-        scale = (jnp.ones(x.shape[-1], dtype=x.dtype) if spec.input_scale is None
-                 else jnp.asarray(spec.input_scale, dtype=x.dtype))
+        scale = input_scale(spec, x.shape[-1], x.dtype)
         s_q, s_qd = scale[:d], scale[d:2 * d]
         tangents = jnp.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
         tangents = tangents.at[:, :d, d:2 * d].set(jnp.diag(s_qd))

@@ -57,6 +57,12 @@ def wrap_angles(spec, q):
     return jnp.mod(q + math.pi, 2 * math.pi) - math.pi
 
 
+def input_scale(spec, n: int, dtype):
+    """spec.input_scale as an (n,) array, ones when it is None (for the chain rule of hand-written
+    derivatives: the MLP sees x = scale * features)."""
+    return jnp.ones(n, dtype=dtype) if spec.input_scale is None else jnp.asarray(spec.input_scale, dtype=dtype)
+
+
 def mlp_input(spec, parts: list):
     """Concatenate the feature parts (each (..., k)) and apply spec.input_scale: (..., n_in)."""
     x = jnp.concatenate(parts, axis=-1)
