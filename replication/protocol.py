@@ -20,6 +20,7 @@ SCHEDULES = ("constant", "step", "onecycle")
 DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
+GUARD_FIELDS = ("grad_clip", "spike_skip")   # omitted from to_dict while 0 (off)
 
 
 @dataclass(frozen=True)
@@ -37,6 +38,10 @@ class Protocol:
     lr/schedule: peak learning rate and its shape; `lr_min_ratio` and `lr_start` parametrise the
                one-cycle cosine, `lr_step_every`/`lr_step_gamma` the step decay.
     l2:        coefficient of sum(theta^2) added to the loss (the original code's weight penalty).
+    grad_clip/spike_skip: the gradient-spike guard (`replication.spike_guard`); 0 = off. grad_clip
+               rescales a gradient whose global norm exceeds it; spike_skip skips a step (no update, Adam
+               state kept) whose gradient norm is at least spike_skip x the median of the recent ones.
+               Left out of `to_dict` (and so of `key`) while 0, so older protocols keep their keys.
     """
 
     data: str
@@ -59,6 +64,8 @@ class Protocol:
     b2: float = 0.999
     eps: float = 1e-8
     l2: float = 0.0
+    grad_clip: float = 0.0
+    spike_skip: float = 0.0
     dtype: str = "float32"
     log_every: int = 50
     eval: dict = field(default_factory=dict, hash=False, compare=True)
@@ -76,10 +83,17 @@ class Protocol:
             raise ValueError(f"batch {self.batch} exceeds the training pool n_train={self.n_train}")
         if not (_real(self.lr) and math.isfinite(self.lr) and self.lr > 0):
             raise ValueError(f"learning rate must be positive and finite, got {self.lr!r}")
+        for name in GUARD_FIELDS:
+            v = getattr(self, name)
+            if not (_real(v) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["system_params"] = [list(p) for p in self.system_params]
+        for name in GUARD_FIELDS:
+            if not d[name]:
+                del d[name]
         return d
 
     @classmethod

@@ -2,7 +2,7 @@
 
 `train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome` runs `protocol.steps`
 Adam steps (optax.scale_by_adam, scaled by the learning rate the neutral schedule gives for the
-step), records loss and global gradient norm every `log_every` steps (and at step 0 and the last;
+step; optionally clipped and spike-skipped, `replication.spike_guard`), records loss and global gradient norm every `log_every` steps (and at step 0 and the last;
 for LNN/LGN also the velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops
 at the first non-finite loss or gradient, keeping the parameters from before that step.
 """
@@ -21,6 +21,7 @@ from replication import hessian_probe
 from replication.objective import loss_value, predict
 from replication.outcome import TrainOutcome, nonfinite_failure
 from replication.schedules import learning_rate
+from replication.spike_guard import SpikeGuard
 
 
 def _to_jax(batch: dict, dtype) -> dict:
@@ -39,16 +40,25 @@ def make_loss(spec, protocol):
 
 
 def make_step(spec, protocol):
+    """(optax transform, step). step(model, opt_state, batch, lr, skip_above=inf) -> (model, opt_state, loss,
+    gnorm): one Adam step on the gradient clipped to protocol.grad_clip (if set); not taken (model and state
+    returned unchanged) when gnorm >= skip_above (`replication.spike_guard`)."""
     loss_fn = make_loss(spec, protocol)
     opt = optax.scale_by_adam(b1=protocol.b1, b2=protocol.b2, eps=protocol.eps)
+    clip = protocol.grad_clip
 
     @eqx.filter_jit
-    def step(model, opt_state, batch, lr):
+    def step(model, opt_state, batch, lr, skip_above=jnp.inf):
         loss, grads = eqx.filter_value_and_grad(loss_fn)(model, batch)
         gnorm = optax.global_norm(grads)
-        updates, opt_state = opt.update(grads, opt_state)
-        updates = jax.tree_util.tree_map(lambda u: -lr * u, updates)
-        return eqx.apply_updates(model, updates), opt_state, loss, gnorm
+        if clip > 0:
+            scale = jnp.where(gnorm > clip, clip / gnorm, 1.0)
+            grads = jax.tree_util.tree_map(lambda g: g * scale.astype(g.dtype), grads)
+        updates, new_state = opt.update(grads, opt_state)
+        take = gnorm < skip_above
+        updates = jax.tree_util.tree_map(lambda u: jnp.where(take, -lr * u, jnp.zeros_like(u)), updates)
+        new_state = jax.tree_util.tree_map(lambda a, b: jnp.where(take, a, b), new_state, opt_state)
+        return eqx.apply_updates(model, updates), new_state, loss, gnorm
 
     return opt, step
 
@@ -77,19 +87,25 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
     opt, step = make_step(spec, protocol)
     look = make_probe(spec, protocol)
     opt_state = opt.init(eqx.filter(model, eqx.is_inexact_array))
+    guard = SpikeGuard(protocol)
     log, failure, t0, t_probe = [], None, time.perf_counter(), 0.0
     for k in range(protocol.steps):
         lr = learning_rate(protocol, k)
         batch = _to_jax(stream.batch(k), dtype)
-        new_model, new_state, loss, gnorm = step(model, opt_state, batch, jnp.asarray(lr, dtype))
+        bound = guard.threshold(protocol.dtype)
+        new_model, new_state, loss, gnorm = step(model, opt_state, batch, jnp.asarray(lr, dtype),
+                                                 jnp.asarray(bound, dtype))
         loss, gnorm = float(loss), float(gnorm)
         if not (np.isfinite(loss) and np.isfinite(gnorm)):
             failure = nonfinite_failure(k, loss, gnorm)
             break
+        guard.record(gnorm, bound)
         model, opt_state = new_model, new_state
         if k % protocol.log_every == 0 or k == protocol.steps - 1:
             row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr,
                    "wall_s": time.perf_counter() - t0 - t_probe}
+            if guard.active:
+                row["skipped_steps"] = guard.skipped
             if look is not None:
                 tp = time.perf_counter()
                 row.update(look(model, batch))

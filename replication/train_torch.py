@@ -17,6 +17,7 @@ from replication import hessian_probe
 from replication.objective import loss_value, predict
 from replication.outcome import TrainOutcome, nonfinite_failure
 from replication.schedules import learning_rate
+from replication.spike_guard import SpikeGuard
 
 
 def _to_torch(batch: dict, dtype) -> dict:
@@ -55,6 +56,7 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
     look = make_probe(spec, protocol)
     opt = torch.optim.Adam(model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
                            eps=protocol.eps, weight_decay=0.0, foreach=False)
+    guard = SpikeGuard(protocol)
     log, failure, t0, t_probe = [], None, time.perf_counter(), 0.0
     for k in range(protocol.steps):
         lr = learning_rate(protocol, k)
@@ -64,15 +66,23 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
         opt.zero_grad(set_to_none=True)
         loss = loss_fn(model, batch)
         loss.backward()
-        gnorm = float(torch.sqrt(sum((p.grad * p.grad).sum() for p in model.parameters() if p.grad is not None)))
-        loss = float(loss.detach())
+        bound = guard.threshold(protocol.dtype)
+        grads = [p.grad for p in model.parameters() if p.grad is not None]
+        gnorm_t = torch.sqrt(sum((g * g).sum() for g in grads))
+        gnorm, loss = float(gnorm_t), float(loss.detach())
         if not (np.isfinite(loss) and np.isfinite(gnorm)):
             failure = nonfinite_failure(k, loss, gnorm)
             break
-        opt.step()
+        if guard.record(gnorm, bound):
+            if guard.clip_scale(gnorm) != 1.0:
+                for g in grads:
+                    g.mul_(guard.clip / gnorm_t)
+            opt.step()
         if k % protocol.log_every == 0 or k == protocol.steps - 1:
             row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr,
                    "wall_s": time.perf_counter() - t0 - t_probe}
+            if guard.active:
+                row["skipped_steps"] = guard.skipped
             if look is not None:
                 tp = time.perf_counter()
                 row.update(look(model, batch))

@@ -1,0 +1,74 @@
+"""The gradient-spike guard: its bookkeeping, the protocol fields, and the JAX step's skip."""
+import math
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import models.jax
+from models import ModelSpec, init_params
+from replication import train_jax
+from replication.data import BatchStream
+from replication.protocol import Protocol
+from replication.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
+
+BASE = Protocol(data="double_pendulum_iid", steps=5, batch=8, n_train=32, dtype="float64", resample=True)
+
+
+def test_off_by_default():
+    guard = SpikeGuard(BASE)
+    assert not guard.active and guard.clip_scale(1e9) == 1.0
+    for g in [1.0] * 50 + [1e12]:
+        assert guard.record(g, guard.threshold())
+    assert guard.skipped == 0
+
+
+def test_skip_bound_is_factor_times_recent_median():
+    guard = SpikeGuard(BASE.replace(spike_skip=10.0))
+    for k in range(MIN_HISTORY):
+        assert guard.threshold() == math.inf  # warming up
+        guard.record(float(k + 1), guard.threshold())
+    assert guard.threshold() == pytest.approx(10.0 * np.median(np.arange(1, MIN_HISTORY + 1)))
+    bound = guard.threshold()
+    assert not guard.record(bound, bound) and guard.record(bound * 0.999, bound)
+    assert guard.skipped == 1
+    for _ in range(WINDOW):
+        guard.record(1000.0, guard.threshold())  # old norms leave the window
+    assert guard.threshold() == pytest.approx(1e4)
+
+
+def test_clip_scale():
+    guard = SpikeGuard(BASE.replace(grad_clip=5.0))
+    assert guard.clip_scale(4.0) == 1.0 and guard.clip_scale(20.0) == pytest.approx(0.25)
+
+
+def test_protocol_fields_validated_and_keys_kept():
+    for bad in (-1.0, float("nan"), float("inf"), "3"):
+        with pytest.raises(ValueError, match="grad_clip"):
+            BASE.replace(grad_clip=bad)
+        with pytest.raises(ValueError, match="spike_skip"):
+            BASE.replace(spike_skip=bad)
+    assert "grad_clip" not in BASE.to_dict() and "spike_skip" not in BASE.to_dict()
+    guarded = BASE.replace(grad_clip=100.0, spike_skip=10.0)
+    assert guarded.key() != BASE.key()
+    assert Protocol.from_dict(guarded.to_dict()) == guarded and Protocol.from_dict(BASE.to_dict()) == BASE
+
+
+def test_jax_step_skip_leaves_model_and_state():
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), dtype="float64", angle_wrap=True)
+    model = models.jax.build(spec, init_params(spec, seed=0))
+    opt, step = train_jax.make_step(spec, BASE)
+    state = opt.init(eqx.filter(model, eqx.is_inexact_array))
+    batch = {k: jnp.asarray(v) for k, v in BatchStream(BASE, 0).batch(0).items()}
+    lr = jnp.asarray(1e-2)
+    m_skip, s_skip, _, gnorm = step(model, state, batch, lr, jnp.asarray(0.0))
+    m_take, _, _, _ = step(model, state, batch, lr, jnp.asarray(float(gnorm) * 1.001))
+    assert _same(m_skip, model) and _same(s_skip, state)
+    assert not _same(m_take, model)
+
+
+def _same(a, b) -> bool:
+    leaves = lambda t: jax.tree_util.tree_leaves(eqx.filter(t, eqx.is_array))  # noqa: E731
+    return all(np.array_equal(x, y) for x, y in zip(leaves(a), leaves(b), strict=True))
