@@ -79,7 +79,8 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
     if "train_target" in res.bench:
         tt = res.bench["train_target"]
         cols = [c for c in ["protocol", "model", "threshold", "samples_to_reach", "reached", "best_l1",
-                            "hessian_rel_err", "samples_per_s", "extrapolated_samples"] if c in tt.columns]
+                            "hessian_rel_err", "skipped_steps", "samples_per_s", "extrapolated_samples"]
+                if c in tt.columns]
         b.add(Table("Samples to reach held-out L1 thresholds (double-pendulum LNN; paper: 7.3e-2 at ~3e8)",
                     _bench_table(tt[cols], missing="-"), ["bench/train_target.csv"],
                     note="extrapolated_samples is a power-law extrapolation of the best-so-far curve, not a "
@@ -87,7 +88,8 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                          "samples_to_reach '-': not reached, the 'reached' column says within which budget. "
                          "baseline_reference: the plain MLP on the variant's protocol, for scale. hessian_rel_err: median relative distance of "
                          "the final LNN's velocity Hessian from the true mass matrix times one best scale "
-                         "(0: the true Lagrangian up to its symmetries)."))
+                         "(0: the true Lagrangian up to its symmetries). skipped_steps: steps the variant's "
+                         "gradient-spike guard skipped (`replication.spike_guard`)."))
     targets = _targets_table(res.root / "bench" / "targets.json")
     if targets is not None:
         b.add(Table("Speed targets: measured against the target", targets, ["bench/targets.json"]))

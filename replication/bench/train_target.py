@@ -8,9 +8,23 @@ study runs both protocols for the same `sizes.target_budget` samples and reports
   "original_scaled": the code's protocol (`claims.double_pendulum.PROTOCOLS["paper"]`: batch 512, Adam,
       cosine one-cycle with peak 1e-3, l2 1e-6/512, per-sample L1, states resampled), its one-cycle
       stretched over the budget instead of 3e8 samples;
-  "variant": batch 32, Adam at 3e-3 for the first quarter of the budget, then x0.1 every quarter
-      (step schedule), and the MLP's velocity inputs scaled by 0.3 (`ModelSpec.input_scale`; velocities
-      are U[-10, 10], angles wrapped to [-pi, pi)). Chosen by short trials, 3 x 64, one seed each
+  "variant": batch 32, Adam at 1e-3, x0.1 after 80% of the budget (step schedule), the gradient-spike
+      guard (`replication.spike_guard`: clip the gradient norm at 100, skip a step whose norm is >= 10 x
+      the median of the last 200), and the MLP's velocity inputs scaled by 0.3 (`ModelSpec.input_scale`;
+      velocities are U[-10, 10], angles wrapped to [-pi, pi)).
+      Why the guard (2026-11-22 trials, 3 x 128, batch 32, one XLA thread, held-out L1 on 4096 states):
+      every unguarded run stalls at L1 16-20, and its gradient norm, median about 60, jumps to 1e6-4e10 on
+      single batches (a state where the learned H is near singular); a run at constant 1e-3 reached 16.2
+      at 6e5 samples, then 176 at 9e5. Clipping at 100 alone: 10.4 at 6.8e5, then thrown off again (22 at
+      1.1e6). Clip + skip at 1e-3 (x0.1 at 80%): 1.5e6 samples 6.9 (1.3% of steps skipped), 5e6 samples
+      see the study's log; the same at 3e-3: best 10.9, skipping 5-9% and unstable; batch 128: 7.6 at
+      2.3e6, skipping 6%. At this study's quick size (3 x 64, 5e5): 13.2 (the earlier unguarded variant,
+      3e-3 with x0.1 every quarter: 16.1; that schedule with the guard: 12.3). The learned H is still not
+      the mass matrix (hessian_rel_err 4-7): the guard removes the divergences, not the non-physical
+      Lagrangian. For contrast, a structured L = 1/2 qdot^T (A A^T + 0.01 I) qdot - V with A and V from one
+      MLP on (cos q, sin q) (a trial model, not in the suite), same protocol unguarded: 1.19 at 5e5 and
+      0.26 at 3e6 samples, hessian_rel_err 0.001.
+      The earlier variant and its trials, 3 x 64, one seed each
       (held-out L1 after 2e5 samples): code-like batch 128 schedules stay on the q-double-dot ~ 0
       plateau (L1 ~ 48); velocity scale 0.1 / 0.3 at batch 128: 31 / 22, at batch 32: 21 / 16 (batch 64
       at 0.3 stayed at 52: leaving the plateau is seed-dependent). At 5e5 samples a constant 3e-3 for
@@ -42,14 +56,15 @@ The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_
 
 `train_target_rows(sizes, progress) -> (rows, log)`:
   rows {protocol, model, description, hidden, budget, threshold, samples_to_reach, reached, best_l1,
-        final_l1, hessian_rel_err, samples_per_s, wall_s, extrapolated_samples, extrapolation}:
+        final_l1, hessian_rel_err, skipped_steps, samples_per_s, wall_s, extrapolated_samples, extrapolation}:
         samples_to_reach is the first evaluation at or below the threshold (NaN: "not reached within
         budget <N>" in `reached`);
         extrapolated_samples is NOT measured: a power law L1 = a * samples^b fitted to the best-so-far
         held-out L1 over the last half of the evaluations, solved for the threshold (`_extrapolate`; NaN:
         flat, inf: beyond 1000 x 3e8 samples);
-  log {protocol, step, samples, lr, train_loss, heldout_l1, wall_s} (wall_s: training steps after the
-  first, compiling one; held-out evaluations excluded).
+  log {protocol, step, samples, lr, train_loss, heldout_l1, wall_s, skipped_steps} (wall_s: training steps
+  after the first, compiling one; held-out evaluations excluded; skipped_steps: steps the spike guard has
+  skipped so far, 0 when it is off).
 """
 from __future__ import annotations
 
@@ -67,6 +82,7 @@ from replication.claims.double_pendulum import MODELS, PROTOCOLS
 from replication.data import BatchStream, heldout
 from replication.objective import loss_value, predict
 from replication.schedules import learning_rate
+from replication.spike_guard import SpikeGuard
 
 THRESHOLDS = (10.0, 3.0, 1.0, 0.3, 0.073)
 PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's held-out L1; the original code's samples
@@ -76,7 +92,8 @@ N_EVALS = 20
 HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 
 
-VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 3e-3, 0.3
+VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE, DECAY_AT = 32, 1e-3, 0.3, 0.8
+GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
 
 
 def protocols(budget: int, n_heldout: int) -> dict:
@@ -87,10 +104,12 @@ def protocols(budget: int, n_heldout: int) -> dict:
     steps = max(budget // VARIANT_BATCH, 3)
     var = PROTOCOLS["quick"].replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
                                      n_heldout=n_heldout, lr=VARIANT_LR, schedule="step",
-                                     lr_step_every=max(steps // 4, 1), lr_step_gamma=0.1, log_every=10**9)
+                                     lr_step_every=max(int(steps * DECAY_AT), 1), lr_step_gamma=0.1,
+                                     grad_clip=GRAD_CLIP, spike_skip=SPIKE_SKIP, log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}
-    var_text = (f"batch {var.batch}, {var.lr:g} then x{var.lr_step_gamma:g} every {var.lr_step_every} of "
-                f"{var.steps} steps, l2 {var.l2:.3g}; MLP input velocities scaled by {VELOCITY_SCALE:g}")
+    var_text = (f"batch {var.batch}, {var.lr:g} then x{var.lr_step_gamma:g} after {var.lr_step_every} of "
+                f"{var.steps} steps, l2 {var.l2:.3g}, gradient clip {var.grad_clip:g}, skip at "
+                f"{var.spike_skip:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
     return {"original_scaled": (orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
                                       f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
             "variant": (var, var_text, scale, "lnn"),
@@ -134,23 +153,26 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> tuple[l
     stream, evaluate = BatchStream(protocol, seed), _heldout_l1(spec, protocol)
     every = max(protocol.steps // N_EVALS, 1)
     log = [{"protocol": name, "step": 0, "samples": 0, "lr": learning_rate(protocol, 0), "train_loss": np.nan,
-            "heldout_l1": evaluate(model), "wall_s": 0.0}]
-    wall = 0.0
+            "heldout_l1": evaluate(model), "wall_s": 0.0, "skipped_steps": 0}]
+    wall, guard, dtype = 0.0, SpikeGuard(protocol), protocol.dtype
     for k in range(protocol.steps):
         lr = learning_rate(protocol, k)
-        batch = {key: jnp.asarray(v, protocol.dtype) for key, v in stream.batch(k).items()}
+        batch = {key: jnp.asarray(v, dtype) for key, v in stream.batch(k).items()}
+        bound = guard.threshold(dtype)
         t0 = time.perf_counter()
-        new_model, new_state, loss, _ = step(model, state, batch, jnp.asarray(lr, protocol.dtype))
-        loss = float(loss)
+        new_model, new_state, loss, gnorm = step(model, state, batch, jnp.asarray(lr, dtype), jnp.asarray(bound, dtype))
+        loss, gnorm = float(loss), float(gnorm)
         wall += time.perf_counter() - t0
         if k == 0:
             wall = 0.0  # the first step compiles: samples_per_s counts the steps after it
-        if not np.isfinite(loss):
+        if not (np.isfinite(loss) and np.isfinite(gnorm)):
             break
+        guard.record(gnorm, bound)
         model, state = new_model, new_state
         if (k + 1) % every == 0 or k == protocol.steps - 1:
             log.append({"protocol": name, "step": k + 1, "samples": (k + 1) * protocol.batch, "lr": lr,
-                        "train_loss": loss, "heldout_l1": evaluate(model), "wall_s": wall})
+                        "train_loss": loss, "heldout_l1": evaluate(model), "wall_s": wall,
+                        "skipped_steps": guard.skipped})
     return log, model
 
 
@@ -187,6 +209,7 @@ def summarise(name, description, spec, protocol, log, h_err=float("nan")) -> lis
                      "samples_to_reach": float(s[hit[0]]) if hit.size else np.nan,
                      "reached": "yes" if hit.size else f"not reached within budget {budget}",
                      "best_l1": float(np.nanmin(v)), "final_l1": float(v[-1]), "hessian_rel_err": h_err,
+                     "skipped_steps": int(log[-1]["skipped_steps"]),
                      "samples_per_s": (s[-1] - protocol.batch) / wall if wall > 0 else np.nan, "wall_s": wall,
                      "extrapolated_samples": _extrapolate(s, v, thr),
                      "extrapolation": "EXTRAPOLATED, not measured: power law fitted to the last half of the "

@@ -130,6 +130,9 @@ def test_train_target_rows(bench_dir):
     assert np.all(np.isfinite(lnn["hessian_rel_err"].to_numpy(float)))
     assert np.all(np.isnan(df.loc[df["model"] == "baseline", "hessian_rel_err"].to_numpy(float)))
     assert "train_target_baseline_reference" not in targets  # a reference, not a target
+    assert (df["skipped_steps"] >= 0).all()
+    assert (df.loc[df["protocol"] == "original_scaled", "skipped_steps"] == 0).all()  # its guard is off
+    assert df.loc[df["protocol"] == "variant", "description"].str.contains("gradient clip 100").all()
     assert set(df["threshold"]) == {10.0, 3.0, 1.0, 0.3, 0.073}
     missed = df[~np.isfinite(df["samples_to_reach"].to_numpy(float))]
     assert missed["reached"].str.startswith("not reached within budget").all()
