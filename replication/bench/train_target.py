@@ -54,7 +54,8 @@ The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_
 ("l1": per-sample sum of |q''_pred - q''_true| over components, mean over samples) on
 `data.heldout(protocol)` (`sizes` decides its size).
 
-`train_target_rows(sizes, progress) -> (rows, log)`:
+`train_target_rows(sizes, progress) -> (rows, log)` (the bench's stage, at the preset's budget and widths);
+`study(budget, hidden, n_heldout, names, progress, on_eval)` the same for any budget (`lagbench train-target`):
   rows {protocol, model, description, hidden, budget, threshold, samples_to_reach, reached, best_l1,
         final_l1, hessian_rel_err, skipped_steps, samples_per_s, wall_s, extrapolated_samples, extrapolation}:
         samples_to_reach is the first evaluation at or below the threshold (NaN: "not reached within
@@ -144,9 +145,9 @@ def _heldout_l1(spec, protocol):
     return lambda model: float(l1(model))
 
 
-def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> tuple[list[dict], object]:
+def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
     """Train from seed-0 init for protocol.steps: (log with the held-out L1 at N_EVALS evenly spaced steps and
-    the last, the final model: the last one with a finite loss)."""
+    the last, the final model: the last one with a finite loss); on_eval(log) after each evaluation."""
     model = models.jax.build(spec, init_params(spec, seed=seed))
     opt, step = train_jax.make_step(spec, protocol)
     state = opt.init(eqx.filter(model, eqx.is_inexact_array))
@@ -173,6 +174,8 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0) -> tuple[l
             log.append({"protocol": name, "step": k + 1, "samples": (k + 1) * protocol.batch, "lr": lr,
                         "train_loss": loss, "heldout_l1": evaluate(model), "wall_s": wall,
                         "skipped_steps": guard.skipped})
+            if on_eval:
+                on_eval(log)
     return log, model
 
 
@@ -220,13 +223,25 @@ def summarise(name, description, spec, protocol, log, h_err=float("nan")) -> lis
 def train_target_rows(sizes, progress=None) -> tuple[list[dict], list[dict]]:
     if not sizes.target_budget:
         return [], []
+    return study(sizes.target_budget, sizes.target_hidden, HELDOUT.get(sizes.name, 4096), progress=progress)
+
+
+def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None):
+    """(rows, log) of the protocols `names` (default all of `protocols`) at `budget` samples and MLP widths
+    `hidden`; `on_eval(log so far)` after every held-out evaluation (the CLI writes the log there)."""
+    table = protocols(int(budget), n_heldout)
+    unknown = sorted(set(names or ()) - set(table))
+    if unknown:
+        raise ValueError(f"unknown train-target protocol(s) {', '.join(unknown)}; valid: {', '.join(table)}")
     rows, logs = [], []
-    for name, (proto, desc, over, label) in protocols(sizes.target_budget, HELDOUT.get(sizes.name, 4096)).items():
+    for name in names or table:
+        proto, desc, over, label = table[name]
         entry = next(m for m in MODELS if m.label == label)
-        spec = ModelSpec(dof=2, hidden=tuple(sizes.target_hidden), dtype=proto.dtype, **{**entry.spec, **over})
+        spec = ModelSpec(dof=2, hidden=tuple(hidden), dtype=proto.dtype, **{**entry.spec, **over})
         if progress:
             progress.set_postfix_str(f"train to target: {name}")
-        log, model = run_protocol(name, spec, proto)
+        each = (lambda lg, done=list(logs): on_eval(done + lg)) if on_eval else None
+        log, model = run_protocol(name, spec, proto, on_eval=each)
         logs += log
         rows += summarise(name, desc, spec, proto, log, hessian_rel_err(model, spec, proto))
         if progress:
