@@ -24,3 +24,21 @@ def test_estimate_scales_measured_steps(tmp_path):
     units = plan("smoke", claims=["dp_loss"], frameworks=("jax",))
     est = estimate_seconds(units, tmp_path)
     assert est > 0 and est < 600
+
+
+def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
+    import pandas as pd
+
+    out = tmp_path / "tt"
+    assert main(["train-target", "--budget", "1024", "--hidden", "8,8", "--heldout", "64", "--protocols",
+                 "variant", "--out", str(out), "--quiet"]) == 0
+    rows = pd.read_csv(out / "train_target" / "train_target.csv")
+    log = pd.read_csv(out / "train_target" / "train_target_log.csv")
+    assert set(rows["protocol"]) == {"variant"} and (rows["budget"] == 1024).all()
+    assert log["samples"].max() == 1024 and log["heldout_l1"].notna().all()
+    assert "variant" in capsys.readouterr().out
+
+
+def test_train_target_command_names_an_unknown_protocol(tmp_path, capsys):
+    assert main(["train-target", "--budget", "256", "--protocols", "bogus", "--out", str(tmp_path), "--quiet"]) == 2
+    assert "unknown train-target protocol(s) bogus" in capsys.readouterr().err
