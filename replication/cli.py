@@ -72,15 +72,20 @@ def cmd_train_target(args):
 
     folder = Path(args.out) / "train_target"
     names = _csv(args.protocols)
-    bar = tqdm(total=len(names or train_target.protocols(1000, 1)), desc="lagbench train-target", unit="protocol",
-               disable=args.quiet)
-    write_log = lambda log: write_csv(folder / "train_target_log.csv", pd.DataFrame(log))  # noqa: E731
+    n = len(names or train_target.protocols(1000, 1))
+    bar = tqdm(total=n * train_target.N_EVALS, desc="lagbench train-target", unit="eval", disable=args.quiet)
+
+    def on_eval(log):
+        write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
+        bar.n = min(sum(r["step"] > 0 for r in log), bar.total)
+        bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
+
     rows, log = train_target.study(float(args.budget), [int(h) for h in args.hidden.split(",")], args.heldout,
-                                   names=names, progress=bar, on_eval=write_log)
+                                   names=names, on_eval=on_eval)
     bar.close()
     df = pd.DataFrame(rows)
     write_csv(folder / "train_target.csv", df)
-    write_log(log)
+    write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
     per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "hessian_rel_err",
                                            "skipped_steps", "samples_per_s"]]
     print(per.to_string(index=False))
