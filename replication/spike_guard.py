@@ -10,11 +10,13 @@ Two protocol knobs, both off at 0 (`Protocol.grad_clip`, `Protocol.spike_skip`):
         optax.clip_by_global_norm does;
   skip: a step whose ||g|| (before clipping) is at least spike_skip x the median of the last `WINDOW`
         gradient norms (skipped ones included) is not taken: parameters and Adam state stay as they are.
-        No step is skipped before `MIN_HISTORY` norms are recorded.
+        No step is skipped before `MIN_HISTORY` norms are recorded. With skip on, a step whose gradient
+        norm is not finite (but whose loss is) is skipped instead of ending the run.
 
 `SpikeGuard(protocol)`: `threshold(dtype)` -> the skip bound for the next step (inf when off or warming up);
 `record(gnorm, threshold)` -> True if that step is taken (gnorm < threshold), counting skips in
-`skipped`; `clip_scale(gnorm)` -> the factor the gradient is multiplied by.
+`skipped`; `fails(loss, gnorm)` -> whether the loop stops there; `clip_scale(gnorm)` -> the factor the
+gradient is multiplied by.
 """
 from __future__ import annotations
 
@@ -45,10 +47,17 @@ class SpikeGuard:
         return float(np.asarray(self.factor * float(np.median(self.history)), dtype=dtype))
 
     def record(self, gnorm: float, threshold: float) -> bool:
-        self.history.append(float(gnorm))
+        """Whether the step is taken; a non-finite norm is never taken and stays out of the history."""
+        if math.isfinite(gnorm):
+            self.history.append(float(gnorm))
         taken = bool(gnorm < threshold)
         self.skipped += not taken
         return taken
+
+    def fails(self, loss: float, gnorm: float) -> bool:
+        """Whether the loop must stop: a non-finite loss always; a non-finite gradient norm only when the
+        guard is off (on, it is a spike: the step is skipped)."""
+        return not math.isfinite(loss) or (not math.isfinite(gnorm) and not self.active)
 
     def clip_scale(self, gnorm: float) -> float:
         return self.clip / gnorm if self.clip > 0 and gnorm > self.clip else 1.0

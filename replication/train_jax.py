@@ -2,9 +2,11 @@
 
 `train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome` runs `protocol.steps`
 Adam steps (optax.scale_by_adam, scaled by the learning rate the neutral schedule gives for the
-step; optionally clipped and spike-skipped, `replication.spike_guard`), records loss and global gradient norm every `log_every` steps (and at step 0 and the last;
-for LNN/LGN also the velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops
-at the first non-finite loss or gradient, keeping the parameters from before that step.
+step; optionally clipped and spike-skipped, `replication.spike_guard`), records loss and global
+gradient norm every `log_every` steps (and at step 0 and the last; for LNN/LGN also the
+velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops at the first
+non-finite loss or gradient (a non-finite gradient is skipped instead while the spike guard skips),
+keeping the parameters from before that step.
 """
 from __future__ import annotations
 
@@ -96,7 +98,7 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
         new_model, new_state, loss, gnorm = step(model, opt_state, batch, jnp.asarray(lr, dtype),
                                                  jnp.asarray(bound, dtype))
         loss, gnorm = float(loss), float(gnorm)
-        if not (np.isfinite(loss) and np.isfinite(gnorm)):
+        if guard.fails(loss, gnorm):
             failure = nonfinite_failure(k, loss, gnorm)
             break
         guard.record(gnorm, bound)

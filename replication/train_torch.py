@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 import torch
 
 import models.torch
@@ -70,7 +69,7 @@ def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
         grads = [p.grad for p in model.parameters() if p.grad is not None]
         gnorm_t = torch.sqrt(sum((g * g).sum() for g in grads))
         gnorm, loss = float(gnorm_t), float(loss.detach())
-        if not (np.isfinite(loss) and np.isfinite(gnorm)):
+        if guard.fails(loss, gnorm):
             failure = nonfinite_failure(k, loss, gnorm)
             break
         if guard.record(gnorm, bound):

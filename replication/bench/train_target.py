@@ -166,7 +166,7 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
         wall += time.perf_counter() - t0
         if k == 0:
             wall = 0.0  # the first step compiles: samples_per_s counts the steps after it
-        if not (np.isfinite(loss) and np.isfinite(gnorm)):
+        if guard.fails(loss, gnorm):
             break
         guard.record(gnorm, bound)
         model, state = new_model, new_state

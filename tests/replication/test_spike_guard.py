@@ -39,6 +39,16 @@ def test_skip_bound_is_factor_times_recent_median():
     assert guard.threshold() == pytest.approx(1e4)
 
 
+def test_non_finite_norm_is_a_skipped_spike_only_when_skipping():
+    off, on = SpikeGuard(BASE.replace(grad_clip=5.0)), SpikeGuard(BASE.replace(spike_skip=10.0))
+    assert off.fails(1.0, float("inf")) and off.fails(float("nan"), 1.0)
+    assert not on.fails(1.0, float("nan")) and not on.fails(1.0, float("inf")) and on.fails(float("inf"), 1.0)
+    for g in [2.0] * MIN_HISTORY:
+        on.record(g, on.threshold())
+    assert not on.record(float("nan"), on.threshold()) and not on.record(float("inf"), on.threshold())
+    assert on.skipped == 2 and on.threshold() == pytest.approx(20.0)  # the history holds finite norms only
+
+
 def test_clip_scale():
     guard = SpikeGuard(BASE.replace(grad_clip=5.0))
     assert guard.clip_scale(4.0) == 1.0 and guard.clip_scale(20.0) == pytest.approx(0.25)
