@@ -93,7 +93,7 @@ N_EVALS = 20
 HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 
 
-VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE, DECAY_AT = 32, 1e-3, 0.3, 0.8
+VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 1e-3, 0.3
 GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
 
 
@@ -104,12 +104,11 @@ def protocols(budget: int, n_heldout: int) -> dict:
     orig = paper.replace(steps=max(budget // paper.batch, 2), n_train=pool, n_heldout=n_heldout, log_every=10**9)
     steps = max(budget // VARIANT_BATCH, 3)
     var = PROTOCOLS["quick"].replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
-                                     n_heldout=n_heldout, lr=VARIANT_LR, schedule="step",
-                                     lr_step_every=max(int(steps * DECAY_AT), 1), lr_step_gamma=0.1,
+                                     n_heldout=n_heldout, lr=VARIANT_LR, schedule="onecycle",
                                      grad_clip=GRAD_CLIP, spike_skip=SPIKE_SKIP, log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}
-    var_text = (f"batch {var.batch}, {var.lr:g} then x{var.lr_step_gamma:g} after {var.lr_step_every} of "
-                f"{var.steps} steps, l2 {var.l2:.3g}, gradient clip {var.grad_clip:g}, skip at "
+    var_text = (f"batch {var.batch}, one-cycle peak {var.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
+                f"gradient clip {var.grad_clip:g}, skip at "
                 f"{var.spike_skip:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
     return {"original_scaled": (orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
                                       f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
