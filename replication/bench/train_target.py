@@ -8,34 +8,13 @@ study runs both protocols for the same `sizes.target_budget` samples and reports
   "original_scaled": the code's protocol (`claims.double_pendulum.PROTOCOLS["paper"]`: batch 512, Adam,
       cosine one-cycle with peak 1e-3, l2 1e-6/512, per-sample L1, states resampled), its one-cycle
       stretched over the budget instead of 3e8 samples;
-  "variant": batch 32, Adam at 1e-3, x0.1 after 80% of the budget (step schedule), the gradient-spike
-      guard (`replication.spike_guard`: clip the gradient norm at 100, skip a step whose norm is >= 10 x
-      the median of the last 200), and the MLP's velocity inputs scaled by 0.3 (`ModelSpec.input_scale`;
-      velocities are U[-10, 10], angles wrapped to [-pi, pi)).
-      Why the guard (2026-11-22 trials, 3 x 128, batch 32, one XLA thread, held-out L1 on 4096 states):
-      every unguarded run stalls at L1 16-20, and its gradient norm, median about 60, jumps to 1e6-4e10 on
-      single batches (a state where the learned H is near singular); a run at constant 1e-3 reached 16.2
-      at 6e5 samples, then 176 at 9e5. Clipping at 100 alone: 10.4 at 6.8e5, then thrown off again (22 at
-      1.1e6). Clip + skip at 1e-3 (x0.1 at 80%): 1.5e6 samples 6.9 (1.3% of steps skipped), 5e6 samples
-      see the study's log; the same at 3e-3: best 10.9, skipping 5-9% and unstable; batch 128: 7.6 at
-      2.3e6, skipping 6%. At this study's quick size (3 x 64, 5e5): 13.2 (the earlier unguarded variant,
-      3e-3 with x0.1 every quarter: 16.1; that schedule with the guard: 12.3). The learned H is still not
-      the mass matrix (hessian_rel_err 4-7): the guard removes the divergences, not the non-physical
-      Lagrangian. For contrast, a structured L = 1/2 qdot^T (A A^T + 0.01 I) qdot - V with A and V from one
-      MLP on (cos q, sin q) (a trial model, not in the suite), same protocol unguarded: 1.19 at 5e5 and
-      0.26 at 3e6 samples, hessian_rel_err 0.001.
-      The earlier variant and its trials, 3 x 64, one seed each
-      (held-out L1 after 2e5 samples): code-like batch 128 schedules stay on the q-double-dot ~ 0
-      plateau (L1 ~ 48); velocity scale 0.1 / 0.3 at batch 128: 31 / 22, at batch 32: 21 / 16 (batch 64
-      at 0.3 stayed at 52: leaving the plateau is seed-dependent). At 5e5 samples a constant 3e-3 for
-      two thirds diverged after 1.5e5 samples (L1 17 -> 95); decaying every quarter: 16.1, stable;
-      1e-3 for two thirds: 20.5. Later trials at 3 x 128, 5e5 samples, seed 0 unless said (held-out L1;
-      the variant itself 17.6, seed 1 19.6): Glorot init 25.7, MSE loss 42, velocity scale 0.1 40,
-      batch 128 at 1e-3 28.7, constant 1e-3 19.0, cosine decay from 3e-3 diverged (best 18.3), Adam
-      b2 0.99 16.8, tanh 263, a velocity curriculum (|qdot| range 5% -> 100% over half the budget) 24.1,
-      a penalty on non-positive-definite velocity Hessians 15.4 then diverged, a scale-free Euler-Lagrange
-      residual loss |H q''_true - rhs| / |H| 139 (small residual, wrong accelerations). The MLP baseline
-      on the same protocol: 1.47.
+  "variant": batch 32, the code's one-cycle cosine at peak 1e-3 over the budget, the gradient-spike guard
+      (`replication.spike_guard`: clip the gradient norm at 100, skip a step whose norm is >= 10 x the
+      median of the last 200), and the MLP's velocity inputs scaled by 0.3 (`ModelSpec.input_scale`;
+      velocities are U[-10, 10], angles wrapped to [-pi, pi)). How it was chosen, and every protocol
+      tried on the way with its held-out L1, is in `train_target_trials.md` beside this file. In short:
+      without the guard every run stalled at L1 16-20 or diverged on gradient spikes from near-singular
+      learned Hessians; with it the LNN gets below 10, but its H is still not the mass matrix.
 Both use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
 them, for reference (not a target row):
   "baseline_reference": the claim's plain MLP baseline (ReLU, Glorot init, q'' straight out) on the
