@@ -72,6 +72,10 @@ def cmd_train_target(args):
 
     folder = Path(args.out) / "train_target"
     names = _csv(args.protocols)
+    try:
+        hidden = [int(h) for h in args.hidden.split(",")]
+    except ValueError:
+        raise ValueError(f"--hidden takes comma-separated layer widths such as 128,128,128, got {args.hidden!r}") from None
     n = len(names or train_target.protocols(1000, 1))
     bar = tqdm(total=n * train_target.N_EVALS, desc="lagbench train-target", unit="eval", disable=args.quiet)
 
@@ -80,8 +84,7 @@ def cmd_train_target(args):
         bar.n = min(sum(r["step"] > 0 for r in log), bar.total)
         bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
 
-    rows, log = train_target.study(float(args.budget), [int(h) for h in args.hidden.split(",")], args.heldout,
-                                   names=names, on_eval=on_eval)
+    rows, log = train_target.study(args.budget, hidden, args.heldout, names=names, on_eval=on_eval)
     bar.close()
     df = pd.DataFrame(rows)
     write_csv(folder / "train_target.csv", df)

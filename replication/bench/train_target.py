@@ -139,7 +139,8 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
         batch = {key: jnp.asarray(v, dtype) for key, v in stream.batch(k).items()}
         bound = guard.threshold(dtype)
         t0 = time.perf_counter()
-        new_model, new_state, loss, gnorm = step(model, state, batch, jnp.asarray(lr, dtype), jnp.asarray(bound, dtype))
+        new_model, new_state, loss, gnorm = step(model, state, batch, jnp.asarray(lr, dtype),
+                                                 jnp.asarray(bound, dtype))
         loss, gnorm = float(loss), float(gnorm)
         wall += time.perf_counter() - t0
         if k == 0:
@@ -207,6 +208,8 @@ def train_target_rows(sizes, progress=None) -> tuple[list[dict], list[dict]]:
 def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None):
     """(rows, log) of the protocols `names` (default all of `protocols`) at `budget` samples and MLP widths
     `hidden`; `on_eval(log so far)` after every held-out evaluation (the CLI writes the log there)."""
+    if not budget >= 1:
+        raise ValueError(f"the train-target budget must be at least 1 sample, got {budget!r}")
     table = protocols(int(budget), n_heldout)
     unknown = sorted(set(names or ()) - set(table))
     if unknown:

@@ -42,3 +42,10 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
 def test_train_target_command_names_an_unknown_protocol(tmp_path, capsys):
     assert main(["train-target", "--budget", "256", "--protocols", "bogus", "--out", str(tmp_path), "--quiet"]) == 2
     assert "unknown train-target protocol(s) bogus" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, message", [(["--budget", "0"], "budget must be at least 1 sample"),
+                                           (["--hidden", "128,wide"], "--hidden takes comma-separated")])
+def test_train_target_command_rejects_bad_sizes(tmp_path, capsys, args, message):
+    assert main(["train-target", *args, "--out", str(tmp_path), "--quiet"]) == 2
+    assert message in capsys.readouterr().err
