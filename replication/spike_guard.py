@@ -1,7 +1,7 @@
 """The gradient-spike guard of a training loop, the same bookkeeping for JAX and PyTorch.
 
 Why: an LNN's accelerations are H^-1 (dL/dq - J qdot) with H = d2L/dqdot2 learned. Where a batch holds a
-state at which the learned H is nearly singular, the gradient norm jumps by 3 to 8 orders of magnitude
+state at which the learned H is nearly singular, the gradient norm jumps by 4 to 9 orders of magnitude
 (measured on the double pendulum, 3 x 128: median about 60, single batches up to 4e10). Adam bounds the
 step size but not its direction, and a run of such steps throws the model off (held-out L1 16 -> 176).
 
