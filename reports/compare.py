@@ -106,7 +106,7 @@ def bench_cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataF
         pick = ok.loc[ok["samples_per_s"].idxmax()] if len(ok) else best
 
         def name(r):
-            mode = "/aoti" if r.get("mode") == "aoti" else ""
+            mode = f"/{r['mode']}" if r.get("mode") in ("aoti", "traced") else ""
             return f"{r['model']}/{r['formulation']} ({r['framework']}{mode}, {r['dtype']})"
 
         rows.append({"system": str(system), "best error": f"{name(best)}: {num(best['error'])}",

@@ -63,9 +63,10 @@ def bench_speed_error(df: pd.DataFrame | None, path: Path) -> bool:
         subset=["error", "samples_per_s"])
     if df.empty:
         return False
-    if "mode" in df.columns:  # PyTorch compiled ahead of time gets its own marker: "torch/aoti"
-        aot = df["mode"].astype(str) == "aoti"
-        df = df.assign(framework=df["framework"].astype(str).where(~aot, df["framework"].astype(str) + "/aoti"))
+    if "mode" in df.columns:  # PyTorch compiled ahead of time gets its own marker: "torch/aoti", "torch/traced"
+        aot = df["mode"].astype(str).isin(["aoti", "traced"])
+        df = df.assign(framework=df["framework"].astype(str).where(
+            ~aot, df["framework"].astype(str) + "/" + df["mode"].astype(str)))
     systems = sorted(df["system"].astype(str).unique())[:6]
     fig, axes = new_figure(ncols=len(systems), width=3.4 * len(systems), height=3.4)
     for ax, system in zip(axes, systems, strict=True):

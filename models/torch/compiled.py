@@ -31,6 +31,7 @@ import tempfile
 import warnings
 
 import torch
+from torch.fx.experimental.proxy_tensor import make_fx
 from torch.utils._pytree import tree_flatten, tree_unflatten
 
 from models.checks import n_required_inputs
@@ -108,12 +109,26 @@ def _package(module, example, dynamic_shapes=None, inductor_configs=None):
     return runner, out_spec
 
 
+def trace_flat(fn, example: tuple) -> torch.fx.GraphModule:
+    """fn(*example) as a graph of plain ATen operators, traced by make_fx on the (real) example tensors:
+    torch.func transforms (vmap, jacrev, hessian) come out flattened, which torch.export cannot do with
+    them inside (torch 2.13). The graph is for the example's shapes; data-dependent branches must use
+    torch.cond while tracing (`models.torch.capture.capturing`)."""
+    with torch.no_grad():
+        return make_fx(lambda *xs: fn(*xs))(*example)  # make_fx would trace every parameter of fn's signature
+
+
 def compile_batched(fn, n_inputs: int, width: int, dtype: str = "float32", batch: int | None = None,
-                    name: str = "fn") -> CompiledMethod:
-    """Compile fn(*inputs), each input (B, width), for every batch size B (batch=None) or for B = batch."""
+                    name: str = "fn", flatten: bool = False) -> CompiledMethod:
+    """Compile fn(*inputs), each input (B, width), for every batch size B (batch=None) or for B = batch.
+    flatten: trace fn with `trace_flat` first (for functions built on torch.func; needs a batch)."""
     if n_inputs < 1 or width < 1:
         raise ValueError(f"compile_batched needs n_inputs >= 1 and width >= 1, got {n_inputs}, {width}")
+    if flatten and batch is None:
+        raise ValueError("compile_batched(flatten=True) traces for one batch size: give batch")
     dt = getattr(torch, dtype)
+    if flatten:
+        fn = trace_flat(fn, tuple(torch.zeros(int(batch), width, dtype=dt) for _ in range(n_inputs)))
     module = fn if isinstance(fn, torch.nn.Module) else _Fn(fn)
     if batch is None:
         dim = torch.export.Dim("batch", min=1, max=MAX_BATCH)

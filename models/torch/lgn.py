@@ -82,6 +82,13 @@ def banded_solve_info(band, rhs, r):
     return x, torch.sum(bad)
 
 
+def _neighbours(x, r):
+    """x (..., n) -> (..., n, 2r+1): x at nodes i-r .. i+r (mod n), as `periodic_neighbours` indexes them,
+    by rolls (whose derivative is a roll: the scatter-add of an index gather's derivative fails inductor's
+    CPU code generation, torch 2.13, when the dense path is traced and compiled)."""
+    return torch.stack([torch.roll(x, r - a, dims=-1) for a in range(2 * r + 1)], dim=-1)
+
+
 def _band_sum(r):
     """(k*k, 4r+1) 0/1: node term (a, b) (velocity slots of neighbours i+a-r, i+b-r) -> band column 2r+b-a."""
     k = 2 * r + 1
@@ -91,8 +98,8 @@ def _band_sum(r):
 
 class LGN(Model):
     def _lagrangian(self, q, qdot):
-        nb = torch.as_tensor(periodic_neighbours(q.shape[-1], self.spec.lgn_radius))
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q)[..., nb], qdot[..., nb]])
+        x = mlp_input(self.spec, [_neighbours(wrap_angles(self.spec, q), self.spec.lgn_radius),
+                                  _neighbours(qdot, self.spec.lgn_radius)])
         return torch.sum(mlp(self.params, x, self.spec)[..., 0], dim=-1)
 
     def _banded_terms(self, q, qdot):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import torch
 from torch.func import grad, hessian, jacrev, jvp, vmap
+from torch.fx.experimental.proxy_tensor import get_proxy_mode
 
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
@@ -74,7 +75,10 @@ def _norm1(a):
 
 
 def solve_with_fallback(hess, rhs):
-    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted."""
+    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. A captured graph
+    has no Python branch on data: under torch.export the pinv is a torch.cond; under make_fx
+    (`models.torch.compiled.trace_flat`, whose graph export rejects that cond, torch 2.13) every sample
+    takes pinv and the bad ones keep it."""
     d = hess.shape[-1]
     h = hess.detach()
     inv, info = torch.linalg.inv_ex(h)
@@ -82,7 +86,9 @@ def solve_with_fallback(hess, rhs):
     bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
     safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype), hess)
     x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
-    if torch.compiler.is_exporting():  # no Python branch on data in an exported graph
+    if get_proxy_mode() is not None:  # traced by make_fx (`compiled.trace_flat`): pinv on every sample
+        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
+    elif torch.compiler.is_exporting():  # no Python branch on data in an exported graph
         x = torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], pinv_solve(h, r), y),
                        lambda h, r, b, y: y.clone(), (hess, rhs, bad, x))
     elif bool(torch.any(bad)):

@@ -33,7 +33,8 @@ ran 10-100x slower than on 1 (threads waiting at barriers while other processes 
 keeps XLA's defaults (the thread settings are recorded in machine.json). The inference rows are the
 exception, and so are the fast/paper and matmul rows: each PyTorch row is timed at 1 thread and at all
 cores and keeps the faster (its `threads` column), so that at large batches PyTorch is not held to half
-the cores XLA uses; PyTorch compiled ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`) has its own rows beside eager.
+the cores XLA uses; PyTorch compiled ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`; mode "traced" for
+the torch.func models, `evaluators.TorchTracedEvaluator`) has its own rows beside eager.
 """
 from __future__ import annotations
 

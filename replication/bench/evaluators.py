@@ -15,7 +15,9 @@ batch size, compiled when the evaluator is made, 10-25 s; its kernels are genera
 thread count at that time, the study's 1). Not every model exports: what differentiates with torch.func
 (the paper-formulation LNN's hessian, the dense LGN's forward-over-reverse) fails inside torch.export
 (torch 2.13), which raises. The fast LNN, the HNN, DeLaN and the banded LGN differentiate their MLPs by
-hand and export. `ev.mode`: "jit", "eager", "aoti", "numpy".
+hand and export. Those two go through mode="traced" (`TorchTracedEvaluator`): make_fx traces the call
+into plain ATen operators first (`models.torch.compiled.trace_flat`), which exports and compiles, one
+library per batch size. `ev.mode`: "jit", "eager", "aoti", "traced", "numpy".
 `ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
 (fusions, dots, custom calls, ... in the optimised HLO's entry computation), PyTorch the ATen operators
 one call dispatches (counted with a TorchDispatchMode); None for NumPy.
@@ -168,6 +170,31 @@ class TorchAotEvaluator(TorchEvaluator):
         return None  # one call into the compiled library
 
 
+class TorchTracedEvaluator(TorchEvaluator):
+    """PyTorch through `compile_batched(..., flatten=True)`: the call traced by make_fx (its torch.func
+    transforms flattened into ATen operators), exported and compiled with AOTInductor, one library per
+    batch size, compiled in `prepare` (outside the timing; 20-30 s each)."""
+    mode = "traced"
+
+    def __init__(self, fn, width, dtype, kind):
+        self.kind, self.dtype, self._fn, self._width = kind, getattr(torch, dtype), fn, width
+        self._dtype_name, self._by_batch = dtype, {}
+
+    def prepare(self, q, qdot):
+        args = super().prepare(q, qdot)
+        b = int(args[0].shape[0])
+        if b not in self._by_batch:
+            self._by_batch[b] = compile_batched(self._fn, 2, self._width, self._dtype_name, batch=b,
+                                                name=f"{self.kind} q'' batch {b}", flatten=True)
+        return args
+
+    def _call(self, args):
+        return self._by_batch[int(args[0].shape[0])](*args)
+
+    def ops(self, args):
+        return None  # one call into the compiled library
+
+
 class TruthNumpy:
     framework, mode = "numpy", "numpy"
 
@@ -190,7 +217,8 @@ class TruthNumpy:
 def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="float32", system=None,
                    mode: str | None = None):
     """An evaluator for a model (spec + NumPy params) or, with kind="truth", for `system`; mode "aoti"
-    (PyTorch only) compiles it ahead of time, otherwise each framework's default (jit, eager)."""
+    (PyTorch only) compiles it ahead of time for any batch, "traced" (PyTorch models only) traces and
+    compiles it per batch size, otherwise each framework's default (jit, eager)."""
     if mode == "aoti":
         if framework != "torch":
             raise ValueError(f"mode 'aoti' is PyTorch's; got framework {framework!r}")
@@ -199,8 +227,13 @@ def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="flo
                                      dtype, "truth")
         model = models.torch.build(spec, params)
         return TorchAotEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind)
+    if mode == "traced":
+        if framework != "torch" or kind == "truth":
+            raise ValueError(f"mode 'traced' is for PyTorch models; got framework {framework!r}, kind {kind!r}")
+        model = models.torch.build(spec, params)
+        return TorchTracedEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind)
     if mode not in (None, "jit", "eager", "numpy"):
-        raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti")
+        raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti, traced")
     if kind == "truth":
         return {"jax": TruthJax, "torch": TruthTorch, "numpy": TruthNumpy}[framework](system, dtype)
     if framework == "jax":

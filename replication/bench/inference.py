@@ -4,7 +4,9 @@
 {system, model, formulation, framework, mode, threads, dtype, batch, samples_per_s, error, source, hidden,
 ops} (ops: kernels per call, `Evaluator.ops`, counted at the smallest batch; the ratio notes use it).
 mode: "jit" (JAX), "eager" or "aoti" (PyTorch compiled ahead of time, `evaluators.TorchAotEvaluator`; the
-kinds in AOT_KINDS, both systems' truths included, where `sizes.torch_compile`), "numpy". threads: PyTorch rows are
+kinds in AOT_KINDS, both systems' truths included, where `sizes.torch_compile`), "traced" (the kinds in
+TRACED_KINDS, whose torch.func does not export: traced into ATen operators, then compiled per batch size,
+`evaluators.TorchTracedEvaluator`), "numpy". threads: PyTorch rows are
 timed at each of TORCH_THREAD_CHOICES intra-op threads (1 and all cores) and keep the faster (the column
 says which: on shared cores a 2-thread pool can lose 10-100x to other processes' load, idle it wins at
 large batches); JAX rows run XLA's default pool ("default").
@@ -37,6 +39,7 @@ DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"),
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
 # kinds that export (torch.export + AOTInductor); the paper LNN and the dense LGN differentiate with torch.func
 AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"), ("lgn", "banded"))
+TRACED_KINDS = (("lnn", "paper"), ("lgn", "dense"))  # torch.func inside: traced, then compiled per batch size
 TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
 
 
@@ -53,7 +56,7 @@ class Case:
     params: dict | None = None
     source: str = "random_init"
     extra: dict = field(default_factory=dict)
-    mode: str | None = None  # None: the framework's default (jit, eager); "aoti": PyTorch compiled
+    mode: str | None = None  # None: the framework's default (jit, eager); "aoti" / "traced": PyTorch compiled
 
 
 def model_spec(kind: str, formulation: str, dof: int, hidden: tuple, dtype: str, **kw) -> ModelSpec:
@@ -87,6 +90,9 @@ def inference_cases(sizes) -> list[Case]:
                 if sizes.torch_compile and (kind, form) in AOT_KINDS:
                     cases.append(Case(system, kw, kind, form, "torch", dtype, batches, spec, params, extra=extra,
                                       mode="aoti"))
+                if sizes.torch_compile and (kind, form) in TRACED_KINDS:
+                    cases.append(Case(system, kw, kind, form, "torch", dtype, batches, spec, params, extra=extra,
+                                      mode="traced"))
     return cases
 
 

@@ -52,7 +52,7 @@ def _us(x) -> str:
 
 def fastest_per_batch(rows) -> list[dict]:
     """The inference rows with one row per (system, model, formulation, framework, dtype, source, batch):
-    the fastest of its modes (PyTorch eager / aoti) and thread counts."""
+    the fastest of its modes (PyTorch eager / aoti / traced) and thread counts."""
     best: dict = {}
     for r in rows:
         k = tuple(r.get(c) for c in ("system", "model", "formulation", "framework", "dtype", "source", "batch"))
@@ -153,7 +153,7 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
     inf = fastest_per_batch([r for r in inference if r.get("source") == "random_init"])
     fit = _fit_call_cost(inf)
     ops = {(r["system"], r["model"], r["formulation"], r["dtype"], r["framework"]): r.get("ops") for r in inf
-           if r.get("mode") != "aoti"}
+           if r.get("mode") not in ("aoti", "traced")}
     used = {(r["system"], r["model"], r["formulation"], r["dtype"], r["batch"]): r for r in inf
             if r["framework"] == "torch"}
     for (sy, m, f, dt, b), v in _pairs(inf, ("system", "model", "formulation", "dtype", "batch"),
