@@ -19,7 +19,7 @@ ignore):
                   held-out L1 against samples consumed (`replication.bench.train_target`)
   scaling.csv     study, formulation, framework, n, seconds_per_eval, samples_per_s, batch
   scaling_fit.csv study, formulation, framework, exponent, n_min, n_max   (`replication.bench.scaling`)
-  fast_paper.csv  dof, framework, formulation, batch, seconds, samples_per_s, flops_per_sample, gflops, threads
+  fast_paper.csv  dof, framework, formulation, mode, batch, seconds, samples_per_s, flops_per_sample, gflops, threads
   matmul.csv      dof, framework, rows, seconds, gflops, threads           (`replication.bench.roofline`)
   structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)

@@ -2,8 +2,11 @@
 
 `roofline_rows(sizes, dof) -> (fast_paper rows, matmul rows)`.
 fast/paper: the LNN (`sizes.ratio_hidden` softplus, empirical init, float32, batch `sizes.ratio_batch`)
-timed in both formulations and both frameworks -> rows {dof, framework, formulation, batch, seconds,
+timed in both formulations and both frameworks -> rows {dof, framework, formulation, mode, batch, seconds,
 samples_per_s, flops_per_sample (JAX only: XLA's compiled cost analysis), gflops (JAX only), threads}.
+PyTorch has its eager rows and, where `sizes.torch_compile`, compiled ones (COMPILED_MODES: the fast LNN
+through AOTInductor, mode "aoti"; the paper LNN, whose torch.func does not export, traced first, mode
+"traced"; `evaluators`); the tables take each formulation's fastest mode.
 matmul: the attainable rate: the chain of matrix products of the same layer shapes (2d -> hidden -> 1,
 a ReLU between) on batch * (d + 1) rows (the width of the fast formulation's batched
 tangent products), FLOPs = 2 * sum(in * out) * rows (matrix products only) -> rows {dof, framework,
@@ -25,6 +28,8 @@ from models import init_params
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import TORCH_THREAD_CHOICES, model_spec
 from replication.bench.timing import interleaved_best, torch_threads
+
+COMPILED_MODES = (("fast", "aoti"), ("paper", "traced"))  # PyTorch compiled rows where sizes.torch_compile
 
 
 def _states(batch, d, seed=0):
@@ -85,15 +90,17 @@ def roofline_rows(sizes, dof: int) -> tuple[list[dict], list[dict]]:
     mm_flops = 2.0 * sum(a * b for a, b in zip(widths[:-1], widths[1:], strict=True)) * n_rows
     fp, mm = [], []
     for fw in ("jax", "torch"):
-        evs = {f: make_evaluator(fw, spec, params) for f, spec in specs.items()}
-        argss = {f: ev.prepare(q, qd) for f, ev in evs.items()}
-        fns = {f: (lambda ev=ev, a=argss[f]: ev.run(a)) for f, ev in evs.items()}
+        evs = {(f, None): make_evaluator(fw, spec, params) for f, spec in specs.items()}
+        if fw == "torch" and sizes.torch_compile:
+            evs.update({(f, m): make_evaluator(fw, specs[f], params, mode=m) for f, m in COMPILED_MODES})
+        argss = {k: ev.prepare(q, qd) for k, ev in evs.items()}
+        fns = {k: (lambda ev=ev, a=argss[k]: ev.run(a)) for k, ev in evs.items()}
         fns["matmul"] = _matmul_chain(fw, params, len(widths) - 1, n_rows, widths[0])
         best = _best_over_threads(fns, sizes.ratio_reps, fw)
-        for f, ev in evs.items():
-            flops = ev.flops(argss[f]) / sizes.ratio_batch if fw == "jax" else float("nan")
-            sec, threads = best[f]
-            fp.append({"dof": dof, "framework": fw, "formulation": f, "batch": sizes.ratio_batch,
+        for (f, mode), ev in evs.items():
+            flops = ev.flops(argss[f, mode]) / sizes.ratio_batch if fw == "jax" else float("nan")
+            sec, threads = best[f, mode]
+            fp.append({"dof": dof, "framework": fw, "formulation": f, "mode": ev.mode, "batch": sizes.ratio_batch,
                        "seconds": sec, "samples_per_s": sizes.ratio_batch / sec, "flops_per_sample": flops,
                        "gflops": flops * sizes.ratio_batch / sec / 1e9, "threads": threads})
         sec, threads = best["matmul"]
