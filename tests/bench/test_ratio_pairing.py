@@ -33,3 +33,31 @@ def test_ratio_uses_the_fastest_torch_row_and_names_it():
     t = tables.targets(list(rows.values()), [], [], ROWS, [])
     assert t["delan_torch"]["batched_acceleration"] == {"1": 8000.0, "256": 5e4}
     assert t["torch_within_1.5x_of_jax_inference"]["n_beyond"] == 1
+
+
+def _fp(fw, form, mode, rate, dof=2, threads=1):
+    return {"dof": dof, "framework": fw, "formulation": form, "mode": mode, "batch": 4096, "seconds": 4096 / rate,
+            "samples_per_s": rate, "flops_per_sample": 1e6 if fw == "jax" else float("nan"), "gflops": 1.0,
+            "threads": threads}
+
+
+FP = [_fp("jax", "paper", "jit", 8000.0), _fp("jax", "fast", "jit", 16000.0),
+      _fp("torch", "paper", "eager", 2000.0), _fp("torch", "paper", "traced", 5000.0, threads=2),
+      _fp("torch", "fast", "eager", 9000.0), _fp("torch", "fast", "aoti", 7000.0)]
+
+
+def test_fast_paper_rows_take_each_formulations_fastest_mode():
+    """The 3 x 600 rows: PyTorch's paper LNN at its traced rate, its fast LNN at its eager one; the fast/paper
+    speedup divides those two; the note of a ratio beyond 2x names the compiled mode."""
+    best = {(r["framework"], r["formulation"]): r["mode"] for r in tables.fastest_mode(FP)}
+    assert best == {("jax", "paper"): "jit", ("jax", "fast"): "jit", ("torch", "paper"): "traced",
+                    ("torch", "fast"): "eager"}
+    matmul = [{"dof": 2, "framework": fw, "rows": 3, "seconds": 1.0, "gflops": 20.0, "threads": 1} for fw in ("jax", "torch")]
+    rows = {r["operation"]: r for r in tables.ratio_rows([], [], [], FP, matmul, [])}
+    assert rows["q'' lnn/paper d=2 float32 batch 4096 (3x600 target)"]["ratio"] == pytest.approx(1.6)
+    assert rows["q'' lnn/fast d=2 float32 batch 4096 (3x600 target)"]["ratio"] == pytest.approx(16 / 9)
+    sp = rows["fast/paper speedup d=2"]
+    assert sp["jax"] == pytest.approx(2.0) and sp["torch"] == pytest.approx(9000 / 5000)
+    slow = tables.ratio_rows([], [], [], [_fp("jax", "paper", "jit", 8000.0), _fp("torch", "paper", "traced", 2000.0)],
+                             [], [])
+    assert "PyTorch traced" in slow[0]["note"] and "eager" not in slow[0]["note"]
