@@ -60,7 +60,7 @@ def cmd_fit(args):
 def cmd_bench(args):
     from replication.bench import run_bench
 
-    run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from)
+    run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from, resume=args.resume)
 
 
 def cmd_train_target(args):
@@ -143,11 +143,16 @@ def build_parser():
     s.add_argument("--loss", default="l1", help="l1 | mse")
     s.add_argument("--seed", type=int, default=0)
     s.set_defaults(func=cmd_fit)
-    s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)")
-    s.add_argument("--out", default="results/quick")
+    s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)",
+                       description="The speed study: inference, latency, training, rollouts, scaling, fast vs "
+                       "paper, structure and train-to-target, each with JAX and PyTorch side by side. Writes "
+                       "OUT/bench/*.csv, targets.json and machine.json (quick preset: about 20 min on 2 cores).")
+    s.add_argument("--out", default="results/quick", help="results folder (default results/quick)")
     s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow)")
     s.add_argument("--trained-from", help="results folder whose training cache holds the learned models rolled "
                                           "out in the solver study (default: --out; else tiny models are trained)")
+    s.add_argument("--resume", action="store_true", help="take the stages an interrupted run into --out finished "
+                   "(same preset and commit) from OUT/bench/stages/ and run only the rest")
     s.set_defaults(func=cmd_bench)
     s = sub.add_parser("train-target", help="the train-to-target study alone, at any budget (writes "
                                             "OUT/train_target/train_target.csv and its log, the log after every "

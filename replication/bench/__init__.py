@@ -24,7 +24,8 @@ ignore):
   structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
   targets.json    the issue's numeric targets, each with the measured values and met: true/false
-  timings.json    wall seconds of the whole study and per stage
+  timings.json    wall seconds of the whole study and per stage, and the stages taken from checkpoints
+  stages/*.json   one checkpoint per finished stage, for `lagbench bench --resume` (`replication.bench.resume`)
 Presets (`replication.bench.timing`): quick (default), full (`quick=False`), tiny (`tiny=True` or the
 environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). Every figure is a throughput or a
 ratio within this one run; numbers from different machines (machine.json) are never to be mixed.
@@ -40,7 +41,6 @@ from __future__ import annotations
 
 import os
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -50,6 +50,7 @@ from tqdm.auto import tqdm
 from replication import environment
 from replication.bench import inference as INF
 from replication.bench import latency, rollout, roofline, scaling, structure, tables, train_target, training
+from replication.bench.resume import StageCache
 from replication.bench.timing import FULL, QUICK, TINY, TORCH_THREADS
 from replication.results import write_csv, write_json
 
@@ -69,11 +70,13 @@ def _write(bench: Path, name: str, rows: list[dict]) -> None:
 
 
 def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True,
-              trained_from=None) -> dict:
+              trained_from=None, resume: bool = False) -> dict:
     """Run the study into OUT/bench/; returns the targets dict (also written as targets.json).
 
     trained_from: a results folder whose training cache (trained/jax/...) holds double-pendulum models
-    for the learned rollouts (default OUT itself; where none is found a tiny model is trained)."""
+    for the learned rollouts (default OUT itself; where none is found a tiny model is trained).
+    resume: take the stages an earlier run into OUT finished, at the same preset and commit, from their
+    checkpoints (OUT/bench/stages/, `replication.bench.resume`) instead of running them again."""
     if tiny is None:
         tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
     sizes = TINY if tiny else (QUICK if quick else FULL)
@@ -82,30 +85,44 @@ def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool 
     bench.mkdir(parents=True, exist_ok=True)
     old_threads = torch.get_num_threads()
     torch.set_num_threads(TORCH_THREADS)
-    write_json(bench / "machine.json", machine(sizes))
+    info = machine(sizes)
+    write_json(bench / "machine.json", info)
+    cache = StageCache(bench, sizes.name, info["commit"], resume)
     try:
-        return _run(out, bench, sizes, progress, Path(trained_from) if trained_from else out)
+        return _run(out, bench, sizes, progress, Path(trained_from) if trained_from else out, cache)
     finally:
         torch.set_num_threads(old_threads)
 
 
 class _Stages:
-    """Wall seconds per stage of the study (written to timings.json)."""
+    """Runs the study's stages: each one's tables written as CSV and checkpointed (or, on resume, taken
+    from its checkpoint); wall seconds per stage kept for timings.json."""
 
-    def __init__(self, bar):
-        self.bar, self.seconds = bar, {}
+    def __init__(self, bar, bench: Path, cache: StageCache, notes: list):
+        self.bar, self.bench, self.cache, self.notes, self.seconds = bar, bench, cache, notes, {}
 
-    @contextmanager
-    def __call__(self, name):
+    def __call__(self, name: str, n_cases: int, compute) -> dict:
+        """compute() -> {file name: rows}, run unless a checkpoint stands in for it."""
         self.bar.set_postfix_str(name)
         t0 = time.perf_counter()
         try:
-            yield
+            got = self.cache.load(name)
+            if got is not None:
+                tables, notes = got
+                self.notes += notes
+                self.bar.update(n_cases)
+            else:
+                before = len(self.notes)
+                tables = compute()
+                self.cache.save(name, tables, self.notes[before:])
+            for file, rows in tables.items():
+                _write(self.bench, file, rows)
+            return tables
         finally:
             self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
 
 
-def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path) -> dict:
+def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cache: StageCache) -> dict:
     notes: list[str] = [f"PyTorch on {TORCH_THREADS} intra-op thread(s) (inference rows: the faster of "
                         f"{' and '.join(map(str, INF.TORCH_THREAD_CHOICES))}); JAX with XLA's default threads"]
     cases = INF.inference_cases(sizes) + INF.trained_cases(out, (1, max(sizes.batches)))
@@ -113,54 +130,63 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path) -> d
     total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
              + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes))
     bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
-    stage, t_start = _Stages(bar), time.perf_counter()
+    stage, t_start = _Stages(bar, bench, cache, notes), time.perf_counter()
     try:
-        with stage("inference"):
-            inf_rows = _inference(cases, sizes, notes, bar)
-            _write(bench, "inference", inf_rows)
-        with stage("single-sample latency"):
-            lat_rows = latency.latency_rows(sizes, notes)
-            _write(bench, "latency", lat_rows)
-            bar.update(1)
-        with stage("training"):
-            train_rows = training.training_rows(sizes, notes, bar)
-            _write(bench, "training", train_rows)
-        with stage("rollouts"):
-            _write(bench, "rollout", rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes))
-        with stage("scaling"):
-            sc_rows = []
-            for group in scaling.scaling_groups(sc_cases):
-                st, form, fw = group[0][:3]
-                bar.set_postfix_str(f"scaling {st} {form} {fw} n={','.join(str(c[3]) for c in group)}")
-                sc_rows += scaling.run_scaling_group(group, sizes)
-                bar.update(len(group))
-            fit = scaling.fit_exponents(sc_rows)
-            _write(bench, "scaling", sc_rows)
-            _write(bench, "scaling_fit", fit)
-        with stage("fast vs paper"):
-            fp_rows, mm_rows = [], []
-            for d in sizes.ratio_dofs:
-                fp, mm = roofline.roofline_rows(sizes, d)
-                fp_rows += fp
-                mm_rows += mm
-                bar.update(2)
-            _write(bench, "fast_paper", fp_rows)
-            _write(bench, "matmul", mm_rows)
-        with stage("structure"):
-            _write(bench, "structure", structure.structure_rows(sizes, inf_rows, bar))
-        with stage("train to target"):
-            tt_rows, tt_log = train_target.train_target_rows(sizes, bar)
-            _write(bench, "train_target", tt_rows)
-            _write(bench, "train_target_log", tt_log)
+        inf_rows = stage("inference", len(cases),
+                         lambda: {"inference": _inference(cases, sizes, notes, bar)})["inference"]
+        lat_rows = stage("single-sample latency", 1, lambda: _latency(sizes, notes, bar))["latency"]
+        train_rows = stage("training", training.n_training_cases(sizes),
+                           lambda: {"training": training.training_rows(sizes, notes, bar)})["training"]
+        stage("rollouts", rollout.n_rollout_cases(sizes),
+              lambda: {"rollout": rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes)})
+        sc = stage("scaling", len(sc_cases), lambda: _scaling(sc_cases, sizes, bar))
+        sc_rows, fit = sc["scaling"], sc["scaling_fit"]
+        fp = stage("fast vs paper", 2 * len(sizes.ratio_dofs), lambda: _fast_paper(sizes, bar))
+        fp_rows, mm_rows = fp["fast_paper"], fp["matmul"]
+        stage("structure", structure.n_structure_cases(),
+              lambda: {"structure": structure.structure_rows(sizes, inf_rows, bar)})
+        tt_rows = stage("train to target", train_target.n_cases(sizes),
+                        lambda: _train_target(sizes, bar))["train_target"]
     finally:
         bar.close()
         write_json(bench / "timings.json", {"preset": sizes.name, "total_s": time.perf_counter() - t_start,
-                                            "stages_s": stage.seconds})
+                                            "stages_s": stage.seconds, "resumed_stages": cache.reused})
     ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes, lat_rows)
     _write(bench, "ratios", ratios)
     targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows, lat_rows, tt_rows)
     write_json(bench / "targets.json", {"preset": sizes.name, "targets": targets})
     return targets
+
+
+def _latency(sizes, notes, bar) -> dict:
+    rows = latency.latency_rows(sizes, notes)
+    bar.update(1)
+    return {"latency": rows}
+
+
+def _scaling(sc_cases, sizes, bar) -> dict:
+    rows = []
+    for group in scaling.scaling_groups(sc_cases):
+        st, form, fw = group[0][:3]
+        bar.set_postfix_str(f"scaling {st} {form} {fw} n={','.join(str(c[3]) for c in group)}")
+        rows += scaling.run_scaling_group(group, sizes)
+        bar.update(len(group))
+    return {"scaling": rows, "scaling_fit": scaling.fit_exponents(rows)}
+
+
+def _train_target(sizes, bar) -> dict:
+    rows, log = train_target.train_target_rows(sizes, bar)
+    return {"train_target": rows, "train_target_log": log}
+
+
+def _fast_paper(sizes, bar) -> dict:
+    fp_rows, mm_rows = [], []
+    for d in sizes.ratio_dofs:
+        fp, mm = roofline.roofline_rows(sizes, d)
+        fp_rows += fp
+        mm_rows += mm
+        bar.update(2)
+    return {"fast_paper": fp_rows, "matmul": mm_rows}
 
 
 def _inference(cases, sizes, notes, bar) -> list[dict]:
