@@ -76,8 +76,9 @@ def cmd_train_target(args):
         hidden = [int(h) for h in args.hidden.split(",")]
     except ValueError:
         raise ValueError(f"--hidden takes comma-separated layer widths such as 128,128,128, got {args.hidden!r}") from None
-    n = len(names or train_target.protocols(1000, 1))
-    bar = tqdm(total=n * train_target.N_EVALS, desc="lagbench train-target", unit="eval", disable=args.quiet)
+    table = train_target.protocols(1000, 1)
+    n = sum(train_target.n_evaluations(table[k]) for k in (names or table) if k in table)
+    bar = tqdm(total=n, desc="lagbench train-target", unit="eval", disable=args.quiet)
 
     def on_eval(log):
         write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
@@ -89,7 +90,7 @@ def cmd_train_target(args):
     df = pd.DataFrame(rows)
     write_csv(folder / "train_target.csv", df)
     write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
-    per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "hessian_rel_err",
+    per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "seed", "hessian_rel_err",
                                            "skipped_steps", "samples_per_s"]]
     print(per.to_string(index=False))
     print(df.pivot(index="protocol", columns="threshold", values="samples_to_reach").to_string())
@@ -162,7 +163,7 @@ def build_parser():
                                                              "issue's target is 3e7)")
     s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
     s.add_argument("--heldout", type=int, default=4096, help="held-out states (default 4096)")
-    s.add_argument("--protocols", help="comma-separated: original_scaled, variant, baseline_reference "
+    s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, baseline_reference "
                                        "(default all)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_train_target)

@@ -1,0 +1,54 @@
+"""The train-to-target "restarts" protocol: scouts are plain runs of their seeds, the one with the lowest
+training loss is continued, and the budget counts every scout's samples."""
+import numpy as np
+import pytest
+
+from models import ModelSpec
+from replication.bench import train_target as TT
+from replication.claims.double_pendulum import MODELS
+
+
+@pytest.fixture(scope="module")
+def restarts():
+    entry = TT.protocols(4096, 64)["restarts"]
+    lnn = next(m for m in MODELS if m.label == "lnn")
+    spec = ModelSpec(dof=2, hidden=(8, 8), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
+    log, model = TT.run_protocol("restarts", spec, entry.protocol, seeds=3)
+    return entry, spec, log, model
+
+
+def test_scouts_are_plain_runs_of_their_seeds(restarts):
+    entry, spec, log, _ = restarts
+    scout = entry.protocol.replace(steps=TT.scout_steps(entry.protocol, 3))
+    ends = [r for r in log if r["phase"] == "scout" and r["step"] > 0]
+    assert [r["seed"] for r in ends] == [0, 1, 2]
+    for r in ends:
+        alone, _ = TT.run_protocol("x", spec, scout, seed=r["seed"])
+        assert alone[-1]["heldout_l1"] == pytest.approx(r["heldout_l1"], rel=1e-6)
+
+
+def test_the_lowest_training_loss_is_continued_and_every_sample_counts(restarts):
+    entry, _, log, _ = restarts
+    ends = [r for r in log if r["phase"] == "scout" and r["step"] > 0]
+    chosen = min(ends, key=lambda r: r["scout_loss"])["seed"]
+    cont = [r for r in log if r["phase"] == "continue"]
+    assert cont and {r["seed"] for r in cont} == {chosen}
+    samples = [r["samples"] for r in log]
+    assert samples == sorted(samples) and samples[-1] == entry.protocol.steps * entry.protocol.batch
+    assert ends[-1]["samples"] == 3 * TT.scout_steps(entry.protocol, 3) * entry.protocol.batch
+
+
+def test_scouting_takes_at_most_half_the_budget():
+    for budget in (2048, 5e5, 3e7):
+        p = TT.protocols(int(budget), 64)["restarts"].protocol
+        n = TT.scout_steps(p, TT.RESTART_SEEDS)
+        assert 3 <= n and TT.RESTART_SEEDS * n * p.batch <= max(budget / 2, TT.RESTART_SEEDS * 3 * p.batch)
+    p = TT.protocols(int(3e7), 64)["restarts"].protocol
+    assert TT.scout_steps(p, TT.RESTART_SEEDS) * p.batch == pytest.approx(TT.SCOUT_SAMPLES, abs=p.batch)
+
+
+def test_summary_names_the_chosen_seed(restarts):
+    entry, spec, log, _ = restarts
+    rows = TT.summarise("restarts", entry.description, spec, entry.protocol, log)
+    assert {r["seed"] for r in rows} == {log[-1]["seed"]}
+    assert np.isfinite(rows[0]["best_l1"])
