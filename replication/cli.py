@@ -85,7 +85,8 @@ def cmd_train_target(args):
         bar.n = min(sum(r["step"] > 0 for r in log), bar.total)
         bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
 
-    rows, log = train_target.study(args.budget, hidden, args.heldout, names=names, on_eval=on_eval)
+    rows, log = train_target.study(args.budget, hidden, args.heldout, names=names, on_eval=on_eval,
+                                   seed=args.seed)
     bar.close()
     df = pd.DataFrame(rows)
     write_csv(folder / "train_target.csv", df)
@@ -165,6 +166,7 @@ def build_parser():
     s.add_argument("--heldout", type=int, default=4096, help="held-out states (default 4096)")
     s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, baseline_reference "
                                        "(default all)")
+    s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7; default 0)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_train_target)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "

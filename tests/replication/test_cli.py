@@ -39,6 +39,15 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     assert "variant" in capsys.readouterr().out
 
 
+def test_train_target_command_takes_the_init_seed(tmp_path):
+    import pandas as pd
+
+    out = tmp_path / "tt"
+    assert main(["train-target", "--budget", "256", "--hidden", "8", "--heldout", "64", "--protocols", "variant",
+                 "--seed", "3", "--out", str(out), "--quiet"]) == 0
+    assert set(pd.read_csv(out / "train_target" / "train_target.csv")["seed"]) == {3}
+
+
 def test_train_target_command_names_an_unknown_protocol(tmp_path, capsys):
     assert main(["train-target", "--budget", "256", "--protocols", "bogus", "--out", str(tmp_path), "--quiet"]) == 2
     assert "unknown train-target protocol(s) bogus" in capsys.readouterr().err
