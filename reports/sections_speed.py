@@ -78,7 +78,7 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                          "dispatch in the calling thread."))
     if "train_target" in res.bench:
         tt = res.bench["train_target"]
-        cols = [c for c in ["protocol", "model", "threshold", "samples_to_reach", "reached", "best_l1",
+        cols = [c for c in ["protocol", "model", "seed", "threshold", "samples_to_reach", "reached", "best_l1",
                             "hessian_rel_err", "skipped_steps", "samples_per_s", "extrapolated_samples"]
                 if c in tt.columns]
         b.add(Table("Samples to reach held-out L1 thresholds (double-pendulum LNN; paper: 7.3e-2 at ~3e8)",
@@ -86,6 +86,8 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                     note="extrapolated_samples is a power-law extrapolation of the best-so-far curve, not a "
                          "measurement ('-': reached, or a flat curve; inf: beyond 1000 x 3e8 samples); "
                          "samples_to_reach '-': not reached, the 'reached' column says within which budget. "
+                         "restarts: the variant scouting 8 inits and continuing the one with the lowest training loss; "
+                         "its samples count every scout. "
                          "baseline_reference: the plain MLP on the variant's protocol, for scale. hessian_rel_err: median relative distance of "
                          "the final LNN's velocity Hessian from the true mass matrix times one best scale "
                          "(0: the true Lagrangian up to its symmetries). skipped_steps: steps the variant's "
