@@ -85,8 +85,15 @@ def cmd_train_target(args):
         bar.n = min(sum(r["step"] > 0 for r in log), bar.total)
         bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
 
+    def on_model(name, spec, model):  # the final model: params and spec, loadable by both frameworks
+        import models.jax
+        from replication.results import write_json, write_npz
+
+        write_npz(folder / f"{name}.npz", models.jax.to_params(model))
+        write_json(folder / f"{name}.spec.json", spec.to_dict())
+
     rows, log = train_target.study(args.budget, hidden, args.heldout, names=names, on_eval=on_eval,
-                                   seed=args.seed)
+                                   seed=args.seed, on_model=on_model)
     bar.close()
     df = pd.DataFrame(rows)
     write_csv(folder / "train_target.csv", df)
@@ -158,7 +165,8 @@ def build_parser():
     s.set_defaults(func=cmd_bench)
     s = sub.add_parser("train-target", help="the train-to-target study alone, at any budget (writes "
                                             "OUT/train_target/train_target.csv and its log, the log after every "
-                                            "held-out evaluation)")
+                                            "held-out evaluation, and each protocol's final model as "
+                                            "<protocol>.npz with <protocol>.spec.json)")
     s.add_argument("--out", default="results/train_target")
     s.add_argument("--budget", type=float, default=5e5, help="training samples per protocol (default 5e5; the "
                                                              "issue's target is 3e7)")

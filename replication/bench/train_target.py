@@ -283,10 +283,12 @@ def train_target_rows(sizes, progress=None) -> tuple[list[dict], list[dict]]:
     return study(sizes.target_budget, sizes.target_hidden, HELDOUT.get(sizes.name, 4096), progress=progress)
 
 
-def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None, seed: int = 0):
+def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None, seed: int = 0,
+          on_model=None):
     """(rows, log) of the protocols `names` (default all of `protocols`) at `budget` samples and MLP widths
     `hidden`; `on_eval(log so far)` after every held-out evaluation (the CLI writes the log there); seed:
-    the init seed (restarts: the first of the RESTART_SEEDS scouted)."""
+    the init seed (restarts: the first of the RESTART_SEEDS scouted); `on_model(name, spec, model)` with each
+    protocol's final model (the CLI saves it)."""
     if not budget >= 1:
         raise ValueError(f"the train-target budget must be at least 1 sample, got {budget!r}")
     table = protocols(int(budget), n_heldout)
@@ -303,6 +305,8 @@ def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eva
         each = (lambda lg, done=list(logs): on_eval(done + lg)) if on_eval else None
         log, model = run_protocol(name, spec, proto, seed=seed, on_eval=each, seeds=seeds)
         logs += log
+        if on_model:
+            on_model(name, spec, model)
         rows += summarise(name, desc, spec, proto, log, hessian_rel_err(model, spec, proto))
         if progress:
             progress.update(1)

@@ -1,4 +1,6 @@
 """The command line: help, list, and the duration estimate the paper profile prints."""
+import json
+
 import pytest
 
 from replication.cli import build_parser, main
@@ -36,6 +38,18 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     log = pd.read_csv(out / "train_target" / "train_target_log.csv")
     assert set(rows["protocol"]) == {"variant"} and (rows["budget"] == 1024).all()
     assert log["samples"].max() == 1024 and log["heldout_l1"].notna().all()
+    from models import ModelSpec
+    from replication.results import load_npz
+
+    spec = ModelSpec.from_dict(json.loads((out / "train_target" / "variant.spec.json").read_text()))
+    params = load_npz(out / "train_target" / "variant.npz")
+    assert spec.kind == "lnn" and spec.hidden == (8, 8)
+    import models.jax
+    from replication.bench import train_target as TT
+
+    proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
+    l1 = TT._heldout_l1(spec, proto)(models.jax.build(spec, params))
+    assert l1 == pytest.approx(rows["final_l1"].iloc[0], rel=1e-5)
     assert "variant" in capsys.readouterr().out
 
 
