@@ -4,6 +4,8 @@
   y = the claim metric; colour per model, marker per framework.
 - ``bench_speed_error``: ``bench/inference.csv``: samples_per_s vs error, one panel per system.
 - ``bench_scaling``: ``bench/scaling.csv``: seconds_per_eval vs n per study, formulation and framework.
+- ``train_target_curve``: a train-to-target log: held-out L1 vs training samples, one line per protocol
+  (a restarts protocol's scouts as points: each is another init), the paper's L1 and the target budget.
 - ``data_efficiency``: the claim metric against training-set size N, from model labels ``<model>_n<N>``
   (the runner's convention, e.g. ``delan_n64``); the plain ``<model>`` joins at its protocol ``n_train``.
 """
@@ -110,6 +112,36 @@ def bench_scaling(df: pd.DataFrame | None, path: Path) -> bool:
         ax.set_xlabel("size n (degrees of freedom or grid points)")
         ax.set_ylabel("seconds per evaluation (s)")
         ax.legend(fontsize=6)
+    return save(fig, path)
+
+
+def train_target_curve(log: pd.DataFrame | None, path: Path, paper_l1: float = 7.3e-2,
+                       budget: float = 3e7) -> bool:
+    if log is None:
+        return False
+    log = log.assign(samples=pd.to_numeric(log["samples"], errors="coerce"),
+                     heldout_l1=pd.to_numeric(log["heldout_l1"], errors="coerce"))
+    log = log[(log["samples"] > 0) & (log["heldout_l1"] > 0)]
+    if log.empty:
+        return False
+    fig, (ax,) = new_figure(height=3.6)
+    names = style_index(list(log["protocol"].astype(str)))
+    phase = log["phase"].astype(str) if "phase" in log.columns else pd.Series("train", index=log.index)
+    for name, g in log.groupby(log["protocol"].astype(str), sort=False):
+        g = g.sort_values("samples")
+        scout = (phase[g.index] == "scout").to_numpy()
+        if scout.any():  # each scout is its own init: a point each, not a line through them
+            ax.scatter(g["samples"][scout], g["heldout_l1"][scout], color=colour(names[name]), marker="x", s=25,
+                       label=f"{name}: scouts (one init each)")
+        ax.plot(g["samples"][~scout], g["heldout_l1"][~scout], color=colour(names[name]), marker=".", label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.axhline(paper_l1, color="k", ls="--", lw=0.8, label=f"paper's L1 {paper_l1:g}")
+    if log["samples"].max() >= budget / 3:
+        ax.axvline(budget, color="grey", ls=":", lw=0.8, label=f"target budget {budget:.0e}")
+    ax.set_xlabel("training samples (restarts: every scout counted)")
+    ax.set_ylabel("held-out L1 of q''")
+    ax.legend(fontsize=7)
     return save(fig, path)
 
 

@@ -27,7 +27,10 @@ BENCH_COLUMNS = {
     "latency": ["system", "model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"],
     "train_target": ["protocol", "description", "budget", "threshold", "samples_to_reach", "reached", "best_l1",
                      "samples_per_s", "extrapolated_samples", "extrapolation"],
+    "train_target_log": ["protocol", "samples", "heldout_l1"],
 }
+# `lagbench train-target --out ROOT` writes ROOT/train_target/ with the bench stage's two files
+TRAIN_TARGET_COLUMNS = {k: BENCH_COLUMNS[k] for k in ("train_target", "train_target_log")}
 UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
 
 
@@ -82,6 +85,7 @@ class Results:
     units_csv: pd.DataFrame | None = None
     listed_missing: list[str] = field(default_factory=list)
     bench: dict[str, pd.DataFrame] = field(default_factory=dict)
+    train_target: dict[str, pd.DataFrame] = field(default_factory=dict)  # train_target/ (lagbench train-target)
     machine: dict | None = None
     problems: list[str] = field(default_factory=list)
 
@@ -159,23 +163,28 @@ def _catalogue(res: Results, claims_json: dict | None) -> list[dict]:
     return sorted(claims, key=lambda c: (c.get("number") if isinstance(c.get("number"), int) else 1 << 30, c["id"]))
 
 
-def _load_bench(res: Results) -> None:
-    bench = res.root / "bench"
-    res.machine = _read_json(bench / "machine.json", res.problems, res.root)
-    for name, columns in BENCH_COLUMNS.items():
-        path = bench / f"{name}.csv"
+def _load_csvs(res: Results, folder: str, wanted: dict, into: dict) -> None:
+    """ROOT/folder/<name>.csv for each name of `wanted` that exists and has its columns, into `into`."""
+    for name, columns in wanted.items():
+        path = res.root / folder / f"{name}.csv"
         if not path.is_file():
             continue
         try:
             df = pd.read_csv(path)
         except (ValueError, OSError) as exc:
-            res.problems.append(f"bench/{name}.csv unreadable: {exc}")
+            res.problems.append(f"{folder}/{name}.csv unreadable: {exc}")
             continue
         missing = [c for c in columns if c not in df.columns]
         if missing:
-            res.problems.append(f"bench/{name}.csv lacks columns {missing}; not used")
+            res.problems.append(f"{folder}/{name}.csv lacks columns {missing}; not used")
             continue
-        res.bench[name] = df
+        into[name] = df
+
+
+def _load_bench(res: Results) -> None:
+    res.machine = _read_json(res.root / "bench" / "machine.json", res.problems, res.root)
+    _load_csvs(res, "bench", BENCH_COLUMNS, res.bench)
+    _load_csvs(res, "train_target", TRAIN_TARGET_COLUMNS, res.train_target)
 
 
 def load_results(root: str | Path) -> Results:
