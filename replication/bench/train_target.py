@@ -16,11 +16,12 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       without the guard every run stalled at L1 16-20 or diverged on gradient spikes from near-singular
       learned Hessians; with it the LNN gets below 10, but its H is still not the mass matrix.
   "restarts": the variant with restarts over initialisations: RESTART_SEEDS inits are each trained for
-      SCOUT_SAMPLES samples (at most half the budget over all of them; a one-cycle over the scout), the one
+      target_loop.SCOUT_SAMPLES samples (at most half the budget over all of them; a one-cycle over the scout), the one
       with the lowest training loss (its last 5 % of batches; the held-out set plays no part) continues
       for the rest of the budget with a new one-cycle and fresh Adam state. The budget counts every scout's
-      samples. Why: which init finds a near-physical Lagrangian is luck (at 3x64 and 5e5 samples, 2 of 7
-      seeds), and a run that found one trains without gradient spikes; its training loss tells which.
+      samples. Why: which init finds a near-physical Lagrangian is luck (after 5e5 samples, 3 of 8 seeds at
+      3x64, 2 of 8 and 3 of 8 at 3x128), a run that found one trains on without gradient spikes, and its
+      training loss tells which it is (`train_target_trials.md`, section 5).
 The three use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
 them, for reference (not a target row):
   "baseline_reference": the claim's plain MLP baseline (ReLU, Glorot init, q'' straight out) on the
@@ -33,14 +34,14 @@ a total time derivative; neither changes c H_true). Near 0: the LNN found the tr
 symmetries; order 1: its accelerations come from some other Lagrangian (the inverse problem admits many),
 whose Euler-Lagrange equations only partly fit. NaN for the baseline.
 
-The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_step`, `data.BatchStream`,
-`schedules.learning_rate`, `objective`); this module only adds a held-out evaluation every
-`budget / N_EVALS` samples, for which `train_jax.train` has no hook. Held-out L1: `objective.loss_value`
+The training loop is `target_loop.run_protocol` (the suite's optimiser step, batches, schedule and loss,
+plus a held-out evaluation every `budget / N_EVALS` samples). Held-out L1: `objective.loss_value`
 ("l1": per-sample sum of |q''_pred - q''_true| over components, mean over samples) on
 `data.heldout(protocol)` (`sizes` decides its size).
 
 `train_target_rows(sizes, progress) -> (rows, log)` (the bench's stage, at the preset's budget and widths);
-`study(budget, hidden, n_heldout, names, progress, on_eval)` the same for any budget (`lagbench train-target`):
+`study(budget, hidden, n_heldout, names, progress, on_eval, seed, on_model)` the same for any budget
+(`lagbench train-target`):
   rows {protocol, model, description, hidden, budget, threshold, samples_to_reach, reached, best_l1,
         final_l1, seed, hessian_rel_err, skipped_steps, samples_per_s, wall_s, extrapolated_samples, extrapolation}:
         samples_to_reach is the first evaluation at or below the threshold (NaN: "not reached within
@@ -48,7 +49,7 @@ The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_
         extrapolated_samples is NOT measured: a power law L1 = a * samples^b fitted to the best-so-far
         held-out L1 over the last half of the evaluations, solved for the threshold (`_extrapolate`; NaN:
         flat, inf: beyond 1000 x 3e8 samples);
-  log {protocol, phase, seed, step, samples, lr, train_loss, heldout_l1, wall_s, skipped_steps} (phase: train,
+  log {protocol, phase, seed, step, samples, lr, train_loss, heldout_l1, wall_s, skipped_steps, scout_loss} (phase: train,
   or scout / continue for restarts; step and samples count from the protocol's start; scout_loss: on a
   scout's row, the training loss its choice was made on, else empty; wall_s: training steps
   after the first, compiling one; held-out evaluations excluded; skipped_steps: steps the spike guard has
@@ -56,34 +57,30 @@ The optimiser step, batches, schedule and loss are the suite's (`train_jax.make_
 """
 from __future__ import annotations
 
-import time
 from typing import NamedTuple
 
-import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-import models.jax
 import systems
-from models import ModelSpec, init_params
-from replication import train_jax
+from models import ModelSpec
+from replication.bench.target_loop import N_EVALS, SCOUT_SAMPLES, heldout_l1, run_protocol, scout_steps
 from replication.claims.double_pendulum import MODELS, PROTOCOLS
-from replication.data import BatchStream, heldout
-from replication.objective import loss_value, predict
-from replication.schedules import learning_rate
-from replication.spike_guard import SpikeGuard
+from replication.data import heldout
+
+__all__ = ["N_EVALS", "SCOUT_SAMPLES", "heldout_l1", "run_protocol", "scout_steps", "protocols", "study",
+           "summarise", "hessian_rel_err", "train_target_rows", "n_cases", "n_evaluations"]
 
 THRESHOLDS = (10.0, 3.0, 1.0, 0.3, 0.073)
 PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's held-out L1; the original code's samples
 TARGET_SAMPLES = ORIGINAL_SAMPLES / 10     # the issue's target: at most a tenth
 EXTRAPOLATION_CAP = 1e3 * ORIGINAL_SAMPLES
-N_EVALS = 20
 HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 
 
 VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 1e-3, 0.3
 GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
-RESTART_SEEDS, SCOUT_SAMPLES = 8, 500_000  # "restarts": inits scouted, samples each (at most half the budget)
+RESTART_SEEDS = 8  # "restarts": inits scouted (each for target_loop.SCOUT_SAMPLES samples)
 
 
 class Entry(NamedTuple):
@@ -94,13 +91,6 @@ class Entry(NamedTuple):
     overrides: dict
     label: str
     seeds: int = 1
-
-
-def scout_steps(protocol, seeds: int) -> int:
-    """Steps of each scouting run of a restarts protocol: SCOUT_SAMPLES samples, at most half the budget
-    over all seeds together, at least 3 steps."""
-    per = min(SCOUT_SAMPLES, protocol.steps * protocol.batch // (2 * seeds))
-    return max(per // protocol.batch, 3)
 
 
 def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
@@ -146,93 +136,6 @@ def hessian_rel_err(model, spec, protocol) -> float:
         return float("nan")
     return float(np.median(np.linalg.norm(h - c * h_true, axis=(-2, -1))
                            / np.linalg.norm(c * h_true, axis=(-2, -1))))
-
-
-def _heldout_l1(spec, protocol):
-    data = {k: jnp.asarray(v, protocol.dtype) for k, v in heldout(protocol).items()}
-
-    @eqx.filter_jit
-    def l1(model):
-        return loss_value(predict(model, spec.kind, protocol.task, data, jnp.concatenate), data["target"],
-                          None, "l1")
-    return lambda model: float(l1(model))
-
-
-class _Loop:
-    """The training loop of one protocol, shared by its phases (one compiled step): `phase(...)` trains a
-    model for a protocol's steps from its own stream and appends a log row at each held-out evaluation;
-    samples, steps, wall seconds and skipped steps accumulate over phases."""
-
-    def __init__(self, name, spec, protocol, on_eval=None):
-        self.name, self.spec, self.on_eval, self.batch = name, spec, on_eval, protocol.batch
-        self.opt, self.step = train_jax.make_step(spec, protocol)
-        self.evaluate = _heldout_l1(spec, protocol)
-        self.log, self.steps, self.wall, self.skipped, self.compiled = [], 0, 0.0, 0, False
-
-    def row(self, model, phase, seed, lr, loss):
-        self.log.append({"protocol": self.name, "phase": phase, "seed": seed, "step": self.steps,
-                         "samples": self.samples, "lr": lr, "train_loss": loss,
-                         "heldout_l1": self.evaluate(model), "wall_s": self.wall, "skipped_steps": self.skipped})
-        if self.on_eval and self.steps:
-            self.on_eval(self.log)
-
-    def phase(self, model, protocol, stream_seed, phase, seed, n_evals):
-        """Train for protocol.steps: (model, mean training loss over the last 5 % of the steps). Stops at a
-        non-finite loss, keeping the last model with a finite one."""
-        state = self.opt.init(eqx.filter(model, eqx.is_inexact_array))
-        stream, guard, dtype = BatchStream(protocol, stream_seed), SpikeGuard(protocol), protocol.dtype
-        every, losses, skipped0 = max(protocol.steps // n_evals, 1), [], self.skipped
-        for k in range(protocol.steps):
-            lr = learning_rate(protocol, k)
-            batch = {key: jnp.asarray(v, dtype) for key, v in stream.batch(k).items()}
-            bound = guard.threshold(dtype)
-            t0 = time.perf_counter()
-            new_model, new_state, loss, gnorm = self.step(model, state, batch, jnp.asarray(lr, dtype),
-                                                          jnp.asarray(bound, dtype))
-            loss, gnorm = float(loss), float(gnorm)
-            if self.compiled:  # the first step compiles: samples_per_s counts the steps after it
-                self.wall += time.perf_counter() - t0
-            self.compiled = True
-            if guard.fails(loss, gnorm):
-                break
-            guard.record(gnorm, bound)
-            model, state, self.steps, self.skipped = new_model, new_state, self.steps + 1, skipped0 + guard.skipped
-            losses.append(loss)
-            if (k + 1) % every == 0 or k == protocol.steps - 1:
-                self.row(model, phase, seed, lr, loss)
-        return model, float(np.mean(losses[-max(len(losses) // 20, 1):])) if losses else np.inf
-
-    @property
-    def samples(self) -> int:
-        return self.steps * self.batch
-
-
-def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None,
-                 seeds: int = 1) -> tuple[list[dict], object]:
-    """Train for protocol.steps in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
-    last, the final model: the last one with a finite loss); on_eval(log) after each evaluation.
-    seeds = 1: one run from the init of `seed`. seeds > 1: restarts: the inits seed .. seed + seeds - 1
-    each train for `scout_steps` (a one-cycle over the scout, evaluated once at its end), the one with the
-    lowest training loss over its last 5 % of batches (the held-out set plays no part in the choice) then
-    continues for the rest of the steps with a new one-cycle and fresh Adam state, from batches of its own
-    stream (seed + 1000). Every scout's samples count."""
-    loop = _Loop(name, spec, protocol, on_eval)
-    if seeds == 1:
-        model = models.jax.build(spec, init_params(spec, seed=seed))
-        loop.row(model, "train", seed, learning_rate(protocol, 0), np.nan)
-        return loop.log, loop.phase(model, protocol, seed, "train", seed, N_EVALS)[0]
-    scout = protocol.replace(steps=scout_steps(protocol, seeds))
-    best = None
-    for s in range(seed, seed + seeds):
-        model = models.jax.build(spec, init_params(spec, seed=s))
-        if s == seed:
-            loop.row(model, "scout", s, learning_rate(scout, 0), np.nan)
-        model, tail = loop.phase(model, scout, s, "scout", s, 1)
-        loop.log[-1]["scout_loss"] = tail
-        if best is None or tail < best[0]:
-            best = (tail, s, model)
-    rest = protocol.replace(steps=max(protocol.steps - seeds * scout.steps, 1))
-    return loop.log, loop.phase(best[2], rest, best[1] + 1000, "continue", best[1], N_EVALS)[0]
 
 
 def _extrapolate(samples, l1, threshold) -> float:

@@ -48,7 +48,7 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     from replication.bench import train_target as TT
 
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
-    l1 = TT._heldout_l1(spec, proto)(models.jax.build(spec, params))
+    l1 = TT.heldout_l1(spec, proto)(models.jax.build(spec, params))
     assert l1 == pytest.approx(rows["final_l1"].iloc[0], rel=1e-5)
     assert "variant" in capsys.readouterr().out
 
