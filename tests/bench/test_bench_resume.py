@@ -23,10 +23,8 @@ SAME = ["inference", "latency", "training", "rollout", "scaling", "scaling_fit",
 
 
 @pytest.fixture(scope="module")
-def first_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("resume")
-    B.run_bench(out, tiny=True, progress=False)
-    return out
+def first_run(bench_dir):
+    return bench_dir[0]  # the session's tiny run (conftest.py); the tests resume into copies of it
 
 
 def _forbid(monkeypatch, stages):

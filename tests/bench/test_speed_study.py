@@ -7,10 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from models import ModelSpec, init_params
-from replication.bench import run_bench
 from replication.bench.inference import TORCH_THREAD_CHOICES
-from replication.results import write_npz
 
 COLUMNS = {
     "inference": ["system", "model", "formulation", "framework", "mode", "threads", "dtype", "batch", "samples_per_s",
@@ -32,38 +29,6 @@ COLUMNS = {
 POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples_per_s"],
             "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"], "latency": ["evals_per_s"],
             "fast_paper": ["samples_per_s"], "matmul": ["gflops"]}
-
-
-def _fake_trained_unit(out):
-    """A double-pendulum unit as `lagbench run` leaves it: result.json with model_spec + checkpoint.npz."""
-    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
-    unit = out / "units" / "dp_loss" / "jax" / "lnn" / "seed0"
-    unit.mkdir(parents=True)
-    write_npz(unit / "checkpoint.npz", init_params(spec, seed=3))
-    (unit / "result.json").write_text(json.dumps({
-        "claim": "dp_loss", "framework": "jax", "model": "lnn", "seed": 0, "status": "ok",
-        "model_spec": spec.to_dict(), "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
-
-
-def _fake_training_cache(out):
-    """An LNN in the training cache (OUT/trained/jax/<key>/) as `replication.training` leaves it; the
-    baseline is missing, so the rollout study trains a tiny one."""
-    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
-    folder = out / "trained" / "jax" / "fakekey"
-    folder.mkdir(parents=True)
-    write_npz(folder / "checkpoint.npz", init_params(spec, seed=4))
-    (folder / "result.json").write_text(json.dumps({
-        "failure": None, "steps_done": 10, "batch": 8, "spec": spec.to_dict(), "seed": 0,
-        "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
-
-
-@pytest.fixture(scope="module")
-def bench_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("bench")
-    _fake_trained_unit(out)
-    _fake_training_cache(out)
-    targets = run_bench(out, tiny=True, progress=False)
-    return out, targets
 
 
 @pytest.mark.parametrize("name", sorted(COLUMNS))
