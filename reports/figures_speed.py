@@ -129,7 +129,7 @@ def train_target_curve(log: pd.DataFrame | None, path: Path, paper_l1: float = 7
     phase = log["phase"].astype(str) if "phase" in log.columns else pd.Series("train", index=log.index)
     for name, g in log.groupby(log["protocol"].astype(str), sort=False):
         g = g.sort_values("samples")
-        scout = (phase[g.index] == "scout").to_numpy()
+        scout = phase[g.index].str.startswith("scout").to_numpy()
         if scout.any():  # each scout is its own init: a point each, not a line through them
             ax.scatter(g["samples"][scout], g["heldout_l1"][scout], color=colour(names[name]), marker="x", s=25,
                        label=f"{name}: scouts (one init each)")

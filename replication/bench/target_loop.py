@@ -63,8 +63,9 @@ class _Loop:
             self.on_eval(self.log)
 
     def phase(self, model, protocol, stream_seed, phase, seed, n_evals):
-        """Train for protocol.steps: (model, mean training loss over the last 5 % of the steps). Stops at a
-        non-finite loss, keeping the last model with a finite one."""
+        """Train for protocol.steps: (model, mean training loss over the last 5 % of the steps, inf if none).
+        Stops at a non-finite loss, keeping the last model with a finite one; the phase always ends with a
+        row of the log."""
         state = self.opt.init(eqx.filter(model, eqx.is_inexact_array))
         stream, guard, dtype = BatchStream(protocol, stream_seed), SpikeGuard(protocol), protocol.dtype
         every, losses, skipped0 = max(protocol.steps // n_evals, 1), [], self.skipped
@@ -79,7 +80,8 @@ class _Loop:
             if self.compiled:  # the first step compiles: samples_per_s counts the steps after it
                 self.wall += time.perf_counter() - t0
             self.compiled = True
-            if guard.fails(loss, gnorm):
+            if guard.fails(loss, gnorm):  # the row shows where it stopped, with the last good model
+                self.row(model, f"{phase} (stopped: non-finite loss)", seed, lr, loss)
                 break
             guard.record(gnorm, bound)
             model, state, self.steps, self.skipped = new_model, new_state, self.steps + 1, skipped0 + guard.skipped

@@ -52,3 +52,26 @@ def test_summary_names_the_chosen_seed(restarts):
     rows = TT.summarise("restarts", entry.description, spec, entry.protocol, log)
     assert {r["seed"] for r in rows} == {log[-1]["seed"]}
     assert np.isfinite(rows[0]["best_l1"])
+
+
+def test_a_scout_that_fails_is_logged_and_never_chosen(monkeypatch):
+    """The second scout's first loss is non-finite: it stops there with a row of its own (scout_loss inf),
+    and the first scout's row keeps its own loss."""
+    from replication.bench import target_loop
+
+    entry = TT.protocols(2048, 64)["restarts"]
+    lnn = next(m for m in MODELS if m.label == "lnn")
+    spec = ModelSpec(dof=2, hidden=(8,), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
+    n = TT.scout_steps(entry.protocol, 2)
+    calls = {"k": 0}
+    real = target_loop.SpikeGuard.fails
+
+    def fails(self, loss, gnorm):
+        calls["k"] += 1
+        return calls["k"] == n + 1 or real(self, loss, gnorm)
+    monkeypatch.setattr(target_loop.SpikeGuard, "fails", fails)
+    log, _ = TT.run_protocol("r", spec, entry.protocol, seeds=2)
+    ends = [r for r in log if "scout_loss" in r]
+    assert [r["seed"] for r in ends] == [0, 1] and np.isfinite(ends[0]["scout_loss"])
+    assert ends[1]["scout_loss"] == np.inf and "stopped" in ends[1]["phase"]
+    assert {r["seed"] for r in log if r["phase"] == "continue"} == {0}
