@@ -50,7 +50,7 @@ class _Loop:
     samples, steps, wall seconds and skipped steps accumulate over phases."""
 
     def __init__(self, name, spec, protocol, on_eval=None):
-        self.name, self.spec, self.on_eval, self.batch = name, spec, on_eval, protocol.batch
+        self.name, self.on_eval, self.batch = name, on_eval, protocol.batch
         self.opt, self.step = train_jax.make_step(spec, protocol)
         self.evaluate = heldout_l1(spec, protocol)
         self.log, self.steps, self.wall, self.skipped, self.compiled = [], 0, 0.0, 0, False

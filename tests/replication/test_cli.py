@@ -46,9 +46,10 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     assert spec.kind == "lnn" and spec.hidden == (8, 8)
     import models.jax
     from replication.bench import train_target as TT
+    from replication.bench.target_loop import heldout_l1
 
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
-    l1 = TT.heldout_l1(spec, proto)(models.jax.build(spec, params))
+    l1 = heldout_l1(spec, proto)(models.jax.build(spec, params))
     assert l1 == pytest.approx(rows["final_l1"].iloc[0], rel=1e-5)
     assert "variant" in capsys.readouterr().out
 
