@@ -59,8 +59,14 @@ def cmd_fit(args):
 
 def cmd_bench(args):
     from replication.bench import run_bench
+    from replication.bench.device import NoGPUError
 
-    run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from, resume=args.resume)
+    try:
+        run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from, resume=args.resume,
+                  gpu=args.gpu)
+    except NoGPUError as e:
+        print(f"lagbench: error: {e}", file=sys.stderr)
+        return 2
 
 
 def cmd_train_target(args):
@@ -162,6 +168,9 @@ def build_parser():
                                           "out in the solver study (default: --out; else tiny models are trained)")
     s.add_argument("--resume", action="store_true", help="take the stages an interrupted run into --out finished "
                    "(same preset and commit) from OUT/bench/stages/ and run only the rest")
+    s.add_argument("--gpu", action="store_true", help="run JAX and PyTorch on the CUDA GPU instead, at the GPU "
+                   "preset (inference to batch 65536, training, scaling, fast vs paper); writes OUT/bench_gpu/ "
+                   "(LAGBENCH_BENCH_TINY=1: a seconds-long check of the same stages)")
     s.set_defaults(func=cmd_bench)
     s = sub.add_parser("train-target", help="the train-to-target study alone, at any budget (writes "
                                             "OUT/train_target/train_target.csv and its log, the log after every "

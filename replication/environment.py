@@ -50,9 +50,9 @@ def commit() -> str | None:
         root = Path(__file__).resolve().parent.parent
         r = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
                            text=True, timeout=5)
-        return r.stdout.strip() or None
-    except (OSError, subprocess.SubprocessError):
-        return None
+        return r.stdout.strip() or os.environ.get("LAGBENCH_COMMIT") or None
+    except (OSError, subprocess.SubprocessError):  # a copy without git: the commit it was copied from, if given
+        return os.environ.get("LAGBENCH_COMMIT") or None
 
 
 def now() -> str:

@@ -4,7 +4,8 @@
   arrays: (B, ...) arrays or None, fn acting on each sample independently; the result (a pytree of
   (B, ...) arrays) is the same as one call, computed by `lax.map` over equal blocks of at most
   `block_size(rows_per_sample)` samples (the last block padded with copies of sample 0, fewer than one
-  per block; the padding is sliced off). Batches up to two blocks run as one call (training batches never block).
+  per block; the padding is sliced off). Batches up to two blocks run as one call (training batches never block), and so does every batch on an
+  accelerator (no cache to fit; `lax.map` would only serialise the blocks).
 `block_size(rows_per_sample) = max(8, BLOCK_ROWS // rows_per_sample)`
   rows_per_sample: the rows each sample adds to the widest intermediate (the fast LNN carries d + 1
   tangent rows per sample through every layer). BLOCK_ROWS = 1024 keeps a (rows, 600) float32
@@ -34,7 +35,7 @@ def _pad(a, pad):
 def in_row_blocks(fn, arrays, rows_per_sample: int):
     """fn(*arrays) computed block by block over the leading axis; see the module docstring."""
     n, target = arrays[0].shape[0], block_size(rows_per_sample)
-    if n <= 2 * target:
+    if n <= 2 * target or jax.default_backend() != "cpu":
         return fn(*arrays)
     n_blocks = -(-n // target)
     block = -(-n // n_blocks)                    # equal blocks: at most n_blocks - 1 padded samples

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import os
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import pandas as pd
@@ -48,10 +49,20 @@ import torch
 from tqdm.auto import tqdm
 
 from replication import environment
+from replication.bench import (
+    device,
+    latency,
+    rollout,
+    roofline,
+    scaling,
+    structure,
+    tables,
+    train_target,
+    training,
+)
 from replication.bench import inference as INF
-from replication.bench import latency, rollout, roofline, scaling, structure, tables, train_target, training
 from replication.bench.resume import StageCache
-from replication.bench.timing import FULL, QUICK, TINY, TORCH_THREADS
+from replication.bench.timing import FULL, GPU, GPU_TINY, QUICK, STAGES, TINY, TORCH_THREADS, Sizes
 from replication.results import write_csv, write_json
 
 __all__ = ["run_bench"]
@@ -59,7 +70,8 @@ __all__ = ["run_bench"]
 
 def machine(sizes) -> dict:
     return {**environment.hardware(), "versions": environment.versions(), "commit": environment.commit(),
-            "date": environment.now(), "preset": sizes.name,
+            "date": environment.now(), "preset": sizes.name, "stages": list(sizes.stages or STAGES),
+            **device.settings(),
             "torch_threads": TORCH_THREADS, "jax_threads": "XLA default",
             "xla_flags": os.environ.get("XLA_FLAGS", ""), "torch_config": torch.__config__.parallel_info()
             .splitlines()[:6]}
@@ -70,39 +82,50 @@ def _write(bench: Path, name: str, rows: list[dict]) -> None:
 
 
 def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True,
-              trained_from=None, resume: bool = False) -> dict:
-    """Run the study into OUT/bench/; returns the targets dict (also written as targets.json).
+              trained_from=None, resume: bool = False, gpu: bool = False, sizes: Sizes | None = None) -> dict:
+    """Run the study into OUT/bench/ (OUT/bench_gpu/ with gpu=True); returns the targets dict (also written
+    as targets.json).
 
     trained_from: a results folder whose training cache (trained/jax/...) holds double-pendulum models
     for the learned rollouts (default OUT itself; where none is found a tiny model is trained).
     resume: take the stages an earlier run into OUT finished, at the same preset and commit, from their
-    checkpoints (OUT/bench/stages/, `replication.bench.resume`) instead of running them again."""
+    checkpoints (OUT/bench/stages/, `replication.bench.resume`) instead of running them again.
+    gpu: run both frameworks on the CUDA GPU (`device.gpu_session`; NoGPUError, before anything is
+    written, where either framework sees none) at the GPU preset (GPU_TINY when tiny), its stages only.
+    sizes: a preset to use instead (tests)."""
     if tiny is None:
         tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
-    sizes = TINY if tiny else (QUICK if quick else FULL)
-    out = Path(out)
-    bench = out / "bench"
-    bench.mkdir(parents=True, exist_ok=True)
-    old_threads = torch.get_num_threads()
-    torch.set_num_threads(TORCH_THREADS)
-    info = machine(sizes)
-    write_json(bench / "machine.json", info)
-    cache = StageCache(bench, sizes.name, info["commit"], resume)
-    try:
-        return _run(out, bench, sizes, progress, Path(trained_from) if trained_from else out, cache)
-    finally:
-        torch.set_num_threads(old_threads)
+    if sizes is None:
+        sizes = (GPU_TINY if tiny else GPU) if gpu else (TINY if tiny else (QUICK if quick else FULL))
+    with device.gpu_session() if gpu else nullcontext():
+        out = Path(out)
+        bench = out / ("bench_gpu" if gpu else "bench")
+        bench.mkdir(parents=True, exist_ok=True)
+        old_threads = torch.get_num_threads()
+        torch.set_num_threads(TORCH_THREADS)
+        info = machine(sizes)
+        write_json(bench / "machine.json", info)
+        cache = StageCache(bench, sizes.name, info["commit"], resume)
+        try:
+            return _run(out, bench, sizes, progress, Path(trained_from) if trained_from else out, cache)
+        finally:
+            torch.set_num_threads(old_threads)
 
 
 class _Stages:
     """Runs the study's stages: each one's tables written as CSV and checkpointed (or, on resume, taken
     from its checkpoint); wall seconds per stage kept for timings.json."""
 
-    def __init__(self, bar, bench: Path, cache: StageCache, notes: list):
+    def __init__(self, bar, bench: Path, cache: StageCache, notes: list, stages: tuple = STAGES):
         self.bar, self.bench, self.cache, self.notes, self.seconds = bar, bench, cache, notes, {}
+        self.stages = stages
 
-    def __call__(self, name: str, n_cases: int, compute) -> dict:
-        """compute() -> {file name: rows}, run unless a checkpoint stands in for it."""
+    def __call__(self, name: str, n_cases: int, compute, files=()) -> dict:
+        """compute() -> {file name: rows}, run unless a checkpoint stands in for it, or the preset leaves
+        the stage out (then {file: []} for each of `files`, nothing written)."""
+        if name not in self.stages:
+            self.bar.update(n_cases)
+            return {f: [] for f in files}
         self.bar.set_postfix_str(name)
         t0 = time.perf_counter()
         try:
@@ -130,23 +153,28 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
     total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
              + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes))
     bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
-    stage, t_start = _Stages(bar, bench, cache, notes), time.perf_counter()
+    stage, t_start = _Stages(bar, bench, cache, notes, sizes.stages or STAGES), time.perf_counter()
+    if sizes.stages:
+        notes.append(f"preset {sizes.name}: stages {', '.join(sizes.stages)} only")
+    if device.on_gpu():
+        notes[0] = "GPU run: JAX jit and PyTorch eager on the same CUDA device, full float32 matrix products"
     try:
         inf_rows = stage("inference", len(cases),
-                         lambda: {"inference": _inference(cases, sizes, notes, bar)})["inference"]
-        lat_rows = stage("single-sample latency", 1, lambda: _latency(sizes, notes, bar))["latency"]
+                         lambda: {"inference": _inference(cases, sizes, notes, bar)}, ["inference"])["inference"]
+        lat_rows = stage("single-sample latency", 1, lambda: _latency(sizes, notes, bar), ["latency"])["latency"]
         train_rows = stage("training", training.n_training_cases(sizes),
-                           lambda: {"training": training.training_rows(sizes, notes, bar)})["training"]
+                           lambda: {"training": training.training_rows(sizes, notes, bar)}, ["training"])["training"]
         stage("rollouts", rollout.n_rollout_cases(sizes),
               lambda: {"rollout": rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes)})
-        sc = stage("scaling", len(sc_cases), lambda: _scaling(sc_cases, sizes, bar))
+        sc = stage("scaling", len(sc_cases), lambda: _scaling(sc_cases, sizes, bar), ["scaling", "scaling_fit"])
         sc_rows, fit = sc["scaling"], sc["scaling_fit"]
-        fp = stage("fast vs paper", 2 * len(sizes.ratio_dofs), lambda: _fast_paper(sizes, bar))
+        fp = stage("fast vs paper", 2 * len(sizes.ratio_dofs), lambda: _fast_paper(sizes, bar),
+                   ["fast_paper", "matmul"])
         fp_rows, mm_rows = fp["fast_paper"], fp["matmul"]
         stage("structure", structure.n_structure_cases(),
               lambda: {"structure": structure.structure_rows(sizes, inf_rows, bar)})
         tt_rows = stage("train to target", train_target.n_cases(sizes),
-                        lambda: _train_target(sizes, bar))["train_target"]
+                        lambda: _train_target(sizes, bar), ["train_target"])["train_target"]
     finally:
         bar.close()
         write_json(bench / "timings.json", {"preset": sizes.name, "total_s": time.perf_counter() - t_start,

@@ -35,6 +35,7 @@ import torch
 import models.jax
 import models.torch
 from models.torch.compiled import compile_batched
+from replication.bench.device import sync, to_numpy
 
 
 def median_rel_error(pred, true) -> float:
@@ -137,10 +138,12 @@ class TorchEvaluator:
             return _qddot(self.model, self.kind, *args)
 
     def run(self, args):
-        return self._call(args)
+        out = self._call(args)
+        sync()  # on a GPU: wait for the queued kernels
+        return out
 
     def numpy(self, args):
-        return self._call(args).detach().numpy().astype(np.float64)
+        return to_numpy(self._call(args)).astype(np.float64)
 
     def ops(self, args) -> int:
         return torch_ops(lambda: self._call(args))

@@ -30,8 +30,9 @@ import numpy as np
 
 import systems
 from models import ModelSpec, init_params
+from replication.bench.device import on_gpu
 from replication.bench.evaluators import make_evaluator, median_rel_error
-from replication.bench.timing import best_time, torch_threads
+from replication.bench.timing import TORCH_THREADS, best_time, torch_threads
 
 GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dense path holds n + 1 tangents)
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
@@ -133,7 +134,7 @@ def _timed(ev, args, min_time) -> tuple[float, object]:
     if ev.framework != "torch":
         return best_time(lambda: ev.run(args), min_time=min_time), "default"
     best = (float("inf"), None)
-    for n in TORCH_THREAD_CHOICES:
+    for n in ((TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES):  # on a GPU the host threads only launch
         with torch_threads(n):
             ev.run(args)  # the pool at this size
             best = min(best, (best_time(lambda: ev.run(args), min_time=min_time), n))

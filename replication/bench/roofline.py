@@ -25,6 +25,7 @@ import numpy as np
 import torch
 
 from models import init_params
+from replication.bench.device import on_gpu, sync
 from replication.bench.evaluators import make_evaluator
 from replication.bench.inference import TORCH_THREAD_CHOICES, model_spec
 from replication.bench.timing import interleaved_best, torch_threads
@@ -61,6 +62,7 @@ def _matmul_chain(framework, params, n_layers, n_rows, n_in):
             for i, w in enumerate(ws):
                 a = a @ w.T
                 a = torch.relu(a) if i < len(ws) - 1 else a
+        sync()
     return run
 
 
@@ -72,7 +74,7 @@ def _best_over_threads(fns: dict, reps: int, framework: str) -> dict:
             fn()
         return {k: (t, "default") for k, t in interleaved_best(fns, min_rounds=reps).items()}
     best = {k: (float("inf"), None) for k in fns}
-    for n in TORCH_THREAD_CHOICES:
+    for n in ((1,) if on_gpu() else TORCH_THREAD_CHOICES):
         with torch_threads(n):
             for k, t in interleaved_best(fns, min_rounds=reps).items():
                 best[k] = min(best[k], (t, n))

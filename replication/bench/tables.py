@@ -181,11 +181,11 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
                f"counts at this batch), XLA default ({os.cpu_count()} cores)" if "threads" in tr else "")
         note = _inference_note((sy, m, f, dt), b, v["jax"], v["torch"], fit, ops, how) if v["torch"] > 0 else None
         out.append(_row(f"q'' {sy} {m}/{f} {dt} batch {b}", v["jax"], v["torch"], batch=b, note=note))
-    jit = {(r["model"]): r["steps_per_s"] for r in training if r["mode"] == "jit"}
+    jit = {(r["model"], r["batch"]): r["steps_per_s"] for r in training if r["mode"] == "jit"}
     for r in training:
-        if r["framework"] == "torch" and r["model"] in jit:
+        if r["framework"] == "torch" and (r["model"], r["batch"]) in jit:
             out.append(_row(f"train {r['system']} {r['model']} jit vs {r['mode']} batch {r['batch']} (steps/s)",
-                            jit[r["model"]], r["steps_per_s"]))
+                            jit[r["model"], r["batch"]], r["steps_per_s"]))
     batch_of = {(r["study"], r["formulation"], r["n"]): r.get("batch") for r in scaling}
     for (st, f, n), v in _pairs(scaling, ("study", "formulation", "n"), "samples_per_s").items():
         out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"], batch=batch_of.get((st, f, n))))
@@ -292,6 +292,8 @@ def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train
             "samples_to_reach": {f"{r['threshold']:g}": r["samples_to_reach"] for r in rs},
             "extrapolated_samples_NOT_MEASURED": {f"{r['threshold']:g}": r["extrapolated_samples"] for r in rs},
             "met": hit}
-    t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}": r["samples_per_s"]
+    one_batch = len({r["batch"] for r in training}) <= 1
+    t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}"
+                                   + ("" if one_batch else f"/batch {r['batch']}"): r["samples_per_s"]
                                    for r in training}
     return t

@@ -110,7 +110,7 @@ class Sizes:
     ratio_dofs: tuple
     ratio_reps: int                # interleaved rounds of the fast/paper/matmul timing
     train_hidden: tuple
-    train_batch: int
+    train_batch: int               # the protocol's batch (training rows also at each of train_extra_batches)
     train_steps: int
     rollout_solvers: tuple
     rollout_rtols: tuple
@@ -128,8 +128,13 @@ class Sizes:
     target_hidden: tuple = (64, 64, 64)
     scaling_s: float = 0.5         # seconds of interleaved timing rounds per scaling case (`replication.bench.scaling`)
     rollout_learned: bool = True   # roll out learned double-pendulum models in the solver study
+    stages: tuple = ()             # the stages run (empty: all of STAGES); the rest are skipped
+    train_extra_batches: tuple = ()
 
 
+STAGES = ("inference", "single-sample latency", "training", "rollouts", "scaling", "fast vs paper", "structure",
+          "train to target")
+GPU_STAGES = ("inference", "training", "scaling", "fast vs paper")  # `lagbench bench --gpu`
 _SOLVERS = ("tsit5", "dopri5", "dopri8")
 TINY = Sizes("tiny", hidden=(16, 16), batches=(8,), dtypes=("float32",), lgn_hidden=(8, 8),
              lgn_n=(16, 32), chain_d=(1, 2), chain_batch=16, ratio_batch=64, ratio_hidden=(16, 16),
@@ -152,3 +157,20 @@ FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), 
              rollout_t_end=20.0, rollout_ics=16, min_time=1.0, torch_compile=True, structure_batch=4096,
              wave_n=64, latency_s=2.0, latency_dtypes=("float32", "float64"), target_budget=5_000_000,
              target_hidden=(128, 128, 128))
+# `lagbench bench --gpu`: the inference plane up to batch 65536, training at the protocol's batch and at 4096, the
+# scaling studies to n = 4096 and the fast/paper timing; PyTorch eager (no AOTInductor: its CUDA build is not
+# part of this study) against JAX jit, both on the GPU. The latency subprocesses, rollouts, structure and
+# train-to-target stay CPU studies.
+GPU = Sizes("gpu", hidden=(128, 128, 128), batches=(1, 256, 4096, 65536), dtypes=("float32", "float64"),
+            lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024, 4096), chain_d=(1, 4, 16, 32), chain_batch=4096,
+            ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=10,
+            train_hidden=(600, 600, 600), train_batch=512, train_steps=20, rollout_solvers=_SOLVERS,
+            rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0, rollout_ics=2, min_time=0.2,
+            torch_compile=False, structure_batch=1024, wave_n=64, stages=GPU_STAGES, train_extra_batches=(4096,))
+GPU_TINY = Sizes("gpu-tiny", hidden=(16, 16), batches=(8, 64), dtypes=("float32",), lgn_hidden=(8, 8),
+                 lgn_n=(16, 32), chain_d=(1, 2), chain_batch=16, ratio_batch=64, ratio_hidden=(16, 16),
+                 ratio_dofs=(2,), ratio_reps=1, train_hidden=(16, 16), train_batch=32, train_steps=3,
+                 rollout_solvers=("tsit5",), rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0,
+                 rollout_ics=2, min_time=0.0, torch_compile=False, structure_batch=64, wave_n=16, scaling_s=0.0,
+                 stages=GPU_STAGES, train_extra_batches=(64,))
+

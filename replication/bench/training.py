@@ -3,7 +3,7 @@
 `training_rows(sizes, notes) -> rows {system, model, framework, mode, dtype, batch, steps_per_s,
 samples_per_s, hidden}` for the claim's LNN (fast formulation) and baseline, with the claim's specs
 (`replication.claims.double_pendulum.MODELS`) at `sizes.train_hidden` and its paper protocol (L1 loss,
-Adam, l2 penalty) at batch `sizes.train_batch`. One optimiser step is timed (fastest of
+Adam, l2 penalty) at batch `sizes.train_batch` (and each of `sizes.train_extra_batches`). One optimiser step is timed (fastest of
 `sizes.train_steps` after one warm-up/compile step) with the training loops' own step functions:
 `train_jax.make_step` (eqx.filter_jit) and `train_torch.make_loss` + torch.optim.Adam.
 mode "compile" wraps the PyTorch loss in `torch.compile`; where that fails or is disabled, no row is
@@ -71,11 +71,18 @@ def _torch_step_time(spec, params, protocol, batch, reps, compile_=False):
 
 
 def training_rows(sizes, notes: list, progress=None) -> list[dict]:
-    protocol = PROTOCOLS["paper"].replace(batch=sizes.train_batch, n_train=sizes.train_batch * 4)
+    rows = []
+    for b in (sizes.train_batch, *sizes.train_extra_batches):
+        rows += _rows_at(sizes, b, notes, progress)
+    return rows
+
+
+def _rows_at(sizes, batch_size, notes, progress) -> list[dict]:
+    protocol = PROTOCOLS["paper"].replace(batch=batch_size, n_train=batch_size * 4)
     batch = BatchStream(protocol, seed=0).batch(0)
     rows = []
     modes = [("jax", "jit"), ("torch", "eager")] + ([("torch", "compile")] if sizes.torch_compile else [])
-    if not sizes.torch_compile:
+    if not sizes.torch_compile and batch_size == sizes.train_batch:
         notes.append("training torch.compile: not measured at this size preset")
     for entry in MODELS:
         spec = _spec(entry, sizes.train_hidden, protocol.dtype)
@@ -100,4 +107,4 @@ def training_rows(sizes, notes: list, progress=None) -> list[dict]:
 
 
 def n_training_cases(sizes) -> int:
-    return len(MODELS) * (3 if sizes.torch_compile else 2)
+    return len(MODELS) * (3 if sizes.torch_compile else 2) * (1 + len(sizes.train_extra_batches))
