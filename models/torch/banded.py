@@ -12,7 +12,8 @@ from models.graph import band_columns
 
 def _gather(band, triple):
     rows, cols, mask = triple
-    return torch.where(torch.as_tensor(mask), band[:, torch.as_tensor(rows), torch.as_tensor(cols)], 0.0)
+    return torch.where(torch.as_tensor(mask, device=band.device),
+                       band[:, torch.as_tensor(rows, device=band.device), torch.as_tensor(cols, device=band.device)], 0.0)
 
 
 def _solve_or_nan(a, b):
@@ -42,7 +43,7 @@ def block_tridiagonal_solve(diag, lower, upper, rhs):
     if m == 1:
         return _solve_or_nan(diag[:, 0], rhs[:, 0])[:, None]
     if m % 2:                                    # append a decoupled identity block (x = 0 there)
-        eye = torch.eye(w, dtype=diag.dtype).expand(bsz, 1, w, w)
+        eye = torch.eye(w, dtype=diag.dtype, device=diag.device).expand(bsz, 1, w, w)
         zero_w, zero_k = torch.zeros_like(diag[:, :1]), torch.zeros_like(rhs[:, :1])
         return block_tridiagonal_solve(torch.cat([diag, eye], 1), torch.cat([lower, zero_w], 1),
                                        torch.cat([upper, zero_w], 1), torch.cat([rhs, zero_k], 1))[:, :m]
@@ -69,7 +70,7 @@ class _ImplicitSolve(torch.autograd.Function):
     def backward(ctx, xbar):
         band, x = ctx.saved_tensors
         lam = _solve(band, xbar, ctx.layout)
-        cols = torch.as_tensor(band_columns(x.shape[-1], band.shape[-1]))
+        cols = torch.as_tensor(band_columns(x.shape[-1], band.shape[-1]), device=x.device)
         return -lam[:, :, None] * x[:, cols], lam, None
 
 

@@ -20,4 +20,4 @@ class Baseline(Model):
 
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration (..., n_out), 0): no fallback exists."""
-        return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64)
+        return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64, device=q.device)

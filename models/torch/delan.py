@@ -152,7 +152,7 @@ class DeLaN(Model):
 
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration (..., dof), 0): M is positive definite, no fallback."""
-        return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64)
+        return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64, device=q.device)
 
     def lagrangian(self, q, qdot, extra=None):
         """L = 1/2 qdot^T M qdot - V (...,)."""

@@ -32,6 +32,6 @@ class HNN(Model):
         z = mlp_input(spec, [wrap_angles(spec, x), y, *self._parts(extra)])  # wrap has derivative 1
         g, _ = input_grad_and_tangent_hessian(self.params, z.reshape(-1, z.shape[-1]), None, spec)
         if spec.input_scale is not None:
-            g = g * torch.tensor(spec.input_scale, dtype=g.dtype)
+            g = g * torch.tensor(spec.input_scale, dtype=g.dtype, device=g.device)
         g = g.reshape(*z.shape[:-1], z.shape[-1])
         return g[..., d:2 * d], -g[..., :d]

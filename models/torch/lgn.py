@@ -41,12 +41,13 @@ def banded_terms(L_fn, q, qdot, r):
     n = q.shape[-1]
     colour, n_col = band_coloring(n, r)
     grads = grad(lambda a, b: torch.sum(L_fn(a, b)), argnums=(0, 1))
-    onehot = torch.as_tensor(colour[None, :] == np.arange(n_col)[:, None], dtype=q.dtype)
-    t_q = torch.cat([torch.zeros((n_col, *q.shape), dtype=q.dtype), qdot[None]])
+    onehot = torch.as_tensor(colour[None, :] == np.arange(n_col)[:, None], dtype=q.dtype, device=q.device)
+    t_q = torch.cat([torch.zeros((n_col, *q.shape), dtype=q.dtype, device=q.device), qdot[None]])
     t_qdot = torch.cat([onehot[:, None, :].expand(n_col, *q.shape), torch.zeros_like(qdot)[None]])
     (g_q, _), (_, dg_qdot) = vmap(lambda a, b: jvp(grads, (q, qdot), (a, b)))(t_q, t_qdot)
     col, row = band_from_colours(n, r)
-    return torch.movedim(dg_qdot[:n_col], 0, 1)[:, torch.as_tensor(col), torch.as_tensor(row)], g_q[0] - dg_qdot[n_col]
+    return torch.movedim(dg_qdot[:n_col], 0, 1)[:, torch.as_tensor(col, device=q.device),
+                                                 torch.as_tensor(row, device=q.device)], g_q[0] - dg_qdot[n_col]
 
 
 def _identity_band(n, r):
@@ -57,8 +58,8 @@ def dense_from_band(band):
     """The (B, n, n) matrix of a cyclic band (B, n, 2w+1) (n >= 2w+1: no two band entries share a place)."""
     bsz, n, width = band.shape
     cols = band_columns(n, width)
-    flat = torch.as_tensor((np.arange(n)[:, None] * n + cols).reshape(-1))
-    return torch.zeros((bsz, n * n), dtype=band.dtype).index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
+    flat = torch.as_tensor((np.arange(n)[:, None] * n + cols).reshape(-1), device=band.device)
+    return torch.zeros((bsz, n * n), dtype=band.dtype, device=band.device).index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
 
 
 def banded_solve_info(band, rhs, r):
@@ -76,7 +77,7 @@ def banded_solve_info(band, rhs, r):
         idx = torch.nonzero(bad).squeeze(1)
         x = x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
     elif bool(torch.any(bad)):
-        safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype), band)
+        safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype, device=band.device), band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
         x = torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
     return x, torch.sum(bad)
@@ -111,18 +112,19 @@ class LGN(Model):
         at row j moves them all into place."""
         spec, (bsz, n), r = self.spec, q.shape, self.spec.lgn_radius
         k = 2 * r + 1
-        nb = torch.as_tensor(periodic_neighbours(n, r))
+        nb = torch.as_tensor(periodic_neighbours(n, r), device=q.device)
         x = mlp_input(spec, [wrap_angles(spec, q)[..., nb], qdot[..., nb]]).reshape(bsz * n, 2 * k)
-        scale = input_scale(spec, 2 * k, x.dtype)
+        scale = input_scale(spec, 2 * k, x.dtype, x.device)
         s_q, s_qd = scale[:k], scale[k:]
-        tangents = torch.zeros((bsz * n, k + 1, 2 * k), dtype=x.dtype)
+        tangents = torch.zeros((bsz * n, k + 1, 2 * k), dtype=x.dtype, device=x.device)
         tangents[:, :k, k:] = torch.diag(s_qd)
         tangents[:, k, :k] = qdot[..., nb].reshape(bsz * n, k) * s_q
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
         g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]], -1)
-        src, slot = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n), torch.arange(k)
+        src = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n, device=x.device)
+        slot = torch.arange(k, device=x.device)
         moved = g[:, src, slot]                  # (B, n, k, k + 2): [j, a] = node j-a+r's slot-a terms
-        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ torch.as_tensor(_band_sum(r), dtype=x.dtype)
+        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ torch.as_tensor(_band_sum(r), dtype=x.dtype, device=x.device)
         return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)
 
     def lagrangian(self, q, qdot, extra=None):

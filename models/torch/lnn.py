@@ -34,8 +34,8 @@ def fast_terms(L_fn, q, qdot, extra=None):
     """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), by forward-over-reverse."""
     d = q.shape[-1]
     grads = grad(lambda a, b: torch.sum(_call(L_fn, a, b, extra)), argnums=(0, 1))
-    eye = torch.eye(d, dtype=q.dtype)[:, None, :].expand(d, *q.shape)
-    t_q = torch.cat([torch.zeros((d, *q.shape), dtype=q.dtype), qdot[None]])
+    eye = torch.eye(d, dtype=q.dtype, device=q.device)[:, None, :].expand(d, *q.shape)
+    t_q = torch.cat([torch.zeros((d, *q.shape), dtype=q.dtype, device=q.device), qdot[None]])
     t_qdot = torch.cat([eye, torch.zeros_like(qdot)[None]])
     (g_q, _), (_, dg_qdot) = vmap(lambda a, b: jvp(grads, (q, qdot), (a, b)))(t_q, t_qdot)
     return torch.movedim(dg_qdot[:d], 0, -1), g_q[0] - dg_qdot[d]
@@ -84,7 +84,7 @@ def solve_with_fallback(hess, rhs):
     inv, info = torch.linalg.inv_ex(h)
     rcond = 1.0 / (_norm1(h) * _norm1(inv))
     bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
-    safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype), hess)
+    safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype, device=hess.device), hess)
     x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
     if get_proxy_mode() is not None:  # traced by make_fx (`compiled.trace_flat`): pinv on every sample
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
@@ -102,7 +102,7 @@ def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):
     qf, qdf, ef = _flat(q, d), _flat(qdot, d), _flat(extra, None)
     if formulation == "paper":
         hess, rhs = paper_terms(L_fn, qf, qdf, ef)
-        return pinv_solve(hess, rhs).reshape(*batch, d), torch.zeros((), dtype=torch.int64)
+        return pinv_solve(hess, rhs).reshape(*batch, d), torch.zeros((), dtype=torch.int64, device=q.device)
     if formulation != "fast":
         raise ValueError(f"unknown formulation {formulation!r}; valid: fast, paper")
     return _solved(*fast_terms(L_fn, qf, qdf, ef), batch)
@@ -142,9 +142,9 @@ class LNN(Model):
         tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
         spec, (n, d) = self.spec, q.shape
         x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
-        scale = input_scale(spec, x.shape[-1], x.dtype)
+        scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         s_q, s_qd = scale[:d], scale[d:2 * d]
-        tangents = torch.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
+        tangents = torch.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype, device=x.device)
         tangents[:, :d, d:2 * d] = torch.diag(s_qd)
         tangents[:, d, :d] = qdot * s_q
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)

@@ -22,7 +22,7 @@ class _Softplus(torch.autograd.Function):
 
     @staticmethod
     def forward(a, s):
-        return torch.logaddexp(a, torch.zeros((), dtype=a.dtype))
+        return torch.logaddexp(a, torch.zeros((), dtype=a.dtype, device=a.device))
 
     @staticmethod
     def setup_context(ctx, inputs, output):
@@ -82,15 +82,17 @@ def wrap_angles(spec, q):
     return torch.remainder(q + math.pi, 2 * math.pi) - math.pi
 
 
-def input_scale(spec, n: int, dtype):
+def input_scale(spec, n: int, dtype, device=None):
     """spec.input_scale as an (n,) tensor, ones when it is None (for the chain rule of hand-written
     derivatives: the MLP sees x = scale * features)."""
-    return torch.ones(n, dtype=dtype) if spec.input_scale is None else torch.tensor(spec.input_scale, dtype=dtype)
+    if spec.input_scale is None:
+        return torch.ones(n, dtype=dtype, device=device)
+    return torch.tensor(spec.input_scale, dtype=dtype, device=device)
 
 
 def mlp_input(spec, parts: list):
     """Concatenate the feature parts (each (..., k)) and apply spec.input_scale: (..., n_in)."""
     x = torch.cat(parts, dim=-1)
     if spec.input_scale is not None:
-        x = x * torch.tensor(spec.input_scale, dtype=x.dtype)
+        x = x * torch.tensor(spec.input_scale, dtype=x.dtype, device=x.device)
     return x
