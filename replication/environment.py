@@ -46,13 +46,17 @@ def hardware() -> dict:
 
 @lru_cache(maxsize=1)
 def commit() -> str | None:
+    """git's short HEAD; LAGBENCH_COMMIT, where set, instead (a copy of the tree run elsewhere, whose .git,
+    if any, is not the checkout's)."""
+    if os.environ.get("LAGBENCH_COMMIT"):
+        return os.environ["LAGBENCH_COMMIT"]
     try:
         root = Path(__file__).resolve().parent.parent
         r = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
                            text=True, timeout=5)
-        return r.stdout.strip() or os.environ.get("LAGBENCH_COMMIT") or None
-    except (OSError, subprocess.SubprocessError):  # a copy without git: the commit it was copied from, if given
-        return os.environ.get("LAGBENCH_COMMIT") or None
+        return r.stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        return None
 
 
 def now() -> str:

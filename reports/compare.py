@@ -92,8 +92,34 @@ def cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataFrame |
     return pd.DataFrame(rows) if rows else None
 
 
-def bench_cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataFrame | None:
-    df = res.bench.get("inference")
+def _fastest(df: pd.DataFrame, keys: list[str]) -> pd.Series:
+    """samples_per_s of the fastest row (any mode, any threads) per key."""
+    df = df.assign(samples_per_s=pd.to_numeric(df["samples_per_s"], errors="coerce"))
+    return df.groupby(keys)["samples_per_s"].max()
+
+
+def gpu_vs_cpu_table(res: Results, batches=(1, 4096)) -> pd.DataFrame | None:
+    """Inference throughput per (system, model, formulation, dtype, batch in `batches`) and framework on the
+    speed study's CPU (bench/) and GPU (bench_gpu/) machines, each framework's fastest mode, and GPU / CPU.
+    Only the operations both runs measured; None when either run is missing."""
+    cpu, gpu = res.bench.get("inference"), res.bench_gpu.get("inference")
+    if cpu is None or gpu is None:
+        return None
+    keys = ["system", "model", "formulation", "framework", "dtype", "batch"]
+    both = pd.concat({"cpu": _fastest(cpu, keys), "gpu": _fastest(gpu, keys)}, axis=1).dropna()
+    both = both[both.index.get_level_values("batch").isin(batches)]
+    if both.empty:
+        return None
+    rows = [{"system": k[0], "model": f"{k[1]}/{k[2]}", "framework": k[3], "dtype": k[4], "batch": int(k[5]),
+             "CPU samples/s": num(r["cpu"]), "GPU samples/s": num(r["gpu"]), "GPU / CPU": num(r["gpu"] / r["cpu"])}
+            for k, r in both.iterrows()]
+    return pd.DataFrame(rows)
+
+
+def bench_cheapest_table(res: Results, tolerance: float = TOLERANCE, gpu: bool = False) -> pd.DataFrame | None:
+    """Per system: the lowest inference error and the fastest row within `tolerance` of it (bench/, or
+    bench_gpu/ with gpu=True)."""
+    df = (res.bench_gpu if gpu else res.bench).get("inference")
     if df is None or df.empty:
         return None
     df = df[pd.to_numeric(df["error"], errors="coerce").notna()].copy()

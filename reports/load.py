@@ -29,6 +29,9 @@ BENCH_COLUMNS = {
                      "samples_per_s", "extrapolated_samples", "extrapolation"],
     "train_target_log": ["protocol", "samples", "heldout_l1"],
 }
+# `lagbench bench --gpu --out ROOT` writes ROOT/bench_gpu/: the GPU preset's stages
+GPU_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("inference", "training", "scaling", "ratios")},
+               "fast_paper": ["dof", "framework", "formulation", "mode", "batch", "samples_per_s"]}
 # `lagbench train-target --out ROOT` writes ROOT/train_target/ with the bench stage's two files
 TRAIN_TARGET_COLUMNS = {k: BENCH_COLUMNS[k] for k in ("train_target", "train_target_log")}
 UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
@@ -86,7 +89,9 @@ class Results:
     listed_missing: list[str] = field(default_factory=list)
     bench: dict[str, pd.DataFrame] = field(default_factory=dict)
     train_target: dict[str, pd.DataFrame] = field(default_factory=dict)  # train_target/ (lagbench train-target)
+    bench_gpu: dict[str, pd.DataFrame] = field(default_factory=dict)  # bench_gpu/ (lagbench bench --gpu)
     machine: dict | None = None
+    machine_gpu: dict | None = None
     problems: list[str] = field(default_factory=list)
 
     def usable(self, claim: str | None = None) -> list[Unit]:
@@ -185,6 +190,9 @@ def _load_bench(res: Results) -> None:
     res.machine = _read_json(res.root / "bench" / "machine.json", res.problems, res.root)
     _load_csvs(res, "bench", BENCH_COLUMNS, res.bench)
     _load_csvs(res, "train_target", TRAIN_TARGET_COLUMNS, res.train_target)
+    if (res.root / "bench_gpu").is_dir():
+        res.machine_gpu = _read_json(res.root / "bench_gpu" / "machine.json", res.problems, res.root)
+        _load_csvs(res, "bench_gpu", GPU_COLUMNS, res.bench_gpu)
 
 
 def load_results(root: str | Path) -> Results:

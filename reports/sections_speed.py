@@ -14,7 +14,13 @@ from pathlib import Path
 import pandas as pd
 
 from reports import figures_speed as FS
-from reports.compare import TOLERANCE, bench_cheapest_table, cheapest_table, cross_framework_table
+from reports.compare import (
+    TOLERANCE,
+    bench_cheapest_table,
+    cheapest_table,
+    cross_framework_table,
+    gpu_vs_cpu_table,
+)
 from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell
 from reports.load import Results
@@ -24,9 +30,12 @@ BENCH_TABLE_ROWS = 40
 
 
 def _bench_table(df: pd.DataFrame, missing: str | None = None) -> pd.DataFrame:
-    """The first BENCH_TABLE_ROWS rows as text; NaN reads "not run" unless a `missing` text says what it means."""
+    """The first BENCH_TABLE_ROWS rows as text; NaN reads "not run" unless a `missing` text says what it means;
+    integer columns (batch, n, dof) stay exact."""
     fmt = cell if missing is None else (lambda x: cell(x, missing))
-    return df.head(BENCH_TABLE_ROWS).map(fmt).astype(str)
+    head = df.head(BENCH_TABLE_ROWS)
+    return pd.DataFrame({c: head[c].astype(str) if pd.api.types.is_integer_dtype(head[c]) else head[c].map(fmt)
+                         for c in head.columns}).astype(str)
 
 
 def speed_sections(res: Results, out_dir: Path) -> list[Section]:
@@ -83,7 +92,50 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
     targets = _targets_table(res.root / "bench" / "targets.json")
     if targets is not None:
         b.add(Table("Speed targets: measured against the target", targets, ["bench/targets.json"]))
-    return [s, b]
+    g = _gpu_section(res, out_dir)
+    return [s, b] + ([g] if g is not None else [])
+
+
+def _gpu_section(res: Results, out_dir: Path) -> Section | None:
+    """bench_gpu/ (lagbench bench --gpu): its own machine, figures and tables, never mixed with bench/."""
+    if not res.bench_gpu and res.machine_gpu is None:
+        return None
+    g = Section("Speed study on a GPU (lagbench bench --gpu)", level=2)
+    m = res.machine_gpu or {}
+    g.add(Para(f"Machine: GPU {m.get('gpu') or m.get('torch_gpu') or 'not recorded'}, host CPU "
+               f"{m.get('cpu', 'not recorded')} ({m.get('cores', '?')} cores); commit {m.get('commit')}, "
+               f"{m.get('date')}; JAX {(m.get('versions') or {}).get('jax')}, PyTorch "
+               f"{(m.get('versions') or {}).get('torch')}. Both frameworks on the same GPU with full float32 "
+               "matrix products (no TF32); PyTorch eager, JAX jit. Figures from this machine are compared with "
+               "the CPU study's only as ratios, in the table below."))
+    if FS.bench_speed_error(res.bench_gpu.get("inference"), out_dir / "figures/bench_gpu_inference.png"):
+        g.add(Figure("figures/bench_gpu_inference.png", "GPU: inference throughput against error per system "
+                     "(colour: model/formulation; marker: framework).", ["bench_gpu/inference.csv"]))
+    bc = bench_cheapest_table(res, gpu=True)
+    if bc is not None:
+        g.add(Table(f"GPU: cheapest model within {TOLERANCE:g}x of the best inference error, per system", bc,
+                    ["bench_gpu/inference.csv"]))
+    both = gpu_vs_cpu_table(res)
+    if both is not None:
+        g.add(Table("Inference on the GPU against the CPU study (each framework's fastest mode)", both,
+                    ["bench/inference.csv", "bench_gpu/inference.csv"],
+                    note="GPU / CPU above 1: the GPU is faster. Two machines: the ratio says which hardware a "
+                         "use needs, not how fast either framework is."))
+    if FS.bench_scaling(res.bench_gpu.get("scaling"), out_dir / "figures/bench_gpu_scaling.png"):
+        g.add(Figure("figures/bench_gpu_scaling.png", "GPU: cost per evaluation against size, per formulation.",
+                     ["bench_gpu/scaling.csv"]))
+    for name, title in (("training", "GPU: training throughput"), ("fast_paper", "GPU: LNN fast against paper "
+                                                                               "formulation (3 x 600, batch 4096)")):
+        if name in res.bench_gpu:
+            g.add(Table(title, _bench_table(res.bench_gpu[name], missing="-"), [f"bench_gpu/{name}.csv"]))
+    targets = _targets_table(res.root / "bench_gpu" / "targets.json")
+    if targets is not None:
+        g.add(Table("GPU: the speed targets (set for the CPU study) measured on the GPU", targets,
+                    ["bench_gpu/targets.json"],
+                    note="The fraction of the matrix-product rate uses XLA's GPU cost analysis, which counts "
+                         "about a quarter of the FLOPs its CPU analysis counts for the same fast LNN: it is not "
+                         "comparable with the CPU fraction."))
+    return g
 
 
 def _train_target(b: Section, tables: dict, folder: str, out_dir: Path, title: str) -> None:

@@ -97,6 +97,9 @@ def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool 
         tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
     if sizes is None:
         sizes = (GPU_TINY if tiny else GPU) if gpu else (TINY if tiny else (QUICK if quick else FULL))
+    unknown = [s for s in sizes.stages if s not in STAGES]
+    if unknown:
+        raise ValueError(f"preset {sizes.name}: unknown stages {unknown}; valid: {', '.join(STAGES)}")
     with device.gpu_session() if gpu else nullcontext():
         out = Path(out)
         bench = out / ("bench_gpu" if gpu else "bench")
