@@ -74,18 +74,37 @@ def _norm1(a):
     return torch.amax(torch.sum(torch.abs(a), dim=-2), dim=-1)
 
 
+def small_inverse(h):
+    """(inverse (B, d, d), info (B,), nonzero where singular): closed form for d <= 2 (no LAPACK call:
+    at batch 1 the call, not the arithmetic, is the cost), torch.linalg.inv_ex otherwise."""
+    d = h.shape[-1]
+    if d == 1:
+        return 1.0 / h, (h[..., 0, 0] == 0).to(torch.int32)
+    if d == 2:
+        a, b, c, e = h[..., 0, 0], h[..., 0, 1], h[..., 1, 0], h[..., 1, 1]
+        det = a * e - b * c
+        adj = torch.stack([torch.stack([e, -b], -1), torch.stack([-c, a], -1)], -2)
+        return adj / det[..., None, None], (det == 0).to(torch.int32)
+    return torch.linalg.inv_ex(h)
+
+
 def solve_with_fallback(hess, rhs):
     """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. A captured graph
     has no Python branch on data: under torch.export the pinv is a torch.cond; under make_fx
     (`models.torch.compiled.trace_flat`, whose graph export rejects that cond, torch 2.13) every sample
-    takes pinv and the bad ones keep it."""
+    takes pinv and the bad ones keep it. Without gradients (inference) the well-conditioned samples use
+    the inverse the condition estimate already needed (`small_inverse`) instead of a second, LU solve;
+    with gradients they solve with H replaced by I on the bad samples, so that no inf reaches backward."""
     d = hess.shape[-1]
     h = hess.detach()
-    inv, info = torch.linalg.inv_ex(h)
+    inv, info = small_inverse(h)
     rcond = 1.0 / (_norm1(h) * _norm1(inv))
     bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
-    safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype, device=hess.device), hess)
-    x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
+    if torch.is_grad_enabled():
+        safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype, device=hess.device), hess)
+        x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
+    else:
+        x = (inv @ rhs[..., None])[..., 0]
     if get_proxy_mode() is not None:  # traced by make_fx (`compiled.trace_flat`): pinv on every sample
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
     elif torch.compiler.is_exporting():  # no Python branch on data in an exported graph
