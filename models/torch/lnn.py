@@ -9,7 +9,7 @@ Outputs stay differentiable w.r.t. tensors L_fn closes over (the nn.Parameters):
 from __future__ import annotations
 
 import torch
-from torch.func import grad, hessian, jacrev, jvp, vmap
+from torch.func import grad, jacfwd, jvp, vmap
 from torch.fx.experimental.proxy_tensor import get_proxy_mode
 
 from models.numerics import pinv_rtol, rcond_min
@@ -43,11 +43,12 @@ def fast_terms(L_fn, q, qdot, extra=None):
 
 def paper_terms(L_fn, q, qdot, extra=None):
     """On flat (B, d), per sample: (H (B, d, d), rhs = dL/dq - J qdot (B, d)) with full Jacobians."""
+    d = q.shape[-1]
+
     def one(q1, qd1, e1):
-        f = lambda a, b: _call(L_fn, a, b, e1)  # noqa: E731
-        hess = hessian(f, 1)(q1, qd1)
-        mixed = jacrev(jacrev(f, 1), 0)(q1, qd1)
-        return hess, grad(f, 0)(q1, qd1) - mixed @ qd1
+        g = grad(lambda x: _call(L_fn, x[:d], x[d:], e1))
+        full, g1 = jacfwd(lambda x: (g(x), g(x)), has_aux=True)(torch.cat([q1, qd1]))
+        return full[d:, d:], g1[:d] - full[d:, :d] @ qd1
     if extra is None:
         return vmap(lambda a, b: one(a, b, None))(q, qdot)
     return vmap(one)(q, qdot, extra)
