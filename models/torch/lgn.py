@@ -59,7 +59,8 @@ def dense_from_band(band):
     bsz, n, width = band.shape
     cols = band_columns(n, width)
     flat = torch.as_tensor((np.arange(n)[:, None] * n + cols).reshape(-1), device=band.device)
-    return torch.zeros((bsz, n * n), dtype=band.dtype, device=band.device).index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
+    dense = torch.zeros((bsz, n * n), dtype=band.dtype, device=band.device)
+    return dense.index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
 
 
 def banded_solve_info(band, rhs, r):
@@ -77,7 +78,8 @@ def banded_solve_info(band, rhs, r):
         idx = torch.nonzero(bad).squeeze(1)
         x = x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
     elif bool(torch.any(bad)):
-        safe = torch.where(bad[:, None, None], torch.as_tensor(_identity_band(n, r), dtype=band.dtype, device=band.device), band)
+        eye = torch.as_tensor(_identity_band(n, r), dtype=band.dtype, device=band.device)
+        safe = torch.where(bad[:, None, None], eye, band)
         x_safe = solve_cyclic_banded(safe, rhs, layout)
         x = torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
     return x, torch.sum(bad)
@@ -124,7 +126,8 @@ class LGN(Model):
         src = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n, device=x.device)
         slot = torch.arange(k, device=x.device)
         moved = g[:, src, slot]                  # (B, n, k, k + 2): [j, a] = node j-a+r's slot-a terms
-        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ torch.as_tensor(_band_sum(r), dtype=x.dtype, device=x.device)
+        band_sum = torch.as_tensor(_band_sum(r), dtype=x.dtype, device=x.device)
+        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ band_sum
         return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)
 
     def lagrangian(self, q, qdot, extra=None):

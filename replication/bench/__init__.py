@@ -27,10 +27,11 @@ ignore):
   timings.json    wall seconds of the whole study and per stage, and the stages taken from checkpoints
   stages/*.json   one checkpoint per finished stage, for `lagbench bench --resume` (`replication.bench.resume`)
 Presets (`replication.bench.timing`): quick (default), full (`quick=False`), tiny (`tiny=True` or the
-environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). With gpu=True (`lagbench bench --gpu`) both frameworks run on
-one CUDA GPU (`replication.bench.device`) at the GPU preset, whose stages are inference, training, scaling
-and fast vs paper, into OUT/bench_gpu/ (same files; machine.json adds the device). Every figure is a throughput or a
-ratio within this one run; numbers from different machines (machine.json) are never to be mixed.
+environment variable LAGBENCH_BENCH_TINY=1: seconds, for the tests). With gpu=True (`lagbench bench
+--gpu`) both frameworks run on one CUDA GPU (`replication.bench.device`) at the GPU preset, whose stages
+are inference, training, scaling and fast vs paper, into OUT/bench_gpu/ (same files; machine.json adds
+the device). Every figure is a throughput or a ratio within this one run; numbers from different
+machines (machine.json) are never to be mixed.
 PyTorch runs with `TORCH_THREADS` (1) intra-op threads: on two shared cores its OpenMP pool at 2 threads
 ran 10-100x slower than on 1 (threads waiting at barriers while other processes hold the cores); JAX
 keeps XLA's defaults (the thread settings are recorded in machine.json). The inference rows are the

@@ -173,4 +173,3 @@ GPU_TINY = Sizes("gpu-tiny", hidden=(16, 16), batches=(8, 64), dtypes=("float32"
                  rollout_solvers=("tsit5",), rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0,
                  rollout_ics=2, min_time=0.0, torch_compile=False, structure_batch=64, wave_n=16, scaling_s=0.0,
                  stages=GPU_STAGES, train_extra_batches=(64,))
-

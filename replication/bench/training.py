@@ -3,8 +3,8 @@
 `training_rows(sizes, notes) -> rows {system, model, framework, mode, dtype, batch, steps_per_s,
 samples_per_s, hidden}` for the claim's LNN (fast formulation) and baseline, with the claim's specs
 (`replication.claims.double_pendulum.MODELS`) at `sizes.train_hidden` and its paper protocol (L1 loss,
-Adam, l2 penalty) at batch `sizes.train_batch` (and each of `sizes.train_extra_batches`). One optimiser step is timed (fastest of
-`sizes.train_steps` after one warm-up/compile step) with the training loops' own step functions:
+Adam, l2 penalty) at batch `sizes.train_batch` (and each of `sizes.train_extra_batches`). One optimiser
+step is timed (fastest of `sizes.train_steps` after one warm-up/compile step) with the training loops' own step functions:
 `train_jax.make_step` (eqx.filter_jit) and `train_torch.make_loss` + torch.optim.Adam.
 mode "compile" wraps the PyTorch loss in `torch.compile`; where that fails or is disabled, no row is
 written and the reason goes to `notes` (shown in ratios.csv).
