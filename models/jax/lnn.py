@@ -3,15 +3,9 @@
 `euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None) -> (qddot, n_fallback)`
   L_fn(q, qdot[, extra]) -> (...,) for q, qdot (..., d), acting on each sample independently.
   q, qdot (..., d); extra (..., e) or None. qddot (..., d); n_fallback an int scalar array.
-  "paper": per sample, q'' = pinv(H) (dL/dq - J qdot), H = d2L/dqdot2 and J = d2L/dqdot dq, the full
-           matrices, pinv by SVD with rtol = 10 d eps (`models.numerics.pinv_rtol`); n_fallback = 0.
-           The original code takes H and J as two transforms (jax.hessian(L, 1) and
-           jax.jacobian(jax.jacobian(L, 1), 0)) and dL/dq as a third; here they are blocks of one full
-           Hessian of L in x = [q, qdot] (2d tangents pushed forward through the reverse pass that also
-           gives dL/dq). Same values (float32: 1e-6 relative). Measured (3 x 600, batch 4096, float32,
-           2 cores, interleaved rounds): PyTorch traced 6.3k -> 8.2k samples/s at d = 2, 1.02k -> 1.03k
-           at d = 16, though its graph does more matrix-product FLOPs (3.5e7 against 2.3e7 per sample
-           at d = 2: fewer, taller products); JAX unchanged within noise (8.1k-9.5k at d = 2).
+  "paper": per sample, q'' = pinv(H) (dL/dq - J qdot), H = jax.hessian(L, 1), J = the full mixed
+           Jacobian jax.jacobian(jax.jacobian(L, 1), 0), pinv by SVD with rtol = 10 d eps
+           (`models.numerics.pinv_rtol`); n_fallback = 0.
   "fast":  one reverse pass for (dL/dq, dL/dqdot) summed over the batch, pushed forward along d + 1
            tangents at once (the d unit vectors in qdot -> the Hessian columns; qdot in q -> the mixed
            term J qdot as ONE Jacobian-vector product), then a linear solve. Fallback: where the
@@ -59,12 +53,11 @@ def fast_terms(L_fn, q, qdot, extra=None):
 
 def paper_terms(L_fn, q, qdot, extra=None):
     """On flat (B, d), per sample: (H (B, d, d), rhs = dL/dq - J qdot (B, d)) with full Jacobians."""
-    d = q.shape[-1]
-
     def one(q1, qd1, e1):
-        g = jax.grad(lambda x: _call(L_fn, x[:d], x[d:], e1))
-        full, g1 = jax.jacfwd(lambda x: (g(x), g(x)), has_aux=True)(jnp.concatenate([q1, qd1]))
-        return full[d:, d:], g1[:d] - full[d:, :d] @ qd1
+        f = lambda a, b: _call(L_fn, a, b, e1)  # noqa: E731
+        hess = jax.hessian(f, 1)(q1, qd1)
+        mixed = jax.jacobian(jax.jacobian(f, 1), 0)(q1, qd1)
+        return hess, jax.grad(f, 0)(q1, qd1) - mixed @ qd1
     if extra is None:
         return jax.vmap(lambda a, b: one(a, b, None))(q, qdot)
     return jax.vmap(one)(q, qdot, extra)
