@@ -12,7 +12,9 @@ each of several fns timed round by round (every fn once per round), for figures 
 `Sizes`: what the tiny / quick / full studies measure. Wall time on the 2 shared cores of the
 development machine (timings.json, 2026-11-22): quick 962 s (inference 411 s with its AOTInductor
 compiles, fast vs paper 143 s, rollouts 124 s, train to target 108 s, scaling 78 s, latency 73 s); up to
-1.5x more while another process holds the cores. Full: not timed here.
+1.5x more while another process holds the cores. Full: not timed here. gpu (`lagbench bench --gpu`, one
+H100, 2026-11-23): inference 195 s, training 78 s, scaling 278 s, fast vs paper 147 s, mostly JAX
+compiling one program per shape.
 """
 from __future__ import annotations
 
