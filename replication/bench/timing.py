@@ -10,9 +10,10 @@ each of several fns timed round by round (every fn once per round), for figures 
 (fast/paper/matmul, the sizes of a scaling fit).
 `jax_ready(fn)` / `torch_ready(fn)` wrap a framework call so that it blocks and returns nothing.
 `Sizes`: what the tiny / quick / full studies measure. Wall time on the 2 shared cores of the
-development machine (timings.json, 2026-11-22): quick 962 s (inference 411 s with its AOTInductor
-compiles, fast vs paper 143 s, rollouts 124 s, train to target 108 s, scaling 78 s, latency 73 s); up to
-1.5x more while another process holds the cores. Full: not timed here. gpu (`lagbench bench --gpu`, one
+development machine (timings.json): quick 962 s on 2026-11-22 (inference 411 s with its AOTInductor
+compiles, fast vs paper 143 s, rollouts 124 s, train to target 108 s, scaling 78 s, latency 73 s), 1296 s
+on 2026-11-23 (inference 553 s, fast vs paper 305 s, train to target 150 s, rollouts 114 s, scaling 79 s,
+latency 72 s); up to 1.5x more while another process holds the cores. Full: not timed here. gpu (`lagbench bench --gpu`, one
 H100, 2026-11-23): inference 195 s, training 78 s, scaling 278 s, fast vs paper 147 s, mostly JAX
 compiling one program per shape.
 """
