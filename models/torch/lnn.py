@@ -59,7 +59,11 @@ def paper_terms(L_fn, q, qdot, extra=None):
 
     def one_hessian(q1, qd1, e1):
         g = grad(lambda x: _call(L_fn, x[:d], x[d:], e1))
-        full, g1 = jacfwd(lambda x: (g(x), g(x)), has_aux=True)(torch.cat([q1, qd1]))
+
+        def grad_and_aux(x):  # one reverse pass: its value is both the output and the aux (dL/dq)
+            gx = g(x)
+            return gx, gx
+        full, g1 = jacfwd(grad_and_aux, has_aux=True)(torch.cat([q1, qd1]))
         return full[d:, d:], g1[:d] - full[d:, :d] @ qd1
 
     def three(q1, qd1, e1):

@@ -44,6 +44,12 @@ TRACED_KINDS = (("lnn", "paper"), ("lgn", "dense"))  # torch.func inside: traced
 TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
 
 
+def torch_thread_choices() -> tuple:
+    """The intra-op thread counts a PyTorch row is timed at: TORCH_THREAD_CHOICES on the CPU; on a GPU only
+    TORCH_THREADS (the host threads only launch kernels there)."""
+    return (TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES
+
+
 @dataclass
 class Case:
     system: str
@@ -134,7 +140,7 @@ def _timed(ev, args, min_time) -> tuple[float, object]:
     if ev.framework != "torch":
         return best_time(lambda: ev.run(args), min_time=min_time), "default"
     best = (float("inf"), None)
-    for n in ((TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES):  # on a GPU the host threads only launch
+    for n in torch_thread_choices():
         with torch_threads(n):
             ev.run(args)  # the pool at this size
             best = min(best, (best_time(lambda: ev.run(args), min_time=min_time), n))

@@ -25,9 +25,9 @@ import numpy as np
 import torch
 
 from models import init_params
-from replication.bench.device import on_gpu, sync
+from replication.bench.device import sync
 from replication.bench.evaluators import make_evaluator
-from replication.bench.inference import TORCH_THREAD_CHOICES, model_spec
+from replication.bench.inference import model_spec, torch_thread_choices
 from replication.bench.timing import interleaved_best, torch_threads
 
 COMPILED_MODES = (("fast", "aoti"), ("paper", "traced"))  # PyTorch compiled rows where sizes.torch_compile
@@ -74,7 +74,7 @@ def _best_over_threads(fns: dict, reps: int, framework: str) -> dict:
             fn()
         return {k: (t, "default") for k, t in interleaved_best(fns, min_rounds=reps).items()}
     best = {k: (float("inf"), None) for k in fns}
-    for n in ((1,) if on_gpu() else TORCH_THREAD_CHOICES):
+    for n in torch_thread_choices():
         with torch_threads(n):
             for k, t in interleaved_best(fns, min_rounds=reps).items():
                 best[k] = min(best[k], (t, n))
