@@ -2,14 +2,10 @@
 
 `in_row_blocks(fn, arrays, rows_per_sample) -> fn(*arrays)`
   arrays: (B, ...) arrays or None, fn acting on each sample independently; the result (a pytree of
-  (B, ...) arrays) is the same as one call, computed by `lax.map` over equal blocks of at most
-  `block_size(rows_per_sample)` samples (the last block padded with copies of sample 0, fewer than one
-  per block; the padding is sliced off). Batches up to two blocks run as one call (training batches never block), and so does every batch on an
-  accelerator (no cache to fit; `lax.map` would only serialise the blocks).
-`block_size(rows_per_sample) = max(8, BLOCK_ROWS // rows_per_sample)`
-  rows_per_sample: the rows each sample adds to the widest intermediate (the fast LNN carries d + 1
-  tangent rows per sample through every layer). BLOCK_ROWS = 1024 keeps a (rows, 600) float32
-  activation at ~2.5 MB, inside this machine's 32 MB L3 with the layer's other operands.
+  (B, ...) arrays) is the same as one call, computed by `lax.map` over the equal blocks of
+  `models.row_blocks.block_plan` (the last padded with copies of sample 0; the padding is sliced off).
+  Batches up to two blocks run as one call, and so does every batch on an accelerator (no cache to fit;
+  `lax.map` would only serialise the blocks). The same plan serves PyTorch's compiled calls.
 Why: at batch 4096 the fast LNN's elementwise passes over the (B, d + 1, width) tangents run at memory
 bandwidth; in blocks they stay in cache. Measured (3 x 600 softplus, float32, batch 4096, 2-core EPYC, best of 5, one
 process per setting; unblocked -> BLOCK_ROWS 1024 (2048)): fast d=2 0.44 -> 0.23 (0.31) s, d=16
@@ -21,11 +17,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-BLOCK_ROWS = 1024
-
-
-def block_size(rows_per_sample: int) -> int:
-    return max(8, BLOCK_ROWS // max(1, rows_per_sample))
+from models.row_blocks import block_plan, block_size  # noqa: F401 - block_size re-exported
 
 
 def _pad(a, pad):
@@ -34,11 +26,11 @@ def _pad(a, pad):
 
 def in_row_blocks(fn, arrays, rows_per_sample: int):
     """fn(*arrays) computed block by block over the leading axis; see the module docstring."""
-    n, target = arrays[0].shape[0], block_size(rows_per_sample)
-    if n <= 2 * target or jax.default_backend() != "cpu":
+    n = arrays[0].shape[0]
+    plan = block_plan(n, rows_per_sample)
+    if plan is None or jax.default_backend() != "cpu":
         return fn(*arrays)
-    n_blocks = -(-n // target)
-    block = -(-n // n_blocks)                    # equal blocks: at most n_blocks - 1 padded samples
+    n_blocks, block = plan
     pad = n_blocks * block - n
     present = [i for i, a in enumerate(arrays) if a is not None]
     stacked = tuple(_pad(arrays[i], pad).reshape(n_blocks, block, *arrays[i].shape[1:]) for i in present)

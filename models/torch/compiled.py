@@ -21,7 +21,9 @@ eager 1.0-1.3k). Inputs must already have the compiled shape and dtype (torch te
 raises a ValueError naming the input. `compile_batched` exports with a dynamic batch dimension (one
 library for every batch size; the speed study's "aoti" mode); code that fixes the batch size while
 tracing fails there with torch's constraint error, and `compile_batched(..., batch=B)` compiles it for
-that one batch size instead.
+that one batch size instead. `compile_batched(..., rows_per_sample=k)` calls large batches in cache-sized
+row blocks (`BlockedMethod`, the blocks of `models.row_blocks`), as the JAX models compute them; a
+fixed-batch library is then compiled for the block size.
 """
 from __future__ import annotations
 
@@ -35,8 +37,9 @@ from torch.fx.experimental.proxy_tensor import make_fx
 from torch.utils._pytree import tree_flatten, tree_unflatten
 
 from models.checks import n_required_inputs
+from models.row_blocks import block_plan
 
-__all__ = ["CompiledMethod", "compile_batched", "compile_single"]
+__all__ = ["BlockedMethod", "CompiledMethod", "compile_batched", "compile_single"]
 
 MAX_BATCH = 1 << 20  # the largest batch a dynamic-batch library accepts
 
@@ -75,6 +78,38 @@ class CompiledMethod:
             xs.append(x if x.is_contiguous() else x.contiguous())  # the kernels index memory densely
         out = self._run(xs)
         return out[0] if self._single else tree_unflatten(out, self._out_spec)
+
+
+class BlockedMethod:
+    """A compiled function called once per row block (`models.row_blocks.block_plan`): the inputs are
+    padded with copies of sample 0 to equal blocks, each block is one call into `inner` (compiled for
+    that block size, or for any batch), and the outputs (tensors with the batch first) are joined and the
+    padding sliced off. Batches of at most two blocks go to `inner` in one call. The PyTorch side of
+    `models.jax.blocking`: the same samples per block, a Python loop instead of lax.map."""
+
+    def __init__(self, inner: CompiledMethod, rows_per_sample: int, batch: int | None = None):
+        self.inner, self.rows_per_sample, self.batch = inner, int(rows_per_sample), batch
+        self.method, self.dtype, self.n_inputs = inner.method, inner.dtype, inner.n_inputs
+        self.in_shape = (batch, *inner.in_shape[1:])
+
+    def __call__(self, *inputs):
+        if self.batch is not None:
+            for i, x in enumerate(inputs):
+                if not (isinstance(x, torch.Tensor) and x.dtype == self.dtype and tuple(x.shape) == self.in_shape):
+                    got = (f"{tuple(x.shape)} {x.dtype}" if isinstance(x, torch.Tensor) else type(x).__name__)
+                    raise ValueError(f"{self.method} input {i}: compiled for a {self.in_shape} {self.dtype} "
+                                     f"tensor, got {got}")
+        n = inputs[0].shape[0] if inputs and isinstance(inputs[0], torch.Tensor) and inputs[0].dim() else 0
+        plan = block_plan(n, self.rows_per_sample)
+        if plan is None:
+            return self.inner(*inputs)
+        n_blocks, block = plan
+        pad = n_blocks * block - n
+        padded = [torch.cat([x, x[:1].expand(pad, *x.shape[1:])]) if pad else x.contiguous() for x in inputs]
+        outs = [tree_flatten(self.inner(*(x[k * block:(k + 1) * block] for x in padded)))
+                for k in range(n_blocks)]
+        leaves = [torch.cat([o[0][j] for o in outs])[:n] for j in range(len(outs[0][0]))]
+        return tree_unflatten(leaves, outs[0][1])
 
 
 class _Fn(torch.nn.Module):
@@ -120,19 +155,31 @@ def trace_flat(fn, example: tuple) -> torch.fx.GraphModule:
     """fn(*example) as a graph of plain ATen operators, traced by make_fx on the (real) example tensors:
     torch.func transforms (vmap, jacrev, hessian) come out flattened, which torch.export cannot do with
     them inside (torch 2.13). The graph is for the example's shapes; data-dependent branches must use
-    torch.cond while tracing (`models.torch.capture.capturing`)."""
-    with torch.no_grad():
+    torch.cond or a gather of the affected samples while tracing (`torch.fx.experimental.proxy_tensor.get_proxy_mode`
+    tells a model it is traced; `models.torch.lnn.solve_with_fallback`)."""
+    # torch.cond runs its branches through dynamo, which makes a size dynamic once it has seen two values
+    # of it (another batch size traced in this process); the graph's export then fails on the size it
+    # passes to the cond (torch 2.13). Each trace is for one batch size: keep sizes static.
+    with torch.no_grad(), torch._dynamo.config.patch(automatic_dynamic_shapes=False):
         return make_fx(lambda *xs: fn(*xs))(*example)  # make_fx would trace every parameter of fn's signature
 
 
 def compile_batched(fn, n_inputs: int, width: int, dtype: str = "float32", batch: int | None = None,
-                    name: str = "fn", flatten: bool = False) -> CompiledMethod:
+                    name: str = "fn", flatten: bool = False,
+                    rows_per_sample: int | None = None) -> CompiledMethod | BlockedMethod:
     """Compile fn(*inputs), each input (B, width), for every batch size B (batch=None) or for B = batch.
-    flatten: trace fn with `trace_flat` first (for functions built on torch.func; needs a batch)."""
+    flatten: trace fn with `trace_flat` first (for functions built on torch.func; needs a batch).
+    rows_per_sample: call large batches in row blocks (`BlockedMethod`; fn must act on each sample
+    independently and return tensors with the batch first); with a batch, the library is compiled for
+    the block size only."""
     if n_inputs < 1 or width < 1:
         raise ValueError(f"compile_batched needs n_inputs >= 1 and width >= 1, got {n_inputs}, {width}")
     if flatten and batch is None:
         raise ValueError("compile_batched(flatten=True) traces for one batch size: give batch")
+    if rows_per_sample is not None and torch.get_default_device().type == "cpu":  # no cache to fit on a GPU
+        plan = None if batch is None else block_plan(int(batch), rows_per_sample)
+        inner = compile_batched(fn, n_inputs, width, dtype, batch if plan is None else plan[1], name, flatten)
+        return BlockedMethod(inner, rows_per_sample, batch)
     dt = getattr(torch, dtype)
     if flatten:
         fn = trace_flat(fn, tuple(torch.zeros(int(batch), width, dtype=dt) for _ in range(n_inputs)))

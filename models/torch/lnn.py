@@ -114,11 +114,13 @@ def small_inverse(h):
 
 def solve_with_fallback(hess, rhs):
     """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. A captured graph
-    has no Python branch on data: under torch.export the pinv is a torch.cond; under make_fx
-    (`models.torch.compiled.trace_flat`, whose graph export rejects that cond, torch 2.13) every sample
-    takes pinv and the bad ones keep it. Without gradients (inference) the well-conditioned samples use
-    the inverse the condition estimate already needed (`small_inverse`) instead of a second, LU solve;
-    with gradients they solve with H replaced by I on the bad samples, so that no inf reaches backward."""
+    has no Python branch on data: under torch.export, and under make_fx without gradients
+    (`models.torch.compiled.trace_flat`, the speed study's "traced" mode), the pinv is a torch.cond that
+    runs only where a sample is bad. Its operands are made contiguous: export of a make_fx graph whose
+    cond takes a strided view (the dense LGN's Hessian) failed in placeholder naming (torch 2.13). Traced
+    with gradients, every sample takes pinv and the bad ones keep it. Without gradients (inference) the
+    well-conditioned samples use the inverse the condition estimate already needed (`small_inverse`)
+    instead of a second, LU solve; with gradients they solve with H replaced by I on the bad samples, so that no inf reaches backward."""
     d = hess.shape[-1]
     h = hess.detach()
     inv, info = small_inverse(h)
@@ -129,11 +131,12 @@ def solve_with_fallback(hess, rhs):
         x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
     else:
         x = (inv @ rhs[..., None])[..., 0]
-    if get_proxy_mode() is not None:  # traced by make_fx (`compiled.trace_flat`): pinv on every sample
+    traced = get_proxy_mode() is not None
+    if traced and torch.is_grad_enabled():  # traced with gradients: pinv on every sample, the bad ones keep it
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
-    elif torch.compiler.is_exporting():  # no Python branch on data in an exported graph
+    elif traced or torch.compiler.is_exporting():  # no Python branch on data in a captured graph
         x = torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], pinv_solve(h, r), y),
-                       lambda h, r, b, y: y.clone(), (hess, rhs, bad, x))
+                       lambda h, r, b, y: y.clone(), (hess.contiguous(), rhs.contiguous(), bad, x.contiguous()))
     elif bool(torch.any(bad)):
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
     return x, torch.sum(bad)

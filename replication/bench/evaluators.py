@@ -34,6 +34,7 @@ import torch
 
 import models.jax
 import models.torch
+from models.row_blocks import rows_per_sample
 from models.torch.compiled import compile_batched
 from replication.bench.device import sync, to_numpy
 
@@ -159,12 +160,14 @@ class TruthTorch(TorchEvaluator):
 
 
 class TorchAotEvaluator(TorchEvaluator):
-    """PyTorch through `compile_batched`: one library for every batch size, compiled when made."""
+    """PyTorch through `compile_batched`: one library for every batch size, compiled when made. rows:
+    large batches are called in row blocks where the JAX model computes them so
+    (`models.row_blocks.rows_per_sample`)."""
     mode = "aoti"
 
-    def __init__(self, fn, width, dtype, kind):
+    def __init__(self, fn, width, dtype, kind, rows=None):
         self.kind, self.dtype = kind, getattr(torch, dtype)
-        self._fn = compile_batched(fn, 2, width, dtype, name=f"{kind} q''")
+        self._fn = compile_batched(fn, 2, width, dtype, name=f"{kind} q''", rows_per_sample=rows)
 
     def _call(self, args):
         return self._fn(*args)
@@ -176,19 +179,21 @@ class TorchAotEvaluator(TorchEvaluator):
 class TorchTracedEvaluator(TorchEvaluator):
     """PyTorch through `compile_batched(..., flatten=True)`: the call traced by make_fx (its torch.func
     transforms flattened into ATen operators), exported and compiled with AOTInductor, one library per
-    batch size, compiled in `prepare` (outside the timing; 20-30 s each)."""
+    batch size, compiled in `prepare` (outside the timing; 20-30 s each). rows: as `TorchAotEvaluator`;
+    a blocked batch size is compiled for its block size."""
     mode = "traced"
 
-    def __init__(self, fn, width, dtype, kind):
+    def __init__(self, fn, width, dtype, kind, rows=None):
         self.kind, self.dtype, self._fn, self._width = kind, getattr(torch, dtype), fn, width
-        self._dtype_name, self._by_batch = dtype, {}
+        self._dtype_name, self._by_batch, self._rows = dtype, {}, rows
 
     def prepare(self, q, qdot):
         args = super().prepare(q, qdot)
         b = int(args[0].shape[0])
         if b not in self._by_batch:
             self._by_batch[b] = compile_batched(self._fn, 2, self._width, self._dtype_name, batch=b,
-                                                name=f"{self.kind} q'' batch {b}", flatten=True)
+                                                name=f"{self.kind} q'' batch {b}", flatten=True,
+                                                rows_per_sample=self._rows)
         return args
 
     def _call(self, args):
@@ -229,12 +234,14 @@ def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="flo
             return TorchAotEvaluator(lambda q, qd: system.acceleration(q, qd, backend="torch"), system.dof,
                                      dtype, "truth")
         model = models.torch.build(spec, params)
-        return TorchAotEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind)
+        return TorchAotEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind,
+                                 rows_per_sample(spec))
     if mode == "traced":
         if framework != "torch" or kind == "truth":
             raise ValueError(f"mode 'traced' is for PyTorch models; got framework {framework!r}, kind {kind!r}")
         model = models.torch.build(spec, params)
-        return TorchTracedEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind)
+        return TorchTracedEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype,
+                                    spec.kind, rows_per_sample(spec))
     if mode not in (None, "jit", "eager", "numpy"):
         raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti, traced")
     if kind == "truth":
