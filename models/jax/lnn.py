@@ -13,8 +13,9 @@
            is not finite) the sample takes the paper's pinv result and is counted in n_fallback.
            Indefinite but well-conditioned H are solved exactly (pinv would give the same).
 `euler_lagrange(...)` returns qddot only; `velocity_hessian(L_fn, q, qdot, extra)` -> (..., d, d).
-Large batches are computed in cache-sized row blocks (`models.jax.blocking`; JAX only, eager PyTorch
-gained nothing reliable from it).
+Large batches are computed in cache-sized row blocks (`models.jax.blocking`, the plan of
+`models.row_blocks`). PyTorch's compiled calls use the same blocks (`models.torch.compiled`); eager
+PyTorch gained nothing reliable from them.
 Mirrored line for line by `models.torch.lnn`; in both, `LNN`'s own fast terms come from the hand-written
 MLP derivatives (`models.jax.mlp_derivatives`), the generic `fast_terms` serves any other L_fn.
 """

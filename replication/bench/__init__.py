@@ -38,7 +38,9 @@ keeps XLA's defaults (the thread settings are recorded in machine.json). The inf
 exception, and so are the fast/paper and matmul rows: each PyTorch row is timed at 1 thread and at all
 cores and keeps the faster (its `threads` column), so that at large batches PyTorch is not held to half
 the cores XLA uses; PyTorch compiled ahead of time (mode "aoti", `evaluators.TorchAotEvaluator`; mode "traced" for
-the torch.func models, `evaluators.TorchTracedEvaluator`) has its own rows beside eager.
+the torch.func models, `evaluators.TorchTracedEvaluator`) has its own rows beside eager. Both compiled
+modes call large batches of the LNN and the dense LGN in the row blocks the JAX models compute them in
+(`models.row_blocks`), so that the two frameworks do the same work per block.
 """
 from __future__ import annotations
 

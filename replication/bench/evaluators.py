@@ -11,10 +11,10 @@ an argument (the weights are inputs of the compiled program, not folded constant
 compiled ahead of time on the first call per shape (the same object serves `flops` and `ops`); PyTorch
 runs eagerly under `torch.no_grad()` (torch.func inside still differentiates), or with mode="aoti"
 through `models.torch.compiled.compile_batched` (torch.export + AOTInductor: one library for every
-batch size, compiled when the evaluator is made, 10-25 s; its kernels are generated for the intra-op
-thread count at that time, the study's 1). Not every model exports: what differentiates with torch.func
-(the paper-formulation LNN's hessian, the dense LGN's forward-over-reverse) fails inside torch.export
-(torch 2.13), which raises. The fast LNN, the HNN, DeLaN and the banded LGN differentiate their MLPs by
+batch size, compiled when the evaluator is made, 10-25 s, once per intra-op thread count the rows are
+timed at: inductor fixes a kernel's thread count when it compiles, `per_thread_count`). Not every model
+exports: what differentiates with torch.func (the paper-formulation LNN's hessian, the dense LGN's
+forward-over-reverse) fails inside torch.export (torch 2.13), which raises. The fast LNN, the HNN, DeLaN and the banded LGN differentiate their MLPs by
 hand and export. Those two go through mode="traced" (`TorchTracedEvaluator`): make_fx traces the call
 into plain ATen operators first (`models.torch.compiled.trace_flat`), which exports and compiles, one
 library per batch size. `ev.mode`: "jit", "eager", "aoti", "traced", "numpy".
@@ -37,6 +37,7 @@ import models.torch
 from models.row_blocks import rows_per_sample
 from models.torch.compiled import compile_batched
 from replication.bench.device import sync, to_numpy
+from replication.bench.timing import torch_threads
 
 
 def median_rel_error(pred, true) -> float:
@@ -159,18 +160,39 @@ class TruthTorch(TorchEvaluator):
             return self.system.acceleration(*args, backend="torch")
 
 
+def per_thread_count(compile_fn, counts=None) -> dict:
+    """{threads: compile_fn()} compiled at each intra-op thread count a row is timed at (default
+    `inference.torch_thread_choices()`). Inductor writes the count in force at compile time into its
+    OpenMP kernels: a library compiled at 1 thread stays serial when timed at 2 (DeLaN float64, batch 256,
+    interleaved: 71k samples/s compiled at 1 thread, 79k at 2, whatever the thread count at run time)."""
+    from replication.bench.inference import torch_thread_choices  # inference imports this module
+
+    out = {}
+    for n in counts or torch_thread_choices():
+        with torch_threads(n):
+            out[n] = compile_fn()
+    return out
+
+
+def for_threads(libraries: dict):
+    """The library compiled for the current intra-op thread count (else the nearest count compiled)."""
+    n = torch.get_num_threads()
+    return libraries[n] if n in libraries else libraries[min(libraries, key=lambda k: abs(k - n))]
+
+
 class TorchAotEvaluator(TorchEvaluator):
-    """PyTorch through `compile_batched`: one library for every batch size, compiled when made. rows:
-    large batches are called in row blocks where the JAX model computes them so
-    (`models.row_blocks.rows_per_sample`)."""
+    """PyTorch through `compile_batched`: one library for every batch size, compiled when made, at each
+    thread count the rows are timed at (`per_thread_count`). rows: large batches are called in row blocks
+    where the JAX model computes them so (`models.row_blocks.rows_per_sample`)."""
     mode = "aoti"
 
     def __init__(self, fn, width, dtype, kind, rows=None):
         self.kind, self.dtype = kind, getattr(torch, dtype)
-        self._fn = compile_batched(fn, 2, width, dtype, name=f"{kind} q''", rows_per_sample=rows)
+        self._libs = per_thread_count(lambda: compile_batched(fn, 2, width, dtype, name=f"{kind} q''",
+                                                              rows_per_sample=rows))
 
     def _call(self, args):
-        return self._fn(*args)
+        return for_threads(self._libs)(*args)
 
     def ops(self, args):
         return None  # one call into the compiled library
@@ -179,8 +201,9 @@ class TorchAotEvaluator(TorchEvaluator):
 class TorchTracedEvaluator(TorchEvaluator):
     """PyTorch through `compile_batched(..., flatten=True)`: the call traced by make_fx (its torch.func
     transforms flattened into ATen operators), exported and compiled with AOTInductor, one library per
-    batch size, compiled in `prepare` (outside the timing; 20-30 s each). rows: as `TorchAotEvaluator`;
-    a blocked batch size is compiled for its block size."""
+    batch size, compiled in `prepare` (outside the timing; 20-30 s each) at each thread count the rows are
+    timed at (`per_thread_count`; batch 1 at one thread only: one sample has no parallel work). rows: as
+    `TorchAotEvaluator`; a blocked batch size is compiled for its block size."""
     mode = "traced"
 
     def __init__(self, fn, width, dtype, kind, rows=None):
@@ -191,13 +214,14 @@ class TorchTracedEvaluator(TorchEvaluator):
         args = super().prepare(q, qdot)
         b = int(args[0].shape[0])
         if b not in self._by_batch:
-            self._by_batch[b] = compile_batched(self._fn, 2, self._width, self._dtype_name, batch=b,
-                                                name=f"{self.kind} q'' batch {b}", flatten=True,
-                                                rows_per_sample=self._rows)
+            self._by_batch[b] = per_thread_count(
+                lambda: compile_batched(self._fn, 2, self._width, self._dtype_name, batch=b,
+                                        name=f"{self.kind} q'' batch {b}", flatten=True, rows_per_sample=self._rows),
+                counts=(1,) if b == 1 else None)
         return args
 
     def _call(self, args):
-        return self._by_batch[int(args[0].shape[0])](*args)
+        return for_threads(self._by_batch[int(args[0].shape[0])])(*args)
 
     def ops(self, args):
         return None  # one call into the compiled library
