@@ -36,6 +36,5 @@ def block_plan(n: int, rows_per_sample: int) -> tuple[int, int] | None:
 def rows_per_sample(spec) -> int | None:
     if spec.kind == "lnn":
         return spec.dof + 1
-    if spec.kind == "lgn" and not (spec.formulation in ("banded", "fast") and banded_supported(spec.dof, spec.lgn_radius)):
-        return spec.dof + 1
-    return None
+    banded = spec.formulation in ("banded", "fast") and banded_supported(spec.dof, spec.lgn_radius)
+    return spec.dof + 1 if spec.kind == "lgn" and not banded else None

@@ -155,8 +155,8 @@ def trace_flat(fn, example: tuple) -> torch.fx.GraphModule:
     """fn(*example) as a graph of plain ATen operators, traced by make_fx on the (real) example tensors:
     torch.func transforms (vmap, jacrev, hessian) come out flattened, which torch.export cannot do with
     them inside (torch 2.13). The graph is for the example's shapes; data-dependent branches must use
-    torch.cond or a gather of the affected samples while tracing (`torch.fx.experimental.proxy_tensor.get_proxy_mode`
-    tells a model it is traced; `models.torch.lnn.solve_with_fallback`)."""
+    torch.cond while tracing (`get_proxy_mode()` tells a model it is traced, as in
+    `models.torch.lnn.solve_with_fallback`)."""
     # torch.cond runs its branches through dynamo, which makes a size dynamic once it has seen two values
     # of it (another batch size traced in this process); the graph's export then fails on the size it
     # passes to the cond (torch 2.13). Each trace is for one batch size: keep sizes static.

@@ -120,7 +120,8 @@ def solve_with_fallback(hess, rhs):
     cond takes a strided view (the dense LGN's Hessian) failed in placeholder naming (torch 2.13). Traced
     with gradients, every sample takes pinv and the bad ones keep it. Without gradients (inference) the
     well-conditioned samples use the inverse the condition estimate already needed (`small_inverse`)
-    instead of a second, LU solve; with gradients they solve with H replaced by I on the bad samples, so that no inf reaches backward."""
+    instead of a second, LU solve; with gradients they solve with H replaced by I on the bad samples, so
+    that no inf reaches backward."""
     d = hess.shape[-1]
     h = hess.detach()
     inv, info = small_inverse(h)
