@@ -9,7 +9,9 @@ TRACED_KINDS, whose torch.func does not export: traced into ATen operators, then
 `evaluators.TorchTracedEvaluator`), "numpy". threads: PyTorch rows are
 timed at each of TORCH_THREAD_CHOICES intra-op threads (1 and all cores) and keep the faster (the column
 says which: on shared cores a 2-thread pool can lose 10-100x to other processes' load, idle it wins at
-large batches); JAX rows run XLA's default pool ("default").
+large batches); JAX rows run XLA's default pool ("default"). A PyTorch row also holds
+jax_paired_samples_per_s: the same operation in JAX, timed in the same interleaved rounds (the ratio
+table compares those two, `tables.paired_best`).
 Systems: the double pendulum (every kind but the graph network, plus the SymPy ground truth as model
 "truth" in NumPy, JAX and PyTorch) and the wave equation on a periodic grid of `sizes.wave_n` points (LGN dense vs banded, and
 truth; batches capped at `GRID_NODES` // n states). Models are untrained (seed-0 random init of the spec, source "random_init"): their error is
@@ -32,7 +34,7 @@ import systems
 from models import ModelSpec, init_params
 from replication.bench.device import on_gpu
 from replication.bench.evaluators import make_evaluator, median_rel_error
-from replication.bench.timing import TORCH_THREADS, best_time, torch_threads
+from replication.bench.timing import TORCH_THREADS, best_time, interleaved_best, torch_threads
 
 GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dense path holds n + 1 tangents)
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
@@ -42,6 +44,7 @@ WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
 AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"), ("lgn", "banded"))
 TRACED_KINDS = (("lnn", "paper"), ("lgn", "dense"))  # torch.func inside: traced, then compiled per batch size
 TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
+PAIRED_ROUNDS = 5  # interleaved rounds (at least) of a PyTorch row and its JAX twin, per thread count
 
 
 def torch_thread_choices() -> tuple:
@@ -147,10 +150,28 @@ def _timed(ev, args, min_time) -> tuple[float, object]:
     return best
 
 
+def _timed_paired(ev, args, jev, jargs, min_time) -> tuple[float, object, float]:
+    """(fastest PyTorch seconds, its threads, fastest JAX seconds): a PyTorch row and the same operation in
+    JAX timed in the same interleaved rounds (`timing.interleaved_best`), at each thread count."""
+    best, jax_best = (float("inf"), None), float("inf")
+    for n in torch_thread_choices():
+        with torch_threads(n):
+            ev.run(args)  # the pool at this size
+            got = interleaved_best({"torch": lambda: ev.run(args), "jax": lambda: jev.run(jargs)},
+                                   min_rounds=PAIRED_ROUNDS, budget_s=2 * min_time)
+        best, jax_best = min(best, (got["torch"], n)), min(jax_best, got["jax"])
+    return best[0], best[1], jax_best
+
+
 def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
+    """The case's rows, one per batch. A PyTorch row also times the same operation in JAX in the same
+    interleaved rounds (`jax_paired_samples_per_s`): the ratio table compares those two, so that a burst of
+    load from other processes on these shared cores hits both sides alike."""
     s = systems.get(case.system, **case.system_kw) if case.model == "truth" else None
     ev = make_evaluator(case.framework, case.spec, case.params, kind="truth" if s else case.model,
                         dtype=case.dtype, system=s, mode=case.mode)
+    jev = (make_evaluator("jax", case.spec, case.params, kind="truth" if s else case.model, dtype=case.dtype,
+                          system=s) if case.framework == "torch" else None)
     n_err = max(case.batches)
     err = median_rel_error(ev.numpy(ev.prepare(states["q"][:n_err], states["qdot"][:n_err])),
                            states["qddot"][:n_err])
@@ -163,9 +184,16 @@ def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
         args = ev.prepare(states["q"][:b], states["qdot"][:b])
         if b != n_err:
             ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape); the error call warmed n_err
-        dt, threads = _timed(ev, args, min_time)
+        paired = {}
+        if jev is None:
+            dt, threads = _timed(ev, args, min_time)
+        else:
+            jargs = jev.prepare(states["q"][:b], states["qdot"][:b])
+            jev.run(jargs)  # JAX compiles for this shape
+            dt, threads, jdt = _timed_paired(ev, args, jev, jargs, min_time)
+            paired = {"jax_paired_samples_per_s": b / jdt}
         rows.append({"system": case.system, "model": case.model, "formulation": case.formulation,
                      "framework": case.framework, "mode": ev.mode, "threads": threads, "dtype": case.dtype,
                      "batch": int(b), "samples_per_s": b / dt, "error": err, "source": case.source, "ops": ops,
-                     **case.extra})
+                     **paired, **case.extra})
     return rows

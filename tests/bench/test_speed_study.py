@@ -55,6 +55,9 @@ def test_inference_covers_every_model_and_framework(bench_dir):
     assert truth["error"].max() < 1e-4  # float32 ground truth against float64
     trained = df[df["source"] == "trained:dp_loss"]
     assert set(trained["framework"]) == {"jax"} and set(trained["hidden"].astype(str)) == {"8"}
+    torch_rows = df[df["framework"] == "torch"]  # each with its JAX twin timed in the same rounds
+    assert len(torch_rows) and (torch_rows["jax_paired_samples_per_s"] > 0).all()
+    assert df.loc[df["framework"] != "torch", "jax_paired_samples_per_s"].isna().all()
 
 
 def test_fast_paper_and_matmul_torch_rows_record_their_thread_count(bench_dir):
