@@ -14,8 +14,8 @@ through `models.torch.compiled.compile_batched` (torch.export + AOTInductor: one
 batch size, compiled when the evaluator is made, 10-25 s, once per intra-op thread count the rows are
 timed at: inductor fixes a kernel's thread count when it compiles, `per_thread_count`). Not every model
 exports: what differentiates with torch.func (the paper-formulation LNN's hessian, the dense LGN's
-forward-over-reverse) fails inside torch.export (torch 2.13), which raises. The fast LNN, the HNN, DeLaN and the banded LGN differentiate their MLPs by
-hand and export. Those two go through mode="traced" (`TorchTracedEvaluator`): make_fx traces the call
+forward-over-reverse) fails inside torch.export (torch 2.13), which raises. The fast LNN, the HNN, DeLaN
+and the banded LGN differentiate their MLPs by hand and export. Those two go through mode="traced" (`TorchTracedEvaluator`): make_fx traces the call
 into plain ATen operators first (`models.torch.compiled.trace_flat`), which exports and compiles, one
 library per batch size. `ev.mode`: "jit", "eager", "aoti", "traced", "numpy".
 `ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
