@@ -44,6 +44,25 @@ __all__ = ["BlockedMethod", "CompiledMethod", "compile_batched", "compile_single
 MAX_BATCH = 1 << 20  # the largest batch a dynamic-batch library accepts
 
 
+def _checked(method, inputs, in_shape, dtype, n_inputs) -> list:
+    """The inputs, contiguous (the kernels index memory densely), after checking their count, dtype and
+    shape against in_shape (None first: any batch up to MAX_BATCH); a ValueError names the first misfit."""
+    if len(inputs) != n_inputs:
+        raise ValueError(f"{method} was compiled for {n_inputs} inputs, got {len(inputs)}")
+    dynamic = bool(in_shape) and in_shape[0] is None
+    xs = []
+    for i, x in enumerate(inputs):
+        fits = isinstance(x, torch.Tensor) and x.dtype == dtype and (
+            x.dim() == len(in_shape) and 1 <= x.shape[0] <= MAX_BATCH and x.shape[1:] == in_shape[1:]
+            if dynamic else x.shape == in_shape)
+        if not fits:
+            got = (f"{tuple(x.shape)} {x.dtype}" if isinstance(x, torch.Tensor) else type(x).__name__)
+            want = "(batch, " + ", ".join(map(str, in_shape[1:])) + ")" if dynamic else in_shape
+            raise ValueError(f"{method} input {i}: compiled for a {want} {dtype} tensor, got {got}")
+        xs.append(x if x.is_contiguous() else x.contiguous())
+    return xs
+
+
 class CompiledMethod:
     """A function compiled for fixed input shapes (None in in_shape[0]: any batch size); `f(*inputs)` runs
     it (one call into the library).
@@ -57,26 +76,9 @@ class CompiledMethod:
         self.runner, self.method, self.in_shape, self.dtype, self.n_inputs = runner, method, in_shape, dtype, n_inputs
         self._run, self._out_spec = runner.loader.run, out_spec
         self._single = out_spec.is_leaf()
-        self._dynamic = bool(in_shape) and in_shape[0] is None
-
-    def _fits(self, x) -> bool:
-        if not isinstance(x, torch.Tensor) or x.dtype != self.dtype:
-            return False
-        if self._dynamic:
-            return x.dim() == len(self.in_shape) and 1 <= x.shape[0] <= MAX_BATCH and x.shape[1:] == self.in_shape[1:]
-        return x.shape == self.in_shape
 
     def __call__(self, *inputs):
-        if len(inputs) != self.n_inputs:
-            raise ValueError(f"{self.method} was compiled for {self.n_inputs} inputs, got {len(inputs)}")
-        xs = []
-        for i, x in enumerate(inputs):
-            if not self._fits(x):
-                got = (f"{tuple(x.shape)} {x.dtype}" if isinstance(x, torch.Tensor) else type(x).__name__)
-                want = "(batch, " + ", ".join(map(str, self.in_shape[1:])) + ")" if self._dynamic else self.in_shape
-                raise ValueError(f"{self.method} input {i}: compiled for a {want} {self.dtype} tensor, got {got}")
-            xs.append(x if x.is_contiguous() else x.contiguous())  # the kernels index memory densely
-        out = self._run(xs)
+        out = self._run(_checked(self.method, inputs, self.in_shape, self.dtype, self.n_inputs))
         return out[0] if self._single else tree_unflatten(out, self._out_spec)
 
 
@@ -93,19 +95,14 @@ class BlockedMethod:
         self.in_shape = (batch, *inner.in_shape[1:])
 
     def __call__(self, *inputs):
-        if self.batch is not None:
-            for i, x in enumerate(inputs):
-                if not (isinstance(x, torch.Tensor) and x.dtype == self.dtype and tuple(x.shape) == self.in_shape):
-                    got = (f"{tuple(x.shape)} {x.dtype}" if isinstance(x, torch.Tensor) else type(x).__name__)
-                    raise ValueError(f"{self.method} input {i}: compiled for a {self.in_shape} {self.dtype} "
-                                     f"tensor, got {got}")
-        n = inputs[0].shape[0] if inputs and isinstance(inputs[0], torch.Tensor) and inputs[0].dim() else 0
+        xs = _checked(self.method, inputs, self.in_shape, self.dtype, self.n_inputs)
+        n = xs[0].shape[0]
         plan = block_plan(n, self.rows_per_sample)
         if plan is None:
-            return self.inner(*inputs)
+            return self.inner(*xs)
         n_blocks, block = plan
         pad = n_blocks * block - n
-        padded = [torch.cat([x, x[:1].expand(pad, *x.shape[1:])]) if pad else x.contiguous() for x in inputs]
+        padded = [torch.cat([x, x[:1].expand(pad, *x.shape[1:])]) if pad else x for x in xs]
         outs = [tree_flatten(self.inner(*(x[k * block:(k + 1) * block] for x in padded)))
                 for k in range(n_blocks)]
         leaves = [torch.cat([o[0][j] for o in outs])[:n] for j in range(len(outs[0][0]))]

@@ -138,18 +138,6 @@ def states_for(system: str, kw: dict, n: int, seed: int = 0) -> dict:
     return {"q": st["q"], "qdot": st["qdot"], "qddot": s.acceleration(st["q"], st["qdot"], backend="numpy")}
 
 
-def _timed(ev, args, min_time) -> tuple[float, object]:
-    """(fastest call seconds, threads): PyTorch at each of TORCH_THREAD_CHOICES, the faster kept."""
-    if ev.framework != "torch":
-        return best_time(lambda: ev.run(args), min_time=min_time), "default"
-    best = (float("inf"), None)
-    for n in torch_thread_choices():
-        with torch_threads(n):
-            ev.run(args)  # the pool at this size
-            best = min(best, (best_time(lambda: ev.run(args), min_time=min_time), n))
-    return best
-
-
 def _timed_paired(ev, args, jev, jargs, min_time) -> tuple[float, object, float]:
     """(fastest PyTorch seconds, its threads, fastest JAX seconds): a PyTorch row and the same operation in
     JAX timed in the same interleaved rounds (`timing.interleaved_best`), at each thread count."""
@@ -186,7 +174,7 @@ def run_case(case: Case, states: dict, min_time: float) -> list[dict]:
             ev.run(args)  # warm-up (JAX: ahead-of-time compile for this shape); the error call warmed n_err
         paired = {}
         if jev is None:
-            dt, threads = _timed(ev, args, min_time)
+            dt, threads = best_time(lambda a=args: ev.run(a), min_time=min_time), "default"  # JAX, NumPy
         else:
             jargs = jev.prepare(states["q"][:b], states["qdot"][:b])
             jev.run(jargs)  # JAX compiles for this shape
