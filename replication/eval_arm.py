@@ -10,6 +10,7 @@ import numpy as np
 
 from replication import data as datamod
 from replication.evaluate import Evaluation, system_of
+from replication.metrics import null_errors
 from replication.objective import predict
 
 
@@ -25,6 +26,7 @@ def eval_arm(ctx) -> Evaluation:
         b = datamod.heldout(p, kind=fam)
         tau = predict(m, kind, p.task, b, np.concatenate)
         out.metrics[f"torque_mse_{fam}"] = _mse(tau, b["target"])
+        out.metrics[f"null_torque_mse_{fam}"] = null_errors(b["target"])["mse"]
         for j in range(tau.shape[-1]):
             out.metrics[f"torque_mse_{fam}_joint{j}"] = float(np.mean((tau[:, j] - b["target"][:, j]) ** 2))
     q, qd, qdd = b["q"], b["qdot"], b["extra"]

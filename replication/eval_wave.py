@@ -36,11 +36,17 @@ def eval_wave(ctx) -> Evaluation:
     qp, qdp = z[..., :n_big], z[..., n_big:]
     E_true, E_pred = s.energy(q, qd, backend="numpy")[0], s.energy(qp, qdp, backend="numpy")[0]
     scale = abs(E_true[0])
-    out.metrics["energy_err_max"] = float(np.max(np.abs(E_pred - E_pred[0])) / scale)
-    out.metrics["energy_err_vs_truth_max"] = float(np.max(np.abs(E_pred - E_true)) / scale)
+    finite = bool(np.all(np.isfinite(E_pred)))   # a diverged rollout's drift is +inf, never NaN
+    out.metrics["energy_err_max"] = float(np.max(np.abs(E_pred - E_pred[0])) / scale) if finite else np.inf
+    out.metrics["energy_err_vs_truth_max"] = float(np.max(np.abs(E_pred - E_true)) / scale) if finite else np.inf
+    out.metrics["n_diverged"] = int(not finite)
     out.metrics["truth_energy_drift_max"] = float(np.max(np.abs(E_true - E_true[0])) / scale)
     err = bounded_relative_error(np.concatenate([qp, qdp], -1), np.concatenate([q, qd], -1))
     out.metrics["rollout_gmean_err"] = float(geometric_mean_over_time(err)[0])
+    # the null rollout: a model that predicts nothing keeps the pulse where it started
+    still = np.broadcast_to(np.concatenate([q0, qd0], -1)[:, None], (1, t.size, 2 * n_big))
+    out.metrics["null_rollout_gmean_err"] = float(geometric_mean_over_time(
+        bounded_relative_error(still, np.concatenate([q, qd], -1)))[0])
     idx = np.unique(np.linspace(0, t.size - 1, min(t.size, 300)).astype(int))
     out.tables["timeseries.csv"] = pd.concat([
         pd.DataFrame({"traj": 0, "t": t[idx], "quantity": "energy_true", "value": E_true[idx]}),

@@ -21,6 +21,7 @@ from replication.metrics import (
     energy_errors,
     geometric_mean_over_time,
     heldout_errors,
+    null_errors,
 )
 from replication.objective import predict
 from replication.rollout import hamiltonian_field, lagrangian_field, rollout
@@ -66,7 +67,9 @@ def eval_heldout(ctx) -> Evaluation:
     pred = predict(m, ctx.spec.kind, p.task, batch, np.concatenate)
     w = batch.get("weight")
     e = heldout_errors(pred, batch["target"], w)
-    out = Evaluation(metrics={"heldout_l1": e["l1"], "heldout_mse": e["mse"]})
+    null = null_errors(batch["target"], w)
+    out = Evaluation(metrics={"heldout_l1": e["l1"], "heldout_mse": e["mse"],
+                              "null_heldout_l1": null["l1"], "null_heldout_mse": null["mse"]})
     if p.task == "hamiltonian":
         d = batch["q"].shape[-1]
         ydot = pred[:, d:]
@@ -77,6 +80,7 @@ def eval_heldout(ctx) -> Evaluation:
         qdd = None
     if qdd is not None:
         out.metrics["heldout_l1_qddot"] = heldout_errors(qdd, batch["qddot"], w)["l1"]
+        out.metrics["null_heldout_l1_qddot"] = null_errors(batch["qddot"], w)["l1"]
     if ctx.spec.kind == "lnn":
         _, n_fb = m.acceleration_info(batch["q"], batch["qdot"], batch.get("extra"))
         out.counters["hessian_fallbacks"] = int(n_fb)
@@ -153,6 +157,7 @@ def eval_energy_rollout(ctx) -> Evaluation:
     out.tables["rollouts.csv"] = pd.DataFrame({
         "traj": np.arange(q.shape[0]), "energy_err_final": np.abs(E_pred[:, -1] - E_true[:, -1]) / cfg["energy_scale"],
         "energy_err_max": np.max(np.abs(E_pred - E_true), 1) / cfg["energy_scale"],
+        "diverged": ~np.all(np.isfinite(E_pred), axis=1),
         "gmean_err": geometric_mean_over_time(err), "chaos_floor_gmean_err": geometric_mean_over_time(floor)})
     out.arrays = {"t": t, "q_true": q[:3], "q_pred": qp[:3]}
     return out

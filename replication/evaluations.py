@@ -1,9 +1,16 @@
-"""The registry of evaluation routines that claims name."""
+"""The registry of evaluation routines that claims name, and the version of what they compute.
+
+`EVALUATION_VERSION` is recorded in every unit's result.json; a unit evaluated under another version
+is not current (the runner re-evaluates it, reusing its cached training). Raise it whenever a routine
+changes what a metric means or adds one a verdict reads."""
 from replication.eval_arm import eval_arm
 from replication.eval_exact import eval_exact_lagrangian
 from replication.eval_precision import eval_precision
 from replication.eval_wave import eval_wave
 from replication.evaluate import eval_energy_rollout, eval_heldout
+
+# 2: null-predictor metrics for the competence bars; diverged rollouts count as +inf in the energy means
+EVALUATION_VERSION = 2
 
 EVALUATIONS = {"heldout": eval_heldout, "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,

@@ -6,8 +6,11 @@ Shapes: trajectories (B, T, k); energies (B, T).
 - rollout: `bounded_relative_error(z_pred, z_true)` = |z_pred - z_true| / (|z_pred| + |z_true|) per step
   (B, T); `geometric_mean_over_time` of it per trajectory (B,), skipping t = 0 where it is 0.
 - energy: `energy_errors(E_pred, E_true, scale)` -> |E_pred - E_true| / scale at the final step and
-  the max over time, each averaged over trajectories (diverged trajectories count as +inf in the max
-  and are reported separately), and the median final error over all trajectories (diverged = +inf).
+  the max over time, each averaged over trajectories; a diverged trajectory counts as +inf, so one
+  blow-up makes the mean +inf. Beside them: the median final error (diverged = +inf), the mean over
+  the finite trajectories only (for display, never for a verdict) and the count of diverged ones.
+- null predictors: `null_errors(target, weight)` -> the held-out l1 and mse of the better of two
+  predictors that learned nothing (zero, and the held-out mean target); the competence bars' yardstick.
 Arrays of the wrong rank, mismatched shapes or no samples raise ValueError naming the problem.
 """
 from __future__ import annotations
@@ -58,13 +61,25 @@ def energy_errors(E_pred, E_true, scale) -> dict:
     E_pred, E_true = _same_shape("energy_errors (E_pred, E_true)", E_pred, E_true, 2, (0, 1))
     if not (np.isfinite(scale) and scale > 0):
         raise ValueError(f"energy_errors: scale must be positive and finite, got {scale!r}")
-    d = np.abs(E_pred - E_true) / scale
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = np.abs(E_pred - E_true) / scale
     diverged = ~np.all(np.isfinite(d), axis=1)
     ok = ~diverged
-    final = float(np.mean(d[ok, -1])) if ok.any() else float("nan")
-    mx = float(np.mean(np.max(d[ok], axis=1))) if ok.any() else float("nan")
-    # the median over every trajectory (a diverged one counts as +inf): robust to one blown-up rollout
-    median = float(np.median(np.where(diverged, np.inf, d[:, -1]))) if len(d) else float("nan")
-    return {"energy_err_final": final, "energy_err_final_median": median, "energy_err_max": mx,
+    final = np.where(diverged, np.inf, d[:, -1])
+    mx = np.where(diverged, np.inf, np.max(np.where(np.isfinite(d), d, 0.0), axis=1))
+    nan = float("nan")
+    return {"energy_err_final": float(np.mean(final)) if len(d) else nan,
+            "energy_err_max": float(np.mean(mx)) if len(d) else nan,
+            # the median over every trajectory (a diverged one counts as +inf): robust to one blown-up rollout
+            "energy_err_final_median": float(np.median(final)) if len(d) else nan,
+            "energy_err_final_finite": float(np.mean(final[ok])) if ok.any() else nan,
             "n_diverged": int(diverged.sum()),
             "n_trajectories": int(d.shape[0])}
+
+
+def null_errors(target, weight=None) -> dict:
+    """Held-out l1 and mse (as `heldout_errors`) of the better of predicting 0 and predicting the mean target."""
+    target = np.asarray(target, np.float64)
+    zero = heldout_errors(np.zeros_like(target), target, weight)
+    mean = heldout_errors(np.broadcast_to(target.mean(0), target.shape), target, weight)
+    return {k: min(zero[k], mean[k]) for k in zero}

@@ -42,7 +42,8 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
 
 
 def _clean(obj):
-    """JSON-safe: NumPy scalars to Python, non-finite floats to None."""
+    """JSON-safe: NumPy scalars to Python, NaN to None. +-inf stay (JSON `Infinity`, which Python and
+    pandas read back): a diverged rollout's error is +inf, and a verdict must see it as such."""
     if isinstance(obj, dict):
         return {str(k): _clean(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -51,7 +52,7 @@ def _clean(obj):
         return _clean(obj.tolist())
     if isinstance(obj, np.generic):
         obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
+    if isinstance(obj, float) and math.isnan(obj):
         return None
     return obj
 

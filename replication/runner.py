@@ -17,6 +17,7 @@ from replication import environment as env
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
+from replication.evaluations import EVALUATION_VERSION
 from replication.units import Unit, run_unit
 from replication.verdicts import write_summary
 
@@ -46,9 +47,10 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
 
 
 def is_current(unit, out) -> bool:
-    """True if the unit's folder holds a verified result of this very protocol, model spec and evaluation
-    config. A verified result of another protocol, spec or evaluation config (the claim was edited) is kept, renamed `superseded-<time>-seed<k>`,
-    and the unit is rerun: nothing finished is lost or silently overwritten."""
+    """True if the unit's folder holds a verified result of this very protocol, model spec, evaluation
+    config and evaluation version. A verified result of another one (the claim or an evaluation routine
+    was edited) is kept, renamed `superseded-<time>-seed<k>`, and the unit is rerun (its training comes
+    from the cache when the protocol is unchanged): nothing finished is lost or silently overwritten."""
     folder = unit.folder(out)
     try:
         d = R.load_result(folder)
@@ -56,7 +58,8 @@ def is_current(unit, out) -> bool:
         return False
     cfg = unit.claim.eval_config.get(unit.profile, {})
     # results written before evaluation configs were recorded carry none: judged on protocol and spec only
-    same_eval = "eval_config" not in d or d["eval_config"] == json.loads(json.dumps(cfg))
+    same_eval = (d.get("eval_config") == json.loads(json.dumps(cfg))
+                 and d.get("evaluation_version") == EVALUATION_VERSION)
     if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
         return True
     stamp = env.now().replace(":", "").replace("-", "")
@@ -91,7 +94,9 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     units = plan(profile, claims, frameworks, seeds, models)
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
-                "claims": sorted({u.claim.id for u in units}), "versions": env.versions(),
+                "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
+                # the units this run plans: the report names any that have no result (an unfinished run)
+                "planned_units": [u.name for u in units], "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
     if profile == "paper":
         est = estimate_seconds(units, out)

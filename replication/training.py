@@ -15,15 +15,18 @@ import pandas as pd
 
 from models import init_params
 from replication import results as R
-from replication.data import BatchStream
+from replication.data import BatchStream, targets_version
 from replication.outcome import TrainOutcome, log_frame
 
 log = logging.getLogger("lagbench")
 
 
 def train_key(framework, spec, protocol, seed) -> str:
-    blob = json.dumps({"fw": framework, "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
-                      sort_keys=True, default=str).encode()
+    key = {"fw": framework, "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed}
+    targets = targets_version(protocol)
+    if targets:
+        key["targets"] = targets
+    blob = json.dumps(key, sort_keys=True, default=str).encode()
     return hashlib.sha256(blob).hexdigest()[:20]
 
 

@@ -11,7 +11,7 @@ from replication import hessian_probe
 from replication import results as R
 from replication.adapters import adapter
 from replication.evaluate import Context, system_of
-from replication.evaluations import EVALUATIONS
+from replication.evaluations import EVALUATION_VERSION, EVALUATIONS
 from replication.outcome import log_frame
 from replication.training import train_cached
 
@@ -68,7 +68,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "seed": unit.seed, "profile": unit.profile, "status": "ok" if failure is None else "failed",
         "failure": failure, "metrics": ev.metrics, "counters": {**ev.counters, **(hessian_probe.summarize(outcome.log) if outcome else {})},
         "model_spec": spec.to_dict(),
-        "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
+        "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "evaluation_version": EVALUATION_VERSION, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
         "train_time_s": outcome.train_time_s if outcome else 0.0,
         "train_steps": outcome.steps_done if outcome else 0,
         "train_samples_per_s": outcome.samples_per_s if outcome else None,

@@ -1,86 +1,142 @@
-"""Per-claim verdicts from the finished units of a results folder (summary/units.csv, verdicts.json)."""
+"""Where a verdict is decided: ``judge(claim, units, profile)``, shared by the runner and the report.
+
+``units`` is the table of summary/units.csv (``frame(records)`` builds it from result.json records):
+one row per unit with claim, framework, model, seed, status, its metrics and ``final_train_loss``.
+Per framework, on the units whose status is "ok":
+
+1. a model the claim runs in ``profile`` whose every unit failed makes the verdict "inconclusive"
+   (failed units never count; the reason names them); a model with no unit at all, "not run";
+2. the competence bars (``claims.bars``): a model below its bar -> "inconclusive", with the numbers;
+3. the claim's rule (``claims.rules``) on the seed statistics; then on every seed alone: a mean that
+   reproduces while some seed does not is only "partly".
+
+The frameworks' verdicts combine into one: equal -> that one; any "inconclusive" -> "inconclusive";
+otherwise "partly".
+"""
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from replication import results as R
 from replication.claims import CLAIMS
+from replication.claims.bars import competence
+from replication.claims.rules import Stat
+
+KEYS = ("claim", "framework", "model", "seed", "status")
+
+
+def frame(records) -> pd.DataFrame:
+    """summary/units.csv rows from result.json records (dicts)."""
+    rows = []
+    for d in records:
+        rows.append({**{k: d.get(k) for k in KEYS}, "profile": d.get("profile"),
+                     "train_time_s": d.get("train_time_s"), "train_samples_per_s": d.get("train_samples_per_s"),
+                     "wall_time_s": d.get("wall_time_s"), "final_train_loss": d.get("final_train_loss"),
+                     "failure": (d.get("failure") or {}).get("kind"),
+                     **{k: v for k, v in (d.get("metrics") or {}).items()},
+                     **{f"counter_{k}": v for k, v in (d.get("counters") or {}).items()}})
+    return pd.DataFrame(rows, columns=None if rows else [*KEYS, "profile"])
 
 
 def collect_units(out) -> pd.DataFrame:
-    rows = []
+    records = []
     for f in sorted(Path(out).glob("units/*/*/*/seed*/result.json")):
         try:
-            d = R.load_result(f.parent)
+            records.append(R.load_result(f.parent))
         except R.CorruptResult:
             continue
-        rows.append({"claim": d["claim"], "framework": d["framework"], "model": d["model"], "seed": d["seed"],
-                     "status": d["status"], "train_time_s": d.get("train_time_s"),
-                     "train_samples_per_s": d.get("train_samples_per_s"), "wall_time_s": d.get("wall_time_s"),
-                     **{k: v for k, v in (d.get("metrics") or {}).items()},
-                     **{f"counter_{k}": v for k, v in (d.get("counters") or {}).items()}})
-    return pd.DataFrame(rows)
+    return frame(records)
 
 
-def _stats(x):
-    x = np.asarray([v for v in x if v is not None and not (isinstance(v, float) and math.isnan(v))], float)
-    if x.size == 0:
+def _numeric(x):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
         return None
-    return {"mean": float(x.mean()), "std": float(x.std(ddof=1)) if x.size > 1 else 0.0, "n": int(x.size)}
+    return None if math.isnan(v) else v
 
 
-def _inputs(claim, s: pd.DataFrame) -> tuple[dict, dict]:
-    """({label: stats of the claim metric}, {label: what claim.verdict takes}) from the units in s."""
-    vals, inputs = {}, {}
-    for label, g in s.groupby("model"):
-        st = _stats(g[claim.metric]) if claim.metric in g else None
-        if st:
-            vals[label] = st
-        # a model whose units all ran but left no finite value (every rollout diverged) is the worst
-        if claim.verdict_metrics:
-            ms = [_stats(g[m]) if m in g else None for m in claim.verdict_metrics]
-            inputs[label] = tuple(m["mean"] if m else math.inf for m in ms)
-        else:
-            inputs[label] = st["mean"] if st else math.inf
-    return vals, inputs
+def model_stats(units: pd.DataFrame) -> dict:
+    """{model: {metric: Stat}} over the rows of ``units`` (one framework), numeric columns only."""
+    out = {}
+    skip = set(KEYS) | {"profile", "failure"}
+    for label, g in units.groupby("model", sort=False):
+        stats = {}
+        for col in g.columns:
+            if col in skip:
+                continue
+            vals = [v for v in map(_numeric, g[col]) if v is not None]
+            if vals:
+                stats[col] = Stat.of(vals)
+        out[str(label)] = stats
+    return out
 
 
-def claim_verdict(claim, df: pd.DataFrame) -> dict:
-    """The claim's rule applied to the seed means, then to every seed alone: a mean that reproduces
-    while some seed does not is only "partly" (the seed spread decides, not one lucky seed)."""
-    sub = df[df["claim"] == claim.id] if len(df) else df
-    entry = {"id": claim.id, "verdict": "not run", "by_framework": {}, "reason": "no finished units", "values": {},
-             "by_seed": {}}
+def _decide(claim, v: dict, failed: dict) -> tuple[str, str, dict]:
+    """(verdict, reason, {label: (passed, why)}) for one framework's (or one seed's) statistics."""
+    if failed:
+        why = "; ".join(f"{m}: every unit failed ({k})" for m, k in failed.items())
+        return "inconclusive", f"no usable model: {why}", {}
+    ok, why, per = competence(claim.bars, v)
+    if not ok:
+        return "inconclusive", "below the competence bar: " + "; ".join(why), per
+    verdict, reason = claim.verdict(v)
+    return verdict, reason, per
+
+
+def _combine(verdicts) -> str:
+    run = set(verdicts)
+    if len(run) == 1:
+        return run.pop()
+    return "inconclusive" if "inconclusive" in run else "partly"
+
+
+def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
+    """The claim's verdict from ``units`` (rows of any claims; see the module docstring)."""
+    sub = units[units["claim"] == claim.id] if len(units) else units
+    entry = {"id": claim.id, "verdict": "not run", "reason": "no finished units", "by_framework": {},
+             "values": {}, "by_seed": {}, "competence": {}, "failed_units": {}}
+    labels = claim.labels(profile)
     reasons = []
     for fw in sorted(set(sub["framework"])) if len(sub) else []:
         s = sub[sub["framework"] == fw]
-        vals, inputs = _inputs(claim, s)
-        verdict, reason = claim.verdict(inputs)
-        seeds = sorted(set(s["seed"]))
-        per_seed = [claim.verdict(_inputs(claim, s[s["seed"] == k])[1])[0] for k in seeds]
-        entry["by_seed"][fw] = dict(zip((f"seed{k}" for k in seeds), per_seed, strict=True))
-        if len(seeds) > 1:
-            agree = sum(v == verdict for v in per_seed)
+        ok = s[s["status"] == "ok"]
+        bad = s[s["status"] != "ok"]
+        failed = {m: ", ".join(sorted({str(k) for k in g["failure"] if isinstance(k, str)}) or {"failed"})
+                  for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
+        v = model_stats(ok)
+        verdict, reason, per = _decide(claim, v, failed)
+        seeds = sorted(set(ok["seed"]))
+        per_seed = [_decide(claim, model_stats(ok[ok["seed"] == k]), failed)[0] for k in seeds]
+        entry["by_seed"][fw] = {f"seed{k}": x for k, x in zip(seeds, per_seed, strict=True)}
+        if len(seeds) > 1 and verdict not in ("inconclusive", "not run"):
+            agree = sum(x == verdict for x in per_seed)
             reason += f" [seeds: {agree}/{len(seeds)} give '{verdict}' alone]"
             if verdict == "reproduced" and agree < len(seeds):
-                verdict = "partly"
-                reason += "; only partly: not every seed reproduces"
+                verdict, reason = "partly", reason + "; only partly: not every seed reproduces"
+        if len(bad):
+            entry["failed_units"][fw] = len(bad)
+            reason += f" ({len(bad)} failed unit{'s' if len(bad) > 1 else ''} excluded)"
         entry["by_framework"][fw] = verdict
-        entry["values"][fw] = vals
+        entry["competence"][fw] = {m: {"passed": p, "why": w} for m, (p, w) in per.items()}
+        entry["values"][fw] = {m: {"mean": st[claim.metric].mean, "std": st[claim.metric].std,
+                                   "n": st[claim.metric].n} for m, st in v.items() if claim.metric in st}
         reasons.append(f"{fw}: {reason}")
-    run = {v for v in entry["by_framework"].values()}
-    if run:
-        entry["verdict"] = run.pop() if len(run) == 1 else "partly"
+    if entry["by_framework"]:
+        entry["verdict"] = _combine(entry["by_framework"].values())
         entry["reason"] = " | ".join(reasons)
     return entry
+
+
+def judge_all(units: pd.DataFrame, profile: str | None) -> list:
+    return [judge(c, units, profile) for c in CLAIMS.values()]
 
 
 def write_summary(out, profile: str) -> dict:
     df = collect_units(out)
     R.write_csv(Path(out) / "summary" / "units.csv", df)
-    verdicts = {"schema": R.SCHEMA, "profile": profile, "claims": [claim_verdict(c, df) for c in CLAIMS.values()]}
+    verdicts = {"schema": R.SCHEMA, "profile": profile, "claims": judge_all(df, profile)}
     return R.write_json(Path(out) / "summary" / "verdicts.json", verdicts)

@@ -2,7 +2,9 @@
 
 Reads the files described in ``replication/RESULTS.md`` (plus ``bench/``) with pandas/NumPy, draws
 figures with matplotlib and typesets the PDF with typst. Never imports jax, torch, equinox, optax,
-diffrax, or the suite's ``systems``, ``models`` or ``replication`` packages.
+diffrax, the suite's ``systems`` or ``models``, or its training and evaluation code; from
+``replication`` it takes only the claim records and ``replication.verdicts.judge`` (NumPy and pandas),
+so that its verdicts are the runner's own rule applied to the unit files it reads.
 """
 
 from reports.build import build_report

@@ -17,6 +17,7 @@ from reports.findings import findings_sections
 from reports.load import load_results
 from reports.markdown import render_markdown
 from reports.pdf import write_pdf
+from reports.scorecard import scorecard_section
 from reports.sections_claims import summary_sections, theme_sections
 from reports.sections_hessian import hessian_sections
 from reports.sections_speed import agreement_sections, speed_sections
@@ -27,7 +28,7 @@ TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
 def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
     res = load_results(results_dir)
-    sections = summary_sections(res)
+    sections = [scorecard_section(res)] + summary_sections(res)
     sections += theme_sections(res, out_dir)
     sections += speed_sections(res, out_dir)
     sections += agreement_sections(res)

@@ -5,6 +5,12 @@
 verdict) or ``"corrupt"`` (unreadable JSON, wrong schema, path mismatch, checksum or listed-file sha256
 mismatch; see :mod:`reports.integrity`). Only ``ok`` units feed numbers into the report. Missing files
 leave ``None``/empty fields; problems are collected as human-readable strings in ``Results.problems``.
+
+Verdicts are recomputed from the verified units by ``replication.verdicts.judge`` (the function the
+runner uses; it imports no framework and no training code), so a deleted or corrupted unit never leaves
+a stale verdict; ``summary/verdicts.json`` is only compared with them. ``run.json``'s planned units
+that have no result are listed in ``Results.planned_missing``, and ``Results.unfinished`` is true when
+the run has not recorded its end.
 """
 
 from __future__ import annotations
@@ -83,8 +89,11 @@ class Results:
     run: dict | None = None
     claims: list[dict] = field(default_factory=list)
     units: list[Unit] = field(default_factory=list)
-    verdicts: dict[str, dict] = field(default_factory=dict)
+    verdicts: dict[str, dict] = field(default_factory=dict)          # recomputed from the unit files
+    stored_verdicts: dict[str, dict] = field(default_factory=dict)   # summary/verdicts.json as written
     verdict_profile: str | None = None
+    planned_missing: list[str] = field(default_factory=list)
+    unfinished: bool = False
     units_csv: pd.DataFrame | None = None
     listed_missing: list[str] = field(default_factory=list)
     bench: dict[str, pd.DataFrame] = field(default_factory=dict)
@@ -208,7 +217,7 @@ def load_results(root: str | Path) -> Results:
     res.verdict_profile = verdicts.get("profile")
     for v in verdicts.get("claims") or []:
         if isinstance(v, dict) and isinstance(v.get("id"), str):
-            res.verdicts[v["id"]] = v
+            res.stored_verdicts[v["id"]] = v
     units_dir = root / "units"
     if units_dir.is_dir():
         # results superseded by a later protocol (folders "superseded-<time>-seed<k>") are history, not units
@@ -228,5 +237,35 @@ def load_results(root: str | Path) -> Results:
             if key not in have:
                 res.listed_missing.append("units/{}/{}/{}/seed{}".format(*key))
     res.claims = _catalogue(res, claims_json)
+    _recompute_verdicts(res)
+    _check_plan(res)
     _load_bench(res)
     return res
+
+
+def _recompute_verdicts(res: Results) -> None:
+    """Verdicts from the verified unit files, by the runner's own function; stored ones only compared."""
+    from replication.claims import CLAIMS
+    from replication.verdicts import frame, judge
+
+    profile = (res.run or {}).get("profile") or res.verdict_profile
+    df = frame([u.result for u in res.units if u.status in ("ok", "failed")])
+    ids = {c["id"] for c in res.claims} | {u.claim for u in res.units}
+    res.verdicts = {cid: judge(CLAIMS[cid], df, profile) for cid in sorted(ids) if cid in CLAIMS}
+    for cid, v in res.stored_verdicts.items():
+        res.verdicts.setdefault(cid, v)   # a claim this code no longer has: its recorded verdict
+    stale = sorted(cid for cid, v in res.stored_verdicts.items()
+                   if cid in CLAIMS and v.get("verdict") != res.verdicts[cid]["verdict"])
+    if stale:
+        res.problems.append("summary/verdicts.json disagrees with the unit files for " + ", ".join(stale)
+                            + " (units changed since it was written, or it predates the current rules); "
+                              "the verdicts shown are recomputed from the unit files")
+
+
+def _check_plan(res: Results) -> None:
+    run = res.run or {}
+    planned = run.get("planned_units")
+    if isinstance(planned, list):
+        have = {f"{u.claim}/{u.framework}/{u.model}/seed{u.seed}" for u in res.units}
+        res.planned_missing = [f"units/{p}" for p in planned if isinstance(p, str) and p not in have]
+    res.unfinished = bool(run) and not run.get("finished")

@@ -16,6 +16,7 @@ from reports import figures_speed as FS
 from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results
+from reports.scorecard import competence_table
 from reports.tables import claim_table, metrics_table, problem_units_table, status_table, summary_table
 from reports.themes import THEMES, assign
 
@@ -33,8 +34,8 @@ def summary_sections(res: Results) -> list[Section]:
     n_ok = len(res.usable())
     s.add(Para(f"{len(res.claims)} claims catalogued; {len(res.units)} units found, {n_ok} usable "
                f"(status ok, checksums verified). Reproduced values are mean ± sample std over seeds "
-               f"(n = seeds) of each claim's metric, recomputed from the unit files; verdicts are the "
-               f"runner's (summary/verdicts.json)."))
+               f"(n = seeds) of each claim's metric; numbers and verdicts are both recomputed from the "
+               f"unit files."))
     s.add(Table("Claims: published against reproduced", summary_table(res),
                 ["claims.json", "units/*/*/*/seed*/result.json", "summary/verdicts.json"]))
     st = Section("Run status", level=2)
@@ -45,6 +46,8 @@ def summary_sections(res: Results) -> list[Section]:
                     "in this report; failed units (the runner's status) are excluded too."))
         st.add(Table("Failed, corrupt and missing units", bad, ["units/*/*/*/seed*/result.json",
                                                                  "summary/units.csv"]))
+    elif res.unfinished:
+        st.add(Para("The run is unfinished (run.json records no end), though every unit it planned is present."))
     else:
         st.add(Para("No failed, corrupt or missing units."))
     if res.problems:
@@ -78,10 +81,14 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
     s.add(Para(f"{cell(claim.get('title'), 'untitled')} — {cell(claim.get('paper'), 'paper unknown')} "
                f"{cell(claim.get('section'), '')}. System: {cell(claim.get('system'), 'unknown')}. "
                f"Metric: {cell(claim.get('metric'), 'unknown')} ({cell(claim.get('metric_label'), 'no label')}). "
-               f"Verdict rule: {cell(claim.get('verdict_rule'), 'not stated')}."))
+               f"Verdict rule: {cell(claim.get('verdict_rule'), 'not stated')}. "
+               f"Competence bars: {'; '.join(claim.get('bars') or []) or 'none (no learned model)'}."))
     v = res.verdicts.get(cid)
     if v is not None:
         s.add(Para(f"Verdict: {cell(v.get('verdict'))}. {cell(v.get('reason'), '')}"))
+    ct = competence_table(res, claim)
+    if ct is not None:
+        s.add(Table(f"{cid}: competence bars per model and framework", ct, [src + "result.json"]))
     if not units:
         s.add(Para(f"Result: {NOT_RUN} (no usable unit for this claim)."))
         return s

@@ -1,7 +1,7 @@
 """Per-claim tables (pandas DataFrames of strings) computed from usable units only.
 
 Numbers are recomputed here from the unit ``result.json`` files (corrupt and failed units excluded), so
-they match the units actually listed; verdicts come from ``summary/verdicts.json``. A claim with no
+they match the units actually listed; verdicts are recomputed from them too (``reports.load``). A claim with no
 usable unit reads ``"not run"`` in every cell that would hold a number.
 """
 
@@ -36,11 +36,21 @@ def values(units: list[Unit], metric: str | None) -> dict:
     return out
 
 
+def published_value(p) -> str:
+    """A published entry (a dict with value, kind, source, or a bare number of an older claims.json)."""
+    if isinstance(p, dict):
+        tag = p.get("kind") or "unknown kind"
+        if p.get("other_data"):
+            tag += ", other data: context"
+        return f"{num(p.get('value'))} ({tag})"
+    return num(p) if p is not None else "none published"
+
+
 def published_text(claim: dict) -> str:
     pub = claim.get("published")
     if not isinstance(pub, dict) or not pub:
         return "none published"
-    return "\n".join(f"{m}: {num(v) if v is not None else 'none published'}" for m, v in pub.items())
+    return "\n".join(f"{m}: {published_value(v)}" for m, v in pub.items())
 
 
 def verdict_text(res: Results, claim: dict) -> str:
@@ -94,7 +104,7 @@ def claim_table(res: Results, claim: dict) -> pd.DataFrame:
     pub = claim.get("published") if isinstance(claim.get("published"), dict) else {}
     rows = []
     for model in claim_models(res, claim):
-        row = {"model": model, "published": num(pub[model]) if pub.get(model) is not None else "none published"}
+        row = {"model": model, "published": published_value(pub.get(model))}
         for fw in res.frameworks or ["any framework"]:
             per = vals.get(fw, {}).get(model)
             row[fw] = stat(**per) if per else NOT_RUN
@@ -159,4 +169,6 @@ def problem_units_table(res: Results) -> pd.DataFrame | None:
     ]
     rows += [{"unit": p, "status": "missing", "reason": "listed in summary/units.csv, no result.json"}
              for p in res.listed_missing]
+    rows += [{"unit": p, "status": "missing", "reason": "planned in run.json, no result.json"}
+             for p in res.planned_missing if p not in res.listed_missing]
     return pd.DataFrame(rows) if rows else None

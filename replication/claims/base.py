@@ -3,18 +3,21 @@
 A `Claim` names a paper result and everything needed to check it: the system, the models (each a
 `ModelEntry`: a label, ModelSpec fields, protocol overrides), the protocol per profile, the
 evaluation routine (a name in `replication.evaluate.EVALUATIONS`), the metric the verdict reads,
-the published values, and the verdict rule (a function of {model label: mean metric} for one
-framework, returning (verdict, reason)).
+the published values (`published.Published`, each with what it is), the competence bars its models
+must pass (`bars.Bar`), and the verdict rule (built from `rules`: a function of
+{model label: {metric: Stat}} for one framework, returning (verdict, reason)). Where a verdict is
+decided: `replication.verdicts.judge` (bars, then the rule, on seed means and on every seed).
 """
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from replication.claims.rules import VERDICTS
 from replication.protocol import Protocol
 
 PROFILES = ("smoke", "quick", "paper")
-VERDICTS = ("reproduced", "partly", "not reproduced", "not run")
+__all__ = ["PROFILES", "VERDICTS", "Claim", "ModelEntry"]
 
 
 @dataclass(frozen=True)
@@ -55,12 +58,13 @@ class Claim:
     evaluate: str
     metric: str
     metric_label: str
-    published: dict
+    published: dict          # model label -> Published (only numbers a paper or its repository prints)
     verdict_rule: str
-    verdict: Callable
+    verdict: Callable        # {label: {metric: Stat}} -> (verdict, reason), built from `rules`
+    bars: tuple = ()         # competence bars (`bars.Bar`); a model below its bar -> "inconclusive"
+    key: str = ""            # the model whose number the scorecard shows (default: the first)
     seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": 3, "paper": 3})
     eval_config: dict = field(default_factory=dict)   # profile -> dict of evaluation settings
-    verdict_metrics: tuple = ()   # if set, the verdict gets {label: tuple of these metrics' means}
 
     def entry(self, label: str) -> ModelEntry:
         for m in self.models:
@@ -71,20 +75,16 @@ class Claim:
     def catalogue(self) -> dict:
         return {"id": self.id, "number": self.number, "paper": self.paper, "section": self.section,
                 "title": self.title, "system": self.system, "models": [m.label for m in self.models],
-                "metric": self.metric, "metric_label": self.metric_label, "published": self.published,
-                "verdict_rule": self.verdict_rule,
+                "metric": self.metric, "metric_label": self.metric_label,
+                "published": {k: p.to_dict() for k, p in self.published.items()},
+                "verdict_rule": self.verdict_rule, "bars": [b.describe() for b in self.bars],
+                "key": self.key_model, "seeds": dict(self.seeds),
                 "protocol": {p: pr.to_dict() for p, pr in self.protocols.items()}}
 
+    @property
+    def key_model(self) -> str:
+        return self.key or self.models[0].label
 
-def ratio_rule(better: str, worse: str, factor: float):
-    """Reproduced if metric[better] * factor < metric[worse]; partly if merely smaller."""
-    def rule(v):
-        a, b = v.get(better), v.get(worse)
-        if a is None or b is None:
-            return "not run", f"missing {better if a is None else worse}"
-        if a * factor < b:
-            return "reproduced", f"{better} {a:.3g} < {worse} {b:.3g} / {factor:g}"
-        if a < b:
-            return "partly", f"{better} {a:.3g} < {worse} {b:.3g}, but not by {factor:g}x"
-        return "not reproduced", f"{better} {a:.3g} >= {worse} {b:.3g}"
-    return rule
+    def labels(self, profile: str | None = None) -> list:
+        """The model labels that run in ``profile`` (all of them if None)."""
+        return [m.label for m in self.models if profile is None or profile in m.profiles]

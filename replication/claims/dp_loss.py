@@ -1,26 +1,25 @@
-"""Claim 1 (LNN §5): the LNN and the baseline reach similar held-out loss on the double pendulum."""
+"""Claim 1 (LNN §5): the LNN and the baseline reach similar held-out loss on the double pendulum.
+
+Published like for like: held-out per-sample L1 on i.i.d. states. The paper prints 7.3e-2 for the LNN,
+but that is its late-epoch training loss (0.0731, code cell 30); the same code's held-out value is
+6.89e-2 (cell 66). The baseline's 7.4e-2 is its held-out 0.0739 (Baseline cell 58).
+"""
 from replication.claims import double_pendulum as dp
 from replication.claims.base import Claim
-
-
-def _similar(v):
-    a, b = v.get("lnn"), v.get("baseline")
-    if a is None or b is None:
-        return "not run", "missing a model"
-    r = a / b
-    if 1 / 3 <= r <= 3:
-        return "reproduced", f"lnn/baseline held-out L1 ratio {r:.2f} within [1/3, 3]"
-    if 0.1 <= r <= 10:
-        return "partly", f"lnn/baseline ratio {r:.2f} within 10x but not 3x"
-    return "not reproduced", f"lnn/baseline ratio {r:.2f}"
-
+from replication.claims.published import Published
+from replication.claims.rules import similar
 
 CLAIM = Claim(
     id="dp_loss", number=1, paper="LNN", section="§5, double pendulum",
     title="LNN and baseline reach similar held-out loss on the double pendulum",
     system="double_pendulum", models=dp.MODELS, protocols=dp.PROTOCOLS, evaluate="heldout",
     metric="heldout_l1", metric_label="held-out per-sample L1 of q-double-dot (sum over 2 components)",
-    published={"lnn": 7.3e-2, "baseline": 7.4e-2},
-    verdict_rule="lnn / baseline within [1/3, 3] (partly: within 10x)", verdict=_similar,
+    published={
+        "lnn": Published(6.89e-2, "held-out", "original code, DoublePendulum cell 66 (1e5 i.i.d. states); "
+                         "the paper's 7.3e-2 is the late-epoch training loss", metric="heldout_l1"),
+        "baseline": Published(7.4e-2, "held-out", "LNN paper §5; code: 0.0739 on 1e5 i.i.d. states",
+                              metric="heldout_l1")},
+    verdict_rule="lnn / baseline within [1/3, 3] (partly: within 10x)",
+    verdict=similar("lnn", "baseline", 3.0, 10.0, "heldout_l1"), bars=(dp.LEARNED,),
     seeds=dp.SEEDS,
 )

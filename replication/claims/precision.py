@@ -6,15 +6,19 @@ rtol = atol = 1e-10): that truth's own final energy drift over 40 ICs to t = 100
 and in float64 (same init numbers, same batches) and reports held-out L1, the energy error against the
 float64 truth, and the ground truth's own energy drift when integrated in each dtype (`eval_precision`).
 
-Budget (quick, about 3 min for both frameworks on 2 cores): one seed and a shortened dp protocol (600
+Budget (quick, about 3 min a seed for both frameworks on 2 cores): a shortened dp protocol (600
 steps, the step decay at 400, 2000 held-out states), shared by both dtypes so that only the dtype differs;
 rollouts of 10 ICs to t = 5. The models are not the dp claims' (those train 4000 steps; their float32
 cache cannot be shared without training float64 for as long, and float64 LNN training costs about 3x
 float32 in JAX). At this scale the LNN is still on its q-double-dot ~ 0 plateau (held-out L1 ~ 47 in both
-dtypes), so only the baseline's comparison is informative; the paper profile trains both fully.
+dtypes): it is below its competence bar, so the verdict is "inconclusive" until it learns.
+The reference's 0.10 % float32 truth drift is measured on the original code, not published: it is
+context in the module docstring, not a published value.
 """
 from replication.claims import double_pendulum as dp
+from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
+from replication.claims.rules import all_parts, better_by, similar
 
 L1_CHANGE = 0.5   # learned-model held-out L1 may change by less than this fraction between dtypes
 
@@ -45,22 +49,16 @@ EVAL = {
 
 
 def verdict(v):
-    """v: {label: (truth_energy_drift_final, heldout_l1)} for one framework; judged on the models run
-    in both dtypes (the smoke profile runs the baseline only)."""
+    """Judged on the models run in both dtypes (the smoke profile runs the baseline only): the float64
+    truth drifts less than the float32 one, and each model's held-out L1 changes by less than
+    L1_CHANGE between the dtypes."""
     pairs = [m.label for m in dp.MODELS if f"{m.label}_f32" in v and f"{m.label}_f64" in v]
     if not pairs:
         return "not run", "no model ran in both float32 and float64"
-    d32, d64 = v[f"{pairs[0]}_f32"][0], v[f"{pairs[0]}_f64"][0]
-    truth_ok = d64 < d32
-    changes = {k: abs(v[f"{k}_f64"][1] - v[f"{k}_f32"][1]) / max(v[f"{k}_f32"][1], 1e-300) for k in pairs}
-    learned_ok = all(c < L1_CHANGE for c in changes.values())
-    text = (f"truth drift float32 {d32:.3g} vs float64 {d64:.3g}; held-out L1 change f32->f64 "
-            + ", ".join(f"{k} {c:.0%}" for k, c in changes.items()))
-    if truth_ok and learned_ok:
-        return "reproduced", text
-    if truth_ok:
-        return "partly", text + f" (a learned model changed by >= {L1_CHANGE:.0%})"
-    return "not reproduced", text
+    k = pairs[0]
+    within = 1.0 + L1_CHANGE
+    return all_parts(better_by(f"{k}_f64", f"{k}_f32", 1.0, "truth_energy_drift_final"),
+                     *(similar(f"{x}_f64", f"{x}_f32", within, within, "heldout_l1") for x in pairs))(v)
 
 
 CLAIM = Claim(
@@ -70,9 +68,9 @@ CLAIM = Claim(
     metric="truth_energy_drift_final",
     metric_label="ground truth's own |E(T) - E(0)| / 29.4 integrated in the model's dtype, mean over ICs "
                  "(same truth for every model of a dtype)",
-    published={"lnn_f32": 0.0010, "baseline_f32": 0.0010},
-    verdict_rule=f"truth drift float64 < float32, and each model's held-out L1 changes by < {L1_CHANGE:.0%} "
-                 "between float32 and float64 (partly: only the truth part)",
-    verdict=verdict, eval_config=EVAL, seeds={"smoke": 1, "quick": 1, "paper": 3},
-    verdict_metrics=("truth_energy_drift_final", "heldout_l1"),
+    published={},
+    verdict_rule=f"truth drift float64 < float32, and each model's held-out L1 f64/f32 within {1 + L1_CHANGE:g}x "
+                 "(partly: some parts)",
+    verdict=verdict, bars=(Bar(tuple(m.label for m in MODELS), "heldout_l1"),),
+    key="baseline_f32", eval_config=EVAL, seeds={"smoke": 1, "quick": 3, "paper": 3},
 )

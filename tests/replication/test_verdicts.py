@@ -1,26 +1,111 @@
-"""Verdicts judge the seed spread: the claim's rule on the seed means, then on every seed alone."""
+"""Every claim's verdict rule, through `replication.verdicts.judge`: a case that reproduces and a case that
+fails, on synthetic unit rows whose models all pass their bars; then what judge does with failed units,
+missing models, seeds that disagree and frameworks that disagree."""
 import pandas as pd
+import pytest
 
-from replication.claims import get
-from replication.verdicts import claim_verdict
+from replication.claims import CLAIMS
+from replication.verdicts import judge
+
+NULL = 1000.0   # every null predictor's error: every model below is far under its bar
 
 
-def _units(values: dict) -> pd.DataFrame:
-    """values {(model, seed): metric} -> the summary/units.csv rows of init_study in JAX."""
-    return pd.DataFrame([{"claim": "init_study", "framework": "jax", "model": m, "seed": k, "status": "ok",
-                          "heldout_l1": v} for (m, k), v in values.items()])
+def _metrics(cid, label, good: bool) -> dict:
+    """The rule's metrics of one model: the claimed winner wins when ``good``, loses otherwise."""
+    win, lose = (1.0, 40.0) if good else (40.0, 1.0)
+    if cid in ("dp_loss",):
+        return {"heldout_l1": 0.07 if good or label == "lnn" else 7.0}
+    if cid == "dp_energy":
+        return {"energy_err_final": win if label == "lnn" else lose, "n_diverged": 0}
+    if cid == "rel_coords":
+        return {"heldout_l1_qddot": lose if label == "hnn_qqdot" else win}
+    if cid == "wave_lgn":
+        return {"transfer_ratio": 1.2 if good else 10.0, "energy_err_max": 0.01 if good else 0.5}
+    if cid == "appendix_b":
+        return {"max_abs_err": 1e-15 if good else 1e-6}
+    if cid == "init_study":
+        return {"heldout_l1": win if label == "lnn_init-cranmer2020" else lose}
+    if cid == "activation_study":
+        if label == "lnn_act-relu":
+            return {"heldout_l1": 100.0 if good else 1.0}
+        return {"heldout_l1": win if label == "lnn_act-softplus" else lose}
+    if cid == "delan_table1":
+        return {"heldout_l1": win if label.startswith("lnn") else lose}
+    if cid == "delan_arm":
+        out = {"torque_mse_test": win if label.startswith("delan") else lose, "torque_mse_train": 1.0}
+        return out | ({"mass_matrix_min_eig": 0.1 if good else -0.1} if label == "delan" else {})
+    if cid == "hnn_energy":
+        return {"energy_err_max": win if label.startswith("hnn") else lose, "n_diverged": 0}
+    if cid == "precision":
+        drift = (1e-9 if label.endswith("f64") else 1e-3) if good else (1e-3 if label.endswith("f64") else 1e-9)
+        return {"truth_energy_drift_final": drift, "heldout_l1": 1.0 if good or label.endswith("f32") else 10.0}
+    raise AssertionError(f"no synthetic case for {cid}")
+
+
+def _row(cid, label, seed, metrics, fw="jax", status="ok"):
+    bars = {f"null_{b.metric}": NULL for b in CLAIMS[cid].bars if b.metric}
+    bar_vals = {b.metric: 1.0 for b in CLAIMS[cid].bars if b.metric}
+    jitter = {k: v * (1 + 0.01 * seed) if k != "n_diverged" else v for k, v in metrics.items()}
+    return {"claim": cid, "framework": fw, "model": label, "seed": seed, "status": status,
+            **bar_vals, **bars, **jitter}
+
+
+def _units(cid, good, seeds=(0, 1, 2), fw="jax"):
+    claim = CLAIMS[cid]
+    return pd.DataFrame([_row(cid, m, k, _metrics(cid, m, good), fw) for m in claim.labels("quick") for k in seeds])
+
+
+@pytest.mark.parametrize("cid", list(CLAIMS))
+def test_each_rule_reproduces_and_fails(cid):
+    good = judge(CLAIMS[cid], _units(cid, True), "quick")
+    bad = judge(CLAIMS[cid], _units(cid, False), "quick")
+    assert good["verdict"] == "reproduced", good["reason"]
+    assert bad["verdict"] == "not reproduced", bad["reason"]
+
+
+def test_a_failed_model_is_excluded_and_makes_the_claim_inconclusive():
+    df = _units("dp_energy", True)
+    df.loc[df["model"] == "lnn", "status"] = "failed"
+    df["failure"] = None
+    df.loc[df["model"] == "lnn", "failure"] = "non_finite_loss"
+    v = judge(CLAIMS["dp_energy"], df, "quick")
+    assert v["verdict"] == "inconclusive" and "lnn: every unit failed (non_finite_loss)" in v["reason"]
+    assert v["failed_units"] == {"jax": 3}
+
+
+def test_one_failed_seed_is_excluded_and_said():
+    df = _units("dp_energy", True)
+    df.loc[(df["model"] == "lnn") & (df["seed"] == 2), "status"] = "failed"
+    v = judge(CLAIMS["dp_energy"], df, "quick")
+    assert v["verdict"] == "partly" and "1 failed unit excluded" in v["reason"]   # seed 2 lacks the lnn
+
+
+def test_a_model_without_units_is_not_run():
+    df = _units("dp_loss", True)
+    v = judge(CLAIMS["dp_loss"], df[df["model"] != "baseline"], "quick")
+    assert v["verdict"] == "not run" and "missing baseline" in v["reason"]
 
 
 def test_a_mean_that_one_seed_contradicts_is_only_partly():
-    claim = get("init_study")
-    ours, theirs = "lnn_init-cranmer2020", "lnn_init-xavier"
-    v = claim_verdict(claim, _units({(ours, 0): 1.0, (ours, 1): 5.0, (theirs, 0): 4.0, (theirs, 1): 3.5}))
-    assert v["by_seed"]["jax"] == {"seed0": "reproduced", "seed1": "not reproduced"}  # mean 3 < 3.75
-    assert v["verdict"] == "partly" and "1/2" in v["reason"]
+    cid = "init_study"
+    ours = "lnn_init-cranmer2020"
+    rows = [_row(cid, m, k, {"heldout_l1": x}) for m in CLAIMS[cid].labels("quick")
+            for k, x in enumerate((1.0, 1.1, 1.2) if m == ours else (3.0, 3.1, 0.5))]
+    v = judge(CLAIMS[cid], pd.DataFrame(rows), "quick")
+    assert v["by_seed"]["jax"]["seed2"] == "not reproduced"
+    assert v["verdict"] in ("partly", "inconclusive") and v["verdict"] != "reproduced"
 
 
 def test_every_seed_agreeing_keeps_reproduced():
-    claim = get("init_study")
-    ours, theirs = "lnn_init-cranmer2020", "lnn_init-xavier"
-    v = claim_verdict(claim, _units({(ours, 0): 1.0, (ours, 1): 2.0, (theirs, 0): 4.0, (theirs, 1): 3.5}))
-    assert v["verdict"] == "reproduced" and "2/2" in v["reason"]
+    v = judge(CLAIMS["init_study"], _units("init_study", True), "quick")
+    assert v["verdict"] == "reproduced" and "3/3" in v["reason"]
+
+
+def test_frameworks_that_disagree_never_reproduce():
+    both = pd.concat([_units("dp_loss", True, fw="jax"), _units("dp_loss", False, fw="torch")])
+    assert judge(CLAIMS["dp_loss"], both, "quick")["verdict"] == "partly"
+    weak = _units("dp_loss", True, fw="torch")
+    weak["heldout_l1"] = NULL
+    both = pd.concat([_units("dp_loss", True, fw="jax"), weak])
+    v = judge(CLAIMS["dp_loss"], both, "quick")
+    assert v["verdict"] == "inconclusive" and v["by_framework"] == {"jax": "reproduced", "torch": "inconclusive"}

@@ -77,6 +77,7 @@ def metrics_for(cid, model, seed, rng) -> dict:
          (("heldout_l1", 1), ("heldout_mse", 0.5), ("energy_err_final", 0.1), ("energy_err_max", 0.3),
           ("final_train_loss", 0.9), ("max_abs_err", 1), ("torque_mse_train", 0.5), ("torque_mse_test", 1),
           ("transfer_l1", 2))}
+    m["null_heldout_l1"] = 50.0   # the null predictor's: every fixture model is far below it
     return m
 
 

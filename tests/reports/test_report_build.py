@@ -12,7 +12,11 @@ from result_fixtures import CLAIMS, CORRUPT, NOT_RUN_CLAIM, write_json
 from reports import build_report
 from reports.pdf import page_count
 
-HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication"]
+# the report recomputes verdicts with replication.verdicts and the claim records (pure NumPy/pandas);
+# it never loads a framework, the systems or models, or the training and evaluation code
+HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication.training",
+         "replication.train_jax", "replication.train_torch", "replication.evaluate", "replication.units",
+         "replication.runner", "replication.data"]
 
 
 def summary_rows(md: str) -> dict[str, list[str]]:
@@ -26,7 +30,11 @@ def test_markdown_has_every_claim_row_and_not_run(built):
     rows = summary_rows(md)
     assert set(rows) == {c[0] for c in CLAIMS}
     assert all(rows[NOT_RUN_CLAIM][i] == "not run" for i in (6, 7, 8, 9))
-    assert rows["dp_energy"][8] == "reproduced"
+    # recomputed from the unit files: dp_loss's models pass their bar (null recorded) and agree;
+    # dp_energy's rollouts record no divergence count, so its LNN cannot pass its rollout bar
+    assert rows["dp_loss"][8] == "reproduced; 1 corrupt unit excluded"
+    assert rows["dp_energy"][8] == "inconclusive"
+    assert "summary/verdicts.json disagrees with the unit files for" in md
     for line in md.splitlines():
         if line.startswith("|"):
             cells = re.split(r"(?<!\\)\|", line.strip())[1:-1]
@@ -111,3 +119,36 @@ def test_report_imports_no_training_code(results_dir, tmp_path):
     assert json.loads(loaded) == []
     assert int(nfig) >= 3
     assert re.search(r"%PDF-", (tmp_path / "out" / "REPORT.pdf").read_bytes()[:8].decode())
+
+
+def scorecard_rows(md: str) -> dict[str, list[str]]:
+    block = md.split("**Scorecard**", 1)[1].split("\n\n")[1]
+    rows = [r.strip("|").split(" | ") for r in block.splitlines()[2:]]
+    return {r[1].strip(): [c.strip() for c in r] for r in rows}
+
+
+def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
+    md = built["markdown"].read_text()
+    assert md.index("## Scorecard") < md.index("## Summary")
+    rows = scorecard_rows(md)
+    assert set(rows) == {c[0] for c in CLAIMS}
+    assert rows["dp_loss"][2] == "reproduced" and rows["dp_energy"][2] == "inconclusive"
+    assert re.fullmatch(r"lnn heldout_l1: jax 0\.0\d+ ± \S+ \(n=2\); torch 0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][3])
+    assert "below the competence bar" in rows["dp_energy"][5]
+
+
+def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(results_dir, tmp_path):
+    res = tmp_path / "res"
+    shutil.copytree(results_dir, res)
+    run = json.loads((res / "run.json").read_text())
+    run["finished"] = None
+    run["planned_units"] = [f"dp_loss/{fw}/{m}/seed{k}" for fw in ("jax", "torch") for m in ("lnn", "baseline")
+                            for k in (0, 1)]
+    write_json(res / "run.json", run)
+    shutil.rmtree(res / "units" / "dp_loss" / "jax" / "baseline")
+    shutil.rmtree(res / "units" / "dp_loss" / "torch" / "baseline")
+    md = build_report(res, tmp_path / "out", pdf=False)["markdown"].read_text()
+    assert scorecard_rows(md)["dp_loss"][2] == "not run"       # the stored verdict said "reproduced"
+    assert "This run is unfinished: 4 planned unit(s) have no result" in md
+    assert "| units/dp_loss/jax/baseline/seed0 | missing |" in md
+    assert "No failed, corrupt or missing units" not in md

@@ -1,0 +1,186 @@
+"""The verdict rules: one small vocabulary that every claim's rule is built from.
+
+A rule is a function of ``v = {model label: {metric: Stat}}`` (one framework; every model in ``v`` has
+passed its competence bar, see ``bars.py``) returning ``(verdict, reason)``. A ``Stat`` holds a
+metric's values over seeds; ``values`` may hold +inf (a diverged rollout), never NaN.
+
+Orderings ("a beats b") need more than a smaller mean: the seed ranges must not overlap
+(``separated``), else the verdict is "inconclusive" (noise decides). With one seed the range is the
+value itself, so the per-seed verdicts that ``replication.verdicts`` takes read as plain comparisons.
+
+- ``better_by(a, b, factor, metric)``: reproduced if mean(a) x factor < mean(b) and the ranges are
+  separated; partly if a < b separated but not by the factor; not reproduced if b < a separated.
+- ``similar(a, b, within, partly_within, metric)``: the ratio of means inside [1/within, within].
+- ``lowest(ours, others, metric)``: ours below every other, separated (partly: below some).
+- ``fails(bad, goods, factor, metric)``: bad above factor x every good, separated (partly: above all).
+- ``bound(metric, upper=, lower=, models=)``: every seed of the models inside the bounds (exact results,
+  tolerances, a property such as a positive definite mass matrix; no ordering).
+- ``all_parts(*rules)``: a conjunction (every part reproduced).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+VERDICTS = ("reproduced", "partly", "not reproduced", "inconclusive", "not run")
+
+
+@dataclass(frozen=True)
+class Stat:
+    """A metric's values over seeds (+inf = diverged). ``mean`` is +inf if any value is."""
+
+    values: tuple
+
+    @classmethod
+    def of(cls, values) -> Stat:
+        vs = tuple(float(x) for x in values if x is not None and not math.isnan(float(x)))
+        if not vs:
+            raise ValueError("Stat.of: no finite or infinite value (all missing or NaN)")
+        return cls(vs)
+
+    @property
+    def n(self) -> int:
+        return len(self.values)
+
+    @property
+    def mean(self) -> float:
+        return math.inf if any(math.isinf(x) for x in self.values) else sum(self.values) / self.n
+
+    @property
+    def std(self) -> float:
+        if self.n < 2:
+            return 0.0
+        if any(math.isinf(x) for x in self.values):
+            return math.inf if not all(math.isinf(x) for x in self.values) else 0.0
+        m = self.mean
+        return math.sqrt(sum((x - m) ** 2 for x in self.values) / (self.n - 1))
+
+    @property
+    def lo(self) -> float:
+        return min(self.values)
+
+    @property
+    def hi(self) -> float:
+        return max(self.values)
+
+    def __format__(self, spec) -> str:
+        return f"{self.mean:.3g}" if self.n == 1 else f"{self.mean:.3g} [{self.lo:.3g}, {self.hi:.3g}]"
+
+
+def separated(a: Stat, b: Stat) -> bool:
+    """a lies below b beyond the seed spread: every seed of a below every seed of b."""
+    return a.hi < b.lo
+
+
+def _get(v, label, metric):
+    return (v.get(label) or {}).get(metric)
+
+
+def _missing(v, labels, metric):
+    gone = [x for x in labels if _get(v, x, metric) is None]
+    return ("not run", "missing " + ", ".join(gone)) if gone else None
+
+
+def better_by(a: str, b: str, factor: float, metric: str):
+    def rule(v):
+        if (m := _missing(v, (a, b), metric)) is not None:
+            return m
+        x, y = _get(v, a, metric), _get(v, b, metric)
+        text = f"{a} {x} vs {b} {y}"
+        if x.mean < y.mean and not separated(x, y):
+            return "inconclusive", f"{text}: the seed ranges overlap"
+        if separated(x, y) and x.mean * factor < y.mean:
+            return "reproduced", f"{text}: lower by more than {factor:g}x, seed ranges apart"
+        if separated(x, y):
+            return "partly", f"{text}: lower, but not by {factor:g}x"
+        if separated(y, x):
+            return "not reproduced", f"{text}: {b} is lower"
+        return "inconclusive", f"{text}: the seed ranges overlap"
+    return rule
+
+
+def similar(a: str, b: str, within: float, partly_within: float, metric: str):
+    def rule(v):
+        if (m := _missing(v, (a, b), metric)) is not None:
+            return m
+        x, y = _get(v, a, metric), _get(v, b, metric)
+        if not (math.isfinite(x.mean) and math.isfinite(y.mean)) or y.mean <= 0:
+            return "not reproduced", f"{a} {x} vs {b} {y}: not finite and positive"
+        r = x.mean / y.mean
+        text = f"{a}/{b} = {x.mean:.3g}/{y.mean:.3g} = {r:.2f}"
+        if 1 / within <= r <= within:
+            return "reproduced", f"{text}, within [1/{within:g}, {within:g}]"
+        if 1 / partly_within <= r <= partly_within:
+            return "partly", f"{text}, within {partly_within:g}x but not {within:g}x"
+        return "not reproduced", f"{text}, outside {partly_within:g}x"
+    return rule
+
+
+def lowest(ours: str, others: tuple, metric: str):
+    def rule(v):
+        if (m := _missing(v, (ours,), metric)) is not None:
+            return m
+        rest = {k: _get(v, k, metric) for k in others if _get(v, k, metric) is not None}
+        if not rest:
+            return "not run", "nothing to compare with"
+        x = _get(v, ours, metric)
+        text = f"{ours} {x}; " + ", ".join(f"{k} {s}" for k, s in rest.items())
+        below = [k for k, s in rest.items() if separated(x, s)]
+        above = [k for k, s in rest.items() if separated(s, x)]
+        if len(below) == len(rest):
+            return "reproduced", f"{text}: lowest, seed ranges apart"
+        if above and not below:
+            return "not reproduced", f"{text}: {', '.join(above)} lower"
+        if below:
+            return "partly", f"{text}: below {', '.join(below)} only"
+        return "inconclusive", f"{text}: the seed ranges overlap"
+    return rule
+
+
+def fails(bad: str, goods: tuple, factor: float, metric: str):
+    def rule(v):
+        if (m := _missing(v, (bad, *goods), metric)) is not None:
+            return m
+        x = _get(v, bad, metric)
+        gs = {k: _get(v, k, metric) for k in goods}
+        text = f"{bad} {x}; " + ", ".join(f"{k} {s}" for k, s in gs.items())
+        if all(separated(s, x) and s.mean * factor < x.mean for s in gs.values()):
+            return "reproduced", f"{text}: {bad} above {factor:g}x every other, seed ranges apart"
+        if all(separated(s, x) for s in gs.values()):
+            return "partly", f"{text}: {bad} the worst, but not by {factor:g}x"
+        if any(separated(x, s) for s in gs.values()):
+            return "not reproduced", f"{text}: {bad} is not the worst"
+        return "inconclusive", f"{text}: the seed ranges overlap"
+    return rule
+
+
+def bound(metric: str, *, upper: float | None = None, lower: float | None = None, models: tuple | None = None):
+    def rule(v):
+        vals = {k: s[metric] for k, s in v.items() if metric in s and (models is None or k in models)}
+        if not vals:
+            return "not run", f"no {metric}"
+        hi, lo = max(s.hi for s in vals.values()), min(s.lo for s in vals.values())
+        over = upper is not None and not hi <= upper
+        under = lower is not None and not lo > lower
+        text = f"{metric} in [{lo:.3g}, {hi:.3g}] over {', '.join(vals)}"
+        if over or under:
+            return "not reproduced", text + (f", above {upper:g}" if over else "") + (f", not above {lower:g}" if under else "")
+        return "reproduced", text + (f", <= {upper:g}" if upper is not None else "") + (f", > {lower:g}" if lower is not None else "")
+    return rule
+
+
+def all_parts(*rules):
+    """Every part reproduced; any part not run or inconclusive decides first, then any success is partly."""
+    def rule(v):
+        out = [r(v) for r in rules]
+        verdicts = [o[0] for o in out]
+        reason = "; ".join(o[1] for o in out)
+        for first in ("not run", "inconclusive"):
+            if first in verdicts:
+                return first, reason
+        if all(x == "reproduced" for x in verdicts):
+            return "reproduced", reason
+        if any(x in ("reproduced", "partly") for x in verdicts):
+            return "partly", reason
+        return "not reproduced", reason
+    return rule

@@ -1,0 +1,84 @@
+"""No claim is ever reproduced by a model that learned nothing.
+
+For every claim, each model of its smoke profile is replaced by a null model, evaluated by the claim's
+own evaluation routine, for three seeds, and the verdict path (`replication.verdicts.judge`) runs on the
+resulting unit records: predicting zero, the untrained initialisation (the real init numbers, through
+the PyTorch adapter), and a model whose rollouts diverge. None may come out "reproduced" or "partly".
+Appendix B trains nothing: its null is an Euler-Lagrange routine that returns zero or inf.
+"""
+import numpy as np
+import pytest
+
+import models.torch.lnn as torch_lnn
+from models import init_params
+from replication.adapters import adapter
+from replication.claims import CLAIMS
+from replication.evaluate import Context, system_of
+from replication.evaluations import EVALUATIONS
+from replication.runner import plan
+from replication.verdicts import frame, judge
+from null_models import Diverging, NoisyOracle, Zero
+
+SEEDS = (0, 1, 2)
+NULLS = ("zero", "untrained", "diverging")
+
+
+def _model(kind, unit, seed):
+    spec = unit.spec()
+    if kind == "learned":
+        return NoisyOracle(spec, system_of(unit.protocol()), seed=seed)
+    if kind == "zero":
+        return Zero(spec)
+    if kind == "diverging":
+        return Diverging(spec)
+    return adapter("torch", spec, init_params(spec, seed=seed))
+
+
+def _records(claim, kind, monkeypatch, kinds=None):
+    """Unit records of ``claim`` at the smoke profile, every model replaced by the null ``kind`` (or by
+    ``kinds[label]``), three seeds each."""
+    if claim.evaluate == "exact_lagrangian":
+        value = 0.0 if kind != "diverging" else np.inf
+        monkeypatch.setattr(torch_lnn, "euler_lagrange", lambda L, q, qdot, form: q * 0 + value)
+    out = []
+    for unit in plan("smoke", claims=[claim.id], frameworks=("torch",)):
+        for seed in SEEDS:
+            cfg = claim.eval_config.get("smoke", {})
+            ctx = Context(claim=claim, entry=unit.entry, framework="torch", spec=unit.spec(), params=None,
+                          protocol=unit.protocol(), profile="smoke", cfg=cfg,
+                          model=_model((kinds or {}).get(unit.entry.label, kind), unit, seed))
+            with np.errstate(all="ignore"):
+                ev = EVALUATIONS[claim.evaluate](ctx)
+            out.append({"claim": claim.id, "framework": "torch", "model": unit.entry.label, "seed": seed,
+                        "status": "ok", "profile": "smoke", "metrics": ev.metrics, "final_train_loss": None})
+    return out
+
+
+@pytest.mark.parametrize("kind", NULLS)
+@pytest.mark.parametrize("cid", list(CLAIMS))
+def test_a_null_model_never_reproduces_a_claim(cid, kind, monkeypatch):
+    claim = CLAIMS[cid]
+    v = judge(claim, frame(_records(claim, kind, monkeypatch)), "smoke")
+    assert v["verdict"] not in ("reproduced", "partly"), v["reason"]
+    assert v["verdict"] in ("inconclusive", "not reproduced"), v["reason"]
+    if claim.bars:   # a learned claim: the null is caught by its competence bar, before any rule
+        assert v["verdict"] == "inconclusive" and "below the competence bar" in v["reason"], v["reason"]
+
+
+@pytest.mark.parametrize("cid, kinds, expected", [
+    # both learned, with the same small error: similar held-out loss
+    ("dp_loss", {"lnn": "learned", "baseline": "learned"}, "reproduced"),
+    # the LNN learned, DeLaN predicts nothing: the LNN is far better on both systems
+    ("delan_table1", {"lnn_relativistic": "learned", "lnn_magnetic": "learned"}, "reproduced"),
+    # the LNN learned, the baseline did not: no comparison
+    ("dp_loss", {"lnn": "learned", "baseline": "zero"}, "inconclusive"),
+    ("dp_energy", {"lnn": "learned", "baseline": "diverging"}, "inconclusive"),
+])
+def test_models_that_learned_are_judged_and_a_null_beside_them_is_caught(cid, kinds, expected, monkeypatch):
+    """The other side of the null tests: the bars let a model that learned through, so a verdict can
+    be reached at all; one null model beside it still makes the claim inconclusive."""
+    claim = CLAIMS[cid]
+    v = judge(claim, frame(_records(claim, "zero", monkeypatch, kinds)), "smoke")
+    assert v["verdict"] == expected, v["reason"]
+    learned = [m for m, k in kinds.items() if k == "learned"]
+    assert all(v["competence"]["torch"][m]["passed"] for m in learned), v["competence"]
