@@ -1,6 +1,8 @@
 """Training to a target: samples the double-pendulum LNN needs to reach held-out L1 thresholds.
 
-The paper's LNN reaches a held-out L1 of 7.3e-2 on the double pendulum; the original code consumed
+The paper prints 7.3e-2 for its double-pendulum LNN. That is a late-epoch training loss, not a held-out
+value (the original code's held-out L1 is 6.9e-2, reference §7); the thresholds below are held-out L1,
+so 0.073 here is a held-out target a little looser than the like-for-like 0.069. The original code consumed
 about 3e8 samples (300 epochs x 2000 batches x 512). The issue asks for a protocol reaching it with at
 most a tenth of that (3e7). On 2 CPU cores the LNN trains at a few thousand samples per second, so this
 study runs every protocol for the same `sizes.target_budget` samples and reports how far each got:
@@ -69,7 +71,7 @@ from replication.claims.double_pendulum import MODELS, PROTOCOLS
 from replication.data import heldout
 
 THRESHOLDS = (10.0, 3.0, 1.0, 0.3, 0.073)
-PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's held-out L1; the original code's samples
+PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's number (a training loss; held-out 6.9e-2); the code's samples
 TARGET_SAMPLES = ORIGINAL_SAMPLES / 10     # the issue's target: at most a tenth
 EXTRAPOLATION_CAP = 1e3 * ORIGINAL_SAMPLES
 HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}

@@ -8,6 +8,7 @@ Appendix B trains nothing: its null is an Euler-Lagrange routine that returns ze
 """
 import numpy as np
 import pytest
+from null_models import Diverging, NoisyOracle, Zero
 
 import models.torch.lnn as torch_lnn
 from models import init_params
@@ -17,7 +18,6 @@ from replication.evaluate import Context, system_of
 from replication.evaluations import EVALUATIONS
 from replication.runner import plan
 from replication.verdicts import frame, judge
-from null_models import Diverging, NoisyOracle, Zero
 
 SEEDS = (0, 1, 2)
 NULLS = ("zero", "untrained", "diverging")
