@@ -4,7 +4,9 @@
 relative difference of means, and the largest per-seed difference over seeds run in both).
 ``cheapest_table`` picks, per claim, among (framework, model) whose mean claim metric is within
 ``tolerance`` x the best (lowest) mean, the one with the highest training throughput
-(``train_samples_per_s``; else the shortest ``train_time_s``). ``bench_cheapest_table`` does the same per
+(``train_samples_per_s``; else the shortest ``train_time_s``), counting only models that passed their
+competence bar (a claim with bars: a model without a passed bar is left out, so a model that learned
+nothing is never recommended). ``bench_cheapest_table`` does the same per
 system from ``bench/inference.csv`` (error vs ``samples_per_s``).
 """
 
@@ -63,14 +65,25 @@ def _cost(units) -> tuple[str, float] | None:
     return ("train s", t["mean"]) if t["n"] else None
 
 
+def _competent(res: Results, cid: str):
+    """(framework, model) -> passed its bar; None when the claim has no bars (every model counts)."""
+    comp = (res.verdicts.get(cid) or {}).get("competence") or {}
+    if not any(comp.values()):
+        return None
+    return {(fw, m) for fw, per in comp.items() for m, r in (per or {}).items() if r.get("passed")}
+
+
 def cheapest_table(res: Results, tolerance: float = TOLERANCE) -> pd.DataFrame | None:
     rows = []
     for claim in res.claims:
         metric, units = claim.get("metric"), res.usable(claim["id"])
         vals = values(units, metric)
+        competent = _competent(res, claim["id"])
         cands = []
         for fw, per in vals.items():
             for model, s in per.items():
+                if competent is not None and (fw, model) not in competent:
+                    continue
                 cost = _cost([u for u in units if u.framework == fw and u.model == model])
                 cands.append((s["mean"], fw, model, cost))
         finite = [c for c in cands if math.isfinite(c[0])]

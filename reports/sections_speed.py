@@ -57,9 +57,10 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
     if cheap is not None:
         s.add(Table(f"Cheapest model within {TOLERANCE:g}x of the best error, per claim", cheap,
                     ["units/*/*/*/seed*/result.json"],
-                    note="Cost: mean training throughput over seeds (samples/s; else training time)."))
+                    note="Cost: mean training throughput over seeds (samples/s; else training time). Only models "
+                         "past their competence bar count: one that learned nothing is never recommended."))
     else:
-        s.add(Para(f"Cheapest model per system: {NOT_RUN}."))
+        s.add(Para(f"Cheapest model per system: {NOT_RUN} (or no model past its competence bar)."))
     b = Section("Speed study (lagbench bench)", level=2)
     if not res.bench and res.machine is None:
         b.add(Para(f"Speed study: {NOT_RUN} (no bench/ files)."))
