@@ -17,20 +17,18 @@ from functools import lru_cache
 import numpy as np
 
 from replication.evaluate import _truth, eval_energy_rollout
+from replication.rollout import rk4_step
 
 
 def _rk4_in_dtype(s, y0, t, dt, dtype):
-    """Fixed-step RK4 with the state, the step and the equations of motion all in ``dtype``."""
+    """Fixed-step RK4 (`replication.rollout.rk4_step`) with the state, the step and the equations of
+    motion all in ``dtype``."""
     dof, y, h = s.dof, y0.astype(dtype), np.asarray(dt, dtype)
     f = lambda z: np.concatenate([z[:, dof:], s.acceleration(z[:, :dof], z[:, dof:]).astype(dtype)], 1)  # noqa: E731
     out = [y]
     for j in range(1, t.size):
         for _ in range(max(1, int(round((t[j] - t[j - 1]) / dt)))):
-            k1 = f(y)
-            k2 = f(y + h / 2 * k1)
-            k3 = f(y + h / 2 * k2)
-            k4 = f(y + h * k3)
-            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            y = rk4_step(f, y, h)
         out.append(y)
     return np.stack(out, 1).astype(np.float64)
 

@@ -25,7 +25,8 @@ class CorruptResult(Exception):
     """A result or cache file failed its checksum, or could not be parsed."""
 
 
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -74,7 +75,7 @@ def write_json(path: Path, d: dict, *, checksum: bool = False) -> dict:
     if checksum:
         d.pop("checksum", None)
         d["checksum"] = sha256_bytes(canonical(d))
-    _atomic_write_bytes(Path(path), json.dumps(d, indent=1, sort_keys=True).encode())
+    atomic_write_bytes(Path(path), json.dumps(d, indent=1, sort_keys=True).encode())
     return d
 
 
@@ -89,7 +90,7 @@ def write_csv(path: Path, df) -> str:
     buf = io.StringIO()
     df.to_csv(buf, index=False)
     data = buf.getvalue().encode()
-    _atomic_write_bytes(Path(path), data)
+    atomic_write_bytes(Path(path), data)
     return sha256_bytes(data)
 
 
@@ -97,7 +98,7 @@ def write_npz(path: Path, arrays: dict) -> str:
     buf = io.BytesIO()
     np.savez_compressed(buf, **{k: np.asarray(v) for k, v in arrays.items()})
     data = buf.getvalue()
-    _atomic_write_bytes(Path(path), data)
+    atomic_write_bytes(Path(path), data)
     return sha256_bytes(data)
 
 

@@ -28,6 +28,8 @@ def _guarded(f):
 
 
 def rk4_step(f, z, h):
+    """One classical RK4 step of dz/dt = f(z): plain arithmetic, so NumPy (any dtype) and JAX arrays alike
+    (the speed study's jitted RK4 scans this same step)."""
     k1 = f(z)
     k2 = f(z + 0.5 * h * k1)
     k3 = f(z + 0.5 * h * k2)

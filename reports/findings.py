@@ -1,4 +1,5 @@
-"""Findings: where the LNN paper and its original code disagree (``shared/reference/lnn_original_code.md`` §9).
+"""The Findings section: where the papers and their original code disagree (the data:
+``replication/claims/findings.py``).
 
 The suite runs the code's protocol by default and offers the paper's wording as a variant. For each
 finding this module reports which one was run, read from the usable units' ``protocol`` and
@@ -8,82 +9,11 @@ restricted to units of claims whose ``system`` contains one of ``systems`` (all 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import pandas as pd
 
+from replication.claims.findings import FINDINGS, Finding
 from reports.document import NOT_RUN, Para, Section, Table
 from reports.load import Results
-
-
-@dataclass(frozen=True)
-class Finding:
-    title: str
-    paper: str
-    code: str
-    changes: str
-    systems: tuple[str, ...] = ()
-    keys: tuple[str, ...] = ()
-
-
-FINDINGS = [
-    Finding("Relativistic Lagrangian", "L = (1−q̇²)^(−1/2) − 1 + g·q, as printed",
-            "the same non-standard L (physical one is −(1−q̇²)^(1/2) + g·q)",
-            "the printed form is run to match the numbers; the standard one is a variant with p = γq̇",
-            ("relativ",), ("lagrangian", "relativistic_form", "form")),
-    Finding("Initialisation", "σ = 2.2/√n, 0.58·i/√n, n/√n (Appendix C)",
-            "n = max(fan_in, fan_out); output σ = √n; zero biases; LNNs only, not baseline or HNN",
-            "the code's rule is applied to LNNs; baselines and HNNs keep default inits",
-            (), ("init",)),
-    Finding("Loss behind 7.3e-2 / 7.4e-2", "called loss, read as MSE",
-            "per-sample L1 sum |Δq̈1|+|Δq̈2|; LNN value is late training loss (held-out 6.9e-2)",
-            "held-out L1 is the claim metric, compared with the code's held-out 6.9e-2 (LNN) and 7.4e-2 (baseline); "
-            "MSE is reported alongside", ("double_pendulum",), ("loss",)),
-    Finding("DeLaN's published torque error", "4.3e-4 (repository README); feed-forward 'about 30x worse'",
-            "measured on the original's own character trajectories",
-            "our arm and trajectories differ: 4.3e-4 is context, not a target; no feed-forward number is "
-            "published, so none is shown", ("two_link_arm",), ()),
-    Finding("Architectures", "one MLP for both models",
-            "LNN 3×600 softplus, 1 output, custom init; baseline 3×600 ReLU, 2 outputs, default init; "
-            "SR 4×500; wave 3×400",
-            "the code's architectures are used per model", (), ("activation", "hidden")),
-    Finding("Energy metric", "energy error over 40 ICs",
-            "final time t = 100 only, /29.4, ICs near rest (ω < 0.1); baseline over 44 ICs; float32 truth",
-            "final-time and max-over-time both reported, truth in float64, a diverged rollout counted as +inf "
-            "(the code's 44th baseline IC froze and was dropped); the quick profile's 10 ICs to t = 20 are not "
-            "comparable with the published numbers, which the scorecard then shows as context",
-            ("double_pendulum",),
-            ("energy_metric", "n_ics", "energy_scale")),
-    Finding("Training vs evaluation states", "not stated",
-            "training ω ∈ [−10, 10]; evaluation ICs start with ω < 0.1",
-            "rollouts probe a small corner of the training distribution", ("double_pendulum",),
-            ("velocity_range", "eval_velocity_range")),
-    Finding("Angle wrapping", "not stated", "angles wrapped to [−π, π): L discontinuous at ±π",
-            "wrapping kept; a sin/cos embedding would be a documented deviation", ("double_pendulum",),
-            ("angle_embedding", "wrap_angles")),
-    Finding("Wave coefficient", "∂²u/∂x² (/dx²)", "second difference divided by 2dx",
-            "the code's /2dx is the default; /dx² is a variant", ("wave",), ("coefficient", "wave_coefficient")),
-    Finding("Wave protocol", "train small grid, test large grid",
-            "10-point periodic grid of white noise, batch 1; test 100 points with a Gaussian pulse; no sparse "
-            "Hessian; plotted energy not conserved by truth either",
-            "same grids; the banded Hessian is a fast-path option", ("wave",), ("grid", "n_train", "n_test")),
-    Finding("Integrator steps", "not stated", "mxstep a no-op in 2020 (unlimited); mxstep=100 in float32 "
-            "corrupts truth", "truth by diffrax in float64 at tight tolerances", (), ("rtol", "solver")),
-    Finding("Precision", "not stated", "everything float32, ground truth included",
-            "truth float64, models float32 by default", (), ("dtype",)),
-    Finding("Canonical HNN's loss (relativistic)", "HNN on canonical (q, p) succeeds (2.4e-4)",
-            "loss on [q̇, q̈]: the predicted ṗ mapped to q̈ through dp/dq̇ before the loss",
-            "loss on [q̇, ṗ] with the exact ṗ = ∂L/∂q from the SymPy system (a central difference broke down "
-            "near |q̇| → 1); the verdict reads q̈; the published 2.4e-4 is context, not a like-for-like target",
-            ("relativ",), ("task", "coords")),
-    Finding("Relativistic data quirk", "not stated",
-            "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",
-            "the 1 + γ weighting is kept", ("relativ",), ("weighting", "fixed_velocities")),
-    Finding("Hidden wrappers", "not stated", "NaN guards, seed restarts, l2 penalty 1e-6·||θ||²/512",
-            "the l2 penalty as each protocol records it (the double-pendulum protocols keep 1e-6/512); non-finite "
-            "losses are reported as failed units, excluded from verdicts, not restarted silently",
-            (), ("weight_decay", "l2")),
-]
 
 
 def _lookup(d, keys: set[str], prefix: str = "") -> dict[str, str]:

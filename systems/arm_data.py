@@ -45,7 +45,7 @@ def _trajectories(kind: str, n_traj: int, t: np.ndarray, rng: np.random.Generato
 def arm_dataset(kind: str = "train", n_traj: int = 16, n_points: int = 200, seed: int = 0, *,
                 duration: float = 4.0, cache: bool = True, **params) -> dict:
     """Trajectory family ``kind`` ("train" | "test") with exact torques; see the module docstring."""
-    from systems.datasets import _key, cached
+    from systems.dataset_cache import _key, cached
     from systems.registry import get
 
     if kind not in FAMILIES:

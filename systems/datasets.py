@@ -23,30 +23,11 @@ import numpy as np
 
 from systems import cache as _cache
 from systems.arm_data import arm_dataset
+from systems.dataset_cache import DATASET_VERSION, _key, cached
 from systems.registry import get
-from systems.system import System
 from systems.trajectories import integrate
 
-DATASET_VERSION = "1"
 _STATE_KEYS = ("q", "qdot")
-
-
-def _key(kind: str, system: System, **spec) -> str:
-    parts = (DATASET_VERSION, kind, system.name, sorted(system.options.items()),
-             sorted(system.params.items()), system.definition.fingerprint(), sorted(spec.items()))
-    return f"{kind}-{system.name}-{_cache.digest(*parts)[:24]}"
-
-
-def cached(key: str, make, use_cache: bool = True) -> dict:
-    """Load ``key`` from the dataset cache, or ``make()`` it and store it."""
-    if use_cache:
-        found = _cache.load_arrays(key)
-        if found is not None:
-            return found
-    data = {k: np.asarray(v, dtype=np.float64) for k, v in make().items()}
-    if use_cache:
-        _cache.store_arrays(key, data)
-    return data
 
 
 def iid_dataset(name: str, n: int, seed: int, /, *, distribution: str = "default",

@@ -57,6 +57,7 @@ from replication import environment
 from replication.bench import (
     device,
     latency,
+    learned,
     rollout,
     roofline,
     scaling,
@@ -173,7 +174,8 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
         train_rows = stage("training", training.n_training_cases(sizes),
                            lambda: {"training": training.training_rows(sizes, notes, bar)}, ["training"])["training"]
         stage("rollouts", rollout.n_rollout_cases(sizes),
-              lambda: {"rollout": rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes)})
+              lambda: {"rollout": rollout.rollout_rows(sizes, bar, trained_from=trained_from, notes=notes,
+                                                             learned_rows=learned.learned_rollout_rows)})
         sc = stage("scaling", len(sc_cases), lambda: _scaling(sc_cases, sizes, bar), ["scaling", "scaling_fit"])
         sc_rows, fit = sc["scaling"], sc["scaling_fit"]
         fp = stage("fast vs paper", 2 * len(sizes.ratio_dofs), lambda: _fast_paper(sizes, bar),

@@ -37,7 +37,7 @@ import models.torch
 from models.row_blocks import rows_per_sample
 from models.torch.compiled import compile_batched
 from replication.bench.device import sync, to_numpy
-from replication.bench.timing import torch_threads
+from replication.bench.timing import torch_thread_choices, torch_threads
 
 
 def median_rel_error(pred, true) -> float:
@@ -165,7 +165,6 @@ def per_thread_count(compile_fn, counts=None) -> dict:
     `inference.torch_thread_choices()`). Inductor writes the count in force at compile time into its
     OpenMP kernels: a library compiled at 1 thread stays serial when timed at 2 (DeLaN float64, batch 256,
     interleaved: 71k samples/s compiled at 1 thread, 79k at 2, whatever the thread count at run time)."""
-    from replication.bench.inference import torch_thread_choices  # inference imports this module
 
     out = {}
     for n in counts or torch_thread_choices():

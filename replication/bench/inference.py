@@ -24,7 +24,6 @@ ground truth on the same states.
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,9 +31,16 @@ import numpy as np
 
 import systems
 from models import ModelSpec, init_params
-from replication.bench.device import on_gpu
 from replication.bench.evaluators import make_evaluator, median_rel_error
-from replication.bench.timing import TORCH_THREADS, best_time, interleaved_best, torch_threads
+from replication.bench.timing import (  # noqa: F401 - TORCH_THREAD_CHOICES is read as inference.*
+    PAIRED_ROUNDS,
+    TORCH_THREAD_CHOICES,
+    TORCH_THREADS,
+    best_time,
+    interleaved_best,
+    torch_thread_choices,
+    torch_threads,
+)
 
 GRID_NODES = 8192  # wave batches are capped at GRID_NODES // n states (the dense path holds n + 1 tangents)
 DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"),
@@ -43,16 +49,6 @@ WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
 # kinds that export (torch.export + AOTInductor); the paper LNN and the dense LGN differentiate with torch.func
 AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"), ("lgn", "banded"))
 TRACED_KINDS = (("lnn", "paper"), ("lgn", "dense"))  # torch.func inside: traced, then compiled per batch size
-TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
-PAIRED_ROUNDS = 5  # interleaved rounds (at least) of a PyTorch row and its JAX twin, per thread count
-
-
-def torch_thread_choices() -> tuple:
-    """The intra-op thread counts a PyTorch row is timed at: TORCH_THREAD_CHOICES on the CPU; on a GPU only
-    TORCH_THREADS (the host threads only launch kernels there)."""
-    return (TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES
-
-
 @dataclass
 class Case:
     system: str

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from replication.results import _atomic_write_bytes
+from replication.results import atomic_write_bytes
 
 __all__ = ["StageCache"]
 
@@ -63,4 +63,4 @@ class StageCache:
     def save(self, stage: str, tables: dict, notes: list) -> None:
         d = {"stage": stage, "preset": self.preset, "commit": self.commit, "notes": list(notes),
              "tables": {k: list(v) for k, v in tables.items()}}
-        _atomic_write_bytes(self.path(stage), json.dumps(d, default=_plain).encode())
+        atomic_write_bytes(self.path(stage), json.dumps(d, default=_plain).encode())

@@ -29,12 +29,13 @@ import numpy as np
 
 import systems
 from replication.bench.timing import best_time
+from replication.claims.double_pendulum import ENERGY_SCALE
+from replication.rollout import rk4_step
 from systems.trajectories import SOLVERS, integrate
 
 REF_RTOL = 1e-13
 MAX_STEPS = 4096  # per adaptive solve of a learned model (a non-smooth learned field can need far more)
 TRUTH_MAX_STEPS = 2**16
-ENERGY_SCALE = 29.4
 CHAOS_EPS = 1e-12
 
 
@@ -51,11 +52,7 @@ def _rk4(system, dt, n_steps):
 
     def one(y0):
         def body(y, _):
-            k1 = field(y)
-            k2 = field(y + 0.5 * dt * k1)
-            k3 = field(y + 0.5 * dt * k2)
-            k4 = field(y + dt * k3)
-            return y + (dt / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4), None
+            return rk4_step(field, y, dt), None
         return jax.lax.scan(body, y0, None, length=n_steps)[0]
     return jax.jit(jax.vmap(one))
 
@@ -98,7 +95,9 @@ def _errors(system, zT, z_ref, e0):
     return float(np.median(state)), float(np.mean(np.abs(e_T - e0)) / ENERGY_SCALE)
 
 
-def rollout_rows(sizes, progress=None, trained_from=None, notes=None) -> list[dict]:
+def rollout_rows(sizes, progress=None, trained_from=None, notes=None, learned_rows=None) -> list[dict]:
+    """The study's rows; with `sizes.rollout_learned`, `learned_rows` (`learned.learned_rollout_rows`, passed
+    in by the caller: learned.py builds on this module) adds the learned models' rows."""
     s = systems.get("double_pendulum")
     q0, qd0 = _ics(sizes.rollout_ics)
     t = np.array([0.0, sizes.rollout_t_end])
@@ -140,12 +139,10 @@ def rollout_rows(sizes, progress=None, trained_from=None, notes=None) -> list[di
                  "state_err": se, "energy_err": ee})
     if progress:
         progress.update(1)
-    if sizes.rollout_learned:
-        from replication.bench.learned import learned_rollout_rows
-
+    if sizes.rollout_learned and learned_rows is not None:
         def errors(zT):
             return _errors(s, zT, z_ref, e0)
-        rows += learned_rollout_rows(sizes, q0, qd0, errors, base, trained_from, notes, progress)
+        rows += learned_rows(sizes, q0, qd0, errors, base, trained_from, notes, progress)
     return rows
 
 

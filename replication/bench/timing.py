@@ -21,6 +21,7 @@ compiling one program per shape.
 """
 from __future__ import annotations
 
+import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -178,3 +179,15 @@ GPU_TINY = Sizes("gpu-tiny", hidden=(16, 16), batches=(8, 64), dtypes=("float32"
                  rollout_solvers=("tsit5",), rollout_rtols=(1e-6,), rollout_dts=(0.01,), rollout_t_end=1.0,
                  rollout_ics=2, min_time=0.0, torch_compile=False, structure_batch=64, wave_n=16, scaling_s=0.0,
                  stages=GPU_STAGES, train_extra_batches=(64,))
+
+
+TORCH_THREAD_CHOICES = tuple(sorted({1, os.cpu_count() or 1}))
+PAIRED_ROUNDS = 5  # interleaved rounds (at least) of a PyTorch row and its JAX twin, per thread count (inference)
+
+
+def torch_thread_choices() -> tuple:
+    """The intra-op thread counts a PyTorch row is timed at: TORCH_THREAD_CHOICES on the CPU; on a GPU only
+    TORCH_THREADS (the host threads only launch kernels there)."""
+    from replication.bench.device import on_gpu
+
+    return (TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES

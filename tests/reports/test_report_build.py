@@ -19,10 +19,15 @@ HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "re
          "replication.runner", "replication.data"]
 
 
-def summary_rows(md: str) -> dict[str, list[str]]:
-    block = md.split("**Claims: published against reproduced**", 1)[1].split("\n\n")[1]
+def table_rows(md: str, title: str) -> dict[str, list[str]]:
+    """The rows of the Markdown table titled ``title``, keyed by their second cell (the claim)."""
+    block = md.split(f"**{title}**", 1)[1].split("\n\n")[1]
     rows = [r.strip("|").split(" | ") for r in block.splitlines()[2:]]
     return {r[1].strip(): [c.strip() for c in r] for r in rows}
+
+
+def summary_rows(md: str) -> dict[str, list[str]]:
+    return table_rows(md, "Claims: published against reproduced")
 
 
 def test_markdown_has_every_claim_row_and_not_run(built):
@@ -122,9 +127,7 @@ def test_report_imports_no_training_code(results_dir, tmp_path):
 
 
 def scorecard_rows(md: str) -> dict[str, list[str]]:
-    block = md.split("**Scorecard**", 1)[1].split("\n\n")[1]
-    rows = [r.strip("|").split(" | ") for r in block.splitlines()[2:]]
-    return {r[1].strip(): [c.strip() for c in r] for r in rows}
+    return table_rows(md, "Scorecard")
 
 
 def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
