@@ -11,33 +11,11 @@ from __future__ import annotations
 import pandas as pd
 
 from reports.document import NOT_RUN, Para, Section, Table
-from reports.fmt import cell, num, stat, summarise
+from reports.fmt import cell, stat, summarise
 from reports.load import Results
+from reports.tables import published_cell, published_entry
 
 REASON_CHARS = 240
-
-
-def _published(claim: dict, model: str) -> dict | None:
-    pub = claim.get("published")
-    p = pub.get(model) if isinstance(pub, dict) else None
-    if isinstance(p, dict):
-        return p
-    return {"value": p, "kind": "unknown", "metric": ""} if isinstance(p, int | float) else None
-
-
-def _like_for_like(p: dict, units) -> tuple[bool, str]:
-    """The published value's conditions against the units' recorded evaluation configs."""
-    if p.get("other_data"):
-        return False, "measured on other data"
-    if not p.get("metric"):
-        return False, f"we measure no {p.get('kind', 'such number')}"
-    cond = p.get("conditions") or {}
-    for u in units:
-        cfg = u.result.get("eval_config") or {}
-        off = [f"{k} {cfg.get(k, 'unset')} (published {v})" for k, v in cond.items() if cfg.get(k) != v]
-        if off:
-            return False, "ours: " + ", ".join(off)
-    return True, ""
 
 
 def _metric_of(u, name: str):
@@ -74,15 +52,9 @@ def scorecard_table(res: Results) -> pd.DataFrame:
     for claim in res.claims:
         cid = claim["id"]
         key = claim.get("key") or next(iter(claim.get("models") or []), "")
-        p = _published(claim, key)
+        p = published_entry(claim, key)
         metric = (p or {}).get("metric") or claim.get("metric") or ""
-        units = [u for u in res.usable(cid) if u.model == key]
-        if p is None:
-            published = "none published"
-        else:
-            same, why = _like_for_like(p, units)
-            published = (f"{num(p.get('value'))} ({p.get('kind')}, like for like)" if same
-                         else f"{num(p.get('value'))} ({p.get('kind')}; context only: {why})")
+        published = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
         v = res.verdicts.get(cid)
         rows.append({"#": cell(claim.get("number"), "–"), "claim": cid,
                      "verdict": cell((v or {}).get("verdict"), NOT_RUN),

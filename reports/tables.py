@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from replication.claims.published import Published
 from reports.document import NOT_RUN
 from reports.fmt import cell, num, stat, summarise
 from reports.load import Results, Unit
@@ -36,21 +37,33 @@ def values(units: list[Unit], metric: str | None) -> dict:
     return out
 
 
-def published_value(p) -> str:
-    """A published entry (a dict with value, kind, source, or a bare number of an older claims.json)."""
-    if isinstance(p, dict):
-        tag = p.get("kind") or "unknown kind"
-        if p.get("other_data"):
-            tag += ", other data: context"
-        return f"{num(p.get('value'))} ({tag})"
-    return num(p) if p is not None else "none published"
-
-
-def published_text(claim: dict) -> str:
+def published_entry(claim: dict, model: str) -> dict | None:
+    """The published record of ``model`` (a bare number from an older claims.json becomes one), or None."""
     pub = claim.get("published")
-    if not isinstance(pub, dict) or not pub:
+    p = pub.get(model) if isinstance(pub, dict) else None
+    if isinstance(p, dict):
+        return p
+    return {"value": p, "kind": "unknown", "metric": ""} if isinstance(p, int | float) else None
+
+
+def like_for_like(p: dict, units) -> tuple[bool, str]:
+    """`Published.like_for_like` against every unit's recorded evaluation config (all must match)."""
+    pub = Published.from_dict(p)
+    for u in units or [None]:
+        same, why = pub.like_for_like(u.result.get("eval_config") if u is not None else {})
+        if not same:
+            return False, why
+    return True, ""
+
+
+def published_cell(claim: dict, model: str, units) -> str:
+    """The published value of ``model``, what it is, and whether ``units`` measured the same thing."""
+    p = published_entry(claim, model)
+    if p is None:
         return "none published"
-    return "\n".join(f"{m}: {published_value(v)}" for m, v in pub.items())
+    same, why = like_for_like(p, units)
+    return (f"{num(p.get('value'))} ({p.get('kind')}, like for like)" if same
+            else f"{num(p.get('value'))} ({p.get('kind')}; context only: {why})")
 
 
 def verdict_text(res: Results, claim: dict) -> str:
@@ -86,7 +99,8 @@ def summary_table(res: Results) -> pd.DataFrame:
             "paper": cell(claim.get("paper"), "unknown"),
             "section": cell(claim.get("section"), "unknown"),
             "metric": cell(claim.get("metric"), "unknown"),
-            "published": published_text(claim),
+            "published": "\n".join(f"{m}: {published_cell(claim, m, [u for u in res.usable(claim['id']) if u.model == m])}"
+                                   for m in (claim.get("published") or {})) or "none published",
         }
         for fw in frameworks:
             per = vals.get(fw, {})
@@ -101,10 +115,10 @@ def summary_table(res: Results) -> pd.DataFrame:
 def claim_table(res: Results, claim: dict) -> pd.DataFrame:
     """Rows: models; columns: published value and the claim metric per framework (mean ± std (n))."""
     vals = values(res.claim_units(claim["id"]), claim.get("metric"))
-    pub = claim.get("published") if isinstance(claim.get("published"), dict) else {}
     rows = []
     for model in claim_models(res, claim):
-        row = {"model": model, "published": published_value(pub.get(model))}
+        row = {"model": model,
+               "published": published_cell(claim, model, [u for u in res.usable(claim["id"]) if u.model == model])}
         for fw in res.frameworks or ["any framework"]:
             per = vals.get(fw, {}).get(model)
             row[fw] = stat(**per) if per else NOT_RUN

@@ -35,6 +35,13 @@ class Published:
             return False, "ours: " + ", ".join(off)
         return True, ""
 
+    @classmethod
+    def from_dict(cls, d: dict) -> Published:
+        """From `to_dict`'s output (claims.json); unknown keys ignored."""
+        return cls(value=d.get("value"), kind=str(d.get("kind") or "unknown"), source=str(d.get("source") or ""),
+                   metric=str(d.get("metric") or ""), conditions=tuple((d.get("conditions") or {}).items()),
+                   other_data=bool(d.get("other_data")), note=str(d.get("note") or ""))
+
     def to_dict(self) -> dict:
         return {"value": self.value, "kind": self.kind, "source": self.source, "metric": self.metric,
                 "conditions": dict(self.conditions), "other_data": self.other_data, "note": self.note}
