@@ -16,6 +16,8 @@ class TrainOutcome:
     train_time_s: float
     steps_done: int
     batch: int
+    step_seconds: float = 0.0   # time in the optimiser steps after the first (compiling) one
+    skipped_steps: int = 0      # steps the spike guard skipped
 
     @property
     def samples_per_s(self) -> float:

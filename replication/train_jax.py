@@ -1,16 +1,13 @@
-"""The JAX training loop (equinox + optax). Mirrors `train_torch.py` line for line.
+"""The JAX optimiser step (equinox + optax) for the one training loop `replication.loop`. Mirrors
+`train_torch.py` line for line.
 
-`train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome` runs `protocol.steps`
-Adam steps (optax.scale_by_adam, scaled by the learning rate the neutral schedule gives for the
-step; optionally clipped and spike-skipped, `replication.spike_guard`), records loss and global
-gradient norm every `log_every` steps (and at step 0 and the last; for LNN/LGN also the
-velocity-Hessian health of `replication.hessian_probe`, timed apart), and stops at the first
-non-finite loss or gradient (a non-finite gradient is skipped instead while the spike guard skips),
-keeping the parameters from before that step.
+`Stepper(spec, params, protocol, step=None)`: an Adam step (optax.scale_by_adam, scaled by the learning
+rate the loop passes; clipped to `protocol.grad_clip` and skipped above the spike guard's bound inside the
+compiled step, `replication.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
+`make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
+stream, on_log=None, hooks=()) -> TrainOutcome`: `replication.loop.train` with this stepper.
 """
 from __future__ import annotations
-
-import time
 
 import equinox as eqx
 import jax
@@ -19,11 +16,9 @@ import numpy as np
 import optax
 
 import models.jax
-from replication import hessian_probe
+from replication import hessian_probe, loop
 from replication.objective import loss_value, predict
-from replication.outcome import TrainOutcome, nonfinite_failure
-from replication.schedules import learning_rate
-from replication.spike_guard import SpikeGuard
+from replication.outcome import TrainOutcome
 
 
 def _to_jax(batch: dict, dtype) -> dict:
@@ -83,38 +78,32 @@ def make_probe(spec, protocol):
     return run
 
 
-def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
-    dtype = jnp.dtype(protocol.dtype)
-    model = models.jax.build(spec, params)
-    opt, step = make_step(spec, protocol)
-    look = make_probe(spec, protocol)
-    opt_state = opt.init(eqx.filter(model, eqx.is_inexact_array))
-    guard = SpikeGuard(protocol)
-    log, failure, t0, t_probe = [], None, time.perf_counter(), 0.0
-    for k in range(protocol.steps):
-        lr = learning_rate(protocol, k)
-        batch = _to_jax(stream.batch(k), dtype)
-        bound = guard.threshold(protocol.dtype)
-        new_model, new_state, loss, gnorm = step(model, opt_state, batch, jnp.asarray(lr, dtype),
-                                                 jnp.asarray(bound, dtype))
-        loss, gnorm = float(loss), float(gnorm)
-        if guard.fails(loss, gnorm):
-            failure = nonfinite_failure(k, loss, gnorm)
-            break
-        guard.record(gnorm, bound)
-        model, opt_state = new_model, new_state
-        if k % protocol.log_every == 0 or k == protocol.steps - 1:
-            row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr,
-                   "wall_s": time.perf_counter() - t0 - t_probe}
-            if guard.active:
-                row["skipped_steps"] = guard.skipped
-            if look is not None:
-                tp = time.perf_counter()
-                row.update(look(model, batch))
-                t_probe += time.perf_counter() - tp
-            log.append(row)
-            if on_log:
-                on_log(row)
-    wall = time.perf_counter() - t0 - t_probe
-    return TrainOutcome(params=models.jax.to_params(model), log=log, failure=failure, train_time_s=wall,
-                        steps_done=k + 1 if failure is None else k, batch=protocol.batch)
+class Stepper:
+    def __init__(self, spec, params, protocol, step=None):
+        self.dtype = jnp.dtype(protocol.dtype)
+        self.model = models.jax.build(spec, params)
+        self.opt, self.step = step or make_step(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt_state = self.opt.init(eqx.filter(self.model, eqx.is_inexact_array))
+        self._next = None
+
+    def propose(self, batch, lr, bound):
+        batch = _to_jax(batch, self.dtype)
+        model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
+                                              jnp.asarray(bound, self.dtype))
+        self._next = (model, state)
+        return float(loss), float(gnorm)
+
+    def commit(self, taken, scale):
+        # the compiled step has clipped, and left model and state unchanged where the bound skipped it
+        self.model, self.opt_state = self._next
+
+    def probe(self, batch):
+        return None if self.look is None else self.look(self.model, _to_jax(batch, self.dtype))
+
+    def params(self) -> dict:
+        return models.jax.to_params(self.model)
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)

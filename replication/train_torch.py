@@ -1,22 +1,19 @@
-"""The PyTorch training loop (torch.optim.Adam). Mirrors `train_jax.py` line for line.
+"""The PyTorch optimiser step (torch.optim.Adam) for the one training loop `replication.loop`. Mirrors
+`train_jax.py` line for line.
 
-`train(spec, params, protocol, seed, stream, on_log=None) -> TrainOutcome`: the same steps, the same
-learning rate per step (set on the optimiser before each step), the same logging, and the same
-stop at the first non-finite loss or gradient (checked before the update is applied), and the same
-velocity-Hessian probe at logged steps.
+`Stepper(spec, params, protocol)`: the gradient and its global norm in `propose` (the learning rate set on
+the optimiser there); in `commit`, if the spike guard takes the step, the gradient scaled by the clip
+factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome`:
+`replication.loop.train` with this stepper.
 """
 from __future__ import annotations
-
-import time
 
 import torch
 
 import models.torch
-from replication import hessian_probe
+from replication import hessian_probe, loop
 from replication.objective import loss_value, predict
-from replication.outcome import TrainOutcome, nonfinite_failure
-from replication.schedules import learning_rate
-from replication.spike_guard import SpikeGuard
+from replication.outcome import TrainOutcome
 
 
 def _to_torch(batch: dict, dtype) -> dict:
@@ -48,47 +45,41 @@ def make_probe(spec, protocol):
     return run
 
 
-def train(spec, params, protocol, stream, on_log=None) -> TrainOutcome:
-    dtype = getattr(torch, protocol.dtype)
-    model = models.torch.build(spec, params)
-    loss_fn = make_loss(spec, protocol)
-    look = make_probe(spec, protocol)
-    opt = torch.optim.Adam(model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
-                           eps=protocol.eps, weight_decay=0.0, foreach=False)
-    guard = SpikeGuard(protocol)
-    log, failure, t0, t_probe = [], None, time.perf_counter(), 0.0
-    for k in range(protocol.steps):
-        lr = learning_rate(protocol, k)
-        batch = _to_torch(stream.batch(k), dtype)
-        for group in opt.param_groups:
+class Stepper:
+    def __init__(self, spec, params, protocol):
+        self.dtype = getattr(torch, protocol.dtype)
+        self.model = models.torch.build(spec, params)
+        self.loss_fn = make_loss(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
+                                    eps=protocol.eps, weight_decay=0.0, foreach=False)
+        self.clip_to, self._grads = float(protocol.grad_clip), []
+
+    def propose(self, batch, lr, bound):
+        batch = _to_torch(batch, self.dtype)
+        for group in self.opt.param_groups:
             group["lr"] = lr
-        opt.zero_grad(set_to_none=True)
-        loss = loss_fn(model, batch)
+        self.opt.zero_grad(set_to_none=True)
+        loss = self.loss_fn(self.model, batch)
         loss.backward()
-        bound = guard.threshold(protocol.dtype)
-        grads = [p.grad for p in model.parameters() if p.grad is not None]
-        gnorm_t = torch.sqrt(sum((g * g).sum() for g in grads))
-        gnorm, loss = float(gnorm_t), float(loss.detach())
-        if guard.fails(loss, gnorm):
-            failure = nonfinite_failure(k, loss, gnorm)
-            break
-        if guard.record(gnorm, bound):
-            if guard.clip_scale(gnorm) != 1.0:
-                for g in grads:
-                    g.mul_(guard.clip / gnorm_t)
-            opt.step()
-        if k % protocol.log_every == 0 or k == protocol.steps - 1:
-            row = {"step": k, "loss": loss, "grad_norm": gnorm, "lr": lr,
-                   "wall_s": time.perf_counter() - t0 - t_probe}
-            if guard.active:
-                row["skipped_steps"] = guard.skipped
-            if look is not None:
-                tp = time.perf_counter()
-                row.update(look(model, batch))
-                t_probe += time.perf_counter() - tp
-            log.append(row)
-            if on_log:
-                on_log(row)
-    wall = time.perf_counter() - t0 - t_probe
-    return TrainOutcome(params=models.torch.to_params(model), log=log, failure=failure, train_time_s=wall,
-                        steps_done=k + 1 if failure is None else k, batch=protocol.batch)
+        self._grads = [p.grad for p in self.model.parameters() if p.grad is not None]
+        self._gnorm = torch.sqrt(sum((g * g).sum() for g in self._grads))
+        return float(loss.detach()), float(self._gnorm)
+
+    def commit(self, taken, scale):
+        if not taken:
+            return
+        if scale != 1.0:   # clip: the norm as a tensor, as the JAX step scales inside its graph
+            for g in self._grads:
+                g.mul_(self.clip_to / self._gnorm)
+        self.opt.step()
+
+    def probe(self, batch):
+        return None if self.look is None else self.look(self.model, _to_torch(batch, self.dtype))
+
+    def params(self) -> dict:
+        return models.torch.to_params(self.model)
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)

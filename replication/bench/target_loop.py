@@ -3,13 +3,11 @@ init, or restarts over several inits, with a held-out evaluation at evenly space
 
 `run_protocol(name, spec, protocol, seed=0, on_eval=None, seeds=1) -> (log, final model)`;
 `scout_steps(protocol, seeds)`: the steps of each scout of a restarts run; `heldout_l1(spec, protocol)`:
-model -> held-out L1. The optimiser step, batches, schedule and loss are the suite's
-(`train_jax.make_step`, `data.BatchStream`, `schedules.learning_rate`, `objective`); this loop adds the
-held-out evaluations and step-only timing, for which `train_jax.train` has no hook.
+model -> held-out L1. Every phase is a run of the suite's one training loop (`replication.loop.train`
+with `train_jax.Stepper`, one compiled step shared by the phases); the held-out evaluations are its hook,
+and its step-only timing is the loop's `step_seconds`.
 """
 from __future__ import annotations
-
-import time
 
 import equinox as eqx
 import jax.numpy as jnp
@@ -17,11 +15,10 @@ import numpy as np
 
 import models.jax
 from models import ModelSpec, init_params
-from replication import train_jax
+from replication import loop, train_jax
 from replication.data import BatchStream, heldout
 from replication.objective import loss_value, predict
 from replication.schedules import learning_rate
-from replication.spike_guard import SpikeGuard
 
 N_EVALS = 20
 SCOUT_SAMPLES = 500_000  # restarts: samples per scout (at most half the budget over all scouts)
@@ -45,13 +42,13 @@ def heldout_l1(spec, protocol):
 
 
 class _Loop:
-    """The training loop of one protocol, shared by its phases (one compiled step): `phase(...)` trains a
-    model for a protocol's steps from its own stream and appends a log row at each held-out evaluation;
-    samples, steps, wall seconds and skipped steps accumulate over phases."""
+    """The phases of one protocol (one compiled step): `phase(...)` trains a model for a protocol's steps
+    from its own stream and appends a log row at each held-out evaluation; samples, steps, step-only wall
+    seconds and skipped steps accumulate over phases."""
 
     def __init__(self, name, spec, protocol, on_eval=None):
-        self.name, self.on_eval, self.batch = name, on_eval, protocol.batch
-        self.opt, self.step = train_jax.make_step(spec, protocol)
+        self.name, self.on_eval, self.batch, self.spec = name, on_eval, protocol.batch, spec
+        self.step = train_jax.make_step(spec, protocol)
         self.evaluate = heldout_l1(spec, protocol)
         self.log, self.steps, self.wall, self.skipped, self.compiled = [], 0, 0.0, 0, False
 
@@ -66,29 +63,24 @@ class _Loop:
         """Train for protocol.steps: (model, mean training loss over the last 5 % of the steps, inf if none).
         Stops at a non-finite loss, keeping the last model with a finite one; the phase always ends with a
         row of the log."""
-        state = self.opt.init(eqx.filter(model, eqx.is_inexact_array))
-        stream, guard, dtype = BatchStream(protocol, stream_seed), SpikeGuard(protocol), protocol.dtype
-        every, losses, skipped0 = max(protocol.steps // n_evals, 1), [], self.skipped
-        for k in range(protocol.steps):
-            lr = learning_rate(protocol, k)
-            batch = {key: jnp.asarray(v, dtype) for key, v in stream.batch(k).items()}
-            bound = guard.threshold(dtype)
-            t0 = time.perf_counter()
-            new_model, new_state, loss, gnorm = self.step(model, state, batch, jnp.asarray(lr, dtype),
-                                                          jnp.asarray(bound, dtype))
-            loss, gnorm = float(loss), float(gnorm)
-            if self.compiled:  # the first step compiles: samples_per_s counts the steps after it
-                self.wall += time.perf_counter() - t0
-            self.compiled = True
-            if guard.fails(loss, gnorm):  # the row shows where it stopped, with the last good model
-                self.row(model, f"{phase} (stopped: non-finite loss)", seed, lr, loss)
-                break
-            guard.record(gnorm, bound)
-            model, state, self.steps, self.skipped = new_model, new_state, self.steps + 1, skipped0 + guard.skipped
-            losses.append(loss)
+        every, losses = max(protocol.steps // n_evals, 1), []
+        steps0, wall0, skipped0 = self.steps, self.wall, self.skipped
+        stepper = train_jax.Stepper(self.spec, models.jax.to_params(model), protocol, step=self.step)
+
+        def evaluate(k, st, info):
+            self.steps, self.wall = steps0 + k + 1, wall0 + info["step_seconds"]
+            self.skipped = skipped0 + info["skipped_steps"]
+            losses.append(info["loss"])
             if (k + 1) % every == 0 or k == protocol.steps - 1:
-                self.row(model, phase, seed, lr, loss)
-        return model, float(np.mean(losses[-max(len(losses) // 20, 1):])) if losses else np.inf
+                self.row(st.model, phase, seed, info["lr"], info["loss"])
+
+        out = loop.train(stepper, protocol, BatchStream(protocol, stream_seed), hooks=(evaluate,),
+                         compiled=self.compiled)
+        self.compiled = True
+        if out.failure is not None:   # the row shows where it stopped, with the last good model
+            k = out.failure["step"]
+            self.row(stepper.model, f"{phase} (stopped: non-finite loss)", seed, learning_rate(protocol, k), np.nan)
+        return stepper.model, float(np.mean(losses[-max(len(losses) // 20, 1):])) if losses else np.inf
 
     @property
     def samples(self) -> int:

@@ -7,6 +7,7 @@ from models import ModelSpec
 from replication.bench import target_loop as TL
 from replication.bench import train_target as TT
 from replication.claims.double_pendulum import MODELS
+from replication.spike_guard import SpikeGuard
 
 
 @pytest.fixture(scope="module")
@@ -63,12 +64,12 @@ def test_a_scout_that_fails_is_logged_and_never_chosen(monkeypatch):
     spec = ModelSpec(dof=2, hidden=(8,), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
     n = TL.scout_steps(entry.protocol, 2)
     calls = {"k": 0}
-    real = TL.SpikeGuard.fails
+    real = SpikeGuard.fails
 
     def fails(self, loss, gnorm):
         calls["k"] += 1
         return calls["k"] == n + 1 or real(self, loss, gnorm)
-    monkeypatch.setattr(TL.SpikeGuard, "fails", fails)
+    monkeypatch.setattr(SpikeGuard, "fails", fails)
     log, _ = TL.run_protocol("r", spec, entry.protocol, seeds=2)
     ends = [r for r in log if "scout_loss" in r]
     assert [r["seed"] for r in ends] == [0, 1] and np.isfinite(ends[0]["scout_loss"])
