@@ -21,6 +21,30 @@ from dataclasses import dataclass
 from models.activations import ACTIVATIONS
 
 KINDS = ("baseline", "lnn", "hnn", "delan", "lgn")
+
+
+@dataclass(frozen=True)
+class Capability:
+    """What a model kind can do; consumers read this table instead of keeping their own lists.
+
+    tasks: the protocol tasks it trains on; lagrangian_hessian: its q-double-dot goes through a learned
+    velocity Hessian d2L/dqdot2 (the Hessian probe watches it); torch_compile: formulation -> how PyTorch
+    compiles it ahead of time: "aot" (torch.export + AOTInductor, any batch) or "traced" (torch.func
+    inside: make_fx, then compiled per batch size)."""
+
+    tasks: tuple
+    lagrangian_hessian: bool
+    torch_compile: dict
+
+
+CAPABILITIES = {
+    "baseline": Capability(("acceleration", "inverse_dynamics"), False, {"-": "aot"}),
+    "lnn": Capability(("acceleration",), True, {"fast": "aot", "paper": "traced"}),
+    "hnn": Capability(("hamiltonian",), False, {"-": "aot"}),
+    "delan": Capability(("acceleration", "inverse_dynamics"), False, {"-": "aot"}),
+    "lgn": Capability(("acceleration",), True, {"banded": "aot", "dense": "traced"}),
+}
+assert set(CAPABILITIES) == set(KINDS)
 INITS = ("cranmer2020", "pytorch_default", "xavier", "kaiming")
 FORMULATIONS = ("fast", "paper", "dense", "banded")
 DTYPES = ("float32", "float64")

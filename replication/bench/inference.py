@@ -31,6 +31,7 @@ import numpy as np
 
 import systems
 from models import ModelSpec, init_params
+from models.spec import CAPABILITIES
 from replication.bench.evaluators import make_evaluator, median_rel_error
 from replication.bench.timing import (  # noqa: F401 - TORCH_THREAD_CHOICES is read as inference.*
     PAIRED_ROUNDS,
@@ -47,8 +48,10 @@ DP_KINDS = (("truth", "sympy"), ("lnn", "paper"), ("lnn", "fast"), ("hnn", "-"),
             ("baseline", "-"))
 WAVE_KINDS = (("truth", "sympy"), ("lgn", "dense"), ("lgn", "banded"))
 # kinds that export (torch.export + AOTInductor); the paper LNN and the dense LGN differentiate with torch.func
-AOT_KINDS = (("truth", "sympy"), ("lnn", "fast"), ("hnn", "-"), ("delan", "-"), ("baseline", "-"), ("lgn", "banded"))
-TRACED_KINDS = (("lnn", "paper"), ("lgn", "dense"))  # torch.func inside: traced, then compiled per batch size
+# from the models' capability table (`models.spec.CAPABILITIES`), plus the SymPy truth (hand-written maths)
+AOT_KINDS = (("truth", "sympy"), *((k, f) for k, c in CAPABILITIES.items() for f, how in c.torch_compile.items()
+                                   if how == "aot"))
+TRACED_KINDS = tuple((k, f) for k, c in CAPABILITIES.items() for f, how in c.torch_compile.items() if how == "traced")
 @dataclass
 class Case:
     system: str
