@@ -3,10 +3,11 @@
 A ``Bar`` names the models it covers, an error metric measured on the model's own training
 distribution, and the null predictor's value of that metric that each unit records beside it
 (``null_<metric>``: the better of predicting zero and predicting the held-out mean target, see
-``replication.evaluation_nulls``). A model passes when its seed mean is at most ``fraction`` x the
-null's. ``max_diverged`` bounds the number of diverged rollouts (metric ``n_diverged``, summed over
-seeds) for claims that read rollouts; with ``metric=None`` that is all the bar checks. ``need="any"`` asks only one of the models to pass (a
-study of which init or activation learns at all needs one that did).
+``replication.metrics.null_errors``; for the wave pulse, the pulse left where it started). A model
+passes when its seed mean is at most ``fraction`` x the null's. ``max_diverged`` bounds the number of
+diverged rollouts (metric ``n_diverged``, summed over seeds) for claims that read rollouts; with
+``metric=None`` that is all the bar checks. ``need="any"`` asks only one of the models to pass (a study of
+which init or activation learns at all needs one that did).
 
 A model below its bar makes its claim "inconclusive", never "reproduced" or "not reproduced":
 a model that has not learned its task says nothing about the paper.
