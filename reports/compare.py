@@ -1,7 +1,9 @@
 """Comparison tables: cross-framework agreement and the cheapest model reaching the best error.
 
 ``cross_framework_table`` compares every framework with the first one (per claim and model: means,
-relative difference of means, and the largest per-seed difference over seeds run in both).
+relative difference of means, the largest per-seed difference over seeds run in both, and beside them
+the seed spread for scale: the larger of the two frameworks' seed standard deviations; "yes" in
+"beyond spread" flags a difference of means larger than that spread).
 ``cheapest_table`` picks, per claim, among (framework, model) whose mean claim metric is within
 ``tolerance`` x the best (lowest) mean, the one with the highest training throughput
 (``train_samples_per_s``; else the shortest ``train_time_s``), counting only models that passed their
@@ -45,11 +47,18 @@ def cross_framework_table(res: Results) -> pd.DataFrame | None:
                 if a and b:
                     scale = max(abs(a["mean"]), abs(b["mean"]))
                     rel = num(abs(a["mean"] - b["mean"]) / scale) if scale > 0 else "0"
+                spread = max((s["std"] for s in (a, b) if s and s["n"] > 1 and math.isfinite(s["std"])),
+                             default=None)
+                beyond = NOT_RUN
+                if a and b and spread is not None:
+                    beyond = "yes" if abs(a["mean"] - b["mean"]) > spread else "no"
                 rows.append({
                     "claim": claim["id"], "model": model, "metric": metric or "unknown",
                     ref: num(a["mean"]) if a else NOT_RUN, fw: num(b["mean"]) if b else NOT_RUN,
                     "rel. diff of means": rel,
                     "max per-seed abs. diff": num(max(diffs)) if diffs else NOT_RUN,
+                    "seed spread (std)": num(spread) if spread is not None else NOT_RUN,
+                    "beyond spread": beyond,
                     "seeds in both": str(len(diffs)),
                 })
     return pd.DataFrame(rows) if rows else None

@@ -192,7 +192,9 @@ def agreement_sections(res: Results) -> list[Section]:
                    f"{', '.join(fws) if fws else 'none'})."))
     else:
         s.add(Para(f"Each framework against {fws[0]}: the same protocol, initial parameters and batch order, "
-                   "so differences come from floating-point order of operations and library kernels."))
+                   "so differences come from floating-point order of operations and library kernels. The seed "
+                   "spread is there for scale: a difference beyond it ('beyond spread': yes) is larger than the "
+                   "variation between seeds of one framework, which float32 chaos alone rarely explains."))
         s.add(Table("Claim metric per framework", table, ["units/*/*/*/seed*/result.json"]))
     if "ratios" in res.bench:
         s.add(Table("JAX against PyTorch speed per operation", _bench_table(res.bench["ratios"]),

@@ -155,3 +155,18 @@ def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(results_
     assert "This run is unfinished: 4 planned unit(s) have no result" in md
     assert "| units/dp_loss/jax/baseline/seed0 | missing |" in md
     assert "No failed, corrupt or missing units" not in md
+
+
+def test_cross_framework_table_flags_a_difference_beyond_the_seed_spread(results_dir):
+    from reports.compare import cross_framework_table
+    from reports.load import load_results
+
+    df = cross_framework_table(load_results(results_dir)).set_index(["claim", "model"])
+    row = df.loc[("dp_loss", "baseline")]
+    assert row["seed spread (std)"] != "not run" and row["beyond spread"] in ("yes", "no")
+    # the flag follows the numbers shown (means and spread, as printed)
+    flags = df["beyond spread"][df["beyond spread"] != "not run"]
+    for (claim, model), flag in flags.items():
+        r = df.loc[(claim, model)]
+        gap = abs(float(r["jax"]) - float(r["torch"]))
+        assert (flag == "yes") == (gap > float(r["seed spread (std)"])), (claim, model)
