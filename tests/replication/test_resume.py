@@ -83,3 +83,48 @@ def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
     (new,) = tmp_path.glob("units/dp_energy/jax/baseline/seed0/result.json")
     assert R.load_result(new.parent)["eval_config"]["n_ics"] == 2
     assert len(list(tmp_path.glob("units/dp_energy/jax/baseline/superseded-*-seed0/result.json"))) == 1
+
+
+def test_compiled_code_is_released_after_every_unit(tmp_path, monkeypatch):
+    """JAX's compiled executables are dropped after each unit: kept, their memory mappings pile up until
+    a long run dies at the kernel's per-process limit (a 220-unit quick run did, at unit 202)."""
+    import jax
+
+    from replication import runner
+
+    calls = []
+    real = jax.clear_caches
+    monkeypatch.setattr(jax, "clear_caches", lambda: (calls.append(1), real()))
+    runner.run(profile="smoke", out=tmp_path, claims=["appendix_b", "hnn_energy"], frameworks=("jax",),
+               progress=False)
+    n_units = len(runner.plan("smoke", claims=["appendix_b", "hnn_energy"], frameworks=("jax",)))
+    assert len(calls) == n_units > 1
+
+
+def _map_count() -> int:
+    with open("/proc/self/maps") as fh:
+        return sum(1 for _ in fh)
+
+
+def test_released_compilations_keep_the_memory_map_count_flat():
+    """The mechanism behind the release, measured: adapters compiled one after another, released after
+    each, leave the process's memory-map count where it was."""
+    import os
+
+    import numpy as np
+    import pytest
+
+    from models import ModelSpec, init_params
+    from replication.adapters import adapter
+    from replication.runner import release_compiled
+
+    if not os.path.exists("/proc/self/maps"):
+        pytest.skip("no /proc/self/maps on this system")
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), dtype="float32")
+    q = np.random.default_rng(0).normal(size=(16, 2))
+    counts = []
+    for seed in range(6):
+        adapter("jax", spec, init_params(spec, seed=seed)).acceleration(q, q, None)
+        release_compiled()
+        counts.append(_map_count())
+    assert max(counts[2:]) - min(counts[2:]) < 50, counts
