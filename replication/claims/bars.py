@@ -64,13 +64,16 @@ class Bar:
 def competence(bars, v: dict) -> tuple[bool, list[str], dict]:
     """Apply every bar to ``v = {label: {metric: Stat}}`` (one framework).
 
-    Returns (all bars met, reasons of the failures, {label: (passed, why)} for each model with a bar).
+    Returns (all bars met, reasons of the failures, {label: (passed all its bars, why)} for each model
+    with a bar).
     A model a bar names but ``v`` lacks is not judged here (the verdict reports it missing)."""
     ok, why, per = True, [], {}
     for bar in bars:
         present = [x for x in bar.models if x in v]
         res = {x: bar.check(x, v[x]) for x in present}
-        per.update(res)
+        for x, (p, w) in res.items():   # a model under several bars passes only if it passes them all
+            p0, w0 = per.get(x, (True, ""))
+            per[x] = (p0 and p, f"{w0}; {w}" if w0 else w)
         passed = [x for x, (p, _) in res.items() if p]
         met = bool(passed) if bar.need == "any" else len(passed) == len(present)
         if present and not met:

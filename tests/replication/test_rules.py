@@ -112,3 +112,10 @@ def test_competence_all_and_any():
     assert ok
     ok, why, _ = competence((Bar(("b",), need="any"),), vals)
     assert not ok and why[0].startswith("none of them passed")
+
+
+def test_a_model_under_two_bars_passes_only_if_it_passes_both():
+    vals = {"a": _with_null(9.0, n_div=0)}
+    ok, _, per = competence((Bar(("a",), "heldout_l1"), Bar(("a",), None, max_diverged=0)), vals)
+    assert not ok and per["a"][0] is False
+    assert "heldout_l1 9 > 0.1 x null 10" in per["a"][1] and "0 diverged rollouts" in per["a"][1]
