@@ -59,7 +59,7 @@ def is_current(unit, out) -> bool:
     except R.CorruptResult:
         return False
     cfg = unit.claim.eval_config.get(unit.profile, {})
-    # results written before evaluation configs were recorded carry none: judged on protocol and spec only
+    # a result that records no evaluation config or version predates them: stale, re-evaluated
     same_eval = (d.get("eval_config") == json.loads(json.dumps(cfg))
                  and d.get("evaluation_version") == EVALUATION_VERSION)
     if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
