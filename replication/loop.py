@@ -6,7 +6,8 @@ A framework gives one optimiser step as a *stepper* (`train_jax.Stepper`, `train
                                                not applied; `bound` is the spike guard's skip threshold
   commit(taken, scale)                          apply the prepared update if `taken`, the gradient scaled
                                                by `scale` (the guard's clip factor)
-  probe(batch) -> dict | None                   the velocity-Hessian health columns (`hessian_probe`)
+  probe() -> dict | None                        the velocity-Hessian health columns (`hessian_probe`) of
+                                               the current model on the batch last proposed
   params() -> dict                              the current parameters, `models.params` layout (NumPy)
 
 `train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False) -> TrainOutcome` runs
@@ -51,7 +52,7 @@ def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False) -> T
             if guard.active:
                 row["skipped_steps"] = guard.skipped
             tp = time.perf_counter()
-            row.update(stepper.probe(batch) or {})
+            row.update(stepper.probe() or {})
             t_probe += time.perf_counter() - tp
             log.append(row)
             if on_log:

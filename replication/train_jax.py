@@ -88,7 +88,7 @@ class Stepper:
         self._next = None
 
     def propose(self, batch, lr, bound):
-        batch = _to_jax(batch, self.dtype)
+        batch = self._batch = _to_jax(batch, self.dtype)
         model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
                                               jnp.asarray(bound, self.dtype))
         self._next = (model, state)
@@ -98,8 +98,8 @@ class Stepper:
         # the compiled step has clipped, and left model and state unchanged where the bound skipped it
         self.model, self.opt_state = self._next
 
-    def probe(self, batch):
-        return None if self.look is None else self.look(self.model, _to_jax(batch, self.dtype))
+    def probe(self):
+        return None if self.look is None else self.look(self.model, self._batch)
 
     def params(self) -> dict:
         return models.jax.to_params(self.model)

@@ -56,7 +56,7 @@ class Stepper:
         self.clip_to, self._grads = float(protocol.grad_clip), []
 
     def propose(self, batch, lr, bound):
-        batch = _to_torch(batch, self.dtype)
+        batch = self._batch = _to_torch(batch, self.dtype)
         for group in self.opt.param_groups:
             group["lr"] = lr
         self.opt.zero_grad(set_to_none=True)
@@ -74,8 +74,8 @@ class Stepper:
                 g.mul_(self.clip_to / self._gnorm)
         self.opt.step()
 
-    def probe(self, batch):
-        return None if self.look is None else self.look(self.model, _to_torch(batch, self.dtype))
+    def probe(self):
+        return None if self.look is None else self.look(self.model, self._batch)
 
     def params(self) -> dict:
         return models.torch.to_params(self.model)

@@ -105,7 +105,7 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
         s = sub[sub["framework"] == fw]
         ok = s[s["status"] == "ok"]
         bad = s[s["status"] != "ok"]
-        failed = {m: ", ".join(sorted({str(k) for k in g["failure"] if isinstance(k, str)}) or {"failed"})
+        failed = {m: ", ".join(sorted({k for k in g.get("failure", ()) if isinstance(k, str)})) or "failed"
                   for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
         v = model_stats(ok)
         verdict, reason, per = _decide(claim, v, failed)
