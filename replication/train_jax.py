@@ -6,6 +6,12 @@ rate the loop passes; clipped to `protocol.grad_clip` and skipped above the spik
 compiled step, `replication.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
 `make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
 stream, on_log=None, hooks=()) -> TrainOutcome`: `replication.loop.train` with this stepper.
+
+`Members(spec, params_list, protocol, step=None)`: K models of one spec trained as one program (the
+stepper of `replication.loop.train_members`): the parameters and Adam states stacked along a leading axis
+and the same compiled step `eqx.filter_vmap`-ed over them and over the K batches (`make_members_step`);
+each member's numbers are those of its own `Stepper` run (`tests/replication/test_members_parity.py`).
+`train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> [TrainOutcome]`.
 """
 from __future__ import annotations
 
@@ -107,3 +113,53 @@ class Stepper:
 
 def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
     return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)
+
+
+def _stack(trees):
+    return jax.tree_util.tree_map(lambda *a: jnp.stack(a), *trees)
+
+
+def make_members_step(spec, protocol):
+    """(optax transform, the `make_step` step vmapped over stacked models, states, batches and bounds)."""
+    opt, step = make_step(spec, protocol)
+    return opt, eqx.filter_jit(eqx.filter_vmap(step, in_axes=(0, 0, 0, None, 0)))
+
+
+class Members:
+    def __init__(self, spec, params_list, protocol, step=None):
+        self.dtype = jnp.dtype(protocol.dtype)
+        built = [models.jax.build(spec, p) for p in params_list]
+        self.static = eqx.filter(built[0], eqx.is_array, inverse=True)
+        self.model = eqx.combine(_stack([eqx.filter(m, eqx.is_array) for m in built]), self.static)
+        self.opt, self.step = step or make_members_step(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt_state = eqx.filter_vmap(self.opt.init)(eqx.filter(self.model, eqx.is_inexact_array))
+        self.n, self._next = len(built), None
+
+    def member(self, i: int):
+        return eqx.combine(jax.tree_util.tree_map(lambda a: a[i], eqx.filter(self.model, eqx.is_array)),
+                           self.static)
+
+    def propose(self, batches, lr, bounds):
+        batch = self._batch = _stack([_to_jax(b, self.dtype) for b in batches])
+        model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
+                                              jnp.asarray(bounds, self.dtype))
+        self._next = (model, state)
+        return np.asarray(loss, np.float64), np.asarray(gnorm, np.float64)
+
+    def commit(self, taken, scale):
+        # as Stepper: the compiled step has clipped each member and skipped those above their bound
+        self.model, self.opt_state = self._next
+
+    def probe(self):
+        if self.look is None:
+            return None
+        return [self.look(self.member(i), jax.tree_util.tree_map(lambda a: a[i], self._batch))
+                for i in range(self.n)]
+
+    def params(self) -> list[dict]:
+        return [models.jax.to_params(self.member(i)) for i in range(self.n)]
+
+
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
+    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks)

@@ -112,6 +112,11 @@ def small_inverse(h):
     return torch.linalg.inv_ex(h)
 
 
+def _vmapped(x) -> bool:
+    """Whether x is batched by torch.func.vmap (the training of stacked members, `replication.ensemble`)."""
+    return torch._C._functorch.is_batchedtensor(x)
+
+
 def solve_with_fallback(hess, rhs):
     """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. A captured graph
     has no Python branch on data: under torch.export, and under make_fx without gradients
@@ -138,6 +143,8 @@ def solve_with_fallback(hess, rhs):
     elif traced or torch.compiler.is_exporting():  # no Python branch on data in a captured graph
         x = torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], pinv_solve(h, r), y),
                        lambda h, r, b, y: y.clone(), (hess.contiguous(), rhs.contiguous(), bad, x.contiguous()))
+    elif _vmapped(hess):   # stacked members (torch.func.vmap): no branch on data; pinv on every sample
+        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
     elif bool(torch.any(bad)):
         x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
     return x, torch.sum(bad)
@@ -191,9 +198,11 @@ class LNN(Model):
         x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         s_q, s_qd = scale[:d], scale[d:2 * d]
-        tangents = torch.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype, device=x.device)
-        tangents[:, :d, d:2 * d] = torch.diag(s_qd)
-        tangents[:, d, :d] = qdot * s_q
+        width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
+        zeros = torch.zeros((d, width - 2 * d), dtype=x.dtype, device=x.device)
+        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd), zeros], -1)
+        mixed = torch.cat([qdot * s_q, torch.zeros((n, width - d), dtype=x.dtype, device=x.device)], -1)
+        tangents = torch.cat([rows.expand(n, d, width), mixed[:, None, :]], 1)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
         return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
 
