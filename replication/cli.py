@@ -48,13 +48,28 @@ def cmd_report(args):
         print(f"{k}: {len(v)} files in {Path(args.out) / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
 
+def widths(text: str, option: str = "--hidden") -> tuple:
+    """Layer widths from "128,128"; a ValueError naming `option` otherwise."""
+    try:
+        out = tuple(int(x) for x in text.split(","))
+    except ValueError:
+        out = ()
+    if not out or min(out) < 1:
+        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
+    return out
+
+
 def cmd_fit(args):
     from replication.fit import fit
 
     d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
-            hidden=tuple(int(x) for x in args.hidden.split(",")), batch=args.batch, lr=args.lr, seed=args.seed,
-            loss=args.loss)
-    print(f"{d['status']}: held-out L1 {d['metrics'].get('heldout_l1')}, written to {args.out}")
+            hidden=widths(args.hidden), batch=args.batch, lr=args.lr, seed=args.seed, loss=args.loss)
+    folder = Path(args.out) / "units" / "fit" / args.framework / args.model / f"seed{args.seed}"
+    if d["status"] != "ok":
+        print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
+        return 1
+    again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
+    print(f"ok: held-out L1 {d['metrics'].get('heldout_l1')}, written to {folder}{again}")
 
 
 def cmd_bench(args):
@@ -78,10 +93,7 @@ def cmd_train_target(args):
 
     folder = Path(args.out) / "train_target"
     names = _csv(args.protocols)
-    try:
-        hidden = [int(h) for h in args.hidden.split(",")]
-    except ValueError:
-        raise ValueError(f"--hidden takes comma-separated layer widths such as 128,128,128, got {args.hidden!r}") from None
+    hidden = list(widths(args.hidden))
     table = train_target.protocols(1000, 1)
     n = sum(train_target.n_evaluations(table[k]) for k in (names or table) if k in table)
     bar = tqdm(total=n, desc="lagbench train-target", unit="eval", disable=args.quiet)

@@ -42,6 +42,21 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         raise
 
 
+def output_folder(path, option: str = "--out") -> Path:
+    """`path` as a folder this process can write into, created if absent; else a ValueError naming
+    `option` (checked before any work starts, so no computation is lost to a bad output folder)."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{option} {path}: exists and is not a folder; give a folder path")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise ValueError(f"{option} {path}: cannot create the folder ({e.strerror or e})") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise ValueError(f"{option} {path}: the folder is not writable; give a writable folder")
+    return path
+
+
 def _clean(obj):
     """JSON-safe: NumPy scalars to Python, NaN to None. +-inf stay (JSON `Infinity`, which Python and
     pandas read back): a diverged rollout's error is +inf, and a verdict must see it as such."""

@@ -64,11 +64,21 @@ def is_current(unit, out) -> bool:
                  and d.get("evaluation_version") == EVALUATION_VERSION)
     if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
         return True
-    stamp = env.now().replace(":", "").replace("-", "")
-    folder.rename(folder.with_name(f"superseded-{stamp}-{folder.name}"))
-    log.warning("%s: its result was made under another protocol or spec; kept as superseded-%s-%s and rerun",
-                unit.name, stamp, folder.name)
+    kept = set_aside(folder)
+    log.warning("%s: its result was made under another protocol, spec or data; kept as %s and rerun",
+                unit.name, kept.name)
     return False
+
+
+def set_aside(folder: Path) -> Path:
+    """Rename `folder` to `superseded-<time>-<name>` (with a counter if that exists): never clobbered."""
+    stamp = env.now().replace(":", "").replace("-", "")
+    for i in range(1000):
+        target = folder.with_name(f"superseded-{stamp}{f'.{i}' if i else ''}-{folder.name}")
+        if not target.exists():
+            folder.rename(target)
+            return target
+    raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
 def release_compiled() -> None:

@@ -58,7 +58,7 @@ def test_user_data_errors(tmp_path):
     (tmp_path / "e.npz").write_bytes(b"not a zip")
     with pytest.raises(ValueError, match="cannot read"):
         userdata.load(str(tmp_path / "e.npz"))
-    with pytest.raises(ValueError, match="unknown model"):
+    with pytest.raises(ValueError, match="--model"):
         fit(_write(tmp_path, "f.csv", **ok), model="gpt")
 
 

@@ -1,0 +1,102 @@
+"""`lagbench fit` under changed data, repeated runs and bad options: nothing stale, nothing lost, no
+silent failure (issue 25, cases 1, 2 and 6)."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from replication import results as R
+from replication.cli import main
+from replication.fit import fit
+
+FAST = {"model": "baseline", "steps": 4, "hidden": (8,), "batch": 16}
+
+
+def _pendulum(path, scale=1.0, rows=40):
+    rng = np.random.default_rng(3)
+    q, qdot = rng.normal(size=(rows, 1)), rng.normal(size=(rows, 1))
+    np.savez(path, q=q, qdot=qdot, qddot=-9.81 * np.sin(q) * scale)
+    return path
+
+
+def test_changed_data_is_trained_afresh_and_the_old_fit_is_kept(tmp_path):
+    data, out = _pendulum(tmp_path / "d.npz"), tmp_path / "out"
+    first = fit(data, out=out, **FAST)
+    again = fit(data, out=out, **FAST)  # same bytes, same options: the verified earlier fit
+    assert again["reused"] and again["checksum"] == first["checksum"]
+    _pendulum(data, scale=100.0)
+    second = fit(data, out=out, **FAST)
+    assert "reused" not in second
+    assert second["protocol"]["data"] != first["protocol"]["data"]
+    assert second["final_train_loss"] != pytest.approx(first["final_train_loss"])
+    assert len(list((out / "trained" / "jax").iterdir())) == 2  # one training per content
+    (old,) = out.glob("units/fit/jax/baseline/superseded-*-seed0/result.json")
+    assert R.load_result(old.parent)["checksum"] == first["checksum"]
+
+
+def test_a_file_edited_after_setup_is_refused(tmp_path):
+    from replication import userdata
+
+    data = _pendulum(tmp_path / "d.npz")
+    digest, _ = userdata.read(str(data))
+    _pendulum(data, scale=2.0)
+    with pytest.raises(ValueError, match="changed since"):
+        userdata.split_rows(userdata.reference(str(data), digest).removeprefix("file:"), "acceleration", "train")
+
+
+def _csv(path, header, rows=40, big=False):
+    rng = np.random.default_rng(0)
+    values = rng.normal(size=(rows, len(header)))
+    if big:
+        values[5, -1] = 1e300
+    pd.DataFrame(values, columns=header).to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize("header, big, message", [
+    (["q0", " qdot0", " qddot0"], False, None),  # spaces after the commas are ignored
+    (["q0", "q2", "qdot0", "qdot1", "qddot0", "qddot1"], False, "without gaps"),
+    (["q0", "qdot0", "qddot0"], True, "beyond the float32 range"),
+])
+def test_csv_headers_gaps_and_float32_range(tmp_path, header, big, message):
+    path = _csv(tmp_path / "d.csv", header, big=big)
+    if message is None:
+        assert fit(path, out=tmp_path / "out", **FAST)["status"] == "ok"
+    else:
+        with pytest.raises(ValueError, match=message):
+            fit(path, out=tmp_path / "out", **FAST)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--hidden", "8,abc"], ["--hidden", "128,128"]),
+    (["--hidden", "0"], ["--hidden"]),
+    (["--model", "gpt"], ["--model", "lnn, hnn, delan, baseline"]),
+    (["--framework", "mxnet"], ["--framework", "jax, torch"]),
+    (["--loss", "huber"], ["--loss", "l1, mse"]),
+    (["--steps", "0"], ["--steps", ">= 1"]),
+    (["--batch", "-3"], ["--batch", ">= 1"]),
+    (["--lr", "nan"], ["--lr", "> 0"]),
+    (["--seed", "-1"], ["--seed", ">= 0"]),
+])
+def test_bad_fit_options_name_the_option_before_any_work(tmp_path, capsys, args, words):
+    out = tmp_path / "out"
+    assert main(["fit", "--data", str(tmp_path / "absent.npz"), "--model", "baseline", "--out", str(out),
+                 *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and all(w in err for w in words), err
+    assert not out.exists()
+
+
+def test_out_is_checked_before_training(tmp_path, capsys):
+    data = _pendulum(tmp_path / "d.npz")
+    (tmp_path / "file").write_text("x")
+    assert main(["fit", "--data", str(data), "--model", "baseline", "--out", str(tmp_path / "file")]) == 2
+    assert "--out" in capsys.readouterr().err
+    assert not list(tmp_path.glob("**/trained"))
+
+
+def test_a_failed_fit_exits_non_zero_with_its_reason(tmp_path, capsys):
+    data = _pendulum(tmp_path / "d.npz")
+    code = main(["fit", "--data", str(data), "--model", "baseline", "--out", str(tmp_path / "o"), "--steps", "3",
+                 "--hidden", "8", "--lr", "1e38"])
+    err = capsys.readouterr().err
+    assert code == 1 and "fit failed: non-finite" in err, err
