@@ -13,10 +13,11 @@ import io
 import json
 import math
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from systems.files import atomic_write
 
 SCHEMA = 1
 
@@ -26,20 +27,9 @@ class CorruptResult(Exception):
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Write ``data`` to ``path`` through a temporary file in the same folder, an fsync and a rename
+    (``systems.files.atomic_write``): never half-written, never through a symlink, mode per umask."""
+    atomic_write(Path(path), data, sync=True)
 
 
 def output_folder(path, option: str = "--out") -> Path:

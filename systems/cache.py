@@ -1,10 +1,15 @@
-"""Checksummed on-disk cache for generated source text and NumPy datasets.
+"""Authenticated on-disk cache for generated source text and NumPy datasets.
 
 Location: ``$LAGBENCH_CACHE`` (default ``.cache/`` under the current directory), subfolders
-``codegen/`` and ``datasets/``. Every entry carries a SHA-256 of its content; a file that
-fails verification (checksum mismatch, truncation, unreadable archive) is reported by
-``load_*`` as missing (``None``) and logged at INFO level, so callers regenerate it. Writes are
-atomic (temporary file + ``os.replace``), safe for concurrent processes.
+``codegen/`` and ``datasets/``. The folder is not trusted: every entry carries an HMAC-SHA256 of its
+kind, name (a hash of everything it is derived from) and content under the user's private key
+(``systems.cache_key``), so only entries this user's lagbench wrote are ever read, and generated
+code is executed only from those. A checksum stored beside a file would authenticate nothing: anyone
+able to plant the file can recompute it. A file that fails verification (planted, edited, truncated,
+unreadable, a symlink, made by an older version) is reported by ``load_*`` as missing (``None``) and
+logged at INFO level, so callers regenerate and overwrite it. Without a private key nothing is loaded
+or stored. Writes are atomic (temporary file + ``os.replace``, which replaces a symlink rather than
+following it), safe for concurrent processes, with the mode the umask allows.
 
 - ``load_text(kind, name) -> str | None``, ``store_text(kind, name, text)``
 - ``load_arrays(name) -> dict[str, np.ndarray] | None``, ``store_arrays(name, arrays)``
@@ -16,15 +21,17 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from systems import cache_key
+from systems.files import atomic_write, read_nofollow
+
 log = logging.getLogger(__name__)
 
-_HEADER = "# lagbench-cache sha256="
-_CHECKSUM_KEY = "__sha256__"
+_HEADER = "# lagbench-cache hmac-sha256="
+_CHECKSUM_KEY = "__hmac_sha256__"
 
 
 def cache_dir(kind: str) -> Path:
@@ -36,43 +43,33 @@ def digest(*parts) -> str:
     return hashlib.sha256("\x1f".join(repr(p) for p in parts).encode()).hexdigest()
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def text_path(kind: str, name: str) -> Path:
     return cache_dir(kind) / f"{name}.py"
 
 
-def store_text(kind: str, name: str, text: str) -> Path:
+def store_text(kind: str, name: str, text: str) -> Path | None:
+    tag = cache_key.tag(kind, name, text.encode())
+    if tag is None:
+        return None
     path = text_path(kind, name)
-    check = hashlib.sha256(text.encode()).hexdigest()
-    _atomic_write(path, f"{_HEADER}{check}\n{text}".encode())
+    atomic_write(path, f"{_HEADER}{tag}\n{text}".encode())
     return path
 
 
 def load_text(kind: str, name: str) -> str | None:
     path = text_path(kind, name)
-    if not path.exists():
+    if not os.path.lexists(path):
         return None
     try:
-        raw = path.read_bytes().decode()
+        raw = read_nofollow(path).decode()
         header, _, body = raw.partition("\n")
         if not header.startswith(_HEADER):
-            raise ValueError("missing checksum header")
-        if hashlib.sha256(body.encode()).hexdigest() != header[len(_HEADER) :]:
-            raise ValueError("checksum mismatch")
+            raise ValueError("no authentication header")
+        if not cache_key.verify(kind, name, body.encode(), header[len(_HEADER) :]):
+            raise ValueError("not written by this user's lagbench (authentication failed)")
         return body
     except (OSError, UnicodeDecodeError, ValueError) as err:
-        log.info("cache entry %s is corrupt (%s); regenerating", path, err)
+        log.info("cache entry %s is not trusted (%s); regenerating", path, err)
         return None
 
 
@@ -89,27 +86,32 @@ def array_path(name: str) -> Path:
     return cache_dir("datasets") / f"{name}.npz"
 
 
-def store_arrays(name: str, arrays: dict) -> Path:
+def store_arrays(name: str, arrays: dict) -> Path | None:
     import io
 
     arrays = {k: np.asarray(v) for k, v in arrays.items()}
+    tag = cache_key.tag("datasets", name, _array_checksum(arrays).encode())
+    if tag is None:
+        return None
     buf = io.BytesIO()
-    np.savez(buf, **arrays, **{_CHECKSUM_KEY: np.array(_array_checksum(arrays))})
+    np.savez(buf, **arrays, **{_CHECKSUM_KEY: np.array(tag)})
     path = array_path(name)
-    _atomic_write(path, buf.getvalue())
+    atomic_write(path, buf.getvalue())
     return path
 
 
 def load_arrays(name: str) -> dict | None:
+    import io
+
     path = array_path(name)
-    if not path.exists():
+    if not os.path.lexists(path):
         return None
     try:
-        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as data:
+        with np.load(io.BytesIO(read_nofollow(path)), allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
         stored = str(arrays.pop(_CHECKSUM_KEY))
-        if stored != _array_checksum(arrays):
-            raise ValueError("checksum mismatch")
+        if not cache_key.verify("datasets", name, _array_checksum(arrays).encode(), stored):
+            raise ValueError("not written by this user's lagbench (authentication failed)")
         return arrays
     except Exception as err:  # any unreadable or inconsistent file is regenerated, never trusted
         log.info("cached dataset %s is corrupt (%s); regenerating", path, err)
