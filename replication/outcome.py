@@ -18,6 +18,7 @@ class TrainOutcome:
     batch: int
     step_seconds: float = 0.0   # time in the optimiser steps after the first (compiling) one
     skipped_steps: int = 0      # steps the spike guard skipped
+    scouting: dict | None = None  # restarts (`replication.scouting`): init seeds, tail losses, the chosen one
 
     @property
     def samples_per_s(self) -> float:

@@ -20,7 +20,9 @@ SCHEDULES = ("constant", "step", "onecycle")
 DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
-GUARD_FIELDS = ("grad_clip", "spike_skip")   # omitted from to_dict while 0 (off)
+GUARD_FIELDS = ("grad_clip", "spike_skip")
+SCOUT_FIELDS = ("scouts", "scout_steps")
+OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS   # omitted from to_dict while 0 (off), so older keys hold
 
 
 @dataclass(frozen=True)
@@ -42,6 +44,11 @@ class Protocol:
                rescales a gradient whose global norm exceeds it; spike_skip skips a step (no update, Adam
                state kept) whose gradient norm is at least spike_skip x the median of the recent ones.
                Left out of `to_dict` (and so of `key`) while 0, so older protocols keep their keys.
+    scouts/scout_steps: restarts over initialisations (`replication.scouting`); scouts <= 1 = off. With
+               scouts = K > 1 the run trains K initialisations side by side for scout_steps each (0: 5e5
+               samples each, at most half the budget over all of them), continues the one with the lowest
+               training loss for the rest of `steps` (every scout's steps count in `steps`). Left out of
+               `to_dict` while 0, as the guard.
     """
 
     data: str
@@ -66,6 +73,8 @@ class Protocol:
     l2: float = 0.0
     grad_clip: float = 0.0
     spike_skip: float = 0.0
+    scouts: int = 0
+    scout_steps: int = 0
     dtype: str = "float32"
     log_every: int = 50
     eval: dict = field(default_factory=dict, hash=False, compare=True)
@@ -87,11 +96,18 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
+        for name in SCOUT_FIELDS:
+            v = getattr(self, name)
+            if not (v == 0 or _positive_integer(v)):
+                raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")
+        if self.scouts > 1 and self.scout_steps and self.scouts * self.scout_steps >= self.steps:
+            raise ValueError(f"{self.scouts} scouts x {self.scout_steps} scout_steps leave nothing of the "
+                             f"{self.steps} steps to continue the chosen one")
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["system_params"] = [list(p) for p in self.system_params]
-        for name in GUARD_FIELDS:
+        for name in OPTIONAL_FIELDS:
             if not d[name]:
                 del d[name]
         return d

@@ -17,6 +17,7 @@ from models import init_params
 from replication import results as R
 from replication.data import BatchStream, targets_version
 from replication.outcome import TrainOutcome, log_frame
+from replication.scouting import train_scouted
 
 log = logging.getLogger("lagbench")
 
@@ -30,16 +31,24 @@ def train_key(framework, spec, protocol, seed) -> str:
     return hashlib.sha256(blob).hexdigest()[:20]
 
 
-def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
-    params = init_params(spec, seed=seed)
-    stream = BatchStream(protocol, seed)
+def trainer(framework):
+    """The framework's training module (`train_jax` or `train_torch`: `train`, `train_members`)."""
     if framework == "jax":
-        from replication.train_jax import train
+        from replication import train_jax as module
     elif framework == "torch":
-        from replication.train_torch import train
+        from replication import train_torch as module
     else:
         raise ValueError(f"unknown framework {framework!r}; valid: jax, torch")
-    return train(spec, params, protocol, stream, on_log=on_log)
+    return module
+
+
+def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    """One run of a protocol from the init of `seed`; with `protocol.scouts` > 1, restarts over inits
+    (`replication.scouting`)."""
+    if protocol.scouts > 1:
+        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log)
+    return trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
+                                    on_log=on_log)
 
 
 def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
@@ -53,12 +62,13 @@ def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutc
         return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
                             log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
                             failure=meta["failure"], train_time_s=meta["train_time_s"],
-                            steps_done=meta["steps_done"], batch=meta["batch"])
+                            steps_done=meta["steps_done"], batch=meta["batch"], scouting=meta.get("scouting"))
     outcome = run_training(framework, spec, protocol, seed, on_log=on_log)
     files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
              "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
+                                          "scouting": outcome.scouting,
                                           "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)
     return outcome

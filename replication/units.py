@@ -73,6 +73,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "train_steps": outcome.steps_done if outcome else 0,
         "train_samples_per_s": outcome.samples_per_s if outcome else None,
         "final_train_loss": outcome.log[-1]["loss"] if outcome and outcome.log else None,
+        "scouting": outcome.scouting if outcome else None,
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

@@ -1,11 +1,11 @@
 """The training loop of the train-to-target study (`replication.bench.train_target`): one run from one
 init, or restarts over several inits, with a held-out evaluation at evenly spaced steps.
 
-`run_protocol(name, spec, protocol, seed=0, on_eval=None, seeds=1) -> (log, final model)`;
-`scout_steps(protocol, seeds)`: the steps of each scout of a restarts run; `heldout_l1(spec, protocol)`:
-model -> held-out L1. Every phase is a run of the suite's one training loop (`replication.loop.train`
-with `train_jax.Stepper`, one compiled step shared by the phases); the held-out evaluations are its hook,
-and its step-only timing is the loop's `step_seconds`.
+`run_protocol(name, spec, protocol, seed=0, on_eval=None) -> (log, final model)`; `heldout_l1(spec,
+protocol)`: model -> held-out L1. Every phase is a run of the suite's one training loop (`replication.loop`:
+the scouts of a restarts protocol side by side through `replication.scouting`, a single run and the
+continuation with `train_jax.Stepper`); the held-out evaluations are its hook, and its step-only timing is
+the loop's `step_seconds`.
 """
 from __future__ import annotations
 
@@ -15,20 +15,12 @@ import numpy as np
 
 import models.jax
 from models import ModelSpec, init_params
-from replication import loop, train_jax
+from replication import loop, scouting, train_jax
 from replication.data import BatchStream, heldout
 from replication.objective import loss_value, predict
 from replication.schedules import learning_rate
 
 N_EVALS = 20
-SCOUT_SAMPLES = 500_000  # restarts: samples per scout (at most half the budget over all scouts)
-
-
-def scout_steps(protocol, seeds: int) -> int:
-    """Steps of each scouting run of a restarts protocol: SCOUT_SAMPLES samples, at most half the budget
-    over all seeds together, at least 3 steps."""
-    per = min(SCOUT_SAMPLES, protocol.steps * protocol.batch // (2 * seeds))
-    return max(per // protocol.batch, 3)
 
 
 def heldout_l1(spec, protocol):
@@ -87,29 +79,35 @@ class _Loop:
         return self.steps * self.batch
 
 
-def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None,
-                 seeds: int = 1) -> tuple[list[dict], object]:
+def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
     """Train for protocol.steps in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
     last, the final model: the last one with a finite loss); on_eval(log) after each evaluation.
-    seeds = 1: one run from the init of `seed`. seeds > 1: restarts: the inits seed .. seed + seeds - 1
-    each train for `scout_steps` (a one-cycle over the scout, evaluated once at its end), the one with the
-    lowest training loss over its last 5 % of batches (the held-out set plays no part in the choice) then
-    continues for the rest of the steps with a new one-cycle and fresh Adam state, from batches of its own
-    stream (seed + 1000). Every scout's samples count."""
+    protocol.scouts <= 1: one run from the init of `seed`. scouts = K > 1: restarts (`replication.scouting`)
+    over the inits seed .. seed + K - 1, trained side by side for `scouting.scout_steps` (a one-cycle over
+    the scout, each evaluated once at its end), the one with the lowest training loss over its last 5 % of
+    batches (the held-out set plays no part) then continued for the rest of the steps with a new one-cycle
+    and fresh Adam state, from batches of its own stream (seed + 1000). Every scout's samples count; the
+    scouts' wall time is the one program's."""
     loop = _Loop(name, spec, protocol, on_eval)
-    if seeds == 1:
+    if protocol.scouts <= 1:
         model = models.jax.build(spec, init_params(spec, seed=seed))
         loop.row(model, "train", seed, learning_rate(protocol, 0), np.nan)
         return loop.log, loop.phase(model, protocol, seed, "train", seed, N_EVALS)[0]
-    scout = protocol.replace(steps=scout_steps(protocol, seeds))
-    best = None
-    for s in range(seed, seed + seeds):
-        model = models.jax.build(spec, init_params(spec, seed=s))
-        if s == seed:
-            loop.row(model, "scout", s, learning_rate(scout, 0), np.nan)
-        model, tail = loop.phase(model, scout, s, "scout", s, 1)
+    seeds, scout = list(range(seed, seed + protocol.scouts)), scouting.scout_protocol(protocol)
+    loop.row(models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
+    outcomes, tails = scouting.scout(train_jax, spec, protocol, seeds)
+    loop.wall += outcomes[0].step_seconds
+    for s, out, tail in zip(seeds, outcomes, tails):
+        loop.steps += scout.steps
+        loop.skipped += out.skipped_steps
+        model = models.jax.build(spec, out.params)
+        if out.failure is None:
+            loop.row(model, "scout", s, learning_rate(scout, scout.steps - 1), out.log[-1]["loss"])
+        else:
+            loop.row(model, "scout (stopped: non-finite loss)", s, learning_rate(scout, out.failure["step"]), np.nan)
         loop.log[-1]["scout_loss"] = tail
-        if best is None or tail < best[0]:
-            best = (tail, s, model)
-    rest = protocol.replace(steps=max(protocol.steps - seeds * scout.steps, 1))
-    return loop.log, loop.phase(best[2], rest, best[1] + 1000, "continue", best[1], N_EVALS)[0]
+    best = scouting.choose(tails) or 0
+    model = models.jax.build(spec, outcomes[best].params)
+    rest = scouting.continuation_protocol(protocol)
+    return loop.log, loop.phase(model, rest, seeds[best] + scouting.CONTINUATION_STREAM, "continue", seeds[best],
+                                N_EVALS)[0]

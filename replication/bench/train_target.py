@@ -18,7 +18,7 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       without the guard every run stalled at L1 16-20 or diverged on gradient spikes from near-singular
       learned Hessians; with it the LNN gets below 10, but its H is still not the mass matrix.
   "restarts": the variant with restarts over initialisations: RESTART_SEEDS inits are each trained for
-      target_loop.SCOUT_SAMPLES samples (at most half the budget over all of them; a one-cycle over the scout), the one
+      scouting.SCOUT_SAMPLES samples (at most half the budget over all of them; a one-cycle over the scout), the one
       with the lowest training loss (its last 5 % of batches; the held-out set plays no part) continues
       for the rest of the budget with a new one-cycle and fresh Adam state. The budget counts every scout's
       samples. Why: which init finds a near-physical Lagrangian is luck (after 5e5 samples, 3 of 8 seeds at
@@ -66,7 +66,8 @@ import numpy as np
 
 import systems
 from models import ModelSpec
-from replication.bench.target_loop import N_EVALS, run_protocol, scout_steps
+from replication import scouting
+from replication.bench.target_loop import N_EVALS, run_protocol
 from replication.claims.double_pendulum import MODELS, PROTOCOLS
 from replication.data import heldout
 
@@ -79,17 +80,16 @@ HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 
 VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 1e-3, 0.3
 GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
-RESTART_SEEDS = 8  # "restarts": inits scouted (each for target_loop.SCOUT_SAMPLES samples)
+RESTART_SEEDS = 8  # "restarts": inits scouted (each for scouting.SCOUT_SAMPLES samples)
 
 
 class Entry(NamedTuple):
     """One protocol of the study: the Protocol (its steps: the whole budget), a description, ModelSpec
-    overrides, the model label in `claims.double_pendulum.MODELS`, and the seeds scouted (1: one run)."""
+    overrides, and the model label in `claims.double_pendulum.MODELS`; restarts are the protocol's `scouts`."""
     protocol: object
     description: str
     overrides: dict
     label: str
-    seeds: int = 1
 
 
 def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
@@ -105,7 +105,8 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     var_text = (f"batch {var.batch}, one-cycle peak {var.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
                 f"gradient clip {var.grad_clip:g}, skip at "
                 f"{var.spike_skip:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
-    scout = scout_steps(var, RESTART_SEEDS)
+    restarts = var.replace(scouts=RESTART_SEEDS)
+    scout = scouting.scout_steps(restarts)
     rest = var.steps - RESTART_SEEDS * scout
     restarts_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each (one-cycle over the scout), the one with "
                      f"the lowest training loss (mean of its last 5 % of batches) continued for {rest} steps "
@@ -115,7 +116,7 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     return {"original_scaled": Entry(orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
                                            f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
             "variant": Entry(var, var_text, scale, "lnn"),
-            "restarts": Entry(var, restarts_text, scale, "lnn", RESTART_SEEDS),
+            "restarts": Entry(restarts, restarts_text, scale, "lnn"),
             "baseline_reference": Entry(var, f"the MLP baseline on the variant's protocol: {var_text}", scale,
                                         "baseline")}
 
@@ -199,13 +200,13 @@ def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eva
         raise ValueError(f"unknown train-target protocol(s) {', '.join(unknown)}; valid: {', '.join(table)}")
     rows, logs = [], []
     for name in names or table:
-        proto, desc, over, label, seeds = table[name]
+        proto, desc, over, label = table[name]
         entry = next(m for m in MODELS if m.label == label)
         spec = ModelSpec(dof=2, hidden=tuple(hidden), dtype=proto.dtype, **{**entry.spec, **over})
         if progress:
             progress.set_postfix_str(f"train to target: {name}")
         each = (lambda lg, done=list(logs): on_eval(done + lg)) if on_eval else None
-        log, model = run_protocol(name, spec, proto, seed=seed, on_eval=each, seeds=seeds)
+        log, model = run_protocol(name, spec, proto, seed=seed, on_eval=each)
         logs += log
         if on_model:
             on_model(name, spec, model)
@@ -217,7 +218,7 @@ def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eva
 
 def n_evaluations(entry: Entry) -> int:
     """Held-out evaluations after step 0 of one protocol (the CLI's progress bar)."""
-    return N_EVALS + (entry.seeds if entry.seeds > 1 else 0)
+    return N_EVALS + (entry.protocol.scouts if entry.protocol.scouts > 1 else 0)
 
 
 def n_cases(sizes) -> int:

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from models import ModelSpec
+from replication import scouting
 from replication.bench import target_loop as TL
 from replication.bench import train_target as TT
 from replication.claims.double_pendulum import MODELS
@@ -15,13 +16,13 @@ def restarts():
     entry = TT.protocols(4096, 64)["restarts"]
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=(8, 8), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
-    log, model = TL.run_protocol("restarts", spec, entry.protocol, seeds=3)
+    log, model = TL.run_protocol("restarts", spec, entry.protocol.replace(scouts=3))
     return entry, spec, log, model
 
 
 def test_scouts_are_plain_runs_of_their_seeds(restarts):
     entry, spec, log, _ = restarts
-    scout = entry.protocol.replace(steps=TL.scout_steps(entry.protocol, 3))
+    scout = scouting.scout_protocol(entry.protocol.replace(scouts=3))
     ends = [r for r in log if r["phase"] == "scout" and r["step"] > 0]
     assert [r["seed"] for r in ends] == [0, 1, 2]
     for r in ends:
@@ -37,16 +38,16 @@ def test_the_lowest_training_loss_is_continued_and_every_sample_counts(restarts)
     assert cont and {r["seed"] for r in cont} == {chosen}
     samples = [r["samples"] for r in log]
     assert samples == sorted(samples) and samples[-1] == entry.protocol.steps * entry.protocol.batch
-    assert ends[-1]["samples"] == 3 * TL.scout_steps(entry.protocol, 3) * entry.protocol.batch
+    assert ends[-1]["samples"] == 3 * scouting.scout_steps(entry.protocol.replace(scouts=3)) * entry.protocol.batch
 
 
 def test_scouting_takes_at_most_half_the_budget():
     for budget in (2048, 5e5, 3e7):
         p = TT.protocols(int(budget), 64)["restarts"].protocol
-        n = TL.scout_steps(p, TT.RESTART_SEEDS)
+        n = scouting.scout_steps(p)
         assert 3 <= n and TT.RESTART_SEEDS * n * p.batch <= max(budget / 2, TT.RESTART_SEEDS * 3 * p.batch)
     p = TT.protocols(int(3e7), 64)["restarts"].protocol
-    assert TL.scout_steps(p, TT.RESTART_SEEDS) * p.batch == pytest.approx(TL.SCOUT_SAMPLES, abs=p.batch)
+    assert scouting.scout_steps(p) * p.batch == pytest.approx(scouting.SCOUT_SAMPLES, abs=p.batch)
 
 
 def test_summary_names_the_chosen_seed(restarts):
@@ -62,15 +63,14 @@ def test_a_scout_that_fails_is_logged_and_never_chosen(monkeypatch):
     entry = TT.protocols(2048, 64)["restarts"]
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=(8,), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
-    n = TL.scout_steps(entry.protocol, 2)
     calls = {"k": 0}
     real = SpikeGuard.fails
 
-    def fails(self, loss, gnorm):
+    def fails(self, loss, gnorm):   # the scouts step together: the second call is the second scout's first step
         calls["k"] += 1
-        return calls["k"] == n + 1 or real(self, loss, gnorm)
+        return calls["k"] == 2 or real(self, loss, gnorm)
     monkeypatch.setattr(SpikeGuard, "fails", fails)
-    log, _ = TL.run_protocol("r", spec, entry.protocol, seeds=2)
+    log, _ = TL.run_protocol("r", spec, entry.protocol.replace(scouts=2))
     ends = [r for r in log if "scout_loss" in r]
     assert [r["seed"] for r in ends] == [0, 1] and np.isfinite(ends[0]["scout_loss"])
     assert ends[1]["scout_loss"] == np.inf and "stopped" in ends[1]["phase"]

@@ -1,0 +1,65 @@
+"""Restarts over initialisations as a protocol option (`Protocol.scouts`, `replication.scouting`)."""
+import numpy as np
+import pytest
+
+from models import ModelSpec, init_params
+from replication import scouting, train_jax
+from replication.data import BatchStream
+from replication.protocol import Protocol
+from replication.training import run_training
+
+SPEC = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64", angle_wrap=True)
+PROTOCOL = Protocol(data="double_pendulum_iid", steps=60, batch=16, n_train=64, dtype="float64", log_every=5,
+                    resample=True, grad_clip=100.0, spike_skip=10.0, scouts=4, scout_steps=10)
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return {fw: run_training(fw, SPEC, PROTOCOL, seed=1) for fw in ("jax", "torch")}
+
+
+def test_the_lowest_tail_is_continued_and_every_step_counts(runs):
+    out = runs["jax"]
+    rec = out.scouting
+    assert rec["init_seeds"] == [4, 5, 6, 7] and rec["scout_steps"] == 10
+    assert rec["chosen"] == rec["init_seeds"][int(np.argmin(rec["tail_loss"]))]
+    assert out.steps_done == PROTOCOL.steps and out.failure is None
+    assert out.log[0]["step"] == 40 and out.log[-1]["step"] == PROTOCOL.steps - 1
+
+
+def test_the_run_is_its_scout_then_a_plain_continuation(runs):
+    """Re-done by hand: the chosen init alone for the scout's steps, then the continuation protocol from
+    its weights on the continuation's stream: the same weights."""
+    rec = runs["jax"].scouting
+    s = rec["chosen"]
+    scout = scouting.scout_protocol(PROTOCOL)
+    alone = train_jax.train(SPEC, init_params(SPEC, seed=s), scout, BatchStream(scout, s))
+    rest = scouting.continuation_protocol(PROTOCOL)
+    assert rest.steps == 20 and rest.scouts == 0
+    then = train_jax.train(SPEC, alone.params, rest, BatchStream(rest, s + scouting.CONTINUATION_STREAM))
+    for k in then.params:
+        np.testing.assert_allclose(runs["jax"].params[k], then.params[k], rtol=1e-9, atol=1e-12)
+
+
+def test_frameworks_choose_alike_and_agree(runs):
+    a, b = runs["jax"], runs["torch"]
+    assert a.scouting["chosen"] == b.scouting["chosen"]
+    np.testing.assert_allclose(a.scouting["tail_loss"], b.scouting["tail_loss"], rtol=1e-8)
+    for k in a.params:
+        np.testing.assert_allclose(a.params[k], b.params[k], rtol=1e-7, atol=1e-10)
+
+
+def test_a_failed_scout_is_never_chosen():
+    assert scouting.choose([3.0, float("inf"), 1.0]) == 2
+    assert scouting.choose([float("inf")] * 3) is None
+
+
+def test_protocol_checks_and_keys():
+    with pytest.raises(ValueError, match="scouts"):
+        PROTOCOL.replace(scouts=-1)
+    with pytest.raises(ValueError, match="nothing of the"):
+        PROTOCOL.replace(scout_steps=15)
+    plain = PROTOCOL.replace(scouts=0, scout_steps=0)
+    assert "scouts" not in plain.to_dict() and "scout_steps" not in plain.to_dict()
+    assert PROTOCOL.key() != plain.key()
+    assert Protocol.from_dict(PROTOCOL.to_dict()) == PROTOCOL
