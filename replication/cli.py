@@ -40,10 +40,19 @@ def cmd_run(args):
     return 1 if summary.get("errors") else 0
 
 
+RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target")
+
+
 def cmd_report(args):
     import reports
 
-    paths = reports.build_report(args.results, args.out)
+    results = Path(args.results)
+    if not results.is_dir():
+        raise ValueError(f"--results {results}: no such folder; give a folder written by `lagbench run` "
+                         f"(or bench, stiff, train-target)")
+    if not any((results / name).exists() for name in RESULT_ENTRIES):
+        raise ValueError(f"--results {results}: holds no lagbench results (none of {', '.join(RESULT_ENTRIES)})")
+    paths = reports.build_report(results, args.out)
     for k, v in paths.items():
         print(f"{k}: {len(v)} files in {Path(args.out) / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 

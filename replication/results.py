@@ -1,7 +1,9 @@
 """Result files: atomic writes, checksums, and the unit layout of `replication/RESULTS.md`.
 
 Every file is written to a temporary name in the same folder and renamed into place, so a killed
-run never leaves a half-written file under a final name. A unit's `result.json` carries the sha256
+run never leaves a half-written file under a final name, and never through a symlink; files get the
+umask's mode. These helpers (`atomic_write_bytes`, `read_nofollow`) are the only file writers of
+`systems.cache` and `reports` too. A unit's `result.json` carries the sha256
 of each of its other files and a checksum of itself (sha256 of the canonical JSON without the
 "checksum" key: `json.dumps(d, sort_keys=True, separators=(",", ":"))`). `load_result` verifies
 both and raises `CorruptResult` on any mismatch; the runner then reruns the unit.
@@ -13,11 +15,10 @@ import io
 import json
 import math
 import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
-
-from systems.files import atomic_write
 
 SCHEMA = 1
 
@@ -26,10 +27,45 @@ class CorruptResult(Exception):
     """A result or cache file failed its checksum, or could not be parsed."""
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder, an fsync and a rename
-    (``systems.files.atomic_write``): never half-written, never through a symlink, mode per umask."""
-    atomic_write(Path(path), data, sync=True)
+def umask() -> int:
+    """The process's umask (read without changing it where /proc allows)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    old = os.umask(0o022)
+    os.umask(old)
+    return old
+
+
+def atomic_write_bytes(path: Path, data: bytes, *, sync: bool = True) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder (fsync'd unless ``sync``
+    is False) and a rename: never half-written, and a symlink at ``path`` is replaced, never written
+    through. The file gets the mode a plain ``open`` would give (0666 less the umask; ``mkstemp``
+    alone makes 0600)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fchmod(fh.fileno(), 0o666 & ~umask())
+            if sync:
+                os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def read_nofollow(path) -> bytes:
+    """The bytes of a regular file at ``path``, never through a symlink (OSError otherwise)."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as fh:
+        return fh.read()
 
 
 def output_folder(path, option: str = "--out") -> Path:

@@ -3,7 +3,9 @@
 Reads only the result files of ``replication/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
 training code. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
 ``figures/*.png``. Returns ``{"markdown": Path, "typst": Path, "pdf": Path, "figures": [Path, ...]}``.
-An empty or missing results folder still yields a report that says nothing was run.
+An empty or missing results folder still yields a report that says nothing was run (the command line
+refuses one that holds no results). Writes go through ``reports.output``: atomic, never through a
+symlink, and only files an earlier build recorded are ever removed.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from reports.document import Figure, Section, tables_and_figures
 from reports.environment import environment_sections, sources_sections
 from reports.findings import findings_sections
 from reports.load import load_results
+from reports import output
 from reports.markdown import render_markdown
 from reports.pdf import write_pdf
 from reports.scorecard import scorecard_section
@@ -41,15 +44,12 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
 
 def build_report(results_dir: str | Path, out_dir: str | Path, *, pdf: bool = True) -> dict:
     """Build REPORT.md (and REPORT.pdf unless ``pdf=False``) from ``results_dir`` into ``out_dir``."""
-    out_dir = Path(out_dir)
-    (out_dir / "figures").mkdir(parents=True, exist_ok=True)
-    for old in (out_dir / "figures").glob("*.png"):
-        old.unlink()
+    out_dir = output.prepare(out_dir)
     sections = build_sections(Path(results_dir), out_dir)
-    md = out_dir / "REPORT.md"
-    md.write_text(render_markdown(TITLE, sections), encoding="utf-8")
+    md = output.write(out_dir / "REPORT.md", render_markdown(TITLE, sections))
     figures = [out_dir / b.path for b in tables_and_figures(sections) if isinstance(b, Figure)]
     paths: dict = {"markdown": md, "figures": figures}
     if pdf:
         paths["typst"], paths["pdf"] = write_pdf(TITLE, sections, out_dir)
+    output.finish(out_dir, [md, *figures, *([paths["typst"], paths["pdf"]] if pdf else [])])
     return paths

@@ -12,12 +12,14 @@ returns False (writing nothing) when the units lack the data it needs. Inputs:
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
 from reports.load import Unit
+from reports.output import write
 
 DPI = 130
 LINESTYLES = ["-", "--", ":", "-."]
@@ -37,8 +39,10 @@ def new_figure(ncols: int = 1, nrows: int = 1, width: float = 6.4, height: float
 
 
 def save(fig: Figure, path: Path) -> bool:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
+    """Render to memory, then replace ``path`` atomically (never writing through a symlink there)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    write(path, buf.getvalue())
     return True
 
 

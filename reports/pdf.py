@@ -12,6 +12,7 @@ import re
 from pathlib import Path
 
 from reports.document import Bullets, Figure, Para, Section, Table
+from reports.output import write
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -86,8 +87,8 @@ def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path,
     out_dir = Path(out_dir)
     typ = out_dir / "REPORT.typ"
     pdf = out_dir / "REPORT.pdf"
-    typ.write_text(render_typst(title, sections, out_dir), encoding="utf-8")
-    typst.compile(str(typ), output=str(pdf), root=str(out_dir.resolve()))
+    write(typ, render_typst(title, sections, out_dir))
+    write(pdf, typst.compile(str(typ), root=str(out_dir.resolve())))  # bytes, written atomically
     return typ, pdf
 
 

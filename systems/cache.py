@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from replication.results import atomic_write_bytes, read_nofollow  # light: NumPy only
 from systems import cache_key
-from systems.files import atomic_write, read_nofollow
 
 log = logging.getLogger(__name__)
 
@@ -52,7 +52,7 @@ def store_text(kind: str, name: str, text: str) -> Path | None:
     if tag is None:
         return None
     path = text_path(kind, name)
-    atomic_write(path, f"{_HEADER}{tag}\n{text}".encode())
+    atomic_write_bytes(path, f"{_HEADER}{tag}\n{text}".encode(), sync=False)
     return path
 
 
@@ -96,7 +96,7 @@ def store_arrays(name: str, arrays: dict) -> Path | None:
     buf = io.BytesIO()
     np.savez(buf, **arrays, **{_CHECKSUM_KEY: np.array(tag)})
     path = array_path(name)
-    atomic_write(path, buf.getvalue())
+    atomic_write_bytes(path, buf.getvalue(), sync=False)
     return path
 
 
