@@ -215,7 +215,15 @@ def build_parser():
     return p
 
 
+RESUME = {"run": "finished units are kept; run the same command again to resume",
+          "bench": "run it again with --resume to keep the finished stages",
+          "train-target": "the log up to the last evaluation is in {out}/train_target/train_target_log.csv",
+          "fit": "no result was written; run the same command again"}
+
+
 def main(argv=None):
+    """Every error is one line on stderr and a non-zero exit: 2 for bad input or an OS error (a file
+    where a folder belongs, no permission, a full disk), 130 for Ctrl-C (with how to resume)."""
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     try:
@@ -224,6 +232,15 @@ def main(argv=None):
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
         print(f"lagbench: error: {msg}", file=sys.stderr)
         return 2
+    except OSError as e:
+        where = f": {e.filename}" if e.filename else ""
+        print(f"lagbench: error: {e.strerror or e}{where}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        hint = RESUME.get(args.command, "nothing half-written was left; run the same command again")
+        hint = hint.format(out=getattr(args, "out", None) or "OUT")
+        print(f"\nlagbench: interrupted; {hint}", file=sys.stderr)
+        return 130
     return code or 0
 
 

@@ -3,6 +3,11 @@
 A unit is finished when its result.json verifies (checksum and file hashes); anything else (absent,
 half-written, corrupt) is (re)run. Units are independent and deterministic given their seed, so an
 interrupted run resumes where it stopped and ends with the same numbers as an uninterrupted one.
+
+Nothing is silent or lost: every option is checked (`plan`) and the output folder made before any
+work; a unit redone because its folder held a damaged or half-written result is named in a warning
+and in run.json's "repaired"; an earlier invocation's run.json is kept as `runs/run-<start>.json`;
+Ctrl-C records "interrupted" in run.json before it propagates.
 """
 from __future__ import annotations
 
@@ -27,13 +32,32 @@ log = logging.getLogger("lagbench")
 FRAMEWORKS = ("jax", "torch")
 
 
+def _once(option: str, values) -> None:
+    twice = sorted({v for v in values if list(values).count(v) > 1})
+    if twice:
+        raise ValueError(f"{option}: {', '.join(twice)} given more than once; name each at most once")
+
+
 def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None) -> list:
+    """The units of a run; a ValueError naming the option if any is invalid or nothing would run."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
     for fw in frameworks:
         if fw not in FRAMEWORKS:
             raise ValueError(f"unknown framework {fw!r}; valid: {', '.join(FRAMEWORKS)}")
+    if not frameworks:
+        raise ValueError(f"--frameworks: none given; valid: {', '.join(FRAMEWORKS)}")
+    _once("--frameworks", frameworks)
+    _once("--claims", claims or ())
+    _once("--models", models or ())
+    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1):
+        raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer >= 1 (or leave it out for "
+                         f"the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
+    labels = sorted({e.label for c in chosen for e in c.models})
+    unknown = sorted(set(models or ()) - set(labels))
+    if unknown:
+        raise ValueError(f"--models: unknown {', '.join(unknown)} for the chosen claims; valid: {', '.join(labels)}")
     units = []
     for claim in chosen:
         n = claim.seeds.get(profile, 1)
@@ -45,18 +69,26 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
             for fw in frameworks:
                 for seed in range(n):
                     units.append(Unit(claim, entry, fw, seed, profile))
+    if not units:
+        raise ValueError(f"nothing to run: no model of the chosen claims and --models runs under profile "
+                         f"{profile!r}; see `lagbench list`")
     return units
 
 
-def is_current(unit, out) -> bool:
+def is_current(unit, out, repairs: list | None = None) -> bool:
     """True if the unit's folder holds a verified result of this very protocol, model spec, evaluation
-    config and evaluation version. A verified result of another one (the claim or an evaluation routine
+    config and evaluation version. A folder that holds no verified result is redone; with `repairs`,
+    one that exists (damaged or interrupted) is logged and listed there. A verified result of another one (the claim or an evaluation routine
     was edited) is kept, renamed `superseded-<time>-seed<k>`, and the unit is rerun (its training comes
     from the cache when the protocol is unchanged): nothing finished is lost or silently overwritten."""
     folder = unit.folder(out)
     try:
         d = R.load_result(folder)
-    except R.CorruptResult:
+    except R.CorruptResult as e:
+        if folder.exists() and repairs is not None:  # half-written or damaged: named, then redone
+            reason = str(e) if (folder / "result.json").exists() else "interrupted (no result.json)"
+            log.warning("lagbench: redoing %s: %s", unit.name, reason)
+            repairs.append(f"{unit.name}: {reason}")
         return False
     cfg = unit.claim.eval_config.get(unit.profile, {})
     # a result that records no evaluation config or version predates them: stale, re-evaluated
@@ -111,10 +143,27 @@ def estimate_seconds(units, out) -> float:
     return total
 
 
+def keep_previous_record(out: Path) -> Path | None:
+    """Copy an earlier invocation's run.json to `runs/run-<its start>.json` before it is replaced, so
+    the record of every attempt (what it planned, repaired, failed, or that it was interrupted) stays."""
+    try:
+        raw = (out / "run.json").read_bytes()
+        started = str(json.loads(raw).get("started") or env.now())
+    except (OSError, ValueError, AttributeError):
+        return None
+    stamp = "".join(ch for ch in started if ch.isalnum())
+    for i in range(1000):
+        target = out / "runs" / f"run-{stamp}{f'.{i}' if i else ''}.json"
+        if not target.exists():
+            R.atomic_write_bytes(target, raw)
+            return target
+    return None
+
+
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
         progress=True) -> dict:
-    out = Path(out)
     units = plan(profile, claims, frameworks, seeds, models)
+    out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
@@ -126,10 +175,28 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
         print(f"lagbench: the paper profile's training is estimated at {est / 3600:.1f} h on this machine "
               f"({env.hardware()['cpu']}, GPU: {env.hardware()['gpu']}); it resumes if interrupted.", flush=True)
         manifest["estimated_train_s"] = est
+    keep_previous_record(out)
     R.write_json(out / "run.json", manifest)
-    todo = [u for u in units if not is_current(u, out)]
+    repairs: list = []
+    todo = [u for u in units if not is_current(u, out, repairs)]
+    manifest["repaired"] = repairs
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
-    failures, errors, t0 = [], [], time.perf_counter()
+    t0 = time.perf_counter()
+    try:
+        failures, errors = _run_units(todo, out, profile, progress)
+    except KeyboardInterrupt:
+        manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
+        R.write_json(out / "run.json", manifest)
+        raise
+    summary = write_summary(out, profile)
+    manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
+                    units_run=len(todo), failures=failures, errors=errors)
+    R.write_json(out / "run.json", manifest)
+    return dict(summary, errors=errors, repaired=repairs)
+
+
+def _run_units(todo, out, profile, progress):
+    failures, errors = [], []
     bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
     for u in bar:
         bar.set_postfix_str(u.name)
@@ -153,9 +220,4 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
             release_compiled()
         if d["status"] != "ok":
             failures.append(f"{u.name}: {d['failure']['message']}")
-    summary = write_summary(out, profile)
-    manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
-                    units_run=len(todo), failures=failures, errors=errors)
-    R.write_json(out / "run.json", manifest)
-    summary = dict(summary, errors=errors)
-    return summary
+    return failures, errors
