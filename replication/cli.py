@@ -11,6 +11,13 @@ def _csv(s):
     return [x.strip() for x in s.split(",") if x.strip()] if s else None
 
 
+def write_folder(path: Path) -> Path:
+    """The output folder, made and checked before any work (a ValueError naming --out)."""
+    from replication.results import output_folder
+
+    return output_folder(path, "--out")
+
+
 def cmd_list(args):
     import systems
     from models import ACTIVATIONS, INITS, KINDS
@@ -85,6 +92,7 @@ def cmd_bench(args):
     from replication.bench import run_bench
     from replication.bench.device import NoGPUError
 
+    write_folder(Path(args.out))
     try:
         run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from, resume=args.resume,
                   gpu=args.gpu)
@@ -100,10 +108,15 @@ def cmd_train_target(args):
     from replication.bench import train_target
     from replication.results import write_csv
 
-    folder = Path(args.out) / "train_target"
+    if args.heldout < 1 or args.seed < 0:
+        raise ValueError(f"--heldout takes an integer >= 1 and --seed one >= 0; got {args.heldout} and {args.seed}")
     names = _csv(args.protocols)
     hidden = list(widths(args.hidden))
     table = train_target.protocols(1000, 1)
+    unknown = sorted(set(names or ()) - set(table))
+    if unknown:  # checked here too, so that --out is not made for nothing
+        raise ValueError(f"unknown train-target protocol(s) {', '.join(unknown)}; valid: {', '.join(table)}")
+    folder = write_folder(Path(args.out) / "train_target")
     n = sum(train_target.n_evaluations(table[k]) for k in (names or table) if k in table)
     bar = tqdm(total=n, desc="lagbench train-target", unit="eval", disable=args.quiet)
 
@@ -138,8 +151,11 @@ def cmd_stiff(args):
     from replication.results import write_csv, write_json
     from replication.stiff_study import stiff_study
 
+    import systems
+
+    systems.get(args.system)  # an unknown name fails here, listing the valid ones
+    folder = write_folder(Path(args.out) / "stiff")
     df = stiff_study(system=args.system)
-    folder = Path(args.out) / "stiff"
     write_csv(folder / "solvers.csv", df)
     write_json(folder / "choice.json", {"system": args.system, **{k: (float(v) if isinstance(v, float) else v)
                                                                     for k, v in df.attrs.items()}})
@@ -157,34 +173,45 @@ def build_parser():
     s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units")
     s.add_argument("--profile", default="quick", help="smoke | quick | paper (default: quick)")
     s.add_argument("--claims", help="comma-separated claim ids (default: all; see `lagbench list`)")
-    s.add_argument("--models", help="comma-separated model labels to restrict to")
-    s.add_argument("--frameworks", default="jax,torch", help="jax,torch (default both)")
-    s.add_argument("--seeds", type=int, help="seeds per claim (default: the profile's)")
+    s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
+                   "list`)")
+    s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
+    s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
     s.add_argument("--out", help="results folder (default: results/<profile>)")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.set_defaults(func=cmd_run)
-    s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder")
-    s.add_argument("--results", default="results/quick")
-    s.add_argument("--out", default="report/quick")
+    s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",
+                       description="Write REPORT.md, REPORT.typ, REPORT.pdf and figures/*.png into --out from "
+                       "the result files in --results. Replaces only files an earlier report wrote there.")
+    s.add_argument("--results", default="results/quick", help="a folder written by `lagbench run` (or bench, "
+                   "stiff, train-target) (default: results/quick)")
+    s.add_argument("--out", default="report/quick", help="the report folder (default: report/quick)")
     s.set_defaults(func=cmd_report)
-    s = sub.add_parser("fit", help="train a model on your own .npz/.csv data (format: README)")
-    s.add_argument("--data", required=True, help="a .npz or .csv file with q*, qdot*, qddot* (and tau*) columns")
+    s = sub.add_parser("fit", help="train a model on your own .npz/.csv data (format: README)",
+                       description="Train one model on a data file and write OUT/units/fit/<framework>/<model>/"
+                       "seed<k>/ (result.json, train_log.csv, checkpoint.npz). 10 % of the rows are held out. "
+                       "A fit of other data or options already there is kept as superseded-<time>-seed<k>.")
+    s.add_argument("--data", required=True, help="a .npz (arrays q, qdot, qddot[, tau]) or .csv (columns q0.., "
+                   "qdot0.., qddot0..[, tau0..]) file, at least 20 rows")
     s.add_argument("--model", required=True, help="lnn | hnn | delan | baseline")
-    s.add_argument("--out", default="results/fit")
-    s.add_argument("--framework", default="jax", help="jax | torch")
-    s.add_argument("--steps", type=int, default=2000)
-    s.add_argument("--batch", type=int, default=256)
-    s.add_argument("--hidden", default="128,128")
-    s.add_argument("--lr", type=float, default=1e-3)
-    s.add_argument("--loss", default="l1", help="l1 | mse")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--out", default="results/fit", help="results folder (default: results/fit)")
+    s.add_argument("--framework", default="jax", help="jax | torch (default: jax)")
+    s.add_argument("--steps", type=int, default=2000, help="optimiser steps, >= 1 (default: 2000)")
+    s.add_argument("--batch", type=int, default=256, help="batch size, >= 1; at most the training rows "
+                   "(default: 256)")
+    s.add_argument("--hidden", default="128,128", help="comma-separated MLP widths (default: 128,128)")
+    s.add_argument("--lr", type=float, default=1e-3, help="peak learning rate of the one-cycle schedule, > 0 "
+                   "(default: 0.001)")
+    s.add_argument("--loss", default="l1", help="l1 | mse (default: l1)")
+    s.add_argument("--seed", type=int, default=0, help="initialisation and batch-order seed, >= 0 (default: 0)")
     s.set_defaults(func=cmd_fit)
     s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)",
                        description="The speed study: inference, latency, training, rollouts, scaling, fast vs "
                        "paper, structure and train-to-target, each with JAX and PyTorch side by side. Writes "
                        "OUT/bench/*.csv, targets.json and machine.json (quick preset: about 20 min on 2 cores).")
     s.add_argument("--out", default="results/quick", help="results folder (default results/quick)")
-    s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow)")
+    s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow; default: the "
+                   "quick preset)")
     s.add_argument("--trained-from", help="results folder whose training cache holds the learned models rolled "
                                           "out in the solver study (default: --out; else tiny models are trained)")
     s.add_argument("--resume", action="store_true", help="take the stages an interrupted run into --out finished "
@@ -197,11 +224,12 @@ def build_parser():
                                             "OUT/train_target/train_target.csv and its log, the log after every "
                                             "held-out evaluation, and each protocol's final model as "
                                             "<protocol>.npz with <protocol>.spec.json)")
-    s.add_argument("--out", default="results/train_target")
+    s.add_argument("--out", default="results/train_target", help="results folder; writes OUT/train_target/ "
+                   "(default: results/train_target)")
     s.add_argument("--budget", type=float, default=5e5, help="training samples per protocol (default 5e5; the "
                                                              "issue's target is 3e7)")
     s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
-    s.add_argument("--heldout", type=int, default=4096, help="held-out states (default 4096)")
+    s.add_argument("--heldout", type=int, default=4096, help="held-out states, >= 1 (default 4096)")
     s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, baseline_reference "
                                        "(default all)")
     s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7; default 0)")
@@ -209,8 +237,10 @@ def build_parser():
     s.set_defaults(func=cmd_train_target)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
                                      "(writes OUT/stiff/solvers.csv for the report)")
-    s.add_argument("--out", default="results/quick")
-    s.add_argument("--system", default="stiff_chain", help="a system name (default: stiff_chain)")
+    s.add_argument("--out", default="results/quick", help="results folder; writes OUT/stiff/ (default: "
+                   "results/quick)")
+    s.add_argument("--system", default="stiff_chain", help="a system name, see `lagbench list` (default: "
+                   "stiff_chain)")
     s.set_defaults(func=cmd_stiff)
     return p
 

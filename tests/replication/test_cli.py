@@ -73,3 +73,33 @@ def test_train_target_command_names_an_unknown_protocol(tmp_path, capsys):
 def test_train_target_command_rejects_bad_sizes(tmp_path, capsys, args, message):
     assert main(["train-target", *args, "--out", str(tmp_path), "--quiet"]) == 2
     assert message in capsys.readouterr().err
+
+
+def _options():
+    import argparse
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for name, parser in sub.choices.items():
+        for action in parser._actions:
+            if action.option_strings and action.dest != "help":
+                yield name, parser, action
+
+
+@pytest.mark.parametrize("command, option", [(n, a.option_strings[-1]) for n, _, a in _options()])
+def test_every_option_has_help_and_shows_its_default(command, option):
+    """Issue 25, case 10: report, stiff, train-target --out and fit's options had no help or default."""
+    (_, parser, action), = [(n, p, a) for n, p, a in _options() if n == command and a.option_strings[-1] == option]
+    assert action.help and len(action.help) > 8, f"{command} {option}: no help text"
+    if action.default not in (None, False) and not action.required:
+        assert "default" in action.help.lower(), f"{command} {option}: default {action.default!r} not shown"
+    assert parser.description or parser.format_usage()
+
+
+@pytest.mark.parametrize("argv", [["stiff", "--system", "nope"], ["train-target", "--protocols", "bogus"],
+                                  ["train-target", "--heldout", "0"], ["bench"]])
+def test_out_is_not_made_for_an_invalid_command(tmp_path, capsys, argv):
+    (tmp_path / "file").write_text("x")
+    out = tmp_path / "file" if argv == ["bench"] else tmp_path / "out"
+    assert main([*argv, "--out", str(out)]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
