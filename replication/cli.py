@@ -148,10 +148,9 @@ def cmd_train_target(args):
 def cmd_stiff(args):
     from pathlib import Path
 
+    import systems
     from replication.results import write_csv, write_json
     from replication.stiff_study import stiff_study
-
-    import systems
 
     systems.get(args.system)  # an unknown name fails here, listing the valid ones
     folder = write_folder(Path(args.out) / "stiff")

@@ -97,8 +97,8 @@ def is_current(unit, out, repairs: list | None = None) -> bool:
     if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
         return True
     kept = set_aside(folder)
-    log.warning("%s: its result was made under another protocol, spec or data; kept as %s and rerun",
-                unit.name, kept.name)
+    log.warning("lagbench: %s: its result was made under another protocol, spec or data; kept as %s "
+                "and rerun", unit.name, kept.name)
     return False
 
 

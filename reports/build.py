@@ -13,11 +13,11 @@ from __future__ import annotations
 import datetime as dt
 from pathlib import Path
 
+from reports import output
 from reports.document import Figure, Section, tables_and_figures
 from reports.environment import environment_sections, sources_sections
 from reports.findings import findings_sections
 from reports.load import load_results
-from reports import output
 from reports.markdown import render_markdown
 from reports.pdf import write_pdf
 from reports.scorecard import scorecard_section
