@@ -141,7 +141,7 @@ class Members:
                            self.static)
 
     def propose(self, batches, lr, bounds):
-        batch = self._batch = _stack([_to_jax(b, self.dtype) for b in batches])
+        batch = self._batch = _to_jax({k: np.stack([b[k] for b in batches]) for k in batches[0]}, self.dtype)
         model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
                                               jnp.asarray(bounds, self.dtype))
         self._next = (model, state)

@@ -17,6 +17,7 @@ on_log=None, hooks=()) -> [TrainOutcome]`.
 """
 from __future__ import annotations
 
+import numpy as np
 import torch
 from torch import nn
 from torch.func import functional_call, stack_module_state, vmap
@@ -135,8 +136,7 @@ class Members:
         return functional_call(self.base, (params, buffers), (batch,))
 
     def propose(self, batches, lr, bounds):
-        self._batches = [_to_torch(b, self.dtype) for b in batches]
-        batch = {k: torch.stack([b[k] for b in self._batches]) for k in self._batches[0]}
+        batch = self._batch = _to_torch({k: np.stack([b[k] for b in batches]) for k in batches[0]}, self.dtype)
         for p in self.stacked.values():
             p.grad = None
         losses = vmap(self._loss)(self.stacked, self.buffers, batch)
@@ -170,7 +170,7 @@ class Members:
     def probe(self):
         if self.look is None:
             return None
-        return [self.look(self._member(i), self._batches[i]) for i in range(self.n)]
+        return [self.look(self._member(i), {k: v[i] for k, v in self._batch.items()}) for i in range(self.n)]
 
     def params(self) -> list[dict]:
         return [{k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
