@@ -19,10 +19,12 @@ class TrainOutcome:
     step_seconds: float = 0.0   # time in the optimiser steps after the first (compiling) one
     skipped_steps: int = 0      # steps the spike guard skipped
     scouting: dict | None = None  # restarts (`replication.scouting`): init seeds, tail losses, the chosen one
+    samples: int | None = None    # training samples, where not steps_done x batch (scouts at their own batch)
 
     @property
     def samples_per_s(self) -> float:
-        return self.steps_done * self.batch / self.train_time_s if self.train_time_s > 0 else float("nan")
+        n = self.samples if self.samples is not None else self.steps_done * self.batch
+        return n / self.train_time_s if self.train_time_s > 0 else float("nan")
 
 
 def nonfinite_failure(step: int, loss: float, gnorm: float) -> dict:

@@ -21,7 +21,7 @@ DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
-SCOUT_FIELDS = ("scouts", "scout_steps")
+SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr")
 OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS   # omitted from to_dict while 0 (off), so older keys hold
 
 
@@ -44,11 +44,12 @@ class Protocol:
                rescales a gradient whose global norm exceeds it; spike_skip skips a step (no update, Adam
                state kept) whose gradient norm is at least spike_skip x the median of the recent ones.
                Left out of `to_dict` (and so of `key`) while 0, so older protocols keep their keys.
-    scouts/scout_steps: restarts over initialisations (`replication.scouting`); scouts <= 1 = off. With
-               scouts = K > 1 the run trains K initialisations side by side for scout_steps each (0: 5e5
-               samples each, at most half the budget over all of them), continues the one with the lowest
-               training loss for the rest of `steps` (every scout's steps count in `steps`). Left out of
-               `to_dict` while 0, as the guard.
+    scouts/scout_steps/scout_batch/scout_lr: restarts over initialisations (`replication.scouting`);
+               scouts <= 1 = off. With scouts = K > 1 the run first trains K initialisations side by side
+               for scout_steps each (0: 5e5 samples) at batch scout_batch and peak rate scout_lr (0: the
+               protocol's batch and lr), then continues the one with the lowest training loss for `steps`
+               steps of `batch`: the budget is K * scout_steps * scout_batch + steps * batch samples.
+               Left out of `to_dict` while 0, as the guard.
     """
 
     data: str
@@ -75,6 +76,8 @@ class Protocol:
     spike_skip: float = 0.0
     scouts: int = 0
     scout_steps: int = 0
+    scout_batch: int = 0
+    scout_lr: float = 0.0
     dtype: str = "float32"
     log_every: int = 50
     eval: dict = field(default_factory=dict, hash=False, compare=True)
@@ -96,13 +99,14 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
-        for name in SCOUT_FIELDS:
+        for name in ("scouts", "scout_steps", "scout_batch"):
             v = getattr(self, name)
             if not (v == 0 or _positive_integer(v)):
                 raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")
-        if self.scouts > 1 and self.scout_steps and self.scouts * self.scout_steps >= self.steps:
-            raise ValueError(f"{self.scouts} scouts x {self.scout_steps} scout_steps leave nothing of the "
-                             f"{self.steps} steps to continue the chosen one")
+        if not (_real(self.scout_lr) and math.isfinite(self.scout_lr) and self.scout_lr >= 0):
+            raise ValueError(f"protocol scout_lr must be a finite number >= 0 (0 = lr), got {self.scout_lr!r}")
+        if self.scout_batch > self.n_train:
+            raise ValueError(f"scout_batch {self.scout_batch} exceeds the training pool n_train={self.n_train}")
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)

@@ -25,6 +25,7 @@ from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
 from replication.evaluations import EVALUATION_VERSION
+from replication.scouting import continuation_protocol, progress_steps
 from replication.units import Unit, run_unit
 from replication.verdicts import write_summary
 
@@ -135,11 +136,12 @@ def estimate_seconds(units, out) -> float:
         p, spec = u.protocol(), u.spec()
         key = (u.framework, spec, p.replace(steps=1))
         if key not in seen:
-            probe = p.replace(steps=4, log_every=1, schedule="constant", n_train=max(p.batch * 4, p.batch))
+            probe = continuation_protocol(p).replace(steps=4, log_every=1, schedule="constant",
+                                                     n_train=max(p.batch * 4, p.batch))
             o = run_training(u.framework, spec, probe, 0)
             walls = [r["wall_s"] for r in o.log]
             seen[key] = (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
-        total += seen[key] * p.steps
+        total += seen[key] * progress_steps(p)   # scouts counted as continuation steps of equal samples
     return total
 
 
@@ -200,7 +202,7 @@ def _run_units(todo, out, profile, progress):
     bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
     for u in bar:
         bar.set_postfix_str(u.name)
-        steps = u.protocol().steps if u.entry.train else 0
+        steps = progress_steps(u.protocol()) if u.entry.train else 0
         inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
         last = {"step": -1}
 

@@ -5,18 +5,19 @@ close to the mass matrix) is luck, a run that found one trains on without gradie
 training loss tells which it is (`replication/bench/train_target_trials.md`, section 5). So a protocol
 with `scouts` = K > 1:
   1. trains the K initialisations `init_seeds(protocol, seed)` side by side for `scout_steps(protocol)`
-     steps each, as one program (`loop.train_members`; each member's numbers are its own run's), a
-     schedule over the scout (the protocol's, over scout_steps), batches from a stream per init seed;
+     steps each, as one program (`loop.train_members`; each member's numbers are its own run's), at
+     `scout_batch` and peak rate `scout_lr` (0: the protocol's), a schedule over the scout (the
+     protocol's shape over scout_steps), batches from a stream per init seed;
   2. chooses the scout with the lowest training loss over its last `TAIL` of steps (a scout that stopped
      on a non-finite loss is never chosen); the held-out set plays no part;
-  3. continues the chosen one for the rest of the budget, `protocol.steps - K * scout_steps` steps: a
-     new schedule over those steps, fresh Adam state, batches from a stream of its own (seed + 1000).
-Every scout's steps count in the budget (`steps_done`, samples). The original code has no restarts: the
-report says so where a claim uses them.
+  3. continues the chosen one for `protocol.steps` steps of `protocol.batch`: a new schedule over those
+     steps, fresh Adam state, batches from a stream of its own (seed + 1000).
+Every scout's samples count in the budget (`budget_samples`; the outcome's `samples`). The original code
+has no restarts: the report says so where a claim uses them.
 
 `train_scouted(trainer, spec, protocol, seed, on_log=None) -> TrainOutcome` (trainer: `train_jax` or
-`train_torch`): the continuation's parameters and log (steps counted from the protocol's start), its
-`scouting` record {init_seeds, tail_loss, chosen, scout_steps}. `scout(...)` and `continuation(...)` are
+`train_torch`): the continuation's parameters and log (its steps shifted by the scouts' samples in
+continuation steps, `progress_steps`), steps_done and samples counting every scout, its `scouting` record {init_seeds, tail_loss, chosen, scout_steps}. `scout(...)` and `continuation(...)` are
 the two phases, for callers that watch them (`bench.target_loop`).
 """
 from __future__ import annotations
@@ -34,12 +35,19 @@ CONTINUATION_STREAM = 1000  # the chosen init seed + this: the continuation's ba
 
 
 def scout_steps(protocol) -> int:
-    """Steps of each scout: `protocol.scout_steps`, or SCOUT_SAMPLES samples, at most half the budget over
-    all scouts together; at least 3."""
-    if protocol.scout_steps:
-        return int(protocol.scout_steps)
-    per = min(SCOUT_SAMPLES, protocol.steps * protocol.batch // (2 * protocol.scouts))
-    return max(per // protocol.batch, 3)
+    """Steps of each scout: `protocol.scout_steps`, or SCOUT_SAMPLES samples at the scout batch."""
+    return int(protocol.scout_steps) or max(SCOUT_SAMPLES // (protocol.scout_batch or protocol.batch), 1)
+
+
+def budget_samples(protocol) -> int:
+    """Training samples of a run: every scout's and the continuation's (steps x batch without scouts)."""
+    scouts = protocol.scouts * scout_steps(protocol) * (protocol.scout_batch or protocol.batch)
+    return protocol.steps * protocol.batch + (scouts if protocol.scouts > 1 else 0)
+
+
+def progress_steps(protocol) -> int:
+    """The run's length for a progress bar, in continuation steps (the scouts' samples converted)."""
+    return -(-budget_samples(protocol) // protocol.batch)
 
 
 def init_seeds(protocol, seed: int) -> list[int]:
@@ -47,13 +55,16 @@ def init_seeds(protocol, seed: int) -> list[int]:
     return [seed * protocol.scouts + i for i in range(protocol.scouts)]
 
 
+_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0}
+
+
 def scout_protocol(protocol):
-    return protocol.replace(steps=scout_steps(protocol), scouts=0, scout_steps=0)
+    return protocol.replace(steps=scout_steps(protocol), batch=protocol.scout_batch or protocol.batch,
+                            lr=protocol.scout_lr or protocol.lr, **_OFF)
 
 
 def continuation_protocol(protocol):
-    return protocol.replace(steps=max(protocol.steps - protocol.scouts * scout_steps(protocol), 1),
-                            scouts=0, scout_steps=0)
+    return protocol.replace(**_OFF)
 
 
 def scout(trainer, spec, protocol, seeds, on_log=None, hooks=()):
@@ -79,11 +90,11 @@ def choose(tails) -> int | None:
 
 def train_scouted(trainer, spec, protocol, seed: int, on_log=None):
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
-    done = len(seeds) * per
+    done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps
 
-    def scout_log(row):   # progress in budget steps: the scouts advance together
+    def scout_log(row):   # progress in continuation steps: the scouts advance together
         if on_log and row.get("member", 0) == 0:
-            on_log({**row, "step": row["step"] * len(seeds)})
+            on_log({**row, "step": row["step"] * done // per})
     outcomes, tails = scout(trainer, spec, protocol, seeds, on_log=scout_log)
     best = choose(tails)
     record = {"init_seeds": seeds, "tail_loss": tails, "scout_steps": per,
@@ -91,6 +102,7 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None):
     if best is None:   # every scout stopped: the first one's failure stands for the run
         o = outcomes[0]
         o.scouting, o.steps_done = record, sum(x.steps_done for x in outcomes)
+        o.samples = o.steps_done * o.batch
         return o
     p = continuation_protocol(protocol)
 
@@ -100,7 +112,8 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None):
     out = trainer.train(spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
                         on_log=shifted)
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
-    out.steps_done += done
+    out.samples = out.steps_done * out.batch + len(seeds) * per * outcomes[0].batch
+    out.steps_done += len(seeds) * per
     out.train_time_s += outcomes[best].train_time_s
     out.scouting = record
     return out

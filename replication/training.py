@@ -62,13 +62,13 @@ def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutc
         return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
                             log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
                             failure=meta["failure"], train_time_s=meta["train_time_s"],
-                            steps_done=meta["steps_done"], batch=meta["batch"], scouting=meta.get("scouting"))
+                            steps_done=meta["steps_done"], batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"))
     outcome = run_training(framework, spec, protocol, seed, on_log=on_log)
     files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
              "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
-                                          "scouting": outcome.scouting,
+                                          "scouting": outcome.scouting, "samples": outcome.samples,
                                           "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)
     return outcome

@@ -80,12 +80,12 @@ class _Loop:
 
 
 def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
-    """Train for protocol.steps in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
+    """Train for `scouting.budget_samples(protocol)` samples in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
     last, the final model: the last one with a finite loss); on_eval(log) after each evaluation.
     protocol.scouts <= 1: one run from the init of `seed`. scouts = K > 1: restarts (`replication.scouting`)
     over the inits seed .. seed + K - 1, trained side by side for `scouting.scout_steps` (a one-cycle over
     the scout, each evaluated once at its end), the one with the lowest training loss over its last 5 % of
-    batches (the held-out set plays no part) then continued for the rest of the steps with a new one-cycle
+    batches (the held-out set plays no part) then continued for protocol.steps with a new one-cycle
     and fresh Adam state, from batches of its own stream (seed + 1000). Every scout's samples count; the
     scouts' wall time is the one program's."""
     loop = _Loop(name, spec, protocol, on_eval)

@@ -105,9 +105,10 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     var_text = (f"batch {var.batch}, one-cycle peak {var.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
                 f"gradient clip {var.grad_clip:g}, skip at "
                 f"{var.spike_skip:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
-    restarts = var.replace(scouts=RESTART_SEEDS)
-    scout = scouting.scout_steps(restarts)
-    rest = var.steps - RESTART_SEEDS * scout
+    # scouts: SCOUT_SAMPLES each, at most half the budget over all of them; the continuation the rest
+    scout = max(min(scouting.SCOUT_SAMPLES, budget // (2 * RESTART_SEEDS)) // var.batch, 3)
+    rest = max(var.steps - RESTART_SEEDS * scout, 1)
+    restarts = var.replace(scouts=RESTART_SEEDS, scout_steps=scout, steps=rest)
     restarts_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each (one-cycle over the scout), the one with "
                      f"the lowest training loss (mean of its last 5 % of batches) continued for {rest} steps "
                      f"(a new one-cycle, fresh Adam state); otherwise the variant: batch {var.batch}, peak "
@@ -165,7 +166,7 @@ def summarise(name, description, spec, protocol, log, h_err=float("nan")) -> lis
     rows = []
     for thr in THRESHOLDS:
         hit = np.nonzero(v <= thr)[0]
-        budget = protocol.steps * protocol.batch
+        budget = scouting.budget_samples(protocol)
         rows.append({"protocol": name, "model": spec.kind, "description": description,
                      "hidden": "x".join(map(str, spec.hidden)), "budget": budget, "threshold": thr,
                      "samples_to_reach": float(s[hit[0]]) if hit.size else np.nan,

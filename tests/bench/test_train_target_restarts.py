@@ -14,15 +14,16 @@ from replication.spike_guard import SpikeGuard
 @pytest.fixture(scope="module")
 def restarts():
     entry = TT.protocols(4096, 64)["restarts"]
+    entry = entry._replace(protocol=entry.protocol.replace(scouts=3))
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=(8, 8), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
-    log, model = TL.run_protocol("restarts", spec, entry.protocol.replace(scouts=3))
+    log, model = TL.run_protocol("restarts", spec, entry.protocol)
     return entry, spec, log, model
 
 
 def test_scouts_are_plain_runs_of_their_seeds(restarts):
     entry, spec, log, _ = restarts
-    scout = scouting.scout_protocol(entry.protocol.replace(scouts=3))
+    scout = scouting.scout_protocol(entry.protocol)
     ends = [r for r in log if r["phase"] == "scout" and r["step"] > 0]
     assert [r["seed"] for r in ends] == [0, 1, 2]
     for r in ends:
@@ -37,8 +38,8 @@ def test_the_lowest_training_loss_is_continued_and_every_sample_counts(restarts)
     cont = [r for r in log if r["phase"] == "continue"]
     assert cont and {r["seed"] for r in cont} == {chosen}
     samples = [r["samples"] for r in log]
-    assert samples == sorted(samples) and samples[-1] == entry.protocol.steps * entry.protocol.batch
-    assert ends[-1]["samples"] == 3 * scouting.scout_steps(entry.protocol.replace(scouts=3)) * entry.protocol.batch
+    assert samples == sorted(samples) and samples[-1] == scouting.budget_samples(entry.protocol)
+    assert ends[-1]["samples"] == 3 * scouting.scout_steps(entry.protocol) * entry.protocol.batch
 
 
 def test_scouting_takes_at_most_half_the_budget():
@@ -46,6 +47,7 @@ def test_scouting_takes_at_most_half_the_budget():
         p = TT.protocols(int(budget), 64)["restarts"].protocol
         n = scouting.scout_steps(p)
         assert 3 <= n and TT.RESTART_SEEDS * n * p.batch <= max(budget / 2, TT.RESTART_SEEDS * 3 * p.batch)
+        assert scouting.budget_samples(p) == max(int(budget) // p.batch, TT.RESTART_SEEDS * n + 1) * p.batch
     p = TT.protocols(int(3e7), 64)["restarts"].protocol
     assert scouting.scout_steps(p) * p.batch == pytest.approx(scouting.SCOUT_SAMPLES, abs=p.batch)
 

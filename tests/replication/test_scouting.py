@@ -10,7 +10,8 @@ from replication.training import run_training
 
 SPEC = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64", angle_wrap=True)
 PROTOCOL = Protocol(data="double_pendulum_iid", steps=60, batch=16, n_train=64, dtype="float64", log_every=5,
-                    resample=True, grad_clip=100.0, spike_skip=10.0, scouts=4, scout_steps=10)
+                    resample=True, grad_clip=100.0, spike_skip=10.0, scouts=4, scout_steps=10, scout_batch=8,
+                    scout_lr=3e-3)
 
 
 @pytest.fixture(scope="module")
@@ -23,8 +24,10 @@ def test_the_lowest_tail_is_continued_and_every_step_counts(runs):
     rec = out.scouting
     assert rec["init_seeds"] == [4, 5, 6, 7] and rec["scout_steps"] == 10
     assert rec["chosen"] == rec["init_seeds"][int(np.argmin(rec["tail_loss"]))]
-    assert out.steps_done == PROTOCOL.steps and out.failure is None
-    assert out.log[0]["step"] == 40 and out.log[-1]["step"] == PROTOCOL.steps - 1
+    assert out.failure is None and out.steps_done == 4 * 10 + PROTOCOL.steps
+    assert out.samples == scouting.budget_samples(PROTOCOL) == 4 * 10 * 8 + 60 * 16
+    # the log counts in continuation steps (the scouts' 320 samples are 20 steps of 16)
+    assert out.log[0]["step"] == 20 and out.log[-1]["step"] == 20 + PROTOCOL.steps - 1
 
 
 def test_the_run_is_its_scout_then_a_plain_continuation(runs):
@@ -33,9 +36,10 @@ def test_the_run_is_its_scout_then_a_plain_continuation(runs):
     rec = runs["jax"].scouting
     s = rec["chosen"]
     scout = scouting.scout_protocol(PROTOCOL)
+    assert (scout.batch, scout.lr, scout.steps, scout.scouts) == (8, 3e-3, 10, 0)
     alone = train_jax.train(SPEC, init_params(SPEC, seed=s), scout, BatchStream(scout, s))
     rest = scouting.continuation_protocol(PROTOCOL)
-    assert rest.steps == 20 and rest.scouts == 0
+    assert rest.steps == 60 and rest.batch == 16 and rest.lr == PROTOCOL.lr and rest.scouts == 0
     then = train_jax.train(SPEC, alone.params, rest, BatchStream(rest, s + scouting.CONTINUATION_STREAM))
     for k in then.params:
         np.testing.assert_allclose(runs["jax"].params[k], then.params[k], rtol=1e-9, atol=1e-12)
@@ -57,9 +61,11 @@ def test_a_failed_scout_is_never_chosen():
 def test_protocol_checks_and_keys():
     with pytest.raises(ValueError, match="scouts"):
         PROTOCOL.replace(scouts=-1)
-    with pytest.raises(ValueError, match="nothing of the"):
-        PROTOCOL.replace(scout_steps=15)
-    plain = PROTOCOL.replace(scouts=0, scout_steps=0)
+    with pytest.raises(ValueError, match="scout_batch"):
+        PROTOCOL.replace(scout_batch=65)
+    with pytest.raises(ValueError, match="scout_lr"):
+        PROTOCOL.replace(scout_lr=float("nan"))
+    plain = PROTOCOL.replace(scouts=0, scout_steps=0, scout_batch=0, scout_lr=0.0)
     assert "scouts" not in plain.to_dict() and "scout_steps" not in plain.to_dict()
     assert PROTOCOL.key() != plain.key()
     assert Protocol.from_dict(PROTOCOL.to_dict()) == PROTOCOL
