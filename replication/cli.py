@@ -39,7 +39,7 @@ def cmd_run(args):
 
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
-                  progress=not args.quiet)
+                  progress=not args.quiet, jobs=args.jobs)
     for c in summary["claims"]:
         print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
     for e in summary.get("errors", []):
@@ -177,6 +177,9 @@ def build_parser():
     s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
     s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
     s.add_argument("--out", help="results folder (default: results/<profile>)")
+    s.add_argument("--jobs", type=int, default=1,
+                   help="worker processes, one CPU thread each; units training the same model stay in one "
+                        "(default: 1, everything in this process)")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.set_defaults(func=cmd_run)
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",

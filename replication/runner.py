@@ -11,22 +11,19 @@ Ctrl-C records "interrupted" in run.json before it propagates.
 """
 from __future__ import annotations
 
-import gc
 import json
 import logging
-import sys
 import time
 from pathlib import Path
-
-from tqdm.auto import tqdm
 
 from replication import environment as env
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
 from replication.evaluations import EVALUATION_VERSION
+from replication.executor import run_units
 from replication.scouting import continuation_protocol, progress_steps
-from replication.units import Unit, run_unit
+from replication.units import Unit
 from replication.verdicts import write_summary
 
 log = logging.getLogger("lagbench")
@@ -114,17 +111,6 @@ def set_aside(folder: Path) -> Path:
     raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
-def release_compiled() -> None:
-    """Drop JAX's compiled executables after a unit. Every unit compiles its own model's functions, and
-    XLA's CPU code is mapped into memory piece by piece: about 190 mappings per model and unit, never
-    given back, so a 220-unit quick run exceeded the kernel's 65 530 mappings per process at unit 202 and
-    died in LLVM ("Cannot allocate memory"). Cleared, the count stays flat (measured); a unit never
-    reuses another's compilations, so nothing is lost."""
-    if "jax" in sys.modules:
-        sys.modules["jax"].clear_caches()
-    gc.collect()
-
-
 def estimate_seconds(units, out) -> float:
     """Time 3 training steps of each distinct configuration (after one to compile) and scale up."""
     from replication.training import run_training
@@ -163,14 +149,16 @@ def keep_previous_record(out: Path) -> Path | None:
 
 
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
-        progress=True) -> dict:
+        progress=True, jobs=1) -> dict:
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     units = plan(profile, claims, frameworks, seeds, models)
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
                 # the units this run plans: the report names any that have no result (an unfinished run)
-                "planned_units": [u.name for u in units], "versions": env.versions(),
+                "planned_units": [u.name for u in units], "jobs": jobs, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
     if profile == "paper":
         est = estimate_seconds(units, out)
@@ -185,7 +173,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()
     try:
-        failures, errors = _run_units(todo, out, profile, progress)
+        failures, errors = run_units(todo, out, profile, progress, jobs)
     except KeyboardInterrupt:
         manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
         R.write_json(out / "run.json", manifest)
@@ -195,31 +183,3 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
                     units_run=len(todo), failures=failures, errors=errors)
     R.write_json(out / "run.json", manifest)
     return dict(summary, errors=errors, repaired=repairs)
-
-
-def _run_units(todo, out, profile, progress):
-    failures, errors = [], []
-    bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
-    for u in bar:
-        bar.set_postfix_str(u.name)
-        steps = progress_steps(u.protocol()) if u.entry.train else 0
-        inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
-        last = {"step": -1}
-
-        def on_log(row, inner=inner, last=last):
-            inner.update(row["step"] - last["step"])
-            last["step"] = row["step"]
-            inner.set_postfix(loss=f"{row['loss']:.3g}")
-
-        try:
-            d = run_unit(u, out, on_log=on_log)
-        except Exception as e:  # noqa: BLE001 - one unit's error must not lose the rest of the run
-            log.exception("%s failed", u.name)
-            errors.append(f"{u.name}: {type(e).__name__}: {e}")
-            continue
-        finally:
-            inner.close()
-            release_compiled()
-        if d["status"] != "ok":
-            failures.append(f"{u.name}: {d['failure']['message']}")
-    return failures, errors

@@ -116,7 +116,7 @@ def test_released_compilations_keep_the_memory_map_count_flat():
 
     from models import ModelSpec, init_params
     from replication.adapters import adapter
-    from replication.runner import release_compiled
+    from replication.executor import release_compiled
 
     if not os.path.exists("/proc/self/maps"):
         pytest.skip("no /proc/self/maps on this system")

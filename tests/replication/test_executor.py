@@ -1,0 +1,34 @@
+"""Units in parallel worker processes: the same numbers as one after another, and a model shared by two
+claims trained once (its units form one chain)."""
+import pandas as pd
+import pytest
+
+from replication import executor, runner
+
+CLAIMS = ["dp_loss", "dp_energy", "appendix_b"]
+
+
+def test_units_sharing_a_model_form_one_chain():
+    todo = runner.plan("smoke", claims=CLAIMS, frameworks=("jax", "torch"))
+    chains = executor.chains(todo)
+    assert sorted(u.name for c in chains for u in c) == sorted(u.name for u in todo)
+    shared = [c for c in chains if len(c) > 1]
+    assert shared and all({u.claim.id for u in c} == {"dp_loss", "dp_energy"} for c in shared)
+    assert all(len({(u.framework, u.entry.label, u.seed) for u in c}) == 1 for c in shared)
+    assert [executor._cost(c) for c in chains] == sorted((executor._cost(c) for c in chains), reverse=True)
+
+
+def test_two_workers_give_the_serial_numbers(tmp_path):
+    runner.run(profile="smoke", out=tmp_path / "serial", claims=CLAIMS, frameworks=("jax",), progress=False)
+    runner.run(profile="smoke", out=tmp_path / "two", claims=CLAIMS, frameworks=("jax",), progress=False, jobs=2)
+    a, b = (pd.read_csv(tmp_path / d / "summary" / "units.csv").sort_values(["claim", "model", "seed"])
+            .reset_index(drop=True) for d in ("serial", "two"))
+    timing = [c for c in a.columns if "time" in c or "per_s" in c]
+    pd.testing.assert_frame_equal(a.drop(columns=timing), b.drop(columns=timing))
+    assert len(a) == len(runner.plan("smoke", claims=CLAIMS, frameworks=("jax",)))
+
+
+def test_jobs_must_be_a_positive_integer(tmp_path):
+    with pytest.raises(ValueError, match="--jobs"):
+        runner.run(profile="smoke", out=tmp_path, claims=["appendix_b"], jobs=0)
+    assert not (tmp_path / "run.json").exists()
