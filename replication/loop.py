@@ -51,7 +51,7 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
         lr = learning_rate(protocol, k)
         batches = [stream.batch(k) for stream in streams]
         # a stopped member gets the bound -inf: no step of it is ever taken again
-        bounds = np.array([g.threshold(protocol.dtype) if on else -np.inf for g, on in zip(guards, live)])
+        bounds = np.array([g.threshold(protocol.dtype) if on else -np.inf for g, on in zip(guards, live, strict=True)])
         ts = time.perf_counter()
         loss, gnorm = stepper.propose(batches, lr, bounds)
         for i in np.flatnonzero(live):
@@ -59,7 +59,7 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
                 failures[i], live[i] = nonfinite_failure(k, loss[i], gnorm[i]), False
         if not live.any():
             break
-        taken = np.array([on and g.record(gnorm[i], bounds[i]) for i, (g, on) in enumerate(zip(guards, live))])
+        taken = np.array([on and g.record(gnorm[i], bounds[i]) for i, (g, on) in enumerate(zip(guards, live, strict=True))])
         stepper.commit(taken, np.array([g.clip_scale(gnorm[i]) for i, g in enumerate(guards)]))
         if k or compiled:
             t_steps += time.perf_counter() - ts

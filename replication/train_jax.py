@@ -154,7 +154,7 @@ class Members:
     def probe(self):
         if self.look is None:
             return None
-        return [self.look(self.member(i), jax.tree_util.tree_map(lambda a: a[i], self._batch))
+        return [self.look(self.member(i), {k: v[i] for k, v in self._batch.items()})
                 for i in range(self.n)]
 
     def params(self) -> list[dict]:
