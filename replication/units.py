@@ -33,7 +33,7 @@ class Unit:
 
     def spec(self):
         p = self.protocol()
-        fields = dict(self.entry.spec)
+        fields = self.entry.spec_fields(self.profile)
         dof = fields.pop("dof", None) or system_of(p).dof
         return ModelSpec(dof=dof, hidden=self.entry.widths(self.profile) or (8,), dtype=p.dtype, **fields)
 

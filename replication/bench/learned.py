@@ -54,12 +54,12 @@ def find_trained(folder) -> dict:
 def tiny_models(sizes, labels=LABELS) -> dict:
     """The claim's models at sizes.target_hidden, trained briefly with the suite's `train_jax.train`."""
     from models import init_params
-    from replication.claims.double_pendulum import MODELS, PROTOCOLS
+    from replication.claims.double_pendulum import MODELS, PLAIN_QUICK
     from replication.data import BatchStream
     from replication.train_jax import train
 
     steps = TINY_STEPS.get(sizes.name, 300)
-    proto = PROTOCOLS["quick"].replace(steps=steps, n_train=128 * 50, n_heldout=256, lr_step_every=steps * 2 // 3)
+    proto = PLAIN_QUICK.replace(steps=steps, n_train=128 * 50, n_heldout=256, lr_step_every=steps * 2 // 3)
     out = {}
     for entry in MODELS:
         if entry.label in labels:

@@ -68,7 +68,7 @@ import systems
 from models import ModelSpec
 from replication import scouting
 from replication.bench.target_loop import N_EVALS, run_protocol
-from replication.claims.double_pendulum import MODELS, PROTOCOLS
+from replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
 from replication.data import heldout
 
 THRESHOLDS = (10.0, 3.0, 1.0, 0.3, 0.073)
@@ -98,7 +98,7 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     pool = min(paper.n_train, max(paper.batch, budget // paper.batch * paper.batch))
     orig = paper.replace(steps=max(budget // paper.batch, 2), n_train=pool, n_heldout=n_heldout, log_every=10**9)
     steps = max(budget // VARIANT_BATCH, 3)
-    var = PROTOCOLS["quick"].replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
+    var = PLAIN_QUICK.replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
                                      n_heldout=n_heldout, lr=VARIANT_LR, schedule="onecycle",
                                      grad_clip=GRAD_CLIP, spike_skip=SPIKE_SKIP, log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}

@@ -25,7 +25,8 @@ class ModelEntry:
     """One model of a claim. `spec` holds ModelSpec fields except dof and dtype (taken from the system
     and the protocol); `hidden` may map a profile to widths; `overrides` change the claim's protocol
     for this model (another data recipe, task, loss, learning rate, pool size...), optionally per
-    profile as {profile: {...}}; `train=False` marks a model evaluated without training; `profiles` limits
+    profile as {profile: {...}}; `profile_spec` adds ModelSpec fields in one profile only, as
+    {profile: {field: value}}; `train=False` marks a model evaluated without training; `profiles` limits
     the profiles the model runs in."""
 
     label: str
@@ -34,6 +35,10 @@ class ModelEntry:
     overrides: dict = field(default_factory=dict)
     train: bool = True
     profiles: tuple = PROFILES   # the profiles this model runs in
+    profile_spec: dict = field(default_factory=dict)
+
+    def spec_fields(self, profile: str) -> dict:
+        return {**self.spec, **self.profile_spec.get(profile, {})}
 
     def widths(self, profile: str) -> tuple:
         h = self.hidden.get(profile, ()) if isinstance(self.hidden, dict) else self.hidden

@@ -73,6 +73,13 @@ FINDINGS = [
     Finding("Relativistic data quirk", "not stated",
             "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",
             "the 1 + γ weighting is kept", ("relativ",), ("weighting", "fixed_velocities")),
+    Finding("Restarts over inits and the gradient guard (quick)", "not stated",
+            "one run per seed (restarted only after a NaN), no gradient clipping or skipping, raw velocity inputs",
+            "the quick profile trains the double-pendulum LNN and baseline alike with restarts: 8 inits scouted "
+            "for 5e5 samples each, the lowest training loss (never the held-out set) continued for 4e6 samples at "
+            "batch 256; the gradient-spike guard (clip 100, skip at 10x the median norm) and velocity inputs "
+            "scaled by 0.3; 8e6 samples in all against the code's 3e8. The paper profile keeps the code's recipe",
+            ("double_pendulum",), ("scouts", "scout_steps", "grad_clip", "spike_skip", "input_scale")),
     Finding("Hidden wrappers", "not stated", "NaN guards, seed restarts, l2 penalty 1e-6·||θ||²/512",
             "the l2 penalty as each protocol records it (the double-pendulum protocols keep 1e-6/512); non-finite "
             "losses are reported as failed units, excluded from verdicts, not restarted silently",

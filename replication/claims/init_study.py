@@ -12,10 +12,10 @@ INITS = ("cranmer2020", "xavier", "kaiming", "pytorch_default")
 W = {"smoke": dp.SMOKE_W, "quick": (64, 64, 64), "paper": dp.PAPER_W}
 MODELS = tuple(ModelEntry(f"lnn_init-{i}", {"kind": "lnn", "activation": "softplus", "init": i,
                                              "angle_wrap": True}, hidden=W) for i in INITS)
-PROTOCOLS = {"smoke": dp.PROTOCOLS["smoke"],
+PROTOCOLS = {"smoke": dp.PLAIN_SMOKE,
              # 500 steps: at this scale every init is still near the q-double-dot ~ 0 plateau after 1000 (L1 44-48,
              # measured), so the extra 500 bought nothing but 4 minutes of the quick budget
-             "quick": dp.PROTOCOLS["quick"].replace(steps=500, n_heldout=10_000),
+             "quick": dp.PLAIN_QUICK.replace(steps=500, n_heldout=10_000),
              "paper": dp.PROTOCOLS["paper"].replace(steps=40_000)}
 
 

@@ -29,15 +29,15 @@ def _entries():
         # smoke: the baseline only (an LNN's rollout compiles for ~15 s per unit in JAX)
         profiles = ("quick", "paper") if m.label == "lnn" else ("smoke", "quick", "paper")
         for dtype in ("float32", "float64"):
-            out.append(ModelEntry(f"{m.label}_{dtype.replace('float', 'f')}", m.spec, hidden=m.hidden,
+            out.append(ModelEntry(f"{m.label}_{dtype.replace('float', 'f')}", m.spec, hidden={**m.hidden, "quick": dp.PLAIN_QUICK_W},
                                   overrides={"dtype": dtype}, profiles=profiles))
     return tuple(out)
 
 
 MODELS = _entries()
 PROTOCOLS = {
-    "smoke": dp.PROTOCOLS["smoke"],
-    "quick": dp.PROTOCOLS["quick"].replace(steps=600, n_train=128 * 150, n_heldout=2000, lr_step_every=400,
+    "smoke": dp.PLAIN_SMOKE,
+    "quick": dp.PLAIN_QUICK.replace(steps=600, n_train=128 * 150, n_heldout=2000, lr_step_every=400,
                                            log_every=50),
     "paper": dp.PROTOCOLS["paper"],
 }
