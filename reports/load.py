@@ -34,6 +34,8 @@ BENCH_COLUMNS = {
     "train_target": ["protocol", "description", "budget", "threshold", "samples_to_reach", "reached", "best_l1",
                      "samples_per_s", "extrapolated_samples", "extrapolation"],
     "train_target_log": ["protocol", "samples", "heldout_l1"],
+    "members": ["framework", "members", "hidden", "batch", "steps", "wall_s", "step_s", "samples_per_s",
+                "cost_vs_one"],
 }
 # `lagbench bench --gpu --out ROOT` writes ROOT/bench_gpu/: the GPU preset's stages
 GPU_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("inference", "training", "scaling", "ratios")},

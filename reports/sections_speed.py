@@ -75,7 +75,9 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
         b.add(Figure("figures/bench_scaling.png", "Cost per evaluation against size, per formulation.",
                      ["bench/scaling.csv"]))
     for name, title in (("training", "Training throughput"), ("rollout", "Rollout cost and error per solver "
-                                                                        "(truth and learned models)")):
+                                                                        "(truth and learned models)"),
+                        ("members", "Many seeds for the price of one: K models trained as one program against one "
+                                    "alone (the restarts' scouting phase; cost_vs_one: wall time over one model's)")):
         if name in res.bench:
             b.add(Table(title, _bench_table(res.bench[name]), [f"bench/{name}.csv"]))
     if "latency" in res.bench:

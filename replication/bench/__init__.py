@@ -22,6 +22,8 @@ ignore):
   fast_paper.csv  dof, framework, formulation, mode, batch, seconds, samples_per_s, flops_per_sample, gflops, threads
   matmul.csv      dof, framework, rows, seconds, gflops, threads           (`replication.bench.roofline`)
   structure.csv   per system: declared structure and what using it buys   (`replication.bench.structure`)
+  members.csv     framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s, cost_vs_one:
+                  K models trained as one program against one alone (`replication.bench.members`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
   targets.json    the issue's numeric targets, each with the measured values and met: true/false
   timings.json    wall seconds of the whole study and per stage, and the stages taken from checkpoints
@@ -58,6 +60,7 @@ from replication.bench import (
     device,
     latency,
     learned,
+    members,
     rollout,
     roofline,
     scaling,
@@ -160,7 +163,8 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
     cases = INF.inference_cases(sizes) + INF.trained_cases(out, (1, max(sizes.batches)))
     sc_cases = list(scaling.lgn_cases(sizes)) + list(scaling.chain_cases(sizes))
     total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
-             + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes))
+             + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes)
+             + members.n_cases(sizes))
     bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
     stage, t_start = _Stages(bar, bench, cache, notes, sizes.stages or STAGES), time.perf_counter()
     if sizes.stages:
@@ -185,6 +189,9 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
               lambda: {"structure": structure.structure_rows(sizes, inf_rows, bar)})
         tt_rows = stage("train to target", train_target.n_cases(sizes),
                         lambda: _train_target(sizes, bar), ["train_target"])["train_target"]
+        mb_rows = stage("members", members.n_cases(sizes),
+                        lambda: {"members": members.members_rows(sizes, bar) if sizes.members_steps else []},
+                        ["members"])["members"]
     finally:
         bar.close()
         write_json(bench / "timings.json", {"preset": sizes.name, "total_s": time.perf_counter() - t_start,
@@ -192,6 +199,8 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
     ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes, lat_rows)
     _write(bench, "ratios", ratios)
     targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows, lat_rows, tt_rows)
+    if mb_rows:
+        targets["members_cost_vs_one"] = members.target(mb_rows)
     write_json(bench / "targets.json", {"preset": sizes.name, "targets": targets})
     return targets
 

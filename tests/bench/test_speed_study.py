@@ -25,10 +25,12 @@ COLUMNS = {
                   "general_model", "speedup"],
     "fast_paper": ["dof", "framework", "formulation", "samples_per_s", "flops_per_sample", "threads"],
     "matmul": ["dof", "framework", "gflops", "threads"],
+    "members": ["framework", "members", "hidden", "batch", "steps", "wall_s", "step_s", "samples_per_s",
+                "cost_vs_one", "step_cost_vs_one"],
 }
 POSITIVE = {"inference": ["samples_per_s"], "training": ["steps_per_s", "samples_per_s"],
             "rollout": ["wall_s"], "scaling": ["seconds_per_eval", "samples_per_s"], "latency": ["evals_per_s"],
-            "fast_paper": ["samples_per_s"], "matmul": ["gflops"]}
+            "fast_paper": ["samples_per_s"], "matmul": ["gflops"], "members": ["wall_s", "cost_vs_one"]}
 
 
 @pytest.mark.parametrize("name", sorted(COLUMNS))
@@ -153,3 +155,14 @@ def load_results_of(out):
     from reports.load import load_results
 
     return load_results(out)
+
+
+def test_members_rows_pair_one_model_with_eight(bench_dir):
+    out, _ = bench_dir
+    df = pd.read_csv(out / "bench" / "members.csv")
+    assert sorted(df["framework"].unique()) == ["jax", "torch"]
+    for _, g in df.groupby("framework"):
+        assert sorted(g["members"]) == [1, 8]
+        assert float(g.loc[g["members"] == 1, "cost_vs_one"].iloc[0]) == 1.0
+    targets = json.loads((out / "bench" / "targets.json").read_text())["targets"]
+    assert targets["members_cost_vs_one"]["target"] == 2.5
