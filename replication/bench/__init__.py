@@ -25,7 +25,8 @@ ignore):
   members.csv     framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s, cost_vs_one:
                   K models trained as one program against one alone (`replication.bench.members`)
   ratios.csv      operation, jax, torch, ratio, note                       (`replication.bench.tables`)
-  targets.json    the issue's numeric targets, each with the measured values and met: true/false
+  targets.json    the issue's numeric targets (`replication.bench.targets.TARGETS`), each with the measured
+                  values and met: true/false
   timings.json    wall seconds of the whole study and per stage, and the stages taken from checkpoints
   stages/*.json   one checkpoint per finished stage, for `lagbench bench --resume` (`replication.bench.resume`)
 Presets (`replication.bench.timing`): quick (default), full (`quick=False`), tiny (`tiny=True` or the
@@ -70,6 +71,7 @@ from replication.bench import (
     training,
 )
 from replication.bench import inference as INF
+from replication.bench import targets as TG
 from replication.bench.resume import StageCache
 from replication.bench.timing import FULL, GPU, GPU_TINY, QUICK, STAGES, TINY, TORCH_THREADS, Sizes
 from replication.results import write_csv, write_json
@@ -198,9 +200,7 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
                                             "stages_s": stage.seconds, "resumed_stages": cache.reused})
     ratios = tables.ratio_rows(inf_rows, train_rows, sc_rows, fp_rows, mm_rows, notes, lat_rows)
     _write(bench, "ratios", ratios)
-    targets = tables.targets(ratios, fit, sc_rows, inf_rows, train_rows, lat_rows, tt_rows)
-    if mb_rows:
-        targets["members_cost_vs_one"] = members.target(mb_rows)
+    targets = TG.targets(ratios, fit, sc_rows, inf_rows, train_rows, lat_rows, tt_rows, mb_rows)
     write_json(bench / "targets.json", {"preset": sizes.name, "targets": targets})
     return targets
 

@@ -10,7 +10,7 @@ the thread counts.
 Also rows for the fast/paper speedups (jax, torch = each framework's fast/paper ratio; ratio empty),
 the fast LNN's achieved GFLOP/s (XLA's FLOP count for both frameworks), the attainable (matrix products)
 GFLOP/s and the achieved fraction.
-`targets(...) -> dict` checks the issue's numeric targets against these rows.
+The issue's numeric targets are checked in `replication.bench.targets`.
 """
 from __future__ import annotations
 
@@ -18,10 +18,8 @@ import os
 
 import numpy as np
 
+from replication.bench.bounds import TARGETS
 from replication.bench.timing import TORCH_THREADS
-from replication.bench.train_target import ORIGINAL_SAMPLES, PAPER_L1, TARGET_SAMPLES
-
-FAST_PAPER_TARGET = {2: 1.25, 16: 1.8}
 
 
 def _fit_call_cost(rows) -> dict:
@@ -215,15 +213,15 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
                         torch_threads=_threads_of(fastpaper, dof=d, framework="torch", formulation=f),
                         torch_mode=_mode_of(fastpaper, dof=d, framework="torch", formulation=f)))
     for d in sorted({r["dof"] for r in fastpaper}):
-        sp = {fw: _get(fastpaper, dof=d, framework=fw, formulation="fast") /
-              _get(fastpaper, dof=d, framework=fw, formulation="paper") for fw in ("jax", "torch")}
-        tgt = FAST_PAPER_TARGET.get(d)
+        sp = {fw: row_value(fastpaper, dof=d, framework=fw, formulation="fast") /
+              row_value(fastpaper, dof=d, framework=fw, formulation="paper") for fw in ("jax", "torch")}
+        tgt = TARGETS["fast_over_paper"].get(d)
         out.append({"operation": f"fast/paper speedup d={d}", "jax": sp["jax"], "torch": sp["torch"],
                     "ratio": np.nan, "note": f"target >= {tgt}" if tgt else ""})
     for d in sorted({r["dof"] for r in matmul}):
-        mm = {fw: _get(matmul, "gflops", dof=d, framework=fw) for fw in ("jax", "torch")}
-        flops = _get(fastpaper, "flops_per_sample", dof=d, framework="jax", formulation="fast")
-        ach = {fw: flops * _get(fastpaper, dof=d, framework=fw, formulation="fast") / 1e9 for fw in mm}
+        mm = {fw: row_value(matmul, "gflops", dof=d, framework=fw) for fw in ("jax", "torch")}
+        flops = row_value(fastpaper, "flops_per_sample", dof=d, framework="jax", formulation="fast")
+        ach = {fw: flops * row_value(fastpaper, dof=d, framework=fw, formulation="fast") / 1e9 for fw in mm}
         out.append(_row(f"matmul roofline: matrix products of the layer shapes d={d} (GFLOP/s)", mm["jax"], mm["torch"],
                         torch_threads=_threads_of(matmul, dof=d, framework="torch")))
         out.append(_row(f"fast LNN achieved d={d} (GFLOP/s; {flops:.3g} FLOP/sample from XLA cost analysis)",
@@ -239,7 +237,7 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
 
 def _threads_of(rows, **match):
     """The `threads` a matching row chose (int), or None where it has none (results from before the column)."""
-    t = _get(rows, "threads", **match)
+    t = row_value(rows, "threads", **match)
     return int(t) if np.isfinite(t) else None
 
 
@@ -248,72 +246,10 @@ def _mode_of(rows, **match):
     return next((r.get("mode") for r in rows if all(r.get(k) == v for k, v in match.items())), None)
 
 
-def _get(rows, value="samples_per_s", **match):
+def row_value(rows, value="samples_per_s", **match):
     """The first matching row's value as a float; NaN where no row matches or the row has no value."""
     for r in rows:
         if all(r.get(k) == v for k, v in match.items()):
             v = r.get(value)
             return np.nan if v is None or v == "" else float(v)
     return np.nan
-
-
-def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train_target=()) -> dict:
-    byop = {r["operation"]: r for r in ratios}
-    t: dict = {}
-    for d, tgt in FAST_PAPER_TARGET.items():
-        r = byop.get(f"fast/paper speedup d={d}")
-        if r:
-            t[f"fast_over_paper_d{d}"] = {"jax": r["jax"], "torch": r["torch"], "target": tgt,
-                                          "met": bool(r["jax"] >= tgt and r["torch"] >= tgt)}
-    for op, r in byop.items():
-        if op.startswith("fast LNN fraction of roofline"):
-            t[op.replace(" ", "_")] = {"jax": r["jax"], "torch": r["torch"], "target": 0.8,
-                                       "met": bool(r["jax"] >= 0.8)}
-    inf_ratios = [r["ratio"] for r in ratios if r["operation"].startswith("q''") and np.isfinite(r["ratio"])]
-    if inf_ratios:
-        t["torch_within_1.5x_of_jax_inference"] = {"worst_jax_over_torch": max(inf_ratios),
-                                                   "n_ops": len(inf_ratios),
-                                                   "n_beyond": sum(x > 1.5 for x in inf_ratios),
-                                                   "met": bool(max(inf_ratios) <= 1.5)}
-    for r in scaling_fit:
-        if r["study"] == "lgn_grid" and r["formulation"] == "banded":
-            t[f"lgn_banded_exponent_{r['framework']}_{r.get('fit_range', 'all')}"] = {
-                "exponent": r["exponent"], "n_min": r.get("n_min"), "n_max": r.get("n_max"), "target": 1.1,
-                "met": bool(r["exponent"] <= 1.1)}
-    for fw in ("jax", "torch"):
-        ns = [r["n"] for r in scaling if r["study"] == "lgn_grid" and r["framework"] == fw]
-        n = 1024 if 1024 in ns else (max(ns) if ns else None)
-        if n is not None:
-            sp = (_get(scaling, study="lgn_grid", formulation="banded", framework=fw, n=n)
-                  / _get(scaling, study="lgn_grid", formulation="dense", framework=fw, n=n))
-            t[f"lgn_banded_over_dense_n{n}_{fw}"] = {"speedup": sp, "target": 50, "met": bool(sp >= 50)}
-    for fw in ("jax", "torch"):
-        dl = {r["batch"]: r["samples_per_s"] for r in fastest_per_batch(inference) if r["model"] == "delan" and
-              r["framework"] == fw and r["dtype"] == "float32" and r["system"] == "double_pendulum"
-              and r.get("source", "random_init") == "random_init"}
-        single = {f"{r['method']}/{r['mode']}/{r['dispatch']}": r["evals_per_s"] for r in latency
-                  if r["framework"] == fw and r["dtype"] == "float32"}
-        if dl or single:
-            best = max(single.items(), key=lambda kv: kv[1]) if single else (None, dl.get(1) or 0.0)
-            t[f"delan_{fw}"] = {"single_sample_per_s": best[1], "best_mode": best[0], "single_sample": single,
-                                "batched_acceleration": {str(b): v for b, v in dl.items()},
-                                "target_single": 1e4, "met": bool(best[1] >= 1e4),
-                                "met_by": sorted(k for k, v in single.items() if v >= 1e4)}
-    for proto in sorted({r["protocol"] for r in train_target if r.get("model", "lnn") == "lnn"}):
-        rs = sorted((r for r in train_target if r["protocol"] == proto), key=lambda r: -r["threshold"])
-        paper = [r for r in rs if abs(r["threshold"] - PAPER_L1) < 1e-9]
-        hit = bool(paper and np.isfinite(paper[0]["samples_to_reach"])
-                   and paper[0]["samples_to_reach"] <= TARGET_SAMPLES)
-        t[f"train_target_{proto}"] = {
-            "target": f"held-out L1 <= {PAPER_L1:g} within {TARGET_SAMPLES:.0e} samples (a tenth of the original's "
-                      f"{ORIGINAL_SAMPLES:.0e})", "budget": rs[0]["budget"], "hidden": rs[0]["hidden"],
-            "best_l1": rs[0]["best_l1"], "description": rs[0]["description"],
-            "hessian_rel_err": rs[0].get("hessian_rel_err", float("nan")),
-            "samples_to_reach": {f"{r['threshold']:g}": r["samples_to_reach"] for r in rs},
-            "extrapolated_samples_NOT_MEASURED": {f"{r['threshold']:g}": r["extrapolated_samples"] for r in rs},
-            "met": hit}
-    one_batch = len({r["batch"] for r in training}) <= 1
-    t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}"
-                                   + ("" if one_batch else f"/batch {r['batch']}"): r["samples_per_s"]
-                                   for r in training}
-    return t

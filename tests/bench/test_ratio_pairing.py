@@ -4,7 +4,7 @@ came from, and the note of a ratio beyond 2x names them; the DeLaN target reads 
 rows timed in the same interleaved rounds as their JAX twin are compared within those rounds."""
 import pytest
 
-from replication.bench import tables
+from replication.bench import tables, targets
 
 
 def _row(fw, mode, threads, batch, rate, model="delan"):
@@ -31,7 +31,7 @@ def test_ratio_uses_the_fastest_torch_row_and_names_it():
     assert one["ratio"] == pytest.approx(0.5) and one["note"] == ""  # within 2x: no note
     assert big["ratio"] == pytest.approx(4.0)
     assert "PyTorch 2 (eager" in big["note"]
-    t = tables.targets(list(rows.values()), [], [], ROWS, [])
+    t = targets.targets(list(rows.values()), [], [], ROWS, [])
     assert t["delan_torch"]["batched_acceleration"] == {"1": 8000.0, "256": 5e4}
     assert t["torch_within_1.5x_of_jax_inference"]["n_beyond"] == 1
 
@@ -79,6 +79,6 @@ def test_paired_rows_compare_within_their_own_rounds():
     one, big = rows["q'' double_pendulum delan/- float32 batch 1"], rows["q'' double_pendulum delan/- float32 batch 256"]
     assert (one["jax"], one["torch"], one["ratio"]) == (12000.0, 8000.0, pytest.approx(1.5))
     assert (big["jax"], big["torch"], big["ratio"]) == (6.25e4, 5e4, pytest.approx(1.25))
-    t = tables.targets(list(rows.values()), [], [], paired, [])
+    t = targets.targets(list(rows.values()), [], [], paired, [])
     assert t["torch_within_1.5x_of_jax_inference"] == {"worst_jax_over_torch": pytest.approx(1.5), "n_ops": 2,
                                                        "n_beyond": 0, "met": True}
