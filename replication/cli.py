@@ -232,8 +232,8 @@ def build_parser():
                                                              "issue's target is 3e7)")
     s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
     s.add_argument("--heldout", type=int, default=4096, help="held-out states, >= 1 (default 4096)")
-    s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, baseline_reference "
-                                       "(default all)")
+    s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, restarts_fast, "
+                                       "baseline_reference (default all)")
     s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7; default 0)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_train_target)

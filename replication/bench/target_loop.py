@@ -43,6 +43,7 @@ class _Loop:
         self.step = train_jax.make_step(spec, protocol)
         self.evaluate = heldout_l1(spec, protocol)
         self.log, self.steps, self.wall, self.skipped, self.compiled = [], 0, 0.0, 0, False
+        self.extra = 0   # samples beyond steps x batch: scouts at a batch of their own
 
     def row(self, model, phase, seed, lr, loss):
         self.log.append({"protocol": self.name, "phase": phase, "seed": seed, "step": self.steps,
@@ -76,7 +77,7 @@ class _Loop:
 
     @property
     def samples(self) -> int:
-        return self.steps * self.batch
+        return self.steps * self.batch + self.extra
 
 
 def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
@@ -99,6 +100,7 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
     loop.wall += outcomes[0].step_seconds
     for s, out, tail in zip(seeds, outcomes, tails, strict=True):
         loop.steps += scout.steps
+        loop.extra += scout.steps * (scout.batch - protocol.batch)
         loop.skipped += out.skipped_steps
         model = models.jax.build(spec, out.params)
         if out.failure is None:

@@ -24,7 +24,9 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       samples. Why: which init finds a near-physical Lagrangian is luck (after 5e5 samples, 3 of 8 seeds at
       3x64, 2 of 8 and 3 of 8 at 3x128), a run that found one trains on without gradient spikes, and its
       training loss tells which it is (`train_target_trials.md`, section 5).
-The three use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
+  "restarts_fast": restarts, the scouts alike, the continuation at batch 256 and peak 2e-3 (the quick
+      profile's double-pendulum protocol): about three times the samples per second of batch 32.
+The four use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
 them, for reference (not a target row):
   "baseline_reference": the claim's plain MLP baseline (ReLU, Glorot init, q'' straight out) on the
       variant's protocol and inputs: what the same samples buy when no Euler-Lagrange solve is learned.
@@ -81,6 +83,7 @@ HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 1e-3, 0.3
 GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
 RESTART_SEEDS = 8  # "restarts": inits scouted (each for scouting.SCOUT_SAMPLES samples)
+FAST_BATCH, FAST_LR = 256, 2e-3   # "restarts_fast": the continuation's batch and peak rate
 
 
 class Entry(NamedTuple):
@@ -114,10 +117,19 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
                      f"(a new one-cycle, fresh Adam state); otherwise the variant: batch {var.batch}, peak "
                      f"{var.lr:g}, clip {var.grad_clip:g}, skip at {var.spike_skip:g} x median, velocity scale "
                      f"{VELOCITY_SCALE:g}. Samples count every scout")
+    # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak (the
+    # quick profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["quick"]`), same budget
+    fast_rest = max((budget - RESTART_SEEDS * scout * var.batch) // FAST_BATCH, 1)
+    fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR,
+                            scout_batch=var.batch, scout_lr=var.lr)
+    fast_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each at batch {var.batch}, peak {var.lr:g}, as "
+                 f"restarts; the chosen one continued for {fast_rest} steps at batch {FAST_BATCH}, peak {FAST_LR:g} "
+                 f"(a new one-cycle, fresh Adam state). Samples count every scout")
     return {"original_scaled": Entry(orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
                                            f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
             "variant": Entry(var, var_text, scale, "lnn"),
             "restarts": Entry(restarts, restarts_text, scale, "lnn"),
+            "restarts_fast": Entry(fast, fast_text, scale, "lnn"),
             "baseline_reference": Entry(var, f"the MLP baseline on the variant's protocol: {var_text}", scale,
                                         "baseline")}
 
