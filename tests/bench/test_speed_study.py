@@ -94,7 +94,7 @@ def test_latency_compiled_matches_method_and_is_in_targets(bench_dir):
 def test_train_target_rows(bench_dir):
     out, targets = bench_dir
     df = pd.read_csv(out / "bench" / "train_target.csv")
-    assert set(df["protocol"]) == {"original_scaled", "variant", "restarts", "baseline_reference"}
+    assert set(df["protocol"]) == {"original_scaled", "variant", "restarts", "restarts_fast", "baseline_reference"}
     assert set(df.loc[df["protocol"] == "baseline_reference", "model"]) == {"baseline"}
     lnn = df[df["model"] == "lnn"]
     assert np.all(np.isfinite(lnn["hessian_rel_err"].to_numpy(float)))
