@@ -8,18 +8,19 @@ import pytest
 
 from replication import bench as B
 from replication.bench import inference as INF
-from replication.bench import latency, rollout, roofline, scaling, structure, train_target, training
+from replication.bench import latency, members, rollout, roofline, scaling, structure, train_target, training
 from replication.bench.resume import StageCache
 
 STAGES = ["inference", "single-sample latency", "training", "rollouts", "scaling", "fast vs paper", "structure",
-          "train to target"]
+          "train to target", "members"]
 # the work each stage calls; a stage that runs again on resume reaches one of these
 WORK = {"inference": (INF, "run_case"), "single-sample latency": (latency, "latency_rows"),
         "training": (training, "training_rows"), "rollouts": (rollout, "rollout_rows"),
         "scaling": (scaling, "run_scaling_group"), "fast vs paper": (roofline, "roofline_rows"),
-        "structure": (structure, "structure_rows"), "train to target": (train_target, "train_target_rows")}
+        "structure": (structure, "structure_rows"), "train to target": (train_target, "train_target_rows"),
+        "members": (members, "members_rows")}
 SAME = ["inference", "latency", "training", "rollout", "scaling", "scaling_fit", "fast_paper", "matmul",
-        "structure", "train_target", "train_target_log", "ratios"]
+        "structure", "train_target", "train_target_log", "members", "ratios"]
 
 
 @pytest.fixture(scope="module")
