@@ -66,9 +66,11 @@ def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatc
     monkeypatch.setitem(claim.protocols, "smoke", claim.protocols["smoke"].replace(steps=7))
     run(**kw)
     (new,) = tmp_path.glob("units/dp_loss/jax/baseline/seed0/result.json")
-    assert R.load_result(new.parent)["train_steps"] == 7
+    assert R.load_result(new.parent)["protocol"]["steps"] == 7
     (old,) = tmp_path.glob("units/dp_loss/jax/baseline/superseded-*-seed0/result.json")
-    assert R.load_result(old.parent)["train_steps"] == 20
+    assert R.load_result(old.parent)["protocol"]["steps"] == 20
+    # train_steps counts every scout's steps as well (the smoke protocol scouts)
+    assert R.load_result(new.parent)["train_steps"] - R.load_result(old.parent)["train_steps"] == 7 - 20
 
 
 def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):

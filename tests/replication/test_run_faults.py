@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from replication import runner
+from replication import runner, units
 from replication.cli import main
 
 ONE = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--models", "baseline", "--quiet"]
@@ -49,7 +49,7 @@ def test_ctrl_c_says_how_to_resume_and_is_recorded(monkeypatch, tmp_path, capsys
     def interrupt(*a, **kw):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(runner, "run_unit", interrupt)
+    monkeypatch.setattr(units, "run_unit", interrupt)   # what the executor calls for every unit
     assert main(["run", *ONE, "--out", str(tmp_path)]) == 130
     err = capsys.readouterr().err
     assert "interrupted; finished units are kept; run the same command again to resume" in err
