@@ -164,17 +164,17 @@ class Members:
                 self.moments[k] = (torch.where(keep, m, self.moments[k][0]), torch.where(keep, v, self.moments[k][1]))
         self.count = count
 
-    def _member(self, i):
-        return models.torch.build(self.spec, self.params()[i])
+    def _params_of(self, i: int) -> dict:
+        return {k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
 
     def probe(self):
         if self.look is None:
             return None
-        return [self.look(self._member(i), {k: v[i] for k, v in self._batch.items()}) for i in range(self.n)]
+        return [self.look(models.torch.build(self.spec, self._params_of(i)), {k: v[i] for k, v in self._batch.items()})
+                for i in range(self.n)]
 
     def params(self) -> list[dict]:
-        return [{k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
-                for i in range(self.n)]
+        return [self._params_of(i) for i in range(self.n)]
 
 
 def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
