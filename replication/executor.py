@@ -128,12 +128,10 @@ def _parallel(todo, out, profile, progress, jobs):
     work = chains(todo)
     failures, errors = [], []
     saved = {k: os.environ.get(k) for k in ONE_THREAD}
-    os.environ.update(ONE_THREAD)   # inherited by the spawned workers before they import JAX or PyTorch
-    try:
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start)
-    finally:
-        for k, v in saved.items():
-            os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
+    # inherited by the spawned workers before they import JAX or PyTorch; kept while the pool lives, as
+    # the pool starts its processes on demand as chains are submitted
+    os.environ.update(ONE_THREAD)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start)
     bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
     try:
         futures = {pool.submit(_run_chain, [_ref(u) for u in c], out): c for c in work}
@@ -152,6 +150,8 @@ def _parallel(todo, out, profile, progress, jobs):
         raise
     finally:
         bar.close()
+        for k, v in saved.items():
+            os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
     pool.shutdown()
     return failures, errors
 

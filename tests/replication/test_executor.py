@@ -32,3 +32,37 @@ def test_jobs_must_be_a_positive_integer(tmp_path):
     with pytest.raises(ValueError, match="--jobs"):
         runner.run(profile="smoke", out=tmp_path, claims=["appendix_b"], jobs=0)
     assert not (tmp_path / "run.json").exists()
+
+
+def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch):
+    """The workers start (on demand, as chains are submitted) with one-thread settings; the parent's
+    environment is as it was afterwards."""
+    import os
+
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    seen = {}
+
+    def fake_chain(refs, out):
+        return [(f"u{i}", None, None) for i, _ in enumerate(refs)]
+
+    class Pool:
+        def __init__(self, **kw):
+            pass
+
+        def submit(self, fn, refs, out):
+            from concurrent.futures import Future
+
+            seen.update({k: os.environ.get(k) for k in executor.ONE_THREAD})
+            f = Future()
+            f.set_result(fake_chain(refs, out))
+            return f
+
+        def shutdown(self, **kw):
+            pass
+
+    monkeypatch.setattr(executor, "ProcessPoolExecutor", Pool)
+    todo = runner.plan("smoke", claims=["appendix_b", "dp_loss"], frameworks=("jax",))
+    failures, errors = executor.run_units(todo, "unused", "smoke", progress=False, jobs=2)
+    assert failures == [] and errors == []
+    assert seen == executor.ONE_THREAD
+    assert "OMP_NUM_THREADS" not in os.environ
