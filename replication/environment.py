@@ -10,6 +10,14 @@ from functools import lru_cache
 from pathlib import Path
 
 PACKAGES = ("numpy", "sympy", "jax", "jaxlib", "equinox", "optax", "diffrax", "torch", "pandas")
+ONE_CORE_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+
+
+def one_thread_env(env) -> dict:
+    """The environment variables that hold a new process's JAX (XLA's Eigen pool off, appended to any
+    XLA_FLAGS already in `env`), PyTorch/OpenMP and MKL to one thread."""
+    return {"XLA_FLAGS": f"{env.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(), "OMP_NUM_THREADS": "1",
+            "MKL_NUM_THREADS": "1"}
 
 
 @lru_cache(maxsize=1)

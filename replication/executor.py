@@ -25,11 +25,10 @@ from multiprocessing import get_context
 
 from tqdm.auto import tqdm
 
+from replication.environment import one_thread_env
 from replication.scouting import budget_samples, progress_steps
 
 log = logging.getLogger("lagbench")
-ONE_THREAD = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-              "XLA_FLAGS": "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"}
 TORCH_COST = 3.0   # PyTorch's eager LNN step against JAX's compiled one, per sample (measured, 3 x 64 and 3 x 128)
 
 
@@ -127,10 +126,11 @@ def _run_chain(refs, out):
 def _parallel(todo, out, profile, progress, jobs):
     work = chains(todo)
     failures, errors = [], []
-    saved = {k: os.environ.get(k) for k in ONE_THREAD}
+    one = one_thread_env(os.environ)
+    saved = {k: os.environ.get(k) for k in one}
     # inherited by the spawned workers before they import JAX or PyTorch; kept while the pool lives, as
     # the pool starts its processes on demand as chains are submitted
-    os.environ.update(ONE_THREAD)
+    os.environ.update(one)
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start)
     bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
     try:

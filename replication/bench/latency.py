@@ -30,11 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from replication.bench.evaluators import torch_ops, xla_kernels
+from replication.environment import one_thread_env
 
 METHODS = ("inverse_dynamics", "acceleration")
 CALLS = 50
 SLICE_S = 0.05  # each fn's turn in `interleaved_rates`
-ONE_CORE_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
 
 
 def interleaved_rates(fns: dict, seconds: float, calls: int = CALLS, slice_s: float = SLICE_S) -> dict:
@@ -147,8 +147,7 @@ def latency_rows(sizes, notes: list | None = None) -> list[dict]:
                           "seconds": sizes.latency_s, "sync": sync,
                           "methods": list(sizes.latency_methods), "torch_aot": sizes.torch_compile})
         root = str(Path(__file__).resolve().parents[2])  # the project root, for an uninstalled checkout
-        env = {**os.environ, "XLA_FLAGS": f"{os.environ.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(),
-               "OMP_NUM_THREADS": "1",
+        env = {**os.environ, **one_thread_env(os.environ),
                "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)}
         proc = subprocess.run([sys.executable, "-m", "replication.bench.latency", arg], env=env,
                               capture_output=True, text=True, timeout=600)

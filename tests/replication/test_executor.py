@@ -4,6 +4,7 @@ import pandas as pd
 import pytest
 
 from replication import executor, runner
+from replication.environment import one_thread_env
 
 CLAIMS = ["dp_loss", "dp_energy", "appendix_b"]
 
@@ -41,6 +42,7 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
     import os
 
     monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    monkeypatch.delenv("XLA_FLAGS", raising=False)
     seen = {}
 
     def fake_chain(refs, out):
@@ -53,7 +55,7 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
         def submit(self, fn, refs, out):
             from concurrent.futures import Future
 
-            seen.update({k: os.environ.get(k) for k in executor.ONE_THREAD})
+            seen.update({k: os.environ.get(k) for k in one_thread_env({})})
             f = Future()
             f.set_result(fake_chain(refs, out))
             return f
@@ -65,5 +67,5 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
     todo = runner.plan("smoke", claims=["appendix_b", "dp_loss"], frameworks=("jax",))
     failures, errors = executor.run_units(todo, "unused", "smoke", progress=False, jobs=2)
     assert failures == [] and errors == []
-    assert seen == executor.ONE_THREAD
+    assert seen == one_thread_env({})
     assert "OMP_NUM_THREADS" not in os.environ
