@@ -16,7 +16,7 @@ wall time per framework, is checked in `replication.bench.targets`.
 from __future__ import annotations
 
 from models import ModelSpec, init_params
-from replication import loop, train_jax, train_torch
+from replication import loop, scouting, train_jax, train_torch
 from replication.claims.double_pendulum import MODELS, PROTOCOLS
 from replication.data import BatchStream
 
@@ -26,11 +26,8 @@ MEMBERS = 8
 def _case(sizes):
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=tuple(sizes.members_hidden), dtype="float32", **lnn.spec_fields("quick"))
-    scout = PROTOCOLS["quick"]
-    protocol = scout.replace(steps=sizes.members_steps, batch=scout.scout_batch, lr=scout.scout_lr,
-                             n_train=scout.scout_batch * 1000, log_every=10**9, scouts=0, scout_steps=0,
-                             scout_batch=0, scout_lr=0.0)
-    return spec, protocol
+    scout = scouting.scout_protocol(PROTOCOLS["quick"])   # a scout of the quick double-pendulum protocol
+    return spec, scout.replace(steps=sizes.members_steps, n_train=scout.batch * 1000, log_every=10**9)
 
 
 def _make_step(framework, spec, protocol, k):
