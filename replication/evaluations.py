@@ -8,10 +8,11 @@ from replication.eval_exact import eval_exact_lagrangian
 from replication.eval_precision import eval_precision
 from replication.eval_wave import eval_wave
 from replication.evaluate import eval_energy_rollout, eval_heldout
+from replication.fit_evaluate import eval_fit
 
 # 2: null-predictor metrics for the competence bars; diverged rollouts count as +inf in the energy means
 EVALUATION_VERSION = 2
 
 EVALUATIONS = {"heldout": eval_heldout, "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,
-               "precision": eval_precision}
+               "precision": eval_precision, "fit": eval_fit}

@@ -2,9 +2,13 @@
 
 Accepted: `.npz` with arrays q, qdot, qddot (each (N, d)) and optionally tau (N, d); or `.csv` with
 columns q0..q{d-1}, qdot0.., qddot0.. and optionally tau0... (spaces around header names are
-ignored). Every problem (unknown suffix, missing columns or a gap in their numbering, mismatched
+ignored). A *trajectory file* has a time column `t` (and optionally `traj`, the trajectory id): then
+only q is required and the missing derivatives are estimated (`replication.trajectories`). A prepared
+file (`replication.fit_data`, written by `lagbench fit`) adds a `split` column (train, heldout, test).
+Every problem (unknown suffix, missing columns or a gap in their numbering, mismatched
 lengths, non-finite values or values beyond the training dtype's range, too few rows) raises a
-ValueError that names it. The split is a fixed random 10 % held out (seed 0), the same for every model.
+ValueError that names it. Rows are split by the file's `split` column; a file without one (a state
+file given straight to `split_rows`) by a fixed random 10 % held out (seed 0), the same for every model.
 
 Content addressing: a file is read once into bytes, hashed (sha256) and parsed from those bytes;
 `reference(path, digest)` is what a protocol records (`file:<path>#sha256=<hex>`), so the training
@@ -23,6 +27,8 @@ import numpy as np
 from replication.results import sha256_bytes
 
 REQUIRED = ("q", "qdot", "qddot")
+ARRAYS = (*REQUIRED, "tau")
+COLUMNS = ("traj", "t", "split")  # single columns: trajectory id, time, and a prepared file's split
 _MARK = "#sha256="
 _PARSED: dict = {}  # (suffix, sha256) -> parsed arrays; a few entries
 
@@ -59,8 +65,8 @@ def _from_csv(path, raw: bytes):
     except Exception as e:
         raise ValueError(f"{path}: cannot read as CSV ({e})") from e
     df.columns = [str(c).strip() for c in df.columns]
-    out = {}
-    for name in (*REQUIRED, "tau"):
+    out = {name: df[name].to_numpy() for name in COLUMNS if name in df.columns}
+    for name in ARRAYS:
         cols = _columns(path, df, name)
         if cols:
             try:
@@ -73,7 +79,8 @@ def _from_csv(path, raw: bytes):
 def _from_npz(path, raw: bytes):
     try:
         with np.load(io.BytesIO(raw), allow_pickle=False) as z:
-            return {k: np.asarray(z[k], dtype=np.float64) for k in z.files if k in (*REQUIRED, "tau")}
+            out = {k: np.asarray(z[k], dtype=np.float64) for k in z.files if k in ARRAYS}
+            return {**out, **{k: np.asarray(z[k]) for k in z.files if k in COLUMNS}}
     except Exception as e:
         raise ValueError(f"{path}: cannot read as .npz ({e})") from e
 
@@ -111,6 +118,8 @@ def check_range(path, d: dict, dtype: str) -> None:
     """Every value must be finite in the training dtype (1e300 is finite in float64, inf in float32)."""
     big = float(np.finfo(dtype).max)
     for k, v in d.items():
+        if k in COLUMNS:
+            continue
         bad = int(np.sum(np.any(np.abs(v) > big, axis=1)))
         if bad:
             raise ValueError(f"{path}: {k} has {bad} rows with values beyond the {dtype} range (|x| > {big:.3g})")
@@ -118,10 +127,15 @@ def check_range(path, d: dict, dtype: str) -> None:
 
 def _validate(p: Path, d: dict) -> dict:
     path = str(p)
-    missing = [k for k in REQUIRED if k not in d]
+    cols = {k: d.pop(k) for k in COLUMNS if k in d}
+    trajectories = "t" in cols and "split" not in cols
+    missing = [k for k in (("q",) if trajectories else REQUIRED) if k not in d]
     if missing:
         hint = "columns q0.., qdot0.., qddot0.." if p.suffix == ".csv" else "arrays q, qdot, qddot"
-        raise ValueError(f"{path}: missing {', '.join(missing)} (expected {hint}, optional tau)")
+        if trajectories:
+            hint = "a trajectory file: t, q" + ("0.." if p.suffix == ".csv" else "")
+        raise ValueError(f"{path}: missing {', '.join(missing)} (expected {hint}, optional tau; or a trajectory "
+                         f"file with t, q and optional traj, qdot, qddot, tau)")
     for k, v in d.items():
         if v.ndim == 1:
             d[k] = v = v[:, None]
@@ -133,21 +147,49 @@ def _validate(p: Path, d: dict) -> dict:
     shapes = {k: v.shape for k, v in d.items()}
     if len(set(shapes.values())) != 1:
         raise ValueError(f"{path}: mismatched shapes {shapes}; every array must be (N, d) with the same N and d")
-    if len(d["q"]) < 20:
-        raise ValueError(f"{path}: only {len(d['q'])} rows; need at least 20 (10 % are held out)")
+    n = len(d["q"])
+    for k, v in cols.items():
+        if v.shape != (n,):
+            raise ValueError(f"{path}: {k} must be one column of {n} values (as q), got shape {v.shape}")
+        if k == "split":
+            cols[k] = v.astype(str)
+            continue
+        try:
+            cols[k] = v = v.astype(np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"{path}: column {k} is not all numbers") from None
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{path}: {k} has {int(np.sum(~np.isfinite(v)))} NaN or infinite values")
+    if not cols and n < 20:
+        raise ValueError(f"{path}: only {n} rows; need at least 20 (10 % are held out)")
+    d.update(cols)
     return d
 
 
-def split_rows(ref: str, task: str, kind: str) -> dict:
-    """The train or held-out rows of the file `ref` names (a path, or `reference`'s text without "file:")."""
+def rows(ref: str, kind: str) -> dict:
+    """The raw arrays (q, qdot, qddot, tau and traj, t where the file has them) of the `kind` rows ("train",
+    "heldout", "test") of the file `ref` names (a path, or `reference`'s text with or without "file:")."""
     d = load(*parse_reference(ref))
-    n = len(d["q"])
-    idx = np.random.default_rng(0).permutation(n)
-    cut = max(1, n // 10)
-    rows = idx[:cut] if kind == "heldout" else idx[cut:]
-    q, qdot, qddot = d["q"][rows], d["qdot"][rows], d["qddot"][rows]
+    if "split" in d:
+        idx = np.flatnonzero(d["split"] == kind)
+    else:
+        n = len(d["q"])
+        perm = np.random.default_rng(0).permutation(n)
+        cut = max(1, n // 10)
+        idx = perm[:cut] if kind == "heldout" else perm[cut:] if kind == "train" else perm[:0]
+    return {k: v[idx] for k, v in d.items() if k != "split"}
+
+
+def batch_of(r: dict, task: str) -> dict:
+    """The model's inputs and target for `task` from rows of `rows`: a batch dict of `replication.data`."""
+    q, qdot, qddot = r["q"], r["qdot"], r["qddot"]
     if task == "inverse_dynamics":
-        return {"q": q, "qdot": qdot, "extra": qddot, "target": d["tau"][rows], "qddot": qddot}
+        return {"q": q, "qdot": qdot, "extra": qddot, "target": r["tau"], "qddot": qddot}
     if task == "hamiltonian":
         return {"q": q, "qdot": qdot, "target": np.concatenate([qdot, qddot], 1), "qddot": qddot}
     return {"q": q, "qdot": qdot, "target": qddot, "qddot": qddot}
+
+
+def split_rows(ref: str, task: str, kind: str) -> dict:
+    """The train or held-out rows of the file `ref` names, as a batch dict for `task`."""
+    return batch_of(rows(ref, kind), task)
