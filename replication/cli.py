@@ -75,19 +75,6 @@ def widths(text: str, option: str = "--hidden") -> tuple:
     return out
 
 
-def cmd_fit(args):
-    from replication.fit import fit
-
-    d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
-            hidden=widths(args.hidden), batch=args.batch, lr=args.lr, seed=args.seed, loss=args.loss)
-    folder = Path(args.out) / "units" / "fit" / args.framework / args.model / f"seed{args.seed}"
-    if d["status"] != "ok":
-        print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
-        return 1
-    again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
-    print(f"ok: held-out L1 {d['metrics'].get('heldout_l1')}, written to {folder}{again}")
-
-
 def cmd_bench(args):
     from replication.bench import run_bench
     from replication.bench.device import NoGPUError
@@ -189,24 +176,9 @@ def build_parser():
                    "stiff, train-target) (default: results/quick)")
     s.add_argument("--out", default="report/quick", help="the report folder (default: report/quick)")
     s.set_defaults(func=cmd_report)
-    s = sub.add_parser("fit", help="train a model on your own .npz/.csv data (format: README)",
-                       description="Train one model on a data file and write OUT/units/fit/<framework>/<model>/"
-                       "seed<k>/ (result.json, train_log.csv, checkpoint.npz). 10 % of the rows are held out. "
-                       "A fit of other data or options already there is kept as superseded-<time>-seed<k>.")
-    s.add_argument("--data", required=True, help="a .npz (arrays q, qdot, qddot[, tau]) or .csv (columns q0.., "
-                   "qdot0.., qddot0..[, tau0..]) file, at least 20 rows")
-    s.add_argument("--model", required=True, help="lnn | hnn | delan | baseline")
-    s.add_argument("--out", default="results/fit", help="results folder (default: results/fit)")
-    s.add_argument("--framework", default="jax", help="jax | torch (default: jax)")
-    s.add_argument("--steps", type=int, default=2000, help="optimiser steps, >= 1 (default: 2000)")
-    s.add_argument("--batch", type=int, default=256, help="batch size, >= 1; at most the training rows "
-                   "(default: 256)")
-    s.add_argument("--hidden", default="128,128", help="comma-separated MLP widths (default: 128,128)")
-    s.add_argument("--lr", type=float, default=1e-3, help="peak learning rate of the one-cycle schedule, > 0 "
-                   "(default: 0.001)")
-    s.add_argument("--loss", default="l1", help="l1 | mse (default: l1)")
-    s.add_argument("--seed", type=int, default=0, help="initialisation and batch-order seed, >= 0 (default: 0)")
-    s.set_defaults(func=cmd_fit)
+    from replication.cli_fit import add_commands
+
+    add_commands(sub)  # simulate, fit, evaluate
     s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)",
                        description="The speed study: inference, latency, training, rollouts, scaling, fast vs "
                        "paper, structure and train-to-target, each with JAX and PyTorch side by side. Writes "
@@ -250,7 +222,8 @@ def build_parser():
 RESUME = {"run": "finished units are kept; run the same command again to resume",
           "bench": "run it again with --resume to keep the finished stages",
           "train-target": "the log up to the last evaluation is in {out}/train_target/train_target_log.csv",
-          "fit": "no result was written; run the same command again"}
+          "fit": "no result was written; run the same command again",
+          "evaluate": "no result was written; run the same command again"}
 
 
 def main(argv=None):

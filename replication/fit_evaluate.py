@@ -115,7 +115,7 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
             series.append(pd.DataFrame({"set": name, "traj": r["traj"][i[0]], "t": t[sub], "quantity": "state_err",
                                         "value": err[b, sub]}))
         qp, qdp = z[..., :d], z[..., d:]
-        if not forced:
+        if not forced and f.has_energy:
             drifts.append(_learned_drift(f, r, qp, qdp))
         if system is not None:
             e_sys.append((system.energy(np.nan_to_num(qp), np.nan_to_num(qdp)) * np.where(np.isfinite(qp[..., 0]), 1, np.nan),
@@ -136,8 +136,6 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
 
 def _learned_drift(f: Fitted, r, qp, qdp):
     energy = f.energy
-    if energy(r["q"][:1], r["qdot"][:1]) is None:
-        return np.full(len(qp), np.nan)
     kinetic = energy(r["q"], r["qdot"]) - energy(r["q"], np.zeros_like(r["qdot"]))
     scale = float(np.mean(np.abs(kinetic)))
     ok = np.isfinite(qp).all(axis=(1, 2))

@@ -76,6 +76,10 @@ class Fitted:
             return self.model.inverse_dynamics(q, qdot, qddot)
         return self.model.acceleration(q, qdot, qddot)
 
+    @property
+    def has_energy(self) -> bool:
+        return self.spec.kind in ("delan", "hnn", "lnn")
+
     def energy(self, q, qdot):
         kind = self.spec.kind
         if kind == "delan":

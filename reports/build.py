@@ -22,6 +22,7 @@ from reports.markdown import render_markdown
 from reports.pdf import write_pdf
 from reports.scorecard import scorecard_section
 from reports.sections_claims import summary_sections, theme_sections
+from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_hessian import hessian_sections
 from reports.sections_speed import agreement_sections, speed_sections
 from reports.sections_stiff import stiff_sections
@@ -31,6 +32,9 @@ TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
 def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
     res = load_results(results_dir)
+    if is_fit_results(res):  # `lagbench fit` / `evaluate` folders: their own section, no paper claims
+        sections = fit_sections(res, out_dir) + environment_sections(res, now)
+        return sections + sources_sections(res, sections)
     sections = [scorecard_section(res)] + summary_sections(res)
     sections += theme_sections(res, out_dir)
     sections += speed_sections(res, out_dir)

@@ -1,0 +1,171 @@
+"""The report of a `lagbench fit` or `lagbench evaluate` folder: units of the claims "fit" / "evaluate".
+
+``is_fit_results(res)``: the folder holds such units and nothing else (then ``reports.build`` renders these
+sections in place of the claim sections, scorecard and findings, which speak of papers' claims).
+``fit_sections(res, out_dir) -> list[Section]``: the data and the models side by side (what each was
+trained on and how: task, loss, steps, widths, activation, weight decay, schedule, time), one-step errors
+per component (``one_step.csv``), rollout and energy metrics (``result.json``, ``rollouts.csv``), and the
+figures: prediction against data (``arrays.npz`` ``<set>_target``/``<set>_pred``), a test trajectory,
+energy against truth, DeLaN's terms and the training curves (the drawing functions of ``reports.figures``).
+Failed or corrupt units are listed with their reason and left out of every number.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from reports import figures as F
+from reports.document import Figure, Para, Section, Table
+from reports.fmt import cell, num
+from reports.load import Results
+from reports.tables import problem_units_table
+
+CLAIMS = ("fit", "evaluate")
+SRC = "units/{claim}/<framework>/<model>/seed<k>/"
+ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"),
+                   ("rollout_final_err", "state error at the end"),
+                   ("learned_energy_drift", "learned energy drift (max over time)"),
+                   ("energy_err_final", "true energy error at the end"),
+                   ("energy_err_max", "true energy error, max over time"),
+                   ("mass_matrix_rel_err", "DeLaN M relative error"), ("coriolis_rel_err", "DeLaN c relative error"),
+                   ("gravity_rel_err", "DeLaN g relative error")]
+
+
+def is_fit_results(res: Results) -> bool:
+    return bool(res.units) and all(u.claim in CLAIMS for u in res.units)
+
+
+def _name(u) -> str:
+    return f"{u.model} ({u.framework}, seed {u.seed})"
+
+
+def _models_table(units) -> pd.DataFrame:
+    rows = []
+    for u in units:
+        p, s, r = u.result.get("protocol") or {}, u.result.get("model_spec") or {}, u.result
+        cfg = r.get("eval_config") or {}
+        rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
+                     "steps": cell(r.get("train_steps") if u.claim == "fit" else "(fit's)"),
+                     "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
+                     "weight decay (l2)": num(p.get("l2")), "schedule": f"{p.get('schedule')}, peak {num(p.get('lr'))}",
+                     "rows (train/held-out/test)": "/".join(str((cfg.get("rows") or {}).get(k, 0))
+                                                            for k in ("train", "heldout", "test")),
+                     "final training loss": num(r.get("final_train_loss")), "train time (s)": num(r.get("train_time_s"))})
+    return pd.DataFrame(rows)
+
+
+def _one_step_table(units) -> pd.DataFrame | None:
+    frames = []
+    for u in units:
+        df = u.table("one_step.csv")
+        if df is not None and {"set", "quantity", "component", "mae", "rel_mae"} <= set(df.columns):
+            frames.append(df.assign(model=_name(u), claim=u.claim))
+    if not frames:
+        return None
+    df = pd.concat(frames, ignore_index=True)
+    df["value"] = [f"{num(a)} ({num(b)} of null)" for a, b in zip(df["mae"], df["rel_mae"], strict=True)]
+    df["row"] = df["claim"] + ": " + df["set"] + " " + df["quantity"] + df["component"].astype(str)
+    wide = df.pivot_table(index="row", columns="model", values="value", aggfunc="first", sort=False)
+    return wide.reset_index().rename(columns={"row": "rows: quantity"}).fillna("–")
+
+
+def _rollout_table(units) -> pd.DataFrame | None:
+    rows = []
+    for u in units:
+        for where in ("heldout", "test"):
+            vals = {label: u.metric(f"{where}_{k}") for k, label in ROLLOUT_METRICS}
+            if any(v is not None for v in vals.values()):
+                rows.append({"model": f"{u.claim}: {_name(u)}", "rows": where,
+                             **{k: num(v) if v is not None else "–" for k, v in vals.items()}})
+    if not rows:
+        return None
+    df = pd.DataFrame(rows)
+    return df[[c for c in df.columns if c in ("model", "rows") or (df[c] != "–").any()]]
+
+
+def parity(units, path: Path) -> bool:
+    """Prediction against data of each model on its main evaluation rows, one panel per output component."""
+    found = {}
+    for u in units:
+        arr = u.arrays() or {}
+        where = (u.result.get("counters") or {}).get("primary")
+        if f"{where}_target" in arr and f"{where}_pred" in arr:
+            found[_name(u) + ("" if u.claim == "fit" else " [evaluate]")] = (arr[f"{where}_target"], arr[f"{where}_pred"])
+    if not found:
+        return False
+    k = min(next(iter(found.values()))[0].shape[1], 4)
+    fig, axes = F.new_figure(ncols=k, width=3.2 * k, height=3.2)
+    for j, ax in enumerate(axes):
+        lo, hi = np.inf, -np.inf
+        for i, (name, (t, p)) in enumerate(found.items()):
+            if t.shape[1] <= j:
+                continue
+            ax.scatter(t[:, j], p[:, j], s=4, alpha=0.5, color=F.colour(i), marker=F.MARKERS[i % 6], label=name)
+            lo, hi = min(lo, np.nanmin(t[:, j])), max(hi, np.nanmax(t[:, j]))
+        ax.plot([lo, hi], [lo, hi], color="k", lw=0.8, label="prediction = data")
+        ax.set_title(f"output {j}", fontsize=9)
+        ax.set_xlabel("data")
+        ax.set_ylabel("prediction")
+    axes[0].legend(fontsize=6)
+    return F.save(fig, path)
+
+
+def _data_para(units) -> Para:
+    seen: dict[str, list[str]] = {}
+    for u in units:
+        cfg = u.result.get("eval_config") or {}
+        src = str(cfg.get("source") or "").removeprefix("file:").split("#sha256=")[0]
+        d = cfg.get("derivatives") or {}
+        traj = cfg.get("trajectories") or {}
+        text = (f"{cell(src, 'unknown file')}: rows {cfg.get('rows')}"
+                + (f", whole trajectories {traj}; derivatives the file lacked estimated by Savitzky–Golay (window "
+                   f"{d.get('window')}, degree {d.get('polyorder')})" if any(traj.values()) else "")
+                + (f"; true energy from system {cfg['system']}" if cfg.get("system") else ""))
+        seen.setdefault(text, []).append(f"{u.claim} {_name(u)}")
+    return Para("Data: " + " | ".join(f"{text} ({', '.join(names)})" for text, names in seen.items()) + ".")
+
+
+def fit_sections(res: Results, out_dir: Path) -> list[Section]:
+    units = res.usable()
+    s = Section("Fitted models")
+    s.add(Para(f"{len(res.units)} fitted or evaluated models found, {len(units)} usable (status ok, checksums "
+               f"verified). One-step errors are in the quantity trained (q̈, or τ for inverse dynamics) on the "
+               f"held-out rows of the training file and on the test file; rollouts start from each test "
+               f"trajectory's first state (replication/fit_evaluate.py)."))
+    bad = problem_units_table(res)
+    if bad is not None:
+        s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))
+    if not units:
+        return [s]
+    s.add(_data_para(units))
+    s.add(Table("The models side by side", _models_table(units), [SRC.format(claim="*") + "result.json"]))
+    out = [s]
+    e = Section("Errors", level=2)
+    ot = _one_step_table(units)
+    if ot is not None:
+        e.add(Table("One-step mean absolute error per component (and as a fraction of the null predictor's)", ot,
+                    [SRC.format(claim="*") + "one_step.csv"]))
+    rt = _rollout_table(units)
+    if rt is not None:
+        e.add(Table("Rollouts and energy (means over trajectories)", rt, [SRC.format(claim="*") + "result.json"]))
+    if e.blocks:
+        out.append(e)
+    g = Section("Figures", level=2)
+    figs = [("parity", parity, "Prediction against data on the test (else held-out) rows", "arrays.npz"),
+            ("trajectory", F.trajectory, "A test trajectory: data against each model's rollout from its first state",
+             "arrays.npz"),
+            ("energy", lambda us, p: F.energy_drift(us, p, "true energy error / mean kinetic energy"),
+             "True energy along each rollout against along the data", "timeseries.csv"),
+            ("decomposition", F.delan_decomposition, "DeLaN's inertia, Coriolis and gravity terms against the "
+                                                     "system's", "arrays.npz"),
+            ("training", F.training_curves, "Training curves", "train_log.csv")]
+    for kind, fn, caption, file in figs:
+        rel = f"figures/fit_{kind}.png"
+        if fn(units, out_dir / rel):
+            g.add(Figure(rel, f"{caption}.", [SRC.format(claim="*") + file]))
+    if g.blocks:
+        out.append(g)
+    return out
