@@ -58,9 +58,12 @@ def cmd_fit(args):
 
     from replication.fit import LOSS_NAMES, fit
 
-    bar = tqdm(total=args.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet)
+    bars = []  # made at the first log row, so that a refused option prints one line and nothing else
 
     def on_log(row):
+        if not bars:
+            bars.append(tqdm(total=args.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet))
+        bar = bars[0]
         bar.set_postfix_str(f"training {LOSS_NAMES[args.loss]} {row['loss']:.4g}", refresh=False)
         bar.update(min(int(row["step"]) + 1, bar.total) - bar.n)
 
@@ -73,7 +76,8 @@ def cmd_fit(args):
                 heldout=args.heldout, test=args.test, window=args.window, polyorder=args.polyorder,
                 system=args.system, substeps=args.substeps, on_log=on_log)
     finally:
-        bar.close()
+        for bar in bars:
+            bar.close()
     folder = Path(args.out) / "units" / "fit" / args.framework / args.model / f"seed{args.seed}"
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)

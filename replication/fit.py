@@ -88,7 +88,7 @@ def _real(v) -> bool:
 
 def task_of(model: str, has_tau: bool, path) -> str:
     if has_tau and model in ("lnn", "hnn"):
-        raise ValueError(f"{path}: has tau columns, but a {model} here learns unforced dynamics and would ignore "
+        raise ValueError(f"{path}: has tau columns, but an {model.upper()} here learns unforced dynamics and would ignore "
                          f"them; drop the tau columns, or fit delan or baseline to learn the inverse dynamics")
     if model == "hnn":
         return "hamiltonian"

@@ -1,0 +1,83 @@
+"""Fitted models loaded back and judged (issue 26, gaps 1, 4, 5 and 7): load_fitted in either framework,
+torques refused by an LNN / HNN and used by DeLaN, the options' defaults in --help, tiny trainings only."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from replication.cli import build_parser, main
+from replication.fit import fit
+from replication.fitted import load_fitted
+
+TINY = {"steps": 6, "hidden": (8,), "batch": 32}
+
+
+def _arm_trajectories(path, n_traj=3, n=40, tau=True):
+    """Two-dof trajectories with torques: smooth q, any tau (the fit learns whatever maps them)."""
+    t = np.arange(n) * 0.02
+    rows = []
+    for k in range(n_traj):
+        q = np.stack([np.sin(t + k), np.cos(2 * t + k)], 1)
+        row = {"traj": k, "t": t, "q0": q[:, 0], "q1": q[:, 1]}
+        if tau:
+            row.update(tau0=np.cos(t) * (k + 1), tau1=np.sin(t))
+        rows.append(pd.DataFrame(row))
+    pd.concat(rows).to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize("model", ["lnn", "hnn"])
+def test_an_lnn_or_hnn_given_torques_refuses_before_any_work(tmp_path, capsys, model):
+    data = _arm_trajectories(tmp_path / "arm.csv")
+    assert main(["fit", "--data", str(data), "--model", model, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "tau" in err and "delan or baseline" in err, err
+    assert not (tmp_path / "out" / "data").exists() and not (tmp_path / "out" / "trained").exists()
+
+
+def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
+    data = _arm_trajectories(tmp_path / "arm.csv")
+    d = fit(data, model="delan", out=tmp_path / "out", split="none", test=_arm_trajectories(tmp_path / "t.csv", 2),
+            **TINY)
+    assert d["status"] == "ok" and d["protocol"]["task"] == "inverse_dynamics" and d["metric"] == "test_l1"
+    assert {"test_l1", "test_rollout_gmean_err", "test_mass_matrix_min_eig"} <= set(d["metrics"])
+    one = pd.read_csv(tmp_path / "out/units/fit/jax/delan/seed0/one_step.csv")
+    assert list(one["quantity"]) == ["tau", "tau"] and list(one["component"]) == [0, 1]
+    folder = tmp_path / "out/units/fit/jax/delan/seed0"
+    jx, tc = load_fitted(folder), load_fitted(tmp_path / "out", framework="torch")
+    rng = np.random.default_rng(0)
+    q, qd, qdd = (rng.normal(size=(5, 2)) for _ in range(3))
+    tau = jx.inverse_dynamics(q, qd, qdd)
+    np.testing.assert_allclose(tc.inverse_dynamics(q, qd, qdd), tau, rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(jx.acceleration(q, qd, tau), qdd, rtol=1e-2, atol=1e-3)  # forward o inverse = id
+    np.testing.assert_allclose(tc.energy(q, qd), jx.energy(q, qd), rtol=1e-4, atol=1e-5)
+    base = fit(data, model="baseline", out=tmp_path / "out", split="none", **TINY)
+    assert base["metric"] == "final_train_loss"  # nothing held out, no test file: the training loss only
+    with pytest.raises(ValueError, match="no forward model"):
+        load_fitted(tmp_path / "out/units/fit/jax/baseline/seed0").acceleration(q, qd)
+    with pytest.raises(ValueError, match="2 fitted models"):
+        load_fitted(tmp_path / "out")
+
+
+def test_load_fitted_refuses_a_damaged_fit(tmp_path):
+    data = _arm_trajectories(tmp_path / "arm.csv", tau=False)
+    fit(data, model="baseline", out=tmp_path / "out", **TINY)
+    folder = tmp_path / "out/units/fit/jax/baseline/seed0"
+    assert load_fitted(folder).acceleration(np.zeros((1, 2)), np.zeros((1, 2))).shape == (1, 2)
+    with pytest.raises(ValueError, match="trained on accelerations"):
+        load_fitted(folder).inverse_dynamics(np.zeros((1, 2)), np.zeros((1, 2)), np.zeros((1, 2)))
+    (folder / "checkpoint.npz").write_bytes(b"x")
+    with pytest.raises(ValueError, match="not a usable fit"):
+        load_fitted(folder)
+    with pytest.raises(ValueError, match="holds no fitted model"):
+        load_fitted(tmp_path)
+
+
+def test_every_fit_option_shows_its_default():
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    parser = sub.choices["fit"]
+    helps = {a.option_strings[-1]: parser.formatter_class("x")._get_help_string(a) for a in parser._actions
+             if a.option_strings and not a.required and a.nargs != 0}
+    assert {"--activation", "--weight-decay", "--schedule", "--lr-final", "--delan-eps", "--delan-offset",
+            "--angle-wrap", "--input-scale", "--split", "--heldout", "--test", "--window"} <= set(helps) | {"--angle-wrap"}
+    missing = [k for k, h in helps.items() if "default" not in h]
+    assert not missing, missing
