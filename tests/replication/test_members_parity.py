@@ -1,29 +1,28 @@
 """Members trained as one program (stacked parameters, one vmapped step) against the one-at-a-time loop:
 in float64 every member's loss, gradient norm and skipped-step count agree at every step, and its final
-weights too, in both frameworks; a member that fails stops alone."""
+weights too, in both frameworks; a member that fails stops alone. (JAX against PyTorch for members: the
+`lnn_members` row of `test_training_parity`, whose spec, protocol, seeds and compiled steps these share.)"""
 import numpy as np
 import pytest
+from parity_kit import Recorder
+from parity_rows import BY_NAME
 
-from models import ModelSpec, init_params
-from replication import train_jax, train_torch
+from models import init_params
 from replication.data import BatchStream
-from replication.protocol import Protocol
 
-SPEC = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64", angle_wrap=True)
 # the guard on and tight (clip below the norms, skip at the median): members clip and skip on different steps
-PROTOCOL = Protocol(data="double_pendulum_iid", steps=40, batch=16, n_train=64, dtype="float64", log_every=1,
-                    resample=True, grad_clip=30.0, spike_skip=1.0)
-FRAMEWORKS = {"jax": train_jax, "torch": train_torch}
-SEEDS = (3, 4, 5)
+ROW = BY_NAME["lnn_members"]
+SPEC, PROTOCOL, SEEDS = ROW.spec, ROW.protocol, ROW.seeds
+FRAMEWORKS = ("jax", "torch")
 
 
 def _alone(fw, seed, protocol=PROTOCOL):
-    return FRAMEWORKS[fw].train(SPEC, init_params(SPEC, seed=seed), protocol, BatchStream(protocol, seed))
+    return Recorder(fw).train(SPEC, init_params(SPEC, seed=seed), protocol, BatchStream(protocol, seed))
 
 
 def _together(fw, protocol=PROTOCOL, params=None):
     params = params or [init_params(SPEC, seed=s) for s in SEEDS]
-    return FRAMEWORKS[fw].train_members(SPEC, params, protocol, [BatchStream(protocol, s) for s in SEEDS])
+    return Recorder(fw).train_members(SPEC, params, protocol, [BatchStream(protocol, s) for s in SEEDS])
 
 
 @pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
@@ -54,7 +53,7 @@ def test_a_failed_member_stops_alone(fw):
     out = _together(fw, protocol, params)
     assert out[1].failure is not None and out[1].failure["step"] == 0 and out[1].steps_done == 0
     assert all(np.isnan(v).all() for v in out[1].params.values())
-    for i in (0, 2):
+    for i in (0, 2, 3):
         alone = _alone(fw, SEEDS[i], protocol)
         assert out[i].failure is None and out[i].steps_done == 5
         for k in alone.params:

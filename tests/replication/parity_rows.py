@@ -1,0 +1,104 @@
+"""The parity table: one row per (model kind, formulation, task, loss, schedule, guard, mode, dtype).
+
+Every model kind and formulation, every loss and schedule, the spike guard, restarts (scouted) and
+vectorised members, each in float64 (`steps` at every step to `TOLERANCE["float64"]`) and float32 (a short
+horizon, `F32_STEPS`, to `TOLERANCE["float32"]`). `slow` rows run only under `-m slow` (and in the printed
+table). Widths are tiny: the JAX compile dominates, and rows that share a spec, loss, optimiser and clip
+share one compiled step (`parity_kit._jax_step`), so the guarded LNN, the members and the scouted rows are
+cut to the same shapes.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from models import ModelSpec
+from replication.protocol import Protocol
+
+# Relative differences allowed (loss, gradient norm, parameters per tensor: max |a - b| / max |a|) over the
+# row's steps. float32: about 10x the largest measured over F32_STEPS steps (`python
+# tests/replication/parity_kit.py`: 4e-7, 1.3e-5, 8e-6). "float32 chaotic": the LNN on the double pendulum,
+# whose learned velocity Hessian is near-singular on some batches (gradient norms from 1e2 to 1e6 from one
+# batch to the next) and amplifies float32 rounding (measured: 3.3e-3, 6.9e-3, 4.6e-4); the step where its
+# two frameworks part is `test_float32_parting`'s.
+TOLERANCE = {"float64": {"loss": 1e-8, "grad_norm": 1e-8, "params": 1e-8},
+             "float32": {"loss": 1e-5, "grad_norm": 1e-4, "params": 1e-4},
+             "float32 chaotic": {"loss": 2e-2, "grad_norm": 5e-2, "params": 5e-3}}
+F32_STEPS = 10
+F64_STEPS = 20
+
+
+@dataclass(frozen=True)
+class Row:
+    name: str
+    spec: ModelSpec
+    protocol: Protocol
+    mode: str = "one"          # one | members | scouted
+    seeds: tuple = (3,)
+    slow: bool = False
+    chaotic: bool = False      # float32 rounding amplified (TOLERANCE["float32 chaotic"])
+
+    @property
+    def tolerance(self) -> dict:
+        dtype = self.protocol.dtype
+        return TOLERANCE[dtype + " chaotic" if dtype == "float32" and self.chaotic else dtype]
+
+
+def _p(data, **kw) -> Protocol:
+    base = {"steps": F64_STEPS, "batch": 16, "n_train": 64, "n_heldout": 16, "dtype": "float64", "log_every": 1}
+    return Protocol(data=data, **{**base, **kw})
+
+
+def _s(kind, dof, **kw) -> ModelSpec:
+    return ModelSpec(kind=kind, dof=dof, **{"hidden": (16, 16), "dtype": "float64", **kw})
+
+
+DP = {"resample": True, "l2": 1e-6 / 512}                       # the double-pendulum protocol (l1, one-cycle)
+REL = {"loss": "l1_gamma", "lr_start": 0.3}                     # the relativistic protocol
+LNN = _s("lnn", 2, angle_wrap=True)
+C = {"chaotic": True}
+GUARD = {"grad_clip": 30.0, "spike_skip": 1.0}   # clip below the norms, skip at the median: both act often
+GUARDED = _p("double_pendulum_iid", **DP, **GUARD, steps=40)
+MEMBERS = GUARDED.replace(batch=8)
+SCOUTED = GUARDED.replace(scouts=4, scout_steps=10, scout_batch=8, scout_lr=3e-3, steps=20)
+WAVE = {"system_params": (("n", 10), ("variant", "code")), "batch": 8, "lr_start": 0.3}
+ARM = {"task": "inverse_dynamics", "loss": "mse", "n_train": 400}
+
+F64 = [
+    Row("baseline_acc", _s("baseline", 1, activation="tanh", init="xavier"), _p("spring_iid", loss="mse")),
+    Row("baseline_invdyn", _s("baseline", 2, activation="softplus", init="xavier", extra_inputs=2),
+        _p("two_link_arm", **ARM, schedule="constant", l2=1e-5)),
+    Row("lnn_fast", LNN, _p("double_pendulum_iid", **DP), **C),
+    Row("lnn_paper", dataclasses.replace(LNN, formulation="paper"), _p("double_pendulum_iid", **DP), **C),
+    Row("lnn_guarded", LNN, GUARDED, **C),
+    Row("lnn_l1_gamma", _s("lnn", 1, extra_inputs=1, input_scale=(0.1, 1.0, 0.1)), _p("relativistic_iid", **REL)),
+    Row("hnn_qp", _s("hnn", 1, activation="tanh", init="xavier"),
+        _p("spring_iid", task="hamiltonian", coords="qp", loss="mse")),
+    Row("hnn_qqdot", _s("hnn", 1, init="xavier", extra_inputs=1, input_scale=(0.1, 1.0, 0.1)),
+        _p("relativistic_iid", task="hamiltonian", coords="qqdot", **REL)),
+    Row("delan_inverse", _s("delan", 2, init="xavier"), _p("two_link_arm", **ARM, schedule="constant", l2=1e-5)),
+    Row("delan_forward", _s("delan", 2, init="xavier"), _p("charged_magnetic_iid")),
+    Row("lgn_banded", _s("lgn", 10, formulation="banded"),
+        _p("wave_iid", **WAVE, schedule="step", lr_step_every=5, lr_step_gamma=0.5)),
+    Row("lgn_dense", _s("lgn", 10, formulation="dense"), _p("wave_iid", **WAVE)),
+    Row("lgn_paper", _s("lgn", 10, formulation="paper"), _p("wave_iid", **WAVE), slow=True),
+    # K = 4 inits as one program; the scouted row's scouts are the same program (its scout phase: 4 x 10
+    # steps at batch 8), its continuation the guarded row's step
+    Row("lnn_members", LNN, MEMBERS, mode="members", seeds=(3, 4, 5, 6), **C),
+    Row("lnn_scouted", LNN, SCOUTED, mode="scouted", seeds=(1,), **C),
+]
+
+
+def in_float32(row: Row, steps: int = F32_STEPS, slow: bool | None = None) -> Row:
+    p = row.protocol.replace(dtype="float32", steps=steps)
+    if p.scouts:
+        p = p.replace(scout_steps=min(p.scout_steps, steps))
+    return dataclasses.replace(row, name=row.name + "_f32", spec=dataclasses.replace(row.spec, dtype="float32"),
+                               protocol=p, slow=row.slow if slow is None else slow)
+
+
+# float32 in the default run for four kinds (the LGN's compile is the dearest: its float32 rows are slow)
+F32_DEFAULT = ("baseline_acc", "lnn_fast", "hnn_qp", "delan_forward")
+F32 = [in_float32(r, slow=r.name not in F32_DEFAULT) for r in F64]
+ROWS = F64 + F32
+BY_NAME = {r.name: r for r in ROWS}
