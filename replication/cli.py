@@ -39,7 +39,7 @@ def cmd_run(args):
 
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
-                  progress=not args.quiet, jobs=args.jobs)
+                  progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address)
     for c in summary["claims"]:
         print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
     for e in summary.get("errors", []):
@@ -167,6 +167,11 @@ def build_parser():
     s.add_argument("--jobs", type=int, default=1,
                    help="worker processes, one CPU thread each; units training the same model stay in one "
                         "(default: 1, everything in this process)")
+    s.add_argument("--executor", default="local", choices=("local", "ray"),
+                   help="local: this process or --jobs workers (default); ray: every unit a Ray task, on a local "
+                        "Ray instance or the cluster at --address (needs `pip install 'lagbench[ray]'`)")
+    s.add_argument("--address", help="with --executor ray: the Ray cluster to join, e.g. 10.0.0.1:6379 or auto "
+                   "(default: start a local Ray instance on this machine's cores)")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.set_defaults(func=cmd_run)
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",

@@ -148,17 +148,35 @@ def keep_previous_record(out: Path) -> Path | None:
     return None
 
 
+def executor_of(executor, jobs, address):
+    """`(todo, out, profile, progress) -> (failures, errors)` of --executor (checked before any work)."""
+    if executor == "local":
+        if address is not None:
+            raise ValueError("--address is for --executor ray; the local executor runs on this machine")
+        return lambda todo, out, profile, progress: run_units(todo, out, profile, progress, jobs)
+    if executor == "ray":
+        from replication.executor_ray import require_ray, run_units_ray
+
+        if jobs != 1:
+            raise ValueError("--jobs is for the local executor; with --executor ray every unit is a task on "
+                             "the Ray cluster's CPUs")
+        require_ray()
+        return lambda todo, out, profile, progress: run_units_ray(todo, out, profile, progress, address)
+    raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
+
+
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
-        progress=True, jobs=1) -> dict:
+        progress=True, jobs=1, executor="local", address=None) -> dict:
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
+    execute = executor_of(executor, jobs, address)
     units = plan(profile, claims, frameworks, seeds, models)
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
                 # the units this run plans: the report names any that have no result (an unfinished run)
-                "planned_units": [u.name for u in units], "jobs": jobs, "versions": env.versions(),
+                "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
     if profile == "paper":
         est = estimate_seconds(units, out)
@@ -173,7 +191,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()
     try:
-        failures, errors = run_units(todo, out, profile, progress, jobs)
+        failures, errors = execute(todo, out, profile, progress)
     except KeyboardInterrupt:
         manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
         R.write_json(out / "run.json", manifest)
