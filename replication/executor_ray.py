@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import functools
 import os
+import socket
 import warnings
 
 from tqdm.auto import tqdm
@@ -73,10 +74,24 @@ def _remote(ray):
     return ray.remote(run_unit_task), ray.remote(num_cpus=0)(Board)
 
 
+def check_address(address, timeout_s=10.0) -> None:
+    """A ValueError naming --address if nothing answers at its host:port (Ray itself would wait on an
+    unreachable address for ever); "auto", "local" and addresses without a port are left to Ray."""
+    host, _, port = (address or "").removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
+    except OSError as e:
+        raise ValueError(f"--address {address}: no Ray cluster answers there ({e.strerror or e}); start one with "
+                         f"`ray start --head` and give the address it prints") from None
+
+
 def _connect(ray, address) -> bool:
     """Connect (or start a local instance); True if this call did, so that it shuts it down after."""
     if ray.is_initialized():
         return False
+    check_address(address)
     try:
         with warnings.catch_warnings():
             # Ray starts its processes with subprocess (fork, then exec at once): not the fork JAX warns of

@@ -155,12 +155,13 @@ def executor_of(executor, jobs, address):
             raise ValueError("--address is for --executor ray; the local executor runs on this machine")
         return lambda todo, out, profile, progress: run_units(todo, out, profile, progress, jobs)
     if executor == "ray":
-        from replication.executor_ray import require_ray, run_units_ray
+        from replication.executor_ray import check_address, require_ray, run_units_ray
 
         if jobs != 1:
             raise ValueError("--jobs is for the local executor; with --executor ray every unit is a task on "
                              "the Ray cluster's CPUs")
         require_ray()
+        check_address(address)
         return lambda todo, out, profile, progress: run_units_ray(todo, out, profile, progress, address)
     raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
 
