@@ -149,7 +149,16 @@ def _submit(ray, todo, out, retries, board):
     return refs
 
 
+def _started(ray, board) -> list:
+    """The units whose task started since the last call ([] if the board is gone: a lost node)."""
+    try:
+        return ray.get(board.take.remote(), timeout=60)
+    except (ray.exceptions.RayError, TimeoutError):
+        return []
+
+
 def run_units_ray(todo, out, profile, progress=True, address=None, retries=None):
+    from replication.results import CorruptResult
     from replication.unit_files import write
 
     retries = RETRIES if retries is None else retries
@@ -158,19 +167,16 @@ def run_units_ray(todo, out, profile, progress=True, address=None, retries=None)
         return [], []
     started = _connect(ray, address)
     board = _remote(ray)[1].remote()
-    refs, pending = {}, []
-    failures, errors, dead = [], [], set()
-    cpus = ray.cluster_resources().get("CPU", 0)
-    bar = _Bar(len(todo), f"lagbench {profile} (ray, {cpus:g} CPUs)", progress)
+    pending, failures, errors, dead = [], [], [], set()
+    bar = _Bar(len(todo), f"lagbench {profile} (ray, {ray.cluster_resources().get('CPU', 0):g} CPUs)", progress)
     try:
         refs = _submit(ray, todo, out, retries, board)
         order = {r: i for i, r in enumerate(refs)}
         pending = list(refs)
         while pending:
             ready, pending = ray.wait(pending, num_returns=len(pending), timeout=POLL_S)
-            started_now = board.take.remote()
             for r in sorted(ready, key=order.get):
-                u, before = refs[r]
+                (u, before), d = refs.pop(r), None   # popped: Ray frees a result once no task needs it
                 try:
                     d = ray.get(r)
                 except ray.exceptions.RayError as e:
@@ -178,20 +184,25 @@ def run_units_ray(todo, out, profile, progress=True, address=None, retries=None)
                     why = (f"not run: {before.name} (which trains its model first) did not finish"
                            if before is not None and before.name in dead else _reason(ray, e, retries))
                     errors.append(f"{u.name}: {why}")
-                    bar.done(u.name, failed=True)
-                    continue
-                write(out, d["files"])
-                failures += [d["failure"]] if d["failure"] else []
-                errors += [d["error"]] if d["error"] else []
-                bar.done(u.name, failed=bool(d["failure"] or d["error"]))
-            bar.started(ray.get(started_now))
+                else:
+                    try:
+                        write(out, d["files"])
+                    except CorruptResult as e:   # written, but not as sent: the rerun redoes the unit
+                        d["error"] = f"{u.name}: its files arrived damaged: {e}"
+                    failures += [d["failure"]] if d["failure"] else []
+                    errors += [d["error"]] if d["error"] else []
+                bar.done(u.name, failed=d is None or bool(d["failure"] or d["error"]))
+            bar.started(_started(ray, board))
     except BaseException:
         for r in pending:
             ray.cancel(r, force=True)
         raise
     finally:
         bar.bar.close()
-        ray.kill(board)
+        try:
+            ray.kill(board)
+        except ray.exceptions.RayError:
+            pass
         if started:
             ray.shutdown()
     return failures, errors

@@ -1,0 +1,43 @@
+"""A unit's files as bytes and back (the Ray executor's driver writes what its workers return)."""
+import pandas as pd
+import pytest
+
+from replication import results as R
+from replication import unit_files
+
+
+def unit_folder(root, name="units/c/jax/m/seed0"):
+    folder = root / name
+    files = {"train_log.csv": R.write_csv(folder / "train_log.csv", pd.DataFrame({"step": [0, 1]}))}
+    R.write_json(folder / "result.json", {"status": "ok", "files": files}, checksum=True)
+    return folder
+
+
+def test_files_travel_as_bytes_and_are_written_verified(tmp_path):
+    unit_folder(tmp_path / "worker")
+    files = unit_files.collect(tmp_path / "worker")
+    assert sorted(files) == ["units/c/jax/m/seed0/result.json", "units/c/jax/m/seed0/train_log.csv"]
+    written = unit_files.write(tmp_path / "driver", files)
+    assert written == [tmp_path / "driver" / "units/c/jax/m/seed0"]
+    assert R.load_result(written[0])["status"] == "ok"
+
+
+def test_a_folder_without_its_result_is_not_written(tmp_path):
+    assert unit_files.write(tmp_path, {"units/c/jax/m/seed0/train_log.csv": b"step\n0\n"}) == []
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bytes_that_do_not_match_their_result_are_refused(tmp_path):
+    unit_folder(tmp_path / "worker")
+    files = unit_files.collect(tmp_path / "worker")
+    files["units/c/jax/m/seed0/train_log.csv"] = b"step\n7\n"
+    with pytest.raises(R.CorruptResult):
+        unit_files.write(tmp_path / "driver", files)
+
+
+@pytest.mark.parametrize("path", ["../units/x/result.json", "/etc/result.json", "units/../../x/result.json",
+                                  "elsewhere/result.json"])
+def test_paths_outside_the_results_folder_are_refused(tmp_path, path):
+    with pytest.raises(ValueError, match="refused"):
+        unit_files.write(tmp_path / "out", {path: b"{}"})
+    assert not (tmp_path / "out").exists()
