@@ -157,7 +157,7 @@ def build_parser():
     s = sub.add_parser("list", help="list systems, models, claims and profiles")
     s.set_defaults(func=cmd_list)
     s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units")
-    s.add_argument("--profile", default="quick", help="smoke | quick | paper (default: quick)")
+    s.add_argument("--profile", default="quick", help="smoke | quick | full | paper (default: quick)")
     s.add_argument("--claims", help="comma-separated claim ids (default: all; see `lagbench list`)")
     s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
                    "list`)")

@@ -22,12 +22,13 @@ from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
 from replication.evaluations import EVALUATION_VERSION
 from replication.executor import run_units
-from replication.scouting import continuation_protocol, progress_steps
+from replication.estimate import describe, estimate
 from replication.units import Unit
 from replication.verdicts import write_summary
 
 log = logging.getLogger("lagbench")
 FRAMEWORKS = ("jax", "torch")
+LONG_PROFILES = ("full", "paper")   # profiles that print their units and an estimated duration first
 
 
 def _once(option: str, values) -> None:
@@ -58,11 +59,11 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         raise ValueError(f"--models: unknown {', '.join(unknown)} for the chosen claims; valid: {', '.join(labels)}")
     units = []
     for claim in chosen:
-        n = claim.seeds.get(profile, 1)
+        n = claim.n_seeds(profile)
         if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
             n = seeds if max(claim.seeds.values()) > 1 else 1
         for entry in claim.models:
-            if (models and entry.label not in models) or profile not in entry.profiles:
+            if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
             for fw in frameworks:
                 for seed in range(n):
@@ -88,7 +89,7 @@ def is_current(unit, out, repairs: list | None = None) -> bool:
             log.warning("lagbench: redoing %s: %s", unit.name, reason)
             repairs.append(f"{unit.name}: {reason}")
         return False
-    cfg = unit.claim.eval_config.get(unit.profile, {})
+    cfg = unit.claim.evaluation_config(unit.profile)
     # a result that records no evaluation config or version predates them: stale, re-evaluated
     same_eval = (d.get("eval_config") == json.loads(json.dumps(cfg))
                  and d.get("evaluation_version") == EVALUATION_VERSION)
@@ -111,24 +112,17 @@ def set_aside(folder: Path) -> Path:
     raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
-def estimate_seconds(units, out) -> float:
-    """Time 3 training steps of each distinct configuration (after one to compile) and scale up."""
-    from replication.training import run_training
-
-    seen, total = {}, 0.0
-    for u in units:
-        if not u.entry.train or is_current(u, out):
-            continue
-        p, spec = u.protocol(), u.spec()
-        key = (u.framework, spec, p.replace(steps=1))
-        if key not in seen:
-            probe = continuation_protocol(p).replace(steps=4, log_every=1, schedule="constant",
-                                                     n_train=max(p.batch * 4, p.batch))
-            o = run_training(u.framework, spec, probe, 0)
-            walls = [r["wall_s"] for r in o.log]
-            seen[key] = (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
-        total += seen[key] * progress_steps(p)   # scouts counted as continuation steps of equal samples
-    return total
+def announce(profile, units, todo, out, jobs) -> dict:
+    """Print the units a long profile will run and its estimated duration (`replication.estimate`)."""
+    print(f"lagbench: profile {profile}: {len(units)} units, {len(todo)} to run:\n{describe(units, todo)}", flush=True)
+    print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
+    est = estimate(todo, out, jobs)
+    hw = env.hardware()
+    print(f"lagbench: {est['trainings']} trainings to do ({est['cached']} reused from OUT/trained), estimated "
+          f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
+          f"worker{'s' if jobs != 1 else ''} (evaluation not included; {hw['cpu']}, GPU: {hw['gpu']}). "
+          f"Interrupt at any time: the run resumes where it stopped.", flush=True)
+    return est
 
 
 def keep_previous_record(out: Path) -> Path | None:
@@ -179,16 +173,14 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
                 # the units this run plans: the report names any that have no result (an unfinished run)
                 "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
-    if profile == "paper":
-        est = estimate_seconds(units, out)
-        print(f"lagbench: the paper profile's training is estimated at {est / 3600:.1f} h on this machine "
-              f"({env.hardware()['cpu']}, GPU: {env.hardware()['gpu']}); it resumes if interrupted.", flush=True)
-        manifest["estimated_train_s"] = est
     keep_previous_record(out)
     R.write_json(out / "run.json", manifest)
     repairs: list = []
     todo = [u for u in units if not is_current(u, out, repairs)]
     manifest["repaired"] = repairs
+    if profile in LONG_PROFILES and todo:
+        manifest["estimate"] = announce(profile, units, todo, out, jobs)
+        R.write_json(out / "run.json", manifest)
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()
     try:

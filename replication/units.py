@@ -29,7 +29,7 @@ class Unit:
         return f"{self.claim.id}/{self.framework}/{self.entry.label}/seed{self.seed}"
 
     def protocol(self):
-        return self.entry.protocol(self.claim.protocols[self.profile], self.profile)
+        return self.entry.protocol(self.claim.protocol(self.profile), self.profile)
 
     def spec(self):
         p = self.protocol()
@@ -55,7 +55,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
     else:
         params = None
     ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
-                  protocol=protocol, profile=unit.profile, cfg=unit.claim.eval_config.get(unit.profile, {}))
+                  protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile))
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
     ev = EVALUATIONS[unit.claim.evaluate](ctx)

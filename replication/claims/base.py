@@ -16,8 +16,25 @@ from dataclasses import dataclass, field
 from replication.claims.rules import VERDICTS
 from replication.protocol import Protocol
 
-PROFILES = ("smoke", "quick", "paper")
-__all__ = ["PROFILES", "VERDICTS", "Claim", "ModelEntry"]
+PROFILES = ("smoke", "quick", "full", "paper")
+# a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`
+# except where a claim says otherwise (longer budgets, more seeds, the paper's evaluation horizon)
+PROFILE_PARENT = {"full": "quick"}
+__all__ = ["PROFILES", "PROFILE_PARENT", "VERDICTS", "Claim", "ModelEntry", "per_profile"]
+
+
+def per_profile(table: dict, profile: str, default=None):
+    """`table[profile]`, else its parent's entry (`PROFILE_PARENT`), else `default`."""
+    while profile is not None:
+        if profile in table:
+            return table[profile]
+        profile = PROFILE_PARENT.get(profile)
+    return default
+
+
+def in_profile(profiles: tuple, profile: str) -> bool:
+    """Whether a model limited to `profiles` runs in `profile` (or in the profile it inherits from)."""
+    return per_profile(dict.fromkeys(profiles, True), profile, False)
 
 
 @dataclass(frozen=True)
@@ -38,15 +55,18 @@ class ModelEntry:
     profile_spec: dict = field(default_factory=dict)
 
     def spec_fields(self, profile: str) -> dict:
-        return {**self.spec, **self.profile_spec.get(profile, {})}
+        return {**self.spec, **per_profile(self.profile_spec, profile, {})}
 
     def widths(self, profile: str) -> tuple:
-        h = self.hidden.get(profile, ()) if isinstance(self.hidden, dict) else self.hidden
+        h = per_profile(self.hidden, profile, ()) if isinstance(self.hidden, dict) else self.hidden
         return tuple(h)
+
+    def runs_in(self, profile: str) -> bool:
+        return in_profile(self.profiles, profile)
 
     def protocol(self, base: Protocol, profile: str) -> Protocol:
         common = {k: v for k, v in self.overrides.items() if k not in PROFILES}
-        per = self.overrides.get(profile, {})
+        per = per_profile({k: v for k, v in self.overrides.items() if k in PROFILES}, profile, {})
         return base.replace(**{**common, **per}) if (common or per) else base
 
 
@@ -92,4 +112,17 @@ class Claim:
 
     def labels(self, profile: str | None = None) -> list:
         """The model labels that run in ``profile`` (all of them if None)."""
-        return [m.label for m in self.models if profile is None or profile in m.profiles]
+        return [m.label for m in self.models if profile is None or m.runs_in(profile)]
+
+    def protocol(self, profile: str) -> Protocol:
+        """The claim's protocol under `profile` (before any model's overrides)."""
+        p = per_profile(self.protocols, profile)
+        if p is None:
+            raise KeyError(f"claim {self.id} has no protocol for profile {profile!r}")
+        return p
+
+    def n_seeds(self, profile: str) -> int:
+        return per_profile(self.seeds, profile, 1)
+
+    def evaluation_config(self, profile: str) -> dict:
+        return per_profile(self.eval_config, profile, {})

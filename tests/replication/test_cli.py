@@ -4,7 +4,8 @@ import json
 import pytest
 
 from replication.cli import build_parser, main
-from replication.runner import estimate_seconds, plan
+from replication.estimate import describe, estimate
+from replication.runner import plan
 
 
 def test_list_names_everything(capsys):
@@ -22,10 +23,33 @@ def test_help_describes_each_command(capsys):
         assert flag in out
 
 
-def test_estimate_scales_measured_steps(tmp_path):
-    units = plan("smoke", claims=["dp_loss"], frameworks=("jax",))
-    est = estimate_seconds(units, tmp_path)
-    assert est > 0 and est < 600
+def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
+    # dp_loss and dp_energy share their trained models (one training cache key): counted once
+    units = plan("smoke", claims=["dp_loss", "dp_energy"], frameworks=("jax",), models=["lnn"])
+    assert len(units) == 2
+    est = estimate(units, tmp_path)
+    assert est["trainings"] == 1 and est["cached"] == 0 and est["train_s"] > 0
+    assert est["wall_s"] >= est["train_s"]          # one worker: the sum
+    assert "dp_loss" in describe(units, units[:1]) and "(0 to run)" in describe(units, units[:1])
+    # once the training is in OUT/trained it costs nothing
+    from replication.training import train_cached
+    u = units[0]
+    train_cached(tmp_path, u.framework, u.spec(), u.protocol(), u.seed)
+    again = estimate(units, tmp_path)
+    assert again["trainings"] == 0 and again["cached"] == 1 and again["train_s"] == 0
+
+
+def test_full_profile_inherits_quick_where_a_claim_is_silent():
+    full = {u.name: u for u in plan("full", frameworks=("jax",))}
+    quick = {u.name: u for u in plan("quick", frameworks=("jax",))}
+    assert set(full) >= set(quick)
+    # the double pendulum trains longer and is judged on the paper's held-out size and energy horizon
+    u, q = full["dp_energy/jax/lnn/seed0"], quick["dp_energy/jax/lnn/seed0"]
+    assert u.protocol().steps > q.protocol().steps and u.protocol().n_heldout == 100_000
+    assert u.claim.evaluation_config("full")["n_ics"] == 40 and u.spec().hidden == (128, 128, 128)
+    # a claim without a full entry runs exactly its quick protocol and model
+    w, wq = full["hnn_energy/jax/hnn_spring/seed0"], quick["hnn_energy/jax/hnn_spring/seed0"]
+    assert w.protocol() == wq.protocol() and w.spec() == wq.spec()
 
 
 def test_train_target_command_writes_rows_and_log(tmp_path, capsys):

@@ -1,0 +1,88 @@
+"""How long a run will take, told before it starts: each distinct training is probed for a few steps.
+
+`estimate(units, out, jobs)` counts every training the run still has to do once (units that share a
+trained model, such as claims 1 and 2, train it once; a training already in `OUT/trained/` costs
+nothing), times three steps of each distinct configuration on this machine after one step to compile
+(the scouts of a protocol with restarts are timed as they run, K members side by side), and scales up
+by the protocol's steps. Evaluation time is not included. The wall time assumes the trainings spread
+evenly over `jobs` workers, and is never below the longest single training.
+
+`describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
+"""
+from __future__ import annotations
+
+from collections import Counter, defaultdict
+from pathlib import Path
+
+from replication.scouting import continuation_protocol, scout, scout_protocol
+from replication.training import run_training, train_key, trainer
+
+PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
+
+
+def _per_step(rows) -> float:
+    walls = [r["wall_s"] for r in rows if r.get("member", 0) == 0]
+    return (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
+
+
+def _probe_plain(framework, spec, protocol) -> float:
+    p = continuation_protocol(protocol).replace(steps=PROBE_STEPS, log_every=1, schedule="constant",
+                                                n_train=protocol.batch * PROBE_STEPS)
+    return _per_step(run_training(framework, spec, p, 0).log) * protocol.steps
+
+
+def _probe_scouts(framework, spec, protocol) -> float:
+    sp = scout_protocol(protocol)
+    probe = protocol.replace(scout_steps=PROBE_STEPS, log_every=1, schedule="constant",
+                             n_train=sp.batch * PROBE_STEPS)
+    rows = []
+    scout(trainer(framework), spec, probe, list(range(protocol.scouts)), on_log=rows.append)
+    return _per_step(rows) * sp.steps
+
+
+def training_seconds(framework, spec, protocol) -> float:
+    """Estimated seconds of one training of `protocol` (scouts and continuation) on this machine."""
+    t = _probe_plain(framework, spec, protocol)
+    if protocol.scouts > 1:
+        t += _probe_scouts(framework, spec, protocol)
+    return t
+
+
+def estimate(units, out, jobs: int = 1) -> dict:
+    """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused}."""
+    probes, todo, cached = {}, {}, 0
+    for u in units:
+        if not u.entry.train:
+            continue
+        p, spec = u.protocol(), u.spec()
+        key = train_key(u.framework, spec, p, u.seed)
+        if key in todo:
+            continue
+        if (Path(out) / "trained" / u.framework / key / "result.json").exists():
+            cached += 1
+            todo[key] = 0.0
+            continue
+        shape = (u.framework, spec, p)   # the same training for another seed costs the same
+        if shape not in probes:
+            probes[shape] = training_seconds(u.framework, spec, p)
+        todo[key] = probes[shape]
+    total = sum(todo.values())
+    longest = max(todo.values(), default=0.0)
+    return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),
+            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(probes)}
+
+
+def describe(units, todo) -> str:
+    """One line per claim: models, seeds and frameworks planned, and how many units remain to run."""
+    left = Counter(u.claim.id for u in todo)
+    by = defaultdict(list)
+    for u in units:
+        by[u.claim.id].append(u)
+    lines = []
+    for cid, us in by.items():
+        models = sorted({u.entry.label for u in us})
+        fws = sorted({u.framework for u in us})
+        seeds = len({u.seed for u in us})
+        lines.append(f"  {cid:<17} {len(us):>3} units ({left[cid]} to run): {', '.join(models)}; "
+                     f"{seeds} seed{'s' if seeds != 1 else ''}; {', '.join(fws)}")
+    return "\n".join(lines)
