@@ -23,8 +23,9 @@ from reports.pdf import write_pdf
 from reports.scorecard import scorecard_section
 from reports.sections_claims import summary_sections, theme_sections
 from reports.sections_fit import fit_sections, is_fit_results
+from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
-from reports.sections_speed import agreement_sections, speed_sections
+from reports.sections_speed import speed_sections
 from reports.sections_stiff import stiff_sections
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
@@ -38,7 +39,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     sections = [scorecard_section(res)] + summary_sections(res)
     sections += theme_sections(res, out_dir)
     sections += speed_sections(res, out_dir)
-    sections += agreement_sections(res)
+    sections += frameworks_sections(res)
     sections += hessian_sections(res)
     sections += stiff_sections(res)
     sections += findings_sections(res)

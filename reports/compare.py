@@ -3,7 +3,9 @@
 ``cross_framework_table`` compares every framework with the first one (per claim and model: means,
 relative difference of means, the largest per-seed difference over seeds run in both, and beside them
 the seed spread for scale: the larger of the two frameworks' seed standard deviations; "yes" in
-"beyond spread" flags a difference of means larger than that spread).
+"beyond spread" flags a difference of means larger than that spread; "non-finite seeds" counts the seeds
+whose metric is inf or NaN, e.g. a diverged rollout, left out of the means and per-seed differences).
+The report's section around it: ``reports.sections_frameworks``.
 ``cheapest_table`` picks, per claim, among (framework, model) whose mean claim metric is within
 ``tolerance`` x the best (lowest) mean, the one with the highest training throughput
 (``train_samples_per_s``; else the shortest ``train_time_s``), counting only models that passed their
@@ -41,8 +43,11 @@ def cross_framework_table(res: Results) -> pd.DataFrame | None:
                 for u in res.usable(claim["id"]):
                     if u.model == model and u.framework in (ref, fw) and metric:
                         by_seed.setdefault(u.seed, {})[u.framework] = u.metric(metric)
-                diffs = [abs(d[ref] - d[fw]) for d in by_seed.values()
-                         if d.get(ref) is not None and d.get(fw) is not None]
+                paired = [abs(d[ref] - d[fw]) for d in by_seed.values()
+                          if d.get(ref) is not None and d.get(fw) is not None]
+                diffs = [x for x in paired if math.isfinite(x)]
+                bad = {f: sum(d.get(f) is not None and not math.isfinite(d[f]) for d in by_seed.values())
+                       for f in (ref, fw)}
                 rel = NOT_RUN
                 if a and b:
                     scale = max(abs(a["mean"]), abs(b["mean"]))
@@ -59,7 +64,8 @@ def cross_framework_table(res: Results) -> pd.DataFrame | None:
                     "max per-seed abs. diff": num(max(diffs)) if diffs else NOT_RUN,
                     "seed spread (std)": num(spread) if spread is not None else NOT_RUN,
                     "beyond spread": beyond,
-                    "seeds in both": str(len(diffs)),
+                    "seeds in both": str(len(paired)),
+                    "non-finite seeds": ", ".join(f"{f} {n}" for f, n in bad.items()) if any(bad.values()) else "none",
                 })
     return pd.DataFrame(rows) if rows else None
 

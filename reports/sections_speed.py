@@ -1,10 +1,9 @@
-"""Speed-against-error and cross-framework-agreement sections.
+"""Speed-against-error sections.
 
 Speed: per claim, every usable unit as a point (training throughput or time against the claim metric),
 the cheapest-model table, and from the speed study (``bench/*.csv``, when present) the inference
 speed-error plane, the cheapest model per system, training/rollout/scaling tables and figures.
-Agreement: per claim and model, framework means, their relative difference, and the largest per-seed
-difference, plus ``bench/ratios.csv``.
+The cross-framework section is ``reports.sections_frameworks``.
 """
 
 from __future__ import annotations
@@ -18,7 +17,6 @@ from reports.compare import (
     TOLERANCE,
     bench_cheapest_table,
     cheapest_table,
-    cross_framework_table,
     gpu_vs_cpu_table,
 )
 from reports.document import NOT_RUN, Figure, Para, Section, Table
@@ -184,22 +182,3 @@ def _targets_table(path: Path) -> pd.DataFrame | None:
                            if k != "met" and isinstance(v, int | float | str) and not isinstance(v, bool))
         rows.append({"target": name, "met": "yes" if t.get("met") else "no", "measured": values})
     return pd.DataFrame(rows) if rows else None
-
-
-def agreement_sections(res: Results) -> list[Section]:
-    s = Section("Cross-framework agreement")
-    fws = res.frameworks
-    table = cross_framework_table(res)
-    if table is None:
-        s.add(Para(f"Comparison across frameworks: {NOT_RUN} (frameworks found: "
-                   f"{', '.join(fws) if fws else 'none'})."))
-    else:
-        s.add(Para(f"Each framework against {fws[0]}: the same protocol, initial parameters and batch order, "
-                   "so differences come from floating-point order of operations and library kernels. The seed "
-                   "spread is there for scale: a difference beyond it ('beyond spread': yes) is larger than the "
-                   "variation between seeds of one framework, which float32 chaos alone rarely explains."))
-        s.add(Table("Claim metric per framework", table, ["units/*/*/*/seed*/result.json"]))
-    if "ratios" in res.bench:
-        s.add(Table("JAX against PyTorch speed per operation", _bench_table(res.bench["ratios"]),
-                    ["bench/ratios.csv"]))
-    return [s]
