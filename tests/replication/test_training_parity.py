@@ -15,9 +15,9 @@ import pytest
 from parity_kit import Recorder, cached_trace, compare, run_row, step_diffs, within
 from parity_rows import BY_NAME, ROWS
 
-from models import FORMULATIONS, KINDS, init_params
+from models import FORMULATIONS, KINDS, ModelSpec, init_params
 from replication.data import BatchStream
-from replication.protocol import DTYPES, LOSSES, SCHEDULES
+from replication.protocol import DTYPES, LOSSES, SCHEDULES, Protocol
 
 
 @pytest.mark.parametrize("row", [pytest.param(r, id=r.name, marks=[pytest.mark.slow] * r.slow) for r in ROWS])
@@ -68,6 +68,36 @@ def test_a_weight_perturbed_by_one_part_in_1e7_is_caught(name):
     torch_run.train(row.spec, params, row.protocol, BatchStream(row.protocol, row.seeds[0]))
     diffs, mismatches = compare(cached_trace("jax", row), torch_run)
     assert not mismatches and not within(row, diffs) and diffs["params"] > 1e-8
+
+
+class _Fixed:
+    """A batch stream that gives one batch at every step."""
+
+    def __init__(self, batch):
+        self.b = batch
+
+    def batch(self, k):
+        return self.b
+
+
+@pytest.mark.parametrize("loss", ["l1", "l1_gamma"])
+def test_an_exact_fit_has_the_same_l1_gradient(loss):
+    """Where a residual is exactly 0, d|e|/de is 0 in both frameworks (JAX's abs alone says 1, PyTorch's 0:
+    `replication.objective.loss_value`): a model that predicts exactly 0 for a target component that is 0."""
+    spec = ModelSpec(kind="baseline", dof=2, hidden=(8,), dtype="float64")
+    params = init_params(spec, seed=0)
+    params["mlp.1.weight"][:], params["mlp.1.bias"][:] = 0.0, 0.0
+    rng = np.random.default_rng(0)
+    batch = {"q": rng.normal(size=(4, 2)), "qdot": rng.normal(size=(4, 2)),
+             "target": np.stack([np.zeros(4), rng.normal(size=4)], -1), "weight": 1.0 + rng.random(4)}
+    if loss == "l1":
+        del batch["weight"]
+    protocol = Protocol(data="spring_iid", steps=3, batch=4, n_train=4, dtype="float64", log_every=1, loss=loss)
+    runs = [Recorder(fw) for fw in ("jax", "torch")]
+    for run in runs:
+        run.train(spec, params, protocol, _Fixed(batch))
+    diffs, mismatches = compare(*runs)
+    assert not mismatches and max(diffs[k] for k in ("loss", "grad_norm", "params")) < 1e-12, diffs
 
 
 PART_HORIZON, PARTED = 100, 1e-2   # steps; relative parameter difference that counts as parted
