@@ -15,14 +15,13 @@ DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optio
              "state file: columns (arrays) q, qdot, qddot and optional tau (format: README)")
 
 
-class _Defaults(argparse.HelpFormatter):
+def _show_defaults(parser) -> None:
     """Every option's help ends with its default, unless it states one itself (flags and required ones aside)."""
-
-    def _get_help_string(self, action):
+    for action in parser._actions:
         text = action.help or ""
         if "default" in text or action.required or not action.option_strings or action.nargs == 0:
-            return text
-        return text + (" (default: none)" if action.default is None else " (default: %(default)s)")
+            continue
+        action.help = text + (" (default: none)" if action.default is None else " (default: %(default)s)")
 
 
 def _widths(text: str, option: str) -> tuple:
@@ -100,8 +99,7 @@ def cmd_evaluate(args):
 
 
 def add_commands(sub) -> None:
-    fmt = _Defaults
-    s = sub.add_parser("simulate", formatter_class=fmt, help="noisy trajectories of a system, as a trajectory file "
+    s = sub.add_parser("simulate", help="noisy trajectories of a system, as a trajectory file "
                        "for fit / evaluate", description="Integrate trajectories of a system of `systems/` (float64, "
                        "tight tolerances) from states of its own distribution and add Gaussian noise.")
     s.add_argument("--system", default="pendulum", help="a system name, see `lagbench list`")
@@ -113,8 +111,9 @@ def add_commands(sub) -> None:
     s.add_argument("--seed", type=int, default=0, help="seed of the initial states and the noise")
     s.add_argument("--out", required=True, help="the .csv file to write")
     s.set_defaults(func=cmd_simulate)
+    _show_defaults(s)
 
-    s = sub.add_parser("fit", formatter_class=fmt, help="train a model on your own data (format: README)",
+    s = sub.add_parser("fit", help="train a model on your own data (format: README)",
                        description="Train one model on a data file and write OUT/units/fit/<framework>/<model>/"
                        "seed<k>/ (result.json, train_log.csv, checkpoint.npz, one_step.csv, rollouts.csv), and the "
                        "prepared rows to OUT/data/. Optimiser: Adam; learning rate: the one-cycle cosine of the "
@@ -156,8 +155,9 @@ def add_commands(sub) -> None:
     s.add_argument("--substeps", type=int, default=2, help="RK4 steps per sample interval in the rollouts")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_fit)
+    _show_defaults(s)
 
-    s = sub.add_parser("evaluate", formatter_class=fmt, help="judge fitted models on a data file",
+    s = sub.add_parser("evaluate", help="judge fitted models on a data file",
                        description="Evaluate fitted models on a data file: one-step errors per component, rollouts "
                        "from each trajectory's first state, energy drift (and the true energy error with --system), "
                        "DeLaN's decomposition. Writes OUT/units/evaluate/<framework>/<model>/seed<k>/ and OUT/data/.")
@@ -171,3 +171,4 @@ def add_commands(sub) -> None:
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")
     s.set_defaults(func=cmd_evaluate)
+    _show_defaults(s)

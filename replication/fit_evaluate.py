@@ -33,7 +33,7 @@ import pandas as pd
 
 from replication import userdata
 from replication.evaluate import Evaluation
-from replication.fitted import Fitted, load_fitted
+from replication.fitted import Fitted, Padded, load_fitted
 from replication.metrics import (
     bounded_relative_error,
     energy_errors,
@@ -189,7 +189,7 @@ def eval_fit(ctx) -> Evaluation:
 
     cfg = ctx.cfg
     if ctx.model is not None:
-        f = Fitted(ctx.spec, ctx.protocol, ctx.framework, cfg.get("model") or "this fit", {}, ctx.model)
+        f = Fitted(ctx.spec, ctx.protocol, ctx.framework, cfg.get("model") or "this fit", {}, Padded(ctx.model))
     else:
         f = load_fitted(cfg["model"], ctx.framework)
     system = systems.get(cfg["system"]) if cfg.get("system") else None

@@ -16,8 +16,8 @@ a fit trained in JAX loads in PyTorch and back (`framework`, default the one it 
                                    LNN qdot . dL/dqdot - L, with qdot . dL/dqdot = d/ds L(q, s qdot) at s = 1
                                    taken by a central difference (step ENERGY_STEP in s: truncation and
                                    float32 round-off both near 1e-5 relative); a baseline has none (None).
-  spec, protocol, task, framework, folder, result, and `model`: the adapter itself (mass_matrix, coriolis,
-  gravity, lagrangian, hamiltonian, ... where the kind has them).
+  spec, protocol, task, framework, folder, result, and `model`: the adapter (`Padded`: any batch size, a few
+  compiled shapes) with all the kind's methods (mass_matrix, coriolis, gravity, lagrangian, hamiltonian, ...).
 """
 from __future__ import annotations
 
@@ -32,6 +32,29 @@ from replication.adapters import adapter
 from replication.protocol import Protocol
 
 ENERGY_STEP = 1e-2
+SMALLEST = 16   # batches are padded to a power of two >= this: a few compiled shapes (JAX), not one per size
+
+
+class Padded:
+    """An adapter whose methods take any batch size N and run on N padded (with copies of the first row) to
+    the next power of two: a JIT-compiled framework compiles a handful of shapes instead of one per N (the
+    rollouts, one-step sets and energies of an evaluation each have their own); rows never mix, so the
+    first N rows of the result are exactly the unpadded call's."""
+
+    def __init__(self, model):
+        self._model = model
+
+    def __getattr__(self, name):
+        method = getattr(self._model, name)
+
+        def call(*args):
+            n = next(len(a) for a in args if a is not None)
+            size = max(SMALLEST, 1 << max(n - 1, 0).bit_length())
+            pad = [None if a is None else np.concatenate([a, np.repeat(np.asarray(a)[:1], size - n, 0)])
+                   for a in args]
+            out = method(*pad)
+            return tuple(o[:n] for o in out) if isinstance(out, tuple) else out[:n]
+        return call
 
 
 def fitted_folders(path) -> list[Path]:
@@ -114,4 +137,4 @@ def load_fitted(path, framework: str | None = None) -> Fitted:
     framework = framework or result["framework"]
     params = R.load_npz(folder / "checkpoint.npz")
     return Fitted(spec, Protocol.from_dict(result["protocol"]), framework, folder, result,
-                  adapter(framework, spec, params))
+                  Padded(adapter(framework, spec, params)))

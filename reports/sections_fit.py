@@ -48,7 +48,7 @@ def _models_table(units) -> pd.DataFrame:
         p, s, r = u.result.get("protocol") or {}, u.result.get("model_spec") or {}, u.result
         cfg = r.get("eval_config") or {}
         rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
-                     "steps": cell(r.get("train_steps") if u.claim == "fit" else "(fit's)"),
+                     "steps": str(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
                      "weight decay (l2)": num(p.get("l2")), "schedule": f"{p.get('schedule')}, peak {num(p.get('lr'))}",
                      "rows (train/held-out/test)": "/".join(str((cfg.get("rows") or {}).get(k, 0))
