@@ -3,7 +3,6 @@
 one line naming the option (raised as ValueError, printed by `cli.main`)."""
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -73,7 +72,7 @@ def cmd_fit(args):
                 lr_min_ratio=args.lr_final, delan_eps=args.delan_eps, delan_offset=args.delan_offset,
                 angle_wrap=args.angle_wrap, input_scale=_scale(args.input_scale), split=args.split,
                 heldout=args.heldout, test=args.test, window=args.window, polyorder=args.polyorder,
-                system=args.system, substeps=args.substeps, on_log=on_log)
+                system=args.system, substeps=args.substeps, energy=args.energy, on_log=on_log)
     finally:
         for bar in bars:
             bar.close()
@@ -90,7 +89,7 @@ def cmd_evaluate(args):
     from replication.evaluate_file import evaluate
 
     for d in evaluate(args.model, args.data, out=args.out, framework=args.framework, system=args.system,
-                      substeps=args.substeps, window=args.window, polyorder=args.polyorder):
+                      substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy):
         m = d["metrics"]
         parts = [f"{k} {m[k]:.4g}" for k in (f"test_{d['protocol']['loss']}", "test_rollout_gmean_err",
                                              "test_learned_energy_drift", "test_energy_err_final") if m.get(k) is not None]
@@ -152,6 +151,8 @@ def add_commands(sub) -> None:
                    "1,1,0.3,0.3")
     s.add_argument("--system", help="a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "
                    "evaluation compares against (default: none)")
+    s.add_argument("--energy", help="your energy function E(q, qdot) as module:function (importable from here; "
+                   "(N, d) arrays to (N,)), compared along the rollouts in place of --system's")
     s.add_argument("--substeps", type=int, default=2, help="RK4 steps per sample interval in the rollouts")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_fit)
@@ -167,6 +168,7 @@ def add_commands(sub) -> None:
     s.add_argument("--out", default="results/evaluate", help="results folder")
     s.add_argument("--framework", help="jax | torch (default: the one each model was trained in)")
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
+    s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")

@@ -1,12 +1,13 @@
 """`lagbench evaluate --model DIR --data FILE`: fitted models judged on a new data file.
 
-`evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None)`
+`evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
+energy=None)`
 -> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
 in it, side by side). Each model is loaded by `fitted.load_fitted` (checksums verified; in `framework`,
 default the one it was trained in: parameters load in either), the data file is prepared as a test file
 (`fit_data.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
 polyorder unless given) and evaluated by the fit routine (`fit_evaluate.eval_fit`: one-step errors per
-component, rollouts, energies with `system`, DeLaN's decomposition). Written as units of a claim
+component, rollouts, energies with `system` or `energy` ("module:function"), DeLaN's decomposition). Written as units of a claim
 "evaluate": `OUT/units/evaluate/<framework>/<model>/seed<k>/` (result.json, one_step.csv, rollouts.csv,
 timeseries.csv, arrays.npz; `lagbench report` renders them) and OUT/data/ (the prepared rows). A verified
 earlier evaluation of the same model, data and options is returned as is; another one there is kept,
@@ -33,11 +34,15 @@ def _check(framework, system, substeps, window, polyorder):
 
 
 def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
-             polyorder=None) -> list[dict]:
+             polyorder=None, energy=None) -> list[dict]:
     _check(framework, system, substeps, window, polyorder)
     path = str(Path(data).resolve())
     has_tau = "tau" in userdata.read(path)[1]
     fits = [load_fitted(f) for f in fitted_folders(model)]
+    if energy:
+        from replication.fit_evaluate import energy_function
+
+        energy_function({"energy": energy}, fits[0].spec.dof)
     for f in fits:
         if (f.task == "inverse_dynamics") != has_tau:
             raise ValueError(f"--data {data}: {'has' if has_tau else 'lacks'} tau columns, but the fit in {f.folder} "
@@ -56,7 +61,9 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
             raise ValueError(f"--data {data}: has {prep.dof} degrees of freedom, the model in {f.folder} {f.spec.dof}")
         fields = {k: v for k, v in r["model_spec"].items() if k not in ("hidden", "dtype")}
         entry = ModelEntry(r["model"], fields, hidden=tuple(f.spec.hidden), train=False)
-        cfg = {"heldout": False, "test": prep.reference, "system": system or (r.get("eval_config") or {}).get("system"),
+        fcfg = r.get("eval_config") or {}
+        cfg = {"heldout": False, "test": prep.reference, "system": system or fcfg.get("system"),
+               "energy": energy or fcfg.get("energy"),
                "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
                "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}

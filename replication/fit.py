@@ -115,7 +115,7 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
         lr=1e-3, seed=0, loss="l1", dtype="float32", activation="softplus", weight_decay=0.0, schedule="onecycle",
         lr_min_ratio=1e-4, delan_eps=0.01, delan_offset=2.0, angle_wrap=False, input_scale=None, split=None,
         heldout=fit_data.HELDOUT, test=None, window=trajectories.WINDOW, polyorder=trajectories.POLYORDER,
-        system=None, substeps=2, on_log=None) -> dict:
+        system=None, substeps=2, energy=None, on_log=None) -> dict:
     hidden = tuple(hidden)
     input_scale = tuple(input_scale) if isinstance(input_scale, (list, tuple)) else input_scale
     check_options(model, framework, steps, hidden, batch, lr, seed, loss, activation, weight_decay, schedule,
@@ -125,7 +125,12 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
     trajectories.check_options(window, polyorder)
     out = R.output_folder(out, "--out")
     path = str(Path(data).resolve())
-    task = task_of(model, "tau" in userdata.read(path)[1], path)
+    raw = userdata.read(path)[1]
+    task = task_of(model, "tau" in raw, path)
+    if energy:  # importable and of the right shape, before any work
+        from replication.fit_evaluate import energy_function
+
+        energy_function({"energy": energy}, raw["q"].shape[1])
     if test is not None:
         test_tau = "tau" in userdata.read(str(Path(test).resolve()))[1]
         if test_tau != (task == "inverse_dynamics"):
@@ -151,7 +156,7 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
                         log_every=max(1, steps // 100))
     metric, label = metric_of(prep.counts, tprep is not None, loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
-           "system": system, "substeps": substeps, "source": prep.source,
+           "system": system, "energy": energy, "substeps": substeps, "source": prep.source,
            "derivatives": {"window": window, "polyorder": polyorder}, "rows": prep.counts,
            "trajectories": prep.trajectories}
     entry = ModelEntry(model, spec, hidden=hidden)

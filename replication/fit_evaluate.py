@@ -2,7 +2,8 @@
 `lagbench fit` (its held-out rows and its `--test` file) and `lagbench evaluate` run.
 
 ctx.cfg: {"heldout": bool (evaluate the protocol file's held-out rows), "test": a prepared file's
-`userdata.reference` or None, "system": a `systems` name or None, "substeps": RK4 steps per sample
+`userdata.reference` or None, "system": a `systems` name or None, "energy": "module:function" (a user's
+E(q, qdot), in place of the system's) or None, "substeps": RK4 steps per sample
 interval, "model": a fit's unit folder (evaluate: the model is loaded from it by `fitted.load_fitted`)}.
 Every evaluation set S ("heldout", "test") gives, all NumPy and framework-neutral:
 
@@ -19,7 +20,7 @@ rollouts   (sets with whole trajectories) every trajectory from its first state 
 energy     (no torques) the model's own energy along its rollout (`Fitted.energy`): S_learned_energy_drift
            = mean over trajectories of max_t |E(t) - E(0)| / scale, scale = the mean learned kinetic energy
            E(q, qdot) - E(q, 0) over S's states (energy offsets cancel). With a system: its energy along the
-           rollout against along the data, `metrics.energy_errors` with scale = the system's mean kinetic
+           rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
            of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig.
@@ -89,7 +90,35 @@ def _forward(f: Fitted, r) -> str | None:
     return None
 
 
-def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list, system):
+def energy_function(cfg, dof):
+    """E(q, qdot) (arrays (..., dof) -> (...)) from cfg["energy"] ("module:function", imported) or the named
+    system's, or None; a ValueError naming --energy if it cannot be imported or does not return one value per
+    state."""
+    spec = cfg.get("energy")
+    if not spec:
+        if not cfg.get("system"):
+            return None
+        import systems
+
+        return systems.get(cfg["system"]).energy
+    import importlib
+
+    module, _, attr = str(spec).partition(":")
+    try:
+        fn = getattr(importlib.import_module(module), attr)
+    except (ImportError, AttributeError, ValueError) as e:
+        raise ValueError(f"--energy {spec}: cannot import it ({e}); give module:function, importable from here") from None
+    probe = np.asarray(fn(np.zeros((2, dof)), np.zeros((2, dof))))
+    if probe.shape != (2,):
+        raise ValueError(f"--energy {spec}: must map q, qdot of shape (N, {dof}) to (N,), gave shape {probe.shape}")
+
+    def energy(q, qdot):
+        q, qdot = np.asarray(q), np.asarray(qdot)
+        return np.asarray(fn(q.reshape(-1, dof), qdot.reshape(-1, dof)), np.float64).reshape(q.shape[:-1])
+    return energy
+
+
+def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list, true_energy):
     d = f.spec.dof
     forced = f.task == "inverse_dynamics"
     groups: dict = {}
@@ -117,9 +146,9 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
         qp, qdp = z[..., :d], z[..., d:]
         if not forced and f.has_energy:
             drifts.append(_learned_drift(f, r, qp, qdp))
-        if system is not None:
-            e_sys.append((system.energy(np.nan_to_num(qp), np.nan_to_num(qdp)) * np.where(np.isfinite(qp[..., 0]), 1, np.nan),
-                          system.energy(z_data[..., :d], z_data[..., d:]), t, members))
+        if true_energy is not None:
+            e_sys.append((true_energy(np.nan_to_num(qp), np.nan_to_num(qdp)) * np.where(np.isfinite(qp[..., 0]), 1, np.nan),
+                          true_energy(z_data[..., :d], z_data[..., d:]), t, members))
         if k == 0 and name == cfg.get("primary"):
             out.arrays.update(t=t, q_true=z_data[:3, :, :d], q_pred=qp[:3])
     ids = [r["traj"][i[0]] for m in groups.values() for i in m]
@@ -130,7 +159,7 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
         table["learned_energy_drift"] = np.concatenate(drifts)
         out.metrics[f"{name}_learned_energy_drift"] = float(table["learned_energy_drift"].mean())
     if e_sys:
-        _true_energy(system, r, name, e_sys, table, out, series)
+        _true_energy(true_energy, r, name, e_sys, table, out, series)
     rows.append(table)
 
 
@@ -147,8 +176,8 @@ def _learned_drift(f: Fitted, r, qp, qdp):
     return np.where(ok, drift, np.inf)
 
 
-def _true_energy(system, r, name, e_sys, table, out, series):
-    kinetic = system.energy(r["q"], r["qdot"]) - system.energy(r["q"], np.zeros_like(r["qdot"]))
+def _true_energy(energy, r, name, e_sys, table, out, series):
+    kinetic = energy(r["q"], r["qdot"]) - energy(r["q"], np.zeros_like(r["qdot"]))
     scale = float(np.mean(np.abs(kinetic)))
     finals, maxes = [], []
     for e_pred, e_true, t, members in e_sys:
@@ -195,6 +224,7 @@ def eval_fit(ctx) -> Evaluation:
     system = systems.get(cfg["system"]) if cfg.get("system") else None
     if system is not None and system.dof != f.spec.dof:
         raise ValueError(f"--system {cfg['system']}: has {system.dof} degrees of freedom, the model {f.spec.dof}")
+    true_energy = energy_function(cfg, f.spec.dof)
     sets = {}
     if cfg.get("heldout"):
         sets["heldout"] = userdata.rows(ctx.protocol.data, "heldout")
@@ -211,7 +241,7 @@ def eval_fit(ctx) -> Evaluation:
         _one_step(f, r, name, out, one)
         why = _forward(f, r)
         if why is None:
-            _rollouts(f, r, name, cfg, out, roll, series, system)
+            _rollouts(f, r, name, cfg, out, roll, series, true_energy)
         else:
             out.counters[f"{name}_rollouts"] = f"not run: {why}"
         if f.spec.kind == "delan":

@@ -77,3 +77,20 @@ def test_every_fit_option_shows_its_default():
             "--input-scale", "--split", "--heldout", "--test", "--window", "--polyorder"} <= set(helps)
     missing = [k for k, h in helps.items() if "default" not in h]
     assert not missing, missing
+
+
+def test_a_users_energy_function_is_imported_and_checked_before_any_work(tmp_path, monkeypatch):
+    from replication.fit_evaluate import energy_function
+
+    (tmp_path / "my_energy.py").write_text("def pendulum(q, qdot):\n    return 0.5 * (qdot**2).sum(-1) - 3 * __import__('numpy').cos(q).sum(-1)\n"
+                                           "def wrong(q, qdot):\n    return q\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    energy = energy_function({"energy": "my_energy:pendulum"}, 1)
+    q = np.zeros((4, 5, 1))
+    assert energy(q, q + 1.0).shape == (4, 5) and np.allclose(energy(q, q + 1.0), 0.5 - 3.0)
+    with pytest.raises(ValueError, match="must map"):
+        energy_function({"energy": "my_energy:wrong"}, 2)
+    data = _arm_trajectories(tmp_path / "arm.csv", tau=False)
+    with pytest.raises(ValueError, match="--energy no_such_module:f: cannot import"):
+        fit(data, model="baseline", out=tmp_path / "out", energy="no_such_module:f", **TINY)
+    assert not (tmp_path / "out" / "data").exists()
