@@ -15,9 +15,10 @@ from models.params import n_layers
 
 ACT = {
     "softplus": lambda x: jnp.logaddexp(x, 0.0),
-    "relu": lambda x: jnp.maximum(x, 0.0),
-    "relu2": lambda x: jnp.maximum(x, 0.0) ** 2,
-    "relu3": lambda x: jnp.maximum(x, 0.0) ** 3,
+    # jax.nn.relu, not jnp.maximum(x, 0): its slope at 0 is 0, as torch.relu's (maximum splits a tie, 0.5)
+    "relu": jax.nn.relu,
+    "relu2": lambda x: jax.nn.relu(x) ** 2,
+    "relu3": lambda x: jax.nn.relu(x) ** 3,
     "tanh": jnp.tanh,
     "sigmoid": jax.nn.sigmoid,
 }

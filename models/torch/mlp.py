@@ -52,9 +52,10 @@ def softplus(x):
 
 ACT = {
     "softplus": softplus,
-    "relu": lambda x: torch.clamp(x, min=0.0),
-    "relu2": lambda x: torch.clamp(x, min=0.0) ** 2,
-    "relu3": lambda x: torch.clamp(x, min=0.0) ** 3,
+    # torch.relu, not clamp(x, min=0): its slope at 0 is 0, as jax.nn.relu's (clamp's is 1)
+    "relu": torch.relu,
+    "relu2": lambda x: torch.relu(x) ** 2,
+    "relu3": lambda x: torch.relu(x) ** 3,
     "tanh": torch.tanh,
     "sigmoid": torch.sigmoid,
 }

@@ -29,16 +29,16 @@ def _softplus(a):
 
 
 def _relu(a):
-    return torch.clamp(a, min=0.0), (a > 0).to(a.dtype), torch.zeros_like(a)
+    return torch.relu(a), (a > 0).to(a.dtype), torch.zeros_like(a)
 
 
 def _relu2(a):
-    r = torch.clamp(a, min=0.0)
+    r = torch.relu(a)
     return r * r, 2.0 * r, 2.0 * (a > 0).to(a.dtype)
 
 
 def _relu3(a):
-    r = torch.clamp(a, min=0.0)
+    r = torch.relu(a)
     r2 = r * r
     return r2 * r, 3.0 * r2, 6.0 * r
 

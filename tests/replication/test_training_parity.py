@@ -100,6 +100,29 @@ def test_an_exact_fit_has_the_same_l1_gradient(loss):
     assert not mismatches and max(diffs[k] for k in ("loss", "grad_norm", "params")) < 1e-12, diffs
 
 
+@pytest.mark.parametrize("kind,activation,formulation", [("baseline", "relu", "fast"), ("lnn", "relu2", "fast"),
+                                                         ("lnn", "relu2", "paper"), ("hnn", "relu", "fast")])
+def test_relu_at_zero_has_the_same_derivative(kind, activation, formulation):
+    """A sample whose inputs are all 0 meets zero biases (every init but pytorch_default's) at pre-activations
+    exactly 0, where relu's slope (and relu2's curvature) are the frameworks' conventions: the same in both
+    (0, `models.jax.mlp.ACT` and `models.torch.mlp.ACT`)."""
+    spec = ModelSpec(kind=kind, dof=2, hidden=(8, 8), dtype="float64", activation=activation,
+                     formulation=formulation)
+    rng = np.random.default_rng(1)
+    batch = {"q": rng.normal(size=(4, 2)), "qdot": rng.normal(size=(4, 2)), "target": rng.normal(size=(4, 2))}
+    batch["q"][0], batch["qdot"][0] = 0.0, 0.0
+    if kind == "hnn":
+        batch["target"] = rng.normal(size=(4, 4))
+    task = "hamiltonian" if kind == "hnn" else "acceleration"
+    protocol = Protocol(data="spring_iid", steps=3, batch=4, n_train=4, dtype="float64", log_every=1, loss="mse",
+                        task=task)
+    runs = [Recorder(fw) for fw in ("jax", "torch")]
+    for run in runs:
+        run.train(spec, init_params(spec, seed=0), protocol, _Fixed(batch))
+    diffs, mismatches = compare(*runs)
+    assert not mismatches and max(diffs[k] for k in ("loss", "grad_norm", "params")) < 1e-10, diffs
+
+
 PART_HORIZON, PARTED = 100, 1e-2   # steps; relative parameter difference that counts as parted
 
 
