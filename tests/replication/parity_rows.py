@@ -2,8 +2,8 @@
 
 Every model kind and formulation, every loss and schedule, the spike guard, restarts (scouted) and
 vectorised members, each in float64 (`steps` at every step to `TOLERANCE["float64"]`) and float32 (a short
-horizon, `F32_STEPS`, to `TOLERANCE["float32"]`). `slow` rows run only under `-m slow` (and in the printed
-table). Widths are tiny: the JAX compile dominates, and rows that share a spec, loss, optimiser and clip
+horizon, `F32_STEPS`, to `TOLERANCE["float32"]`), and the non-chaotic ones in float64 over `LONG_STEPS`.
+`slow` rows run only under `-m slow` (and in the printed table). Widths are tiny: the JAX compile dominates, and rows that share a spec, loss, optimiser and clip
 share one compiled step (`parity_kit._jax_step`), so the guarded LNN, the members and the scouted rows are
 cut to the same shapes.
 """
@@ -101,5 +101,10 @@ def in_float32(row: Row, steps: int = F32_STEPS, slow: bool | None = None) -> Ro
 # in float32 they are the chaotic LNN again, at the price of two more compiles)
 F32_SLOW = ("lnn_members", "lnn_scouted")
 F32 = [in_float32(r, slow=r.slow or r.name in F32_SLOW) for r in F64]
-ROWS = F64 + F32
+# float64 over LONG_STEPS, slow: the kinds whose float64 runs do not part (the double-pendulum LNN's do,
+# after about 100 steps: `test_float32_parting`)
+LONG_STEPS = 200
+LONG = [dataclasses.replace(r, name=r.name + "_long", protocol=r.protocol.replace(steps=LONG_STEPS), slow=True)
+        for r in F64 if not (r.chaotic or r.slow)]
+ROWS = F64 + F32 + LONG
 BY_NAME = {r.name: r for r in ROWS}

@@ -13,7 +13,7 @@ import dataclasses
 import numpy as np
 import pytest
 from parity_kit import Recorder, cached_trace, compare, run_row, step_diffs, within
-from parity_rows import BY_NAME, ROWS
+from parity_rows import BY_NAME, F32, F64, ROWS
 
 from models import FORMULATIONS, KINDS, ModelSpec, init_params
 from replication.data import BatchStream
@@ -44,9 +44,9 @@ def test_the_table_covers_every_kind_formulation_loss_schedule_and_mode():
         assert {r.protocol.dtype for r in rows} == set(DTYPES)
         assert {r.mode for r in rows} == {"one", "members", "scouted"}
         assert any(r.protocol.grad_clip and r.protocol.spike_skip for r in rows)
-    # every float64 row of the default run also has its float32 twin (default or slow)
-    assert {r.name for r in ROWS if r.protocol.dtype == "float32"} == {r.name + "_f32" for r in ROWS
-                                                                       if r.protocol.dtype == "float64"}
+    # every float64 row also has its float32 twin (default or slow)
+    assert {r.name for r in F32} == {r.name + "_f32" for r in F64}
+    assert {r.protocol.dtype for r in F64} == {"float64"} and {r.protocol.dtype for r in F32} == {"float32"}
 
 
 def test_the_guard_clips_and_skips_in_its_row():
