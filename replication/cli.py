@@ -39,7 +39,10 @@ def cmd_run(args):
 
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
-                  progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address)
+                  progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
+                  dry_run=args.dry_run)
+    if summary.get("dry_run"):
+        return 0
     for c in summary["claims"]:
         print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
     for e in summary.get("errors", []):
@@ -172,6 +175,8 @@ def build_parser():
                         "Ray instance or the cluster at --address (needs `pip install 'lagbench[ray]'`)")
     s.add_argument("--address", help="with --executor ray: the Ray cluster to join, e.g. 10.0.0.1:6379 or auto "
                    "(default: start a local Ray instance on this machine's cores)")
+    s.add_argument("--dry-run", action="store_true", help="print the units and an estimated duration (a few "
+                   "probed steps of each training), then stop; writes nothing")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.set_defaults(func=cmd_run)
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",

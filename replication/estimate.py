@@ -11,6 +11,7 @@ evenly over `jobs` workers, and is never below the longest single training.
 """
 from __future__ import annotations
 
+import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
@@ -25,32 +26,34 @@ def _per_step(rows) -> float:
     return (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
 
 
-def _probe_plain(framework, spec, protocol) -> float:
+def _plain_step(framework, spec, protocol) -> float:
     p = continuation_protocol(protocol).replace(steps=PROBE_STEPS, log_every=1, schedule="constant",
                                                 n_train=protocol.batch * PROBE_STEPS)
-    return _per_step(run_training(framework, spec, p, 0).log) * protocol.steps
+    return _per_step(run_training(framework, spec, p, 0).log)
 
 
-def _probe_scouts(framework, spec, protocol) -> float:
-    sp = scout_protocol(protocol)
+def _scout_step(framework, spec, protocol) -> float:
     probe = protocol.replace(scout_steps=PROBE_STEPS, log_every=1, schedule="constant",
-                             n_train=sp.batch * PROBE_STEPS)
+                             n_train=max(scout_protocol(protocol).batch, protocol.batch) * PROBE_STEPS)
     rows = []
     scout(trainer(framework), spec, probe, list(range(protocol.scouts)), on_log=rows.append)
-    return _per_step(rows) * sp.steps
+    return _per_step(rows)
 
 
-def training_seconds(framework, spec, protocol) -> float:
-    """Estimated seconds of one training of `protocol` (scouts and continuation) on this machine."""
-    t = _probe_plain(framework, spec, protocol)
-    if protocol.scouts > 1:
-        t += _probe_scouts(framework, spec, protocol)
-    return t
+# what does not change the cost of a step: the init, the step counts, the rates and the pool sizes
+_FREE = ("steps", "scout_steps", "lr", "scout_lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start",
+         "lr_step_every", "lr_step_gamma")
+
+
+def _shape(framework, spec, protocol) -> str:
+    p = {k: v for k, v in protocol.to_dict().items() if k not in _FREE}
+    return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
 
 
 def estimate(units, out, jobs: int = 1) -> dict:
-    """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused}."""
-    probes, todo, cached = {}, {}, 0
+    """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
+    "probes": configurations timed}."""
+    per_step, todo, cached = {}, {}, 0
     for u in units:
         if not u.entry.train:
             continue
@@ -62,14 +65,16 @@ def estimate(units, out, jobs: int = 1) -> dict:
             cached += 1
             todo[key] = 0.0
             continue
-        shape = (u.framework, spec, p)   # the same training for another seed costs the same
-        if shape not in probes:
-            probes[shape] = training_seconds(u.framework, spec, p)
-        todo[key] = probes[shape]
+        shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
+        if shape not in per_step:
+            per_step[shape] = (_plain_step(u.framework, spec, p),
+                               _scout_step(u.framework, spec, p) if p.scouts > 1 else 0.0)
+        plain, scouts = per_step[shape]
+        todo[key] = plain * p.steps + (scouts * scout_protocol(p).steps if p.scouts > 1 else 0.0)
     total = sum(todo.values())
     longest = max(todo.values(), default=0.0)
     return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),
-            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(probes)}
+            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step)}
 
 
 def describe(units, todo) -> str:

@@ -74,7 +74,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
     return units
 
 
-def is_current(unit, out, repairs: list | None = None) -> bool:
+def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = True) -> bool:
     """True if the unit's folder holds a verified result of this very protocol, model spec, evaluation
     config and evaluation version. A folder that holds no verified result is redone; with `repairs`,
     one that exists (damaged or interrupted) is logged and listed there. A verified result of another one (the claim or an evaluation routine
@@ -95,6 +95,8 @@ def is_current(unit, out, repairs: list | None = None) -> bool:
                  and d.get("evaluation_version") == EVALUATION_VERSION)
     if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
         return True
+    if not set_stale_aside:   # a look only (--dry-run): nothing renamed
+        return False
     kept = set_aside(folder)
     log.warning("lagbench: %s: its result was made under another protocol, spec or data; kept as %s "
                 "and rerun", unit.name, kept.name)
@@ -161,11 +163,15 @@ def executor_of(executor, jobs, address):
 
 
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
-        progress=True, jobs=1, executor="local", address=None) -> dict:
+        progress=True, jobs=1, executor="local", address=None, dry_run=False) -> dict:
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
     units = plan(profile, claims, frameworks, seeds, models)
+    if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
+        todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
+        return {"dry_run": True, "units": len(units), "todo": len(todo),
+                "estimate": announce(profile, units, todo, out, jobs) if todo else None}
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
