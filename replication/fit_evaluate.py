@@ -218,7 +218,8 @@ def eval_fit(ctx) -> Evaluation:
 
     cfg = ctx.cfg
     if ctx.model is not None:
-        f = Fitted(ctx.spec, ctx.protocol, ctx.framework, cfg.get("model") or "this fit", {}, Padded(ctx.model))
+        f = Fitted(ctx.spec, ctx.protocol, ctx.framework, cfg.get("model") or "this fit", {}, Padded(ctx.model),
+                   ctx.params)
     else:
         f = load_fitted(cfg["model"], ctx.framework)
     system = systems.get(cfg["system"]) if cfg.get("system") else None

@@ -14,13 +14,16 @@ a fit trained in JAX loads in PyTorch and back (`framework`, default the one it 
                                    baseline: its prediction); any other raises a ValueError.
   energy(q, qdot) -> (N,) or None  the model's own energy: DeLaN 1/2 qdot^T M qdot + V; HNN H(q, qdot);
                                    LNN qdot . dL/dqdot - L, with qdot . dL/dqdot = d/ds L(q, s qdot) at s = 1
-                                   taken by a central difference (step ENERGY_STEP in s: truncation and
-                                   float32 round-off both near 1e-5 relative); a baseline has none (None).
+                                   by a central difference (step ENERGY_STEP in s); a baseline has none (None).
+                                   Evaluated in float64 with the same parameters (exactly the trained
+                                   float32 function, without float32 round-off: in float32 the round-off of an
+                                   LNN's L, whose offset is arbitrary, swamped the drift it was to measure).
   spec, protocol, task, framework, folder, result, and `model`: the adapter (`Padded`: any batch size, a few
   compiled shapes) with all the kind's methods (mass_matrix, coriolis, gravity, lagrangian, hamiltonian, ...).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +34,7 @@ from replication import results as R
 from replication.adapters import adapter
 from replication.protocol import Protocol
 
-ENERGY_STEP = 1e-2
+ENERGY_STEP = 1e-4   # in float64: truncation ~1e-8 relative, round-off ~1e-12 x |L|
 SMALLEST = 16   # batches are padded to a power of two >= this: a few compiled shapes (JAX), not one per size
 
 
@@ -78,6 +81,7 @@ class Fitted:
     folder: Path
     result: dict
     model: object
+    params: dict   # the parameters (the float64 copy that `energy` uses is built from them)
 
     @property
     def task(self) -> str:
@@ -105,14 +109,20 @@ class Fitted:
 
     def energy(self, q, qdot):
         kind = self.spec.kind
+        if not self.has_energy:
+            return None
+        if not hasattr(self, "_model64"):
+            spec64 = dataclasses.replace(self.spec, dtype="float64")
+            self._model64 = Padded(adapter(self.framework, spec64, self.params))
+        model = self._model64
         if kind == "delan":
-            m = self.model.mass_matrix(q)
-            return 0.5 * np.einsum("ni,nij,nj->n", qdot, m, qdot) + self.model.potential(q)
+            m = model.mass_matrix(q)
+            return 0.5 * np.einsum("ni,nij,nj->n", qdot, m, qdot) + model.potential(q)
         if kind == "hnn":
-            return self.model.hamiltonian(q, qdot, None)
+            return model.hamiltonian(q, qdot, None)
         if kind == "lnn":
             h = ENERGY_STEP
-            lag = self.model.lagrangian
+            lag = model.lagrangian
             p_dot_qdot = (lag(q, (1 + h) * qdot, None) - lag(q, (1 - h) * qdot, None)) / (2 * h)
             return p_dot_qdot - lag(q, qdot, None)
         return None
@@ -137,4 +147,4 @@ def load_fitted(path, framework: str | None = None) -> Fitted:
     framework = framework or result["framework"]
     params = R.load_npz(folder / "checkpoint.npz")
     return Fitted(spec, Protocol.from_dict(result["protocol"]), framework, folder, result,
-                  Padded(adapter(framework, spec, params)))
+                  Padded(adapter(framework, spec, params)), params)
