@@ -31,13 +31,16 @@ def shrink(args: list[str]) -> list[str]:
     return [*args, *SMALL.get(args[0], [])]
 
 
-def _run(tmp_path, monkeypatch, small: bool) -> dict:
+def _run(tmp_path, monkeypatch, small: bool, capsys=None) -> dict:
     monkeypatch.chdir(tmp_path)
     commands = example_commands()
     assert [c[0] for c in commands] == ["simulate", "simulate", "fit", "fit", "evaluate", "report"]
     for args in commands:
         args = shrink(args) if small else args
         assert main(args if args[0] != "fit" else [*args, "--quiet"]) == 0, args
+        printed = capsys.readouterr().out if capsys is not None else "ok: test L1 "
+        if args[0] == "fit":  # the metric printed is named for the loss and the rows
+            assert printed.startswith("ok: test L1 "), printed
     out = {}
     for path in tmp_path.glob("results/*/units/*/*/*/seed0/result.json"):
         d = json.loads(path.read_text())
@@ -45,8 +48,8 @@ def _run(tmp_path, monkeypatch, small: bool) -> dict:
     return out
 
 
-def test_the_worked_example_runs_end_to_end(tmp_path, monkeypatch):
-    metrics = _run(tmp_path, monkeypatch, small=True)
+def test_the_worked_example_runs_end_to_end(tmp_path, monkeypatch, capsys):
+    metrics = _run(tmp_path, monkeypatch, small=True, capsys=capsys)
     assert set(metrics) == {("fit", "jax", "lnn"), ("fit", "jax", "baseline"), ("evaluate", "torch", "lnn"),
                             ("evaluate", "torch", "baseline")}
     for model in ("lnn", "baseline"):

@@ -68,6 +68,14 @@ def test_an_inverse_dynamics_baseline_and_a_damaged_fit(tmp_path):
         load_fitted(tmp_path)
 
 
+def test_the_metric_is_named_for_the_loss_and_the_rows():
+    from replication.fit import metric_of
+
+    assert metric_of({"train": 9, "heldout": 1}, False, "mse") == ("heldout_mse", "held-out MSE")
+    assert metric_of({"train": 9, "heldout": 1}, True, "l1") == ("test_l1", "test L1")
+    assert metric_of({"train": 9}, False, "l1")[0] == "final_train_loss"
+
+
 def test_every_fit_option_shows_its_default():
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     parser = sub.choices["fit"]
