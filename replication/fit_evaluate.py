@@ -12,7 +12,8 @@ one step   S_l1, S_mse (as the training loss: per-sample sum over components, me
            component, mae, rmse, null_mae, rel_mae = mae / null_mae) in the quantity trained: qddot,
            (qdot, qddot) for an HNN, tau for inverse dynamics.
 rollouts   (sets with whole trajectories) every trajectory from its first state over its own times by the
-           shared RK4 (`rollout.rollout`, step = sample spacing / substeps), under the recorded torques
+           shared RK4 (`rollout.rollout`, step = sample spacing / substeps; an HNN by its own flow, with qdot
+           in the place of p as it was trained), under the recorded torques
            when the model is a forward model given tau (DeLaN; linear interpolation in t). State error:
            `metrics.bounded_relative_error` of (q, qdot) against the data per time; S_rollout_gmean_err
            is its geometric mean over time (`geometric_mean_over_time`), averaged over trajectories;
@@ -43,7 +44,7 @@ from replication.metrics import (
     null_errors,
 )
 from replication.objective import predict
-from replication.rollout import rollout
+from replication.rollout import hamiltonian_field, lagrangian_field, rollout
 from replication.trajectories import starts
 
 KEEP = 2000   # rows kept for the parity and decomposition figures
@@ -70,9 +71,12 @@ def _one_step(f: Fitted, r, name, out: Evaluation, rows: list):
 
 
 def _field(f: Fitted, dof, taus=None, t0=None):
-    """dz/dt of z = (q, qdot) or, under recorded torques, z = (q, qdot, t) with tau interpolated per row."""
+    """dz/dt of z = (q, qdot) (`rollout.lagrangian_field`; an HNN's own flow (dH/dy, -dH/dx) by
+    `rollout.hamiltonian_field`) or, under recorded torques, of z = (q, qdot, t) with tau interpolated per row."""
     if taus is None:
-        return lambda z: np.concatenate([z[:, dof:], f.acceleration(z[:, :dof], z[:, dof:])], 1)
+        if f.task == "hamiltonian":
+            return hamiltonian_field(lambda x, y: f.model.time_derivative(x, y, None), dof)
+        return lagrangian_field(f.acceleration, dof)
 
     def g(z):
         tau = np.stack([[np.interp(z[i, -1], t0[i], taus[i][:, j]) for j in range(dof)] for i in range(len(z))])
