@@ -24,7 +24,9 @@ energy     (no torques) the model's own energy along its rollout (`Fitted.energy
            rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
-           of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig.
+           of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig. Trained on
+           accelerations, a Lagrangian is fixed only up to a constant factor: the terms are then compared at
+           the least-squares factor over all three, recorded as S_decomposition_scale.
 Tables: one_step.csv, rollouts.csv (set, traj, ...), timeseries.csv (set, traj, t, quantity, value);
 arrays.npz: parity data (target, pred) and the first test trajectories (t, q_true, q_pred; M/c/g pairs).
 """
@@ -207,6 +209,11 @@ def _decomposition(f: Fitted, r, name, system, out: Evaluation):
     if system is None:
         return
     true = {"M": system.mass_matrix(q), "c": system.coriolis(q, qd), "g": system.gravity(q)}
+    if f.task != "inverse_dynamics":  # accelerations fix L only up to a factor: compare at the best one
+        a = np.concatenate([pred[k].ravel() for k in pred])
+        scale = float(a @ np.concatenate([true[k].ravel() for k in pred]) / (a @ a))
+        pred = {k: scale * v for k, v in pred.items()}
+        out.metrics[f"{name}_decomposition_scale"] = scale
     for k, label in (("M", "mass_matrix"), ("c", "coriolis"), ("g", "gravity")):
         axes = (1, 2) if k == "M" else (1,)
         num = np.sqrt(np.sum((pred[k] - true[k]) ** 2, axis=axes))

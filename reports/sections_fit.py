@@ -31,7 +31,8 @@ ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"
                    ("energy_err_final", "true energy error at the end"),
                    ("energy_err_max", "true energy error, max over time"),
                    ("mass_matrix_rel_err", "DeLaN M relative error"), ("coriolis_rel_err", "DeLaN c relative error"),
-                   ("gravity_rel_err", "DeLaN g relative error")]
+                   ("gravity_rel_err", "DeLaN g relative error"),
+                   ("decomposition_scale", "DeLaN: factor to the system's L (accelerations fix L up to one)")]
 
 
 def is_fit_results(res: Results) -> bool:
