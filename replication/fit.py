@@ -127,6 +127,13 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
     path = str(Path(data).resolve())
     raw = userdata.read(path)[1]
     task = task_of(model, "tau" in raw, path)
+    if isinstance(input_scale, tuple):
+        dof = raw["q"].shape[1]
+        width = dof if model == "delan" else 3 * dof if task == "inverse_dynamics" else 2 * dof
+        if len(input_scale) != width:
+            names = "q" if model == "delan" else "q, qdot, qddot" if task == "inverse_dynamics" else "q, qdot"
+            raise ValueError(f"--input-scale: {len(input_scale)} numbers given; this {model}'s MLP takes {width} "
+                             f"inputs ({names}, {dof} each)")
     if energy:  # importable and of the right shape, before any work
         from replication.fit_evaluate import energy_function
 
