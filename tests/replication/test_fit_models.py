@@ -36,9 +36,17 @@ def test_an_lnn_or_hnn_given_torques_refuses_before_any_work(tmp_path, capsys, m
 
 def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
     data = _arm_trajectories(tmp_path / "arm.csv")
+    options = {"activation": "tanh", "weight_decay": 1e-5, "schedule": "constant", "delan_eps": 0.1,
+               "delan_offset": 1.0, "input_scale": "auto"}
     d = fit(data, model="delan", out=tmp_path / "out", split="none", test=_arm_trajectories(tmp_path / "t.csv", 2),
-            **TINY)
+            **options, **TINY)
     assert d["status"] == "ok" and d["protocol"]["task"] == "inverse_dynamics" and d["metric"] == "test_l1"
+    p, s = d["protocol"], d["model_spec"]
+    assert (s["activation"], p["l2"], p["schedule"], s["delan_eps"], s["delan_diag_offset"]) == ("tanh", 1e-5,
+                                                                                                 "constant", 0.1, 1.0)
+    q_train = np.concatenate([np.stack([np.sin(np.arange(40) * 0.02 + k), np.cos(2 * np.arange(40) * 0.02 + k)], 1)
+                              for k in range(3)])
+    np.testing.assert_allclose(s["input_scale"], 1 / q_train.std(0), rtol=1e-5)  # auto: 1 / std of DeLaN's input q
     assert {"test_l1", "test_rollout_gmean_err", "test_mass_matrix_min_eig"} <= set(d["metrics"])
     one = pd.read_csv(tmp_path / "out/units/fit/jax/delan/seed0/one_step.csv")
     assert list(one["quantity"]) == ["tau", "tau"] and list(one["component"]) == [0, 1]
