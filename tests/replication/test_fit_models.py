@@ -4,6 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from replication import userdata
 from replication.cli import build_parser, main
 from replication.fit import fit
 from replication.fitted import load_fitted
@@ -51,13 +52,13 @@ def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
     one = pd.read_csv(tmp_path / "out/units/fit/jax/delan/seed0/one_step.csv")
     assert list(one["quantity"]) == ["tau", "tau"] and list(one["component"]) == [0, 1]
     folder = tmp_path / "out/units/fit/jax/delan/seed0"
-    jx, tc = load_fitted(folder), load_fitted(tmp_path / "out", framework="torch")
-    rng = np.random.default_rng(0)
-    q, qd, qdd = (rng.normal(size=(5, 2)) for _ in range(3))
-    tau = jx.inverse_dynamics(q, qd, qdd)
-    np.testing.assert_allclose(tc.inverse_dynamics(q, qd, qdd), tau, rtol=1e-4, atol=1e-5)
-    np.testing.assert_allclose(jx.acceleration(q, qd, tau), qdd, rtol=1e-2, atol=1e-3)  # forward o inverse = id
-    np.testing.assert_allclose(tc.energy(q, qd), jx.energy(q, qd), rtol=1e-4, atol=1e-5)
+    tc = load_fitted(tmp_path / "out", framework="torch")  # trained in JAX, loaded in PyTorch
+    rows = userdata.rows(d["eval_config"]["test"], "test")
+    saved = np.load(folder / "arrays.npz")  # the JAX model's own predictions on those rows, saved by the fit
+    tau = tc.inverse_dynamics(rows["q"], rows["qdot"], rows["qddot"])
+    np.testing.assert_allclose(tau, saved["test_pred"], rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(tc.acceleration(rows["q"], rows["qdot"], tau), rows["qddot"], rtol=1e-3, atol=1e-3)
+    assert tc.energy(rows["q"], rows["qdot"]).shape == (len(tau),)
 
 
 def test_an_inverse_dynamics_baseline_and_a_damaged_fit(tmp_path):
