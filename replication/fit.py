@@ -166,6 +166,8 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
            "system": system, "energy": energy, "substeps": substeps, "source": prep.source,
            "derivatives": {"window": window, "polyorder": polyorder}, "rows": prep.counts,
            "trajectories": prep.trajectories}
+    if tprep is not None:  # the user's test file and its rows, for the report
+        cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
     entry = ModelEntry(model, spec, hidden=hidden)
     claim = Claim(id="fit", number=0, paper="user", section="-", title=f"{model} on {Path(data).name}",
                   system=system or Path(data).name, models=(entry,), protocols={"quick": protocol}, evaluate="fit",

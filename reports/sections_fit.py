@@ -24,6 +24,7 @@ from reports.load import Results
 from reports.tables import problem_units_table
 
 CLAIMS = ("fit", "evaluate")
+SETS = {"train": "train", "heldout": "held-out", "test": "test"}
 SRC = "units/{claim}/<framework>/<model>/seed<k>/"
 ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"),
                    ("rollout_final_err", "state error at the end"),
@@ -114,17 +115,28 @@ def parity(units, path: Path) -> bool:
     return F.save(fig, path)
 
 
+def _path(ref) -> str:
+    return str(ref or "").removeprefix("file:").split("#sha256=")[0]
+
+
 def _data_para(units) -> Para:
     seen: dict[str, list[str]] = {}
     for u in units:
         cfg = u.result.get("eval_config") or {}
-        src = str(cfg.get("source") or "").removeprefix("file:").split("#sha256=")[0]
+        src = _path(cfg.get("source"))
         d = cfg.get("derivatives") or {}
         traj = cfg.get("trajectories") or {}
-        text = (f"{cell(src, 'unknown file')}: rows {cfg.get('rows')}"
-                + (f", whole trajectories {traj}; derivatives the file lacked estimated by Savitzky–Golay (window "
-                   f"{d.get('window')}, degree {d.get('polyorder')})" if any(traj.values()) else "")
-                + (f"; true energy from system {cfg['system']}" if cfg.get("system") else ""))
+        rows = cfg.get("rows") or {}
+        split = " / ".join(f"{rows[k]} {SETS[k]}" for k in SETS if k in rows)
+        whole = " / ".join(f"{traj[k]}" for k in SETS if traj.get(k))
+        text = (f"{cell(src, 'unknown file')}: {split} rows"
+                + (f" ({whole} whole trajectories); derivatives the file lacked estimated by Savitzky–Golay "
+                   f"(window {d.get('window')}, degree {d.get('polyorder')})" if any(traj.values()) else "")
+                + (f"; test file {_path(cfg['test_source'])}: {cfg.get('test_rows')} rows"
+                   + (f" ({cfg['test_trajectories']} whole trajectories)" if cfg.get("test_trajectories") else "")
+                   if cfg.get("test_source") else "")
+                + (f"; true energy from system {cfg['system']}" if cfg.get("system") else "")
+                + (f"; true energy from {cfg['energy']}" if cfg.get("energy") else ""))
         seen.setdefault(text, []).append(f"{u.claim} {_name(u)}")
     return Para("Data: " + " | ".join(f"{text} ({', '.join(names)})" for text, names in seen.items()) + ".")
 
