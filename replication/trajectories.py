@@ -10,16 +10,17 @@ by time. What the file gives is used as is; what it lacks is estimated, trajecto
 
 The estimator is a Savitzky-Golay filter (`scipy.signal.savgol_filter`): at each sample, a polynomial of
 degree `polyorder` is fitted by least squares to the `window` samples centred on it and differentiated
-analytically there; within window // 2 samples of either end, the fit to the first (last) full window
-is used (`mode="interp"`), so those estimates are less accurate. Exact for polynomials of degree <=
-polyorder; with white noise of standard deviation s on q at spacing h, the noise in the k-th derivative
+analytically there. The first and last window // 2 samples of a trajectory have no centred window (a
+one-sided fit there is biased and several times noisier), so when any derivative is estimated they are
+dropped: each trajectory keeps its samples window // 2 ... T - 1 - window // 2. Exact for polynomials of
+degree <= polyorder; with white noise of standard deviation s on q at spacing h, the noise in the k-th derivative
 scales as s / h^k / window^(k + 1/2): a wider window averages more noise away, but biases the estimate
 where q curves on the window's time scale (window * h well below the motion's shortest period).
 Checked against analytic trajectories with noise in tests/replication/test_fit_trajectories.py.
 
 Requirements (a ValueError naming the problem otherwise): an odd window >= polyorder + 2 >= 3 (so
-that the second derivative exists and the fit is overdetermined), at least `window` samples per
-trajectory, strictly increasing times within a trajectory, and a uniform spacing (relative spread
+that the second derivative exists and the fit is overdetermined), at least window + 1 samples per
+trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory, and a uniform spacing (relative spread
 below 1e-6; resample a non-uniform recording first).
 """
 from __future__ import annotations
@@ -67,9 +68,10 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
         rows = np.flatnonzero(traj == k)
         rows = rows[np.argsort(d["t"][rows], kind="stable")]
         where = f"{path}: trajectory {k:g}"
-        if rows.size < window:
-            raise ValueError(f"{where} has {rows.size} samples; the derivative window needs at least {window} "
-                             f"(--window)")
+        estimate = "qdot" not in d or "qddot" not in d
+        if estimate and rows.size < window + 1:
+            raise ValueError(f"{where} has {rows.size} samples; estimating its derivatives needs at least "
+                             f"{window + 1} (--window {window}, whose first and last {window // 2} are dropped)")
         t = d["t"][rows]
         h = spacing(t, where)
         part = {"traj": np.full(rows.size, float(k)), "t": t, "q": d["q"][rows]}
@@ -82,6 +84,8 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
             part["qddot"] = derivative(part["q"], h, 2, window, polyorder)
         if "tau" in d:
             part["tau"] = d["tau"][rows]
+        if estimate:  # no centred window at the ends
+            part = {key: v[window // 2: rows.size - window // 2] for key, v in part.items()}
         parts.append(part)
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 

@@ -56,10 +56,11 @@ def test_trajectory_rows_are_sorted_and_given_derivatives_kept(tmp_path):
     path = str(_file(tmp_path / "a.csv"))
     d = trajectories.with_derivatives(userdata.read(path)[1], path)
     assert set(d) == {"traj", "t", "q", "qdot", "qddot"}
+    assert len(d["q"]) == 3 * (40 - 2 * (W // 2))  # the ends of each trajectory, without a centred window, dropped
     for k in range(3):
         rows = d["traj"] == k
         assert np.all(np.diff(d["t"][rows]) > 0)
-        np.testing.assert_allclose(d["qdot"][rows, 0], np.cos(d["t"][rows] + k), atol=1e-3)  # ends: ~1e-4
+        np.testing.assert_allclose(d["qdot"][rows, 0], np.cos(d["t"][rows] + k), atol=1e-6)
     n = 120
     given = str(_file(tmp_path / "b.csv", shuffle=False, qdot0=np.full(n, 7.0)))
     d = trajectories.with_derivatives(userdata.read(given)[1], given)
@@ -68,7 +69,7 @@ def test_trajectory_rows_are_sorted_and_given_derivatives_kept(tmp_path):
 
 @pytest.mark.parametrize("change, message", [
     ({"t": lambda t: t**2}, "not uniformly spaced"),
-    ({"n": 10}, "needs at least 15"),
+    ({"n": 15}, "needs at least 16"),
     ({"window": 14}, "odd window"),
 ])
 def test_bad_trajectories_name_the_problem(tmp_path, change, message):
@@ -84,16 +85,17 @@ def test_bad_trajectories_name_the_problem(tmp_path, change, message):
 def test_splits_hold_out_whole_trajectories_random_rows_or_nothing(tmp_path):
     path = _file(tmp_path / "d.csv", n_traj=10)
     by = fit_data.prepare(tmp_path / "out", path)             # trajectory file: by-trajectory by default
-    assert by.trajectories == {"heldout": 1, "train": 9} and by.counts == {"heldout": 40, "train": 360}
+    kept = 40 - 2 * (W // 2)
+    assert by.trajectories == {"heldout": 1, "train": 9} and by.counts == {"heldout": kept, "train": 9 * kept}
     rows = {k: userdata.rows(by.reference, k) for k in ("train", "heldout")}
     assert not set(rows["train"]["traj"]) & set(rows["heldout"]["traj"])
     again = fit_data.prepare(tmp_path / "out", path)
     assert again.reference == by.reference                    # same data and options: the same prepared file
     wider = fit_data.prepare(tmp_path / "out", path, window=21)
     assert wider.reference != by.reference                    # another option: another file (and training key)
-    assert fit_data.prepare(tmp_path / "out", path, "none").counts == {"train": 400}
+    assert fit_data.prepare(tmp_path / "out", path, "none").counts == {"train": 10 * kept}
     rnd = fit_data.prepare(tmp_path / "out", path, "random", heldout=0.25)
-    assert rnd.counts == {"heldout": 100, "train": 300}
+    assert rnd.counts == {"heldout": round(2.5 * kept), "train": 10 * kept - round(2.5 * kept)}
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["data"]   # writes only under --out/data
     one = _file(tmp_path / "e.csv", n_traj=1)
     with pytest.raises(ValueError, match="one trajectory only"):
