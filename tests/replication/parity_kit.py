@@ -10,7 +10,7 @@ and tests that train the same spec under the same loss, optimiser and clip compi
 probe (a logging diagnostic, not training) is off.
 
 `compare(a, b) -> (diffs, mismatches)`: diffs = the largest relative difference over all phases, members
-and steps of the loss, the gradient norm and the parameters (per tensor: max |a - b| / max |a|, |b|), and
+and steps of the loss, the gradient norm and the parameters (all of them as one vector, `_params_rel`), and
 `steps` (steps compared per member, phases summed); mismatches: what must be equal and is not (step
 counts, learning rates, skipped-step counts, failures, the scout chosen).
 
@@ -92,13 +92,24 @@ def _rel(a, b) -> float:
     return float(np.max(np.abs(a - b), initial=0.0) / scale) if scale > 0 else 0.0
 
 
+def _params_rel(qa: dict, qb: dict) -> float:
+    """||a - b|| / max(||a||, ||b||) over all parameters (one vector). Not per element: in float32 a gradient
+    component that cancels to rounding level (an L1 loss's signs summing to 0 on a bias: 0 in one framework,
+    1e-8 in the other) is turned by Adam into a step of 0 or about lr, so single small parameters part at once
+    while the model does not."""
+    sq = lambda d: sum(float(np.sum(np.asarray(v, np.float64) ** 2)) for v in d.values())   # noqa: E731
+    diff = sum(float(np.sum((np.asarray(qa[k], np.float64) - np.asarray(qb[k], np.float64)) ** 2)) for k in qa)
+    scale = max(sq(qa), sq(qb))
+    return float(np.sqrt(diff / scale)) if scale > 0 else 0.0
+
+
 def step_diffs(ma: dict, mb: dict) -> np.ndarray:
     """(steps, 3): the relative differences of loss, gradient norm and parameters at each step of one
     member's record in two frameworks (as many steps as both have)."""
     rows = []
     for ra, rb, qa, qb in zip(ma["log"], mb["log"], ma["params"], mb["params"], strict=False):
         rows.append((_rel(ra["loss"], rb["loss"]), _rel(ra["grad_norm"], rb["grad_norm"]),
-                     max((_rel(qa[k], qb[k]) for k in qa), default=0.0)))
+                     _params_rel(qa, qb)))
     return np.asarray(rows, np.float64).reshape(-1, 3)
 
 
@@ -153,8 +164,10 @@ def table(rows) -> str:
         form = row.spec.formulation if row.spec.kind in ("lnn", "lgn") else "-"
         task = p.task + (f" ({p.coords})" if p.task == "hamiltonian" else "")
         guard = " + guard" if p.grad_clip or p.spike_skip else ""
+        steps = {"one": f"{d['steps']}", "members": f"{d['steps']} (x{len(row.seeds)} members)",
+                 "scouted": f"{p.scout_steps} (x{p.scouts} scouts) + {d['steps'] - p.scout_steps}"}[row.mode]
         lines.append(f"| {row.name} | {row.spec.kind} | {form} | {task} | {p.loss} | {p.schedule} | "
-                     f"{row.mode}{guard} | {p.dtype} | {d['steps']} | {d['loss']:.1e} | {d['grad_norm']:.1e} | "
+                     f"{row.mode}{guard} | {p.dtype} | {steps} | {d['loss']:.1e} | {d['grad_norm']:.1e} | "
                      f"{d['params']:.1e} | {tol['loss']:.0e} / {tol['grad_norm']:.0e} / {tol['params']:.0e} | "
                      f"{'yes' if within(row, d) and not bad else 'NO ' + '; '.join(bad[:2])} |")
         print(lines[-1], file=sys.stderr, flush=True)

@@ -15,15 +15,16 @@ from dataclasses import dataclass
 from models import ModelSpec
 from replication.protocol import Protocol
 
-# Relative differences allowed (loss, gradient norm, parameters per tensor: max |a - b| / max |a|) over the
-# row's steps. float32: about 10x the largest measured over F32_STEPS steps (`python
-# tests/replication/parity_kit.py`: 4e-7, 1.3e-5, 8e-6). "float32 chaotic": the LNN on the double pendulum,
-# whose learned velocity Hessian is near-singular on some batches (gradient norms from 1e2 to 1e6 from one
-# batch to the next) and amplifies float32 rounding (measured: 3.3e-3, 6.9e-3, 4.6e-4); the step where its
-# two frameworks part is `test_float32_parting`'s.
+# Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
+# (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
+# tests/replication/parity_kit.py`: 7.7e-7, 1.3e-5, 3.9e-5; the parameters' largest is an L1 loss whose
+# signs cancel on a bias, which Adam turns into a step of 0 or about lr). "float32 chaotic": the LNN on the
+# double pendulum, whose learned velocity Hessian is near-singular on some batches (gradient norms from 1e2
+# to 1e6 from one batch to the next) and amplifies float32 rounding (measured: 3.3e-3, 6.9e-3, 1.1e-6); the
+# step where its two frameworks part is `test_float32_parting`'s.
 TOLERANCE = {"float64": {"loss": 1e-8, "grad_norm": 1e-8, "params": 1e-8},
-             "float32": {"loss": 1e-5, "grad_norm": 1e-4, "params": 1e-4},
-             "float32 chaotic": {"loss": 2e-2, "grad_norm": 5e-2, "params": 5e-3}}
+             "float32": {"loss": 1e-5, "grad_norm": 1e-4, "params": 3e-4},
+             "float32 chaotic": {"loss": 2e-2, "grad_norm": 5e-2, "params": 1e-5}}
 F32_STEPS = 10
 F64_STEPS = 20
 
@@ -68,7 +69,12 @@ F64 = [
     Row("baseline_acc", _s("baseline", 1, activation="tanh", init="xavier"), _p("spring_iid", loss="mse")),
     Row("baseline_invdyn", _s("baseline", 2, activation="softplus", init="xavier", extra_inputs=2),
         _p("two_link_arm", **ARM, schedule="constant", l2=1e-5)),
+    Row("baseline_dp", _s("baseline", 2, activation="relu", init="xavier", angle_wrap=True),
+        _p("double_pendulum_iid", **DP)),
     Row("lnn_fast", LNN, _p("double_pendulum_iid", **DP), **C),
+    # the side studies' LNNs: another activation and init (pytorch_default: biases not 0)
+    Row("lnn_relu2", dataclasses.replace(LNN, activation="relu2", init="pytorch_default"),
+        _p("double_pendulum_iid", **DP), **C),
     Row("lnn_paper", dataclasses.replace(LNN, formulation="paper"), _p("double_pendulum_iid", **DP), **C),
     Row("lnn_guarded", LNN, GUARDED, **C),
     Row("lnn_l1_gamma", _s("lnn", 1, extra_inputs=1, input_scale=(0.1, 1.0, 0.1)), _p("relativistic_iid", **REL)),
@@ -99,7 +105,7 @@ def in_float32(row: Row, steps: int = F32_STEPS, slow: bool | None = None) -> Ro
 
 # float32 in the default run but for the slow rows' and the members' (their float64 rows show the mechanics;
 # in float32 they are the chaotic LNN again, at the price of two more compiles)
-F32_SLOW = ("lnn_members", "lnn_scouted")
+F32_SLOW = ("lnn_members", "lnn_scouted", "lnn_relu2")
 F32 = [in_float32(r, slow=r.slow or r.name in F32_SLOW) for r in F64]
 # float64 over LONG_STEPS, slow: the kinds whose float64 runs do not part (the double-pendulum LNN's do,
 # after about 100 steps: `test_float32_parting`)
