@@ -49,11 +49,11 @@ def run_one(unit, out, on_log=None):
 
 def chains(todo) -> list[list]:
     """The units grouped by the model they train (untrained units alone), longest chain first."""
-    from replication.training import train_key
+    from replication.training import group_key
 
     groups: dict = {}
-    for u in todo:
-        key = train_key(u.framework, u.spec(), u.protocol(), u.seed) if u.entry.train else u.name
+    for u in todo:   # a cohort's seeds (`Protocol.cohort`) train in one program: one chain
+        key = group_key(u.framework, u.spec(), u.protocol(), u.seed) if u.entry.train else u.name
         groups.setdefault(key, []).append(u)
     return sorted(groups.values(), key=cost, reverse=True)
 

@@ -3,7 +3,8 @@
 `estimate(units, out, jobs)` counts every training the run still has to do once (units that share a
 trained model, such as claims 1 and 2, train it once; a training already in `OUT/trained/` costs
 nothing), times three steps of each distinct configuration on this machine after one step to compile
-(the scouts of a protocol with restarts are timed as they run, K members side by side), and scales up
+(the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K members side by
+side), and scales up
 by the protocol's steps. Evaluation time is not included. The wall time assumes the trainings spread
 evenly over `jobs` workers, and is never below the longest single training.
 
@@ -15,8 +16,10 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
-from replication.scouting import continuation_protocol, scout, scout_protocol
-from replication.training import run_training, train_key, trainer
+from models import init_params
+from replication.data import BatchStream
+from replication.scouting import continuation_protocol, scout_protocol
+from replication.training import group_key, run_training, train_key, trainer
 
 PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
 
@@ -32,11 +35,13 @@ def _plain_step(framework, spec, protocol) -> float:
     return _per_step(run_training(framework, spec, p, 0).log)
 
 
-def _scout_step(framework, spec, protocol) -> float:
-    probe = protocol.replace(scout_steps=PROBE_STEPS, log_every=1, schedule="constant",
-                             n_train=max(scout_protocol(protocol).batch, protocol.batch) * PROBE_STEPS)
+def _members_step(framework, spec, protocol, k: int) -> float:
+    """Seconds per step of `k` members side by side (scouts, or a cohort of seeds)."""
+    p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
+                         cohort=0)
     rows = []
-    scout(trainer(framework), spec, probe, list(range(protocol.scouts)), on_log=rows.append)
+    trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in range(k)], p,
+                                     [BatchStream(p, s) for s in range(k)], on_log=rows.append)
     return _per_step(rows)
 
 
@@ -58,19 +63,22 @@ def estimate(units, out, jobs: int = 1) -> dict:
         if not u.entry.train:
             continue
         p, spec = u.protocol(), u.spec()
-        key = train_key(u.framework, spec, p, u.seed)
-        if key in todo:
+        group = group_key(u.framework, spec, p, u.seed)   # a cohort of seeds trains as one program
+        if group in todo:
             continue
-        if (Path(out) / "trained" / u.framework / key / "result.json").exists():
+        if (Path(out) / "trained" / u.framework / train_key(u.framework, spec, p, u.seed) / "result.json").exists():
             cached += 1
-            todo[key] = 0.0
+            todo[group] = 0.0
             continue
         shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
         if shape not in per_step:
-            per_step[shape] = (_plain_step(u.framework, spec, p),
-                               _scout_step(u.framework, spec, p) if p.scouts > 1 else 0.0)
+            if p.cohort > 1:
+                per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), 0.0)
+            else:
+                per_step[shape] = (_plain_step(u.framework, spec, p), _members_step(
+                    u.framework, spec, scout_protocol(p), p.scouts) if p.scouts > 1 else 0.0)
         plain, scouts = per_step[shape]
-        todo[key] = plain * p.steps + (scouts * scout_protocol(p).steps if p.scouts > 1 else 0.0)
+        todo[group] = plain * p.steps + (scouts * scout_protocol(p).steps if p.scouts > 1 else 0.0)
     total = sum(todo.values())
     longest = max(todo.values(), default=0.0)
     return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),

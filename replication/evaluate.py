@@ -38,6 +38,7 @@ class Context:
     profile: str
     cfg: dict
     model: object = None
+    log: list | None = None   # the training log rows (`TrainOutcome.log`), for routines that read the pace
 
 
 @dataclass

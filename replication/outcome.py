@@ -20,6 +20,7 @@ class TrainOutcome:
     skipped_steps: int = 0      # steps the spike guard skipped
     scouting: dict | None = None  # restarts (`replication.scouting`): init seeds, tail losses, the chosen one
     samples: int | None = None    # training samples, where not steps_done x batch (scouts at their own batch)
+    cohort: dict | None = None    # trained side by side with other seeds (`Protocol.cohort`): {"seeds": [...]}
 
     @property
     def samples_per_s(self) -> float:

@@ -22,7 +22,7 @@ TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
 SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr")
-OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS   # omitted from to_dict while 0 (off), so older keys hold
+OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("cohort",)   # omitted from to_dict while 0 (off), so older keys hold
 
 
 @dataclass(frozen=True)
@@ -50,6 +50,10 @@ class Protocol:
                protocol's batch and lr), then continues the one with the lowest training loss for `steps`
                steps of `batch`: the budget is K * scout_steps * scout_batch + steps * batch samples.
                Left out of `to_dict` while 0, as the guard.
+    cohort:    train the seeds in groups of `cohort` as one vectorised program (`replication.training`:
+               seeds g*cohort .. g*cohort + cohort - 1 side by side, each its own init, batches, guard and
+               stop); each seed's numbers are those of its own run (up to floating-point reassociation).
+               0 or 1 = one seed at a time; not combined with scouts. Left out of `to_dict` while 0.
     """
 
     data: str
@@ -78,6 +82,7 @@ class Protocol:
     scout_steps: int = 0
     scout_batch: int = 0
     scout_lr: float = 0.0
+    cohort: int = 0
     dtype: str = "float32"
     log_every: int = 50
     eval: dict = field(default_factory=dict, hash=False, compare=True)
@@ -99,12 +104,15 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
-        for name in ("scouts", "scout_steps", "scout_batch"):
+        for name in ("scouts", "scout_steps", "scout_batch", "cohort"):
             v = getattr(self, name)
             if not (v == 0 or _positive_integer(v)):
                 raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")
         if not (_real(self.scout_lr) and math.isfinite(self.scout_lr) and self.scout_lr >= 0):
             raise ValueError(f"protocol scout_lr must be a finite number >= 0 (0 = lr), got {self.scout_lr!r}")
+        if self.cohort > 1 and self.scouts > 1:
+            raise ValueError(f"protocol cohort {self.cohort} with scouts {self.scouts}: a cohort trains seeds side "
+                             f"by side, scouts train initialisations side by side; use one of them")
         if self.scout_batch > self.n_train:
             raise ValueError(f"scout_batch {self.scout_batch} exceeds the training pool n_train={self.n_train}")
 

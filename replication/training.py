@@ -51,24 +51,72 @@ def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
                                     on_log=on_log)
 
 
-def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
-    folder = Path(out) / "trained" / framework / train_key(framework, spec, protocol, seed)
+def cohort_seeds(protocol, seed: int) -> list[int]:
+    """The seeds trained together with `seed` (`protocol.cohort`: groups g*K .. g*K + K - 1; else itself)."""
+    k = int(protocol.cohort)
+    if k <= 1:
+        return [seed]
+    return list(range(seed // k * k, seed // k * k + k))
+
+
+def group_key(framework, spec, protocol, seed) -> str:
+    """The key of the training program that makes `seed`'s model: units sharing it run in one chain."""
+    return train_key(framework, spec, protocol, cohort_seeds(protocol, seed)[0])
+
+
+def train_cohort(framework, spec, protocol, seeds, on_log=None) -> list[TrainOutcome]:
+    """The seeds' runs of `protocol` as one vectorised program (`train_members`): each its own init and
+    batch stream, as when run alone. `on_log` sees the first seed's rows; every outcome's `train_time_s` is
+    the program's (shared by the cohort)."""
+    def first(row):
+        if on_log and row.get("member", 0) == 0:
+            on_log(row)
+    outcomes = trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
+                                                [BatchStream(protocol, s) for s in seeds], on_log=first)
+    for o in outcomes:
+        o.cohort = {"seeds": list(seeds)}
+    return outcomes
+
+
+def _cached(folder: Path) -> TrainOutcome | None:
     try:
         meta = R.load_result(folder) if (folder / "result.json").exists() else None
     except R.CorruptResult as e:
         log.warning("retraining: %s", e)
-        meta = None
-    if meta is not None:
-        return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
-                            log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
-                            failure=meta["failure"], train_time_s=meta["train_time_s"],
-                            steps_done=meta["steps_done"], batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"))
-    outcome = run_training(framework, spec, protocol, seed, on_log=on_log)
+        return None
+    if meta is None:
+        return None
+    return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
+                        log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
+                        failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
+                        batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
+                        cohort=meta.get("cohort"))
+
+
+def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
     files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
              "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
                                           "scouting": outcome.scouting, "samples": outcome.samples,
-                                          "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed},
+                                          "cohort": outcome.cohort, "spec": spec.to_dict(),
+                                          "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)
-    return outcome
+
+
+def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    """`seed`'s training, from `OUT/trained/` when it is there; a cohort protocol trains (and stores) its
+    whole group of seeds at once."""
+    def folder(s):
+        return Path(out) / "trained" / framework / train_key(framework, spec, protocol, s)
+    done = _cached(folder(seed))
+    if done is not None:
+        return done
+    seeds = cohort_seeds(protocol, seed)
+    if len(seeds) > 1:
+        outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log)
+    else:
+        outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log)]
+    for s, o in zip(seeds, outcomes, strict=True):
+        _store(folder(s), o, spec, protocol, s)
+    return outcomes[seeds.index(seed)]

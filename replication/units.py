@@ -58,6 +58,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
                   protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile))
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
+        ctx.log = outcome.log
     ev = EVALUATIONS[unit.claim.evaluate](ctx)
     for name, df in ev.tables.items():
         files[name] = R.write_csv(folder / name, df)
@@ -74,6 +75,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "train_samples_per_s": outcome.samples_per_s if outcome else None,
         "final_train_loss": outcome.log[-1]["loss"] if outcome and outcome.log else None,
         "scouting": outcome.scouting if outcome else None,
+        "cohort": outcome.cohort if outcome else None,
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

@@ -8,7 +8,8 @@ Per framework, on the units whose status is "ok":
    (failed units never count; the reason names them); a model with no unit at all, "not run";
 2. the competence bars (``claims.bars``): a model below its bar -> "inconclusive", with the numbers;
 3. the claim's rule (``claims.rules``) on the seed statistics; then on every seed alone: a mean that
-   reproduces while some seed does not is only "partly".
+   reproduces while some seed does not is only "partly" (not for a ``pooled`` claim, whose rule reads
+   the seeds as one sample: a share with its interval).
 
 The frameworks' verdicts combine into one: equal -> that one; any "inconclusive" -> "inconclusive";
 otherwise "partly".
@@ -112,7 +113,7 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
         seeds = sorted(set(ok["seed"]))
         per_seed = [_decide(claim, model_stats(ok[ok["seed"] == k]), failed)[0] for k in seeds]
         entry["by_seed"][fw] = {f"seed{k}": x for k, x in zip(seeds, per_seed, strict=True)}
-        if len(seeds) > 1 and verdict not in ("inconclusive", "not run"):
+        if len(seeds) > 1 and verdict not in ("inconclusive", "not run") and not claim.pooled:
             agree = sum(x == verdict for x in per_seed)
             reason += f" [seeds: {agree}/{len(seeds)} give '{verdict}' alone]"
             if verdict == "reproduced" and agree < len(seeds):

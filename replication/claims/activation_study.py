@@ -1,13 +1,22 @@
 """Claim 7 (LNN §4 / Appendix): softplus beats ReLU^2, ReLU^3, tanh and sigmoid; plain ReLU cannot
-work (its second derivative is zero, so the velocity Hessian vanishes)."""
+work (its second derivative is zero, so the velocity Hessian vanishes).
+
+Judged as claim 6 is (`init_study`): each activation over many seeds trained side by side, the share of
+runs that left the q-double-dot ~ 0 plateau within the budget with its Wilson interval; plain ReLU must
+stay more than 3x softplus's held-out L1 (it cannot leave: its q-double-dot is undefined).
+"""
+from replication.claims import double_pendulum as dp
 from replication.claims import init_study
-from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
-from replication.claims.rules import all_parts, fails, lowest
+from replication.claims.rules import all_parts, fails, share_highest
 
 ACTS = ("softplus", "relu2", "relu3", "tanh", "sigmoid", "relu")
+SMOKE_ACTS = ("softplus", "tanh", "relu")   # smoke: the reference, one smooth rival and plain ReLU
 MODELS = tuple(ModelEntry(f"lnn_act-{a}", {"kind": "lnn", "activation": a, "init": "cranmer2020",
-                                            "angle_wrap": True}, hidden=init_study.W) for a in ACTS)
+                                            "angle_wrap": True}, hidden=init_study.W,
+                          profile_spec=dp.VELOCITY_SCALE,
+                          profiles=("smoke", "quick", "paper") if a in SMOKE_ACTS else ("quick", "paper"))
+               for a in ACTS)
 
 
 SMOOTH = tuple(f"lnn_act-{a}" for a in ACTS if a not in ("softplus", "relu"))
@@ -15,14 +24,12 @@ SMOOTH = tuple(f"lnn_act-{a}" for a in ACTS if a not in ("softplus", "relu"))
 CLAIM = Claim(
     id="activation_study", number=7, paper="LNN", section="§4, activation functions",
     title="Softplus beats ReLU^2, ReLU^3, tanh, sigmoid; plain ReLU cannot work",
-    system="double_pendulum", models=MODELS, protocols=init_study.PROTOCOLS, evaluate="heldout",
-    metric="heldout_l1", metric_label="held-out L1 after a fixed short budget",
+    system="double_pendulum", models=MODELS, protocols=init_study.PROTOCOLS, evaluate="pace",
+    metric="left_plateau", metric_label="share of seeds off the q-double-dot ~ 0 plateau after a fixed budget",
     published={},
-    verdict_rule="softplus lowest of the smooth ones and relu > 3x softplus, seed ranges apart "
-                 "(partly: one of the two)",
-    verdict=all_parts(lowest("lnn_act-softplus", SMOOTH, "heldout_l1"),
+    verdict_rule="softplus's share off the plateau highest of the smooth ones, 95 % Wilson intervals apart, "
+                 "and relu's held-out L1 > 3x softplus's, seed ranges apart (partly: one of the two)",
+    verdict=all_parts(share_highest("lnn_act-softplus", SMOOTH),
                       fails("lnn_act-relu", ("lnn_act-softplus",), 3.0, "heldout_l1")),
-    # plain relu is expected not to learn; among the smooth ones at least one must have
-    bars=(Bar(("lnn_act-softplus", *SMOOTH), "heldout_l1", need="any"),),
-    seeds={"smoke": 1, "quick": 3, "paper": 3},
+    seeds=init_study.SEEDS, pooled=True,
 )

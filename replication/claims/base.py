@@ -90,6 +90,7 @@ class Claim:
     key: str = ""            # the model whose number the scorecard shows (default: the first)
     seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": 3, "paper": 3})
     eval_config: dict = field(default_factory=dict)   # profile -> dict of evaluation settings
+    pooled: bool = False     # the rule reads the seeds as one sample (a share), not each seed as a replication
 
     def entry(self, label: str) -> ModelEntry:
         for m in self.models:

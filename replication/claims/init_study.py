@@ -1,33 +1,46 @@
 """Claim 6 (LNN Appendix C): the empirical initialisation trains faster than standard inits.
 
-Same LNN and double-pendulum data as claims 1-2, a shorter budget; one model per init scheme. The
-metric is the held-out L1 after the budget (lower = trained faster); the curves are in train_log.csv.
+Same LNN and double-pendulum data as claims 1-2; one model per init scheme. Which init reaches a good
+Lagrangian is decided more by the seed than by the scheme (of 8 cranmer2020 inits scouted for claims 1-2,
+one or two reach the competence bar, the others stop at a held-out L1 of 13-18; measured), so the claim is
+judged as a share over many seeds, each seed's run its own init and batches, trained side by side as one
+vectorised program (`Protocol.cohort`): the share of runs that left the q-double-dot ~ 0 plateau within
+the budget (held-out L1 at most half the null predictor's, `eval_pace`), with its Wilson interval; the
+samples each took and the share that reached the competence bar are reported beside.
+
+quick: 8 seeds of the claims 1-2 scouts' protocol (3 x 64, batch 32, peak 1e-3, velocity inputs x 0.3,
+the spike guard) for PACE_STEPS steps; full: 16 seeds.
 """
 from replication.claims import double_pendulum as dp
-from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
-from replication.claims.rules import lowest
+from replication.claims.rules import share_highest
+from replication.scouting import scout_protocol
 
 INITS = ("cranmer2020", "xavier", "kaiming", "pytorch_default")
-W = {"smoke": dp.SMOKE_W, "quick": (64, 64, 64), "paper": dp.PAPER_W}
+W = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "paper": dp.PAPER_W}
+SMOKE_INITS = ("cranmer2020", "kaiming")   # smoke: two cohorts of two seeds, to keep the test run short
 MODELS = tuple(ModelEntry(f"lnn_init-{i}", {"kind": "lnn", "activation": "softplus", "init": i,
-                                             "angle_wrap": True}, hidden=W) for i in INITS)
-PROTOCOLS = {"smoke": dp.PLAIN_SMOKE,
-             # 500 steps: at this scale every init is still near the q-double-dot ~ 0 plateau after 1000 (L1 44-48,
-             # measured), so the extra 500 bought nothing but 4 minutes of the quick budget
-             "quick": dp.PLAIN_QUICK.replace(steps=500, n_heldout=10_000),
+                                             "angle_wrap": True}, hidden=W, profile_spec=dp.VELOCITY_SCALE,
+                          profiles=("smoke", "quick", "paper") if i in SMOKE_INITS else ("quick", "paper"))
+               for i in INITS)
+
+PACE_STEPS = 8000   # 2.6e5 samples a seed at batch 32
+_scout = scout_protocol(dp.PROTOCOLS["quick"])   # the claims 1-2 scouts: batch 32, peak 1e-3, guard
+PROTOCOLS = {"smoke": scout_protocol(dp.PROTOCOLS["smoke"]).replace(cohort=2),
+             "quick": _scout.replace(steps=PACE_STEPS, n_heldout=10_000, log_every=100, cohort=8),
+             "full": _scout.replace(n_heldout=20_000, log_every=100, cohort=8),
              "paper": dp.PROTOCOLS["paper"].replace(steps=40_000)}
+SEEDS = {"smoke": 2, "quick": 8, "full": 16, "paper": 3}
 
 
 CLAIM = Claim(
     id="init_study", number=6, paper="LNN", section="Appendix C",
     title="The empirical initialisation trains faster than standard initialisations",
-    system="double_pendulum", models=MODELS, protocols=PROTOCOLS, evaluate="heldout",
-    metric="heldout_l1", metric_label="held-out L1 after a fixed short budget",
+    system="double_pendulum", models=MODELS, protocols=PROTOCOLS, evaluate="pace",
+    metric="left_plateau", metric_label="share of seeds off the q-double-dot ~ 0 plateau after a fixed budget",
     published={},
-    verdict_rule="cranmer2020 lowest, seed ranges apart (partly: below some)",
-    verdict=lowest("lnn_init-cranmer2020", tuple(m.label for m in MODELS[1:]), "heldout_l1"),
-    # a study of which init trains faster needs at least one that trained at all within the budget
-    bars=(Bar(tuple(m.label for m in MODELS), "heldout_l1", need="any"),),
-    seeds={"smoke": 1, "quick": 3, "paper": 3},
+    verdict_rule="cranmer2020's share of seeds off the plateau highest, 95 % Wilson intervals apart "
+                 "(partly: above some)",
+    verdict=share_highest("lnn_init-cranmer2020", tuple(m.label for m in MODELS[1:])),
+    seeds=SEEDS, pooled=True,
 )

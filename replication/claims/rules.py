@@ -15,6 +15,9 @@ value itself, so the per-seed verdicts that ``replication.verdicts`` takes read 
 - ``fails(bad, goods, factor, metric)``: bad above factor x every good, separated (partly: above all).
 - ``bound(metric, upper=, lower=, models=)``: every seed of the models inside the bounds (exact results,
   tolerances, a property such as a positive definite mass matrix; no ordering).
+- ``share_highest(ours, others, metric)``: a share over seeds (1/0 per seed, e.g. reached the competence
+  bar), ours' Wilson interval above every other's (partly: above some); the seeds are a sample, not
+  separate replications (the claim sets ``pooled``).
 - ``all_parts(*rules)``: a conjunction (every part reproduced).
 """
 from __future__ import annotations
@@ -166,6 +169,53 @@ def bound(metric: str, *, upper: float | None = None, lower: float | None = None
         if over or under:
             return "not reproduced", text + (f", above {upper:g}" if over else "") + (f", not above {lower:g}" if under else "")
         return "reproduced", text + (f", <= {upper:g}" if upper is not None else "") + (f", > {lower:g}" if lower is not None else "")
+    return rule
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """The Wilson score interval (95 % at z = 1.96) of a share k/n."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    mid = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, mid - half), min(1.0, mid + half)
+
+
+def share_highest(ours: str, others: tuple, metric: str = "left_plateau", pace: str = "samples_to_leave"):
+    """A statistical ordering over seeds: ``metric`` is 1/0 per seed (reached the bar or not), its share's
+    Wilson interval decides. Reproduced if ours' interval lies above every other's, partly above some;
+    not reproduced if another's lies above ours; inconclusive where they overlap, and when no seed of any
+    model got there (a study of which trains faster needs one that trained). The median ``pace`` of the
+    seeds that got there is reported beside."""
+    def rule(v):
+        if (m := _missing(v, (ours,), metric)) is not None:
+            return m
+        labels = [ours, *[k for k in others if _get(v, k, metric) is not None]]
+        if len(labels) == 1:
+            return "not run", "nothing to compare with"
+        ci, parts = {}, []
+        for k in labels:
+            vals = _get(v, k, metric).values
+            hits = int(sum(x >= 0.5 for x in vals))
+            ci[k] = wilson(hits, len(vals))
+            p = _get(v, k, pace)
+            fast = sorted(x for x in (p.values if p else ()) if math.isfinite(x))
+            when = f", median {fast[len(fast) // 2]:.3g} samples" if fast else ""
+            parts.append(f"{k} {hits}/{len(vals)} [{ci[k][0]:.2f}, {ci[k][1]:.2f}]{when}")
+        text = f"share of seeds with {metric} (95 % Wilson interval): " + "; ".join(parts)
+        if not any(x >= 0.5 for k in labels for x in _get(v, k, metric).values):
+            return "inconclusive", text + f": no seed of any model has {metric}"
+        rest = labels[1:]
+        above = [k for k in rest if ci[ours][0] > ci[k][1]]
+        below = [k for k in rest if ci[k][0] > ci[ours][1]]
+        if below:
+            return "not reproduced", f"{text}: {', '.join(below)} higher"
+        if len(above) == len(rest):
+            return "reproduced", f"{text}: {ours} highest, intervals apart"
+        if above:
+            return "partly", f"{text}: {ours} above {', '.join(above)} only"
+        return "inconclusive", f"{text}: the intervals overlap"
     return rule
 
 

@@ -23,12 +23,12 @@ def _metrics(cid, label, good: bool) -> dict:
         return {"transfer_ratio": 1.2 if good else 10.0, "energy_err_max": 0.01 if good else 0.5}
     if cid == "appendix_b":
         return {"max_abs_err": 1e-15 if good else 1e-6}
-    if cid == "init_study":
-        return {"heldout_l1": win if label == "lnn_init-cranmer2020" else lose}
+    if cid == "init_study":   # a share over seeds: every seed of the winner off the plateau, none of the others
+        return {"left_plateau": float((label == "lnn_init-cranmer2020") == good)}
     if cid == "activation_study":
         if label == "lnn_act-relu":
-            return {"heldout_l1": 100.0 if good else 1.0}
-        return {"heldout_l1": win if label == "lnn_act-softplus" else lose}
+            return {"heldout_l1": 100.0 if good else 1.0, "left_plateau": 0.0}
+        return {"heldout_l1": win, "left_plateau": float((label == "lnn_act-softplus") == good)}
     if cid == "delan_table1":
         return {"heldout_l1": win if label.startswith("lnn") else lose}
     if cid == "delan_arm":
@@ -50,8 +50,9 @@ def _row(cid, label, seed, metrics, fw="jax", status="ok"):
             **bar_vals, **bars, **jitter}
 
 
-def _units(cid, good, seeds=(0, 1, 2), fw="jax"):
+def _units(cid, good, seeds=None, fw="jax"):
     claim = CLAIMS[cid]
+    seeds = seeds or (range(8) if claim.pooled else (0, 1, 2))   # a share needs a sample of seeds
     return pd.DataFrame([_row(cid, m, k, _metrics(cid, m, good), fw) for m in claim.labels("quick") for k in seeds])
 
 
@@ -87,18 +88,47 @@ def test_a_model_without_units_is_not_run():
 
 
 def test_a_mean_that_one_seed_contradicts_is_only_partly():
-    cid = "init_study"
-    ours = "lnn_init-cranmer2020"
-    rows = [_row(cid, m, k, {"heldout_l1": x}) for m in CLAIMS[cid].labels("quick")
-            for k, x in enumerate((1.0, 1.1, 1.2) if m == ours else (3.0, 3.1, 0.5))]
+    cid = "dp_energy"
+    rows = [_row(cid, m, k, {"energy_err_final": x, "n_diverged": 0}) for m in CLAIMS[cid].labels("quick")
+            for k, x in enumerate((1.0, 1.1, 1.2) if m == "lnn" else (30.0, 31.0, 0.5))]
     v = judge(CLAIMS[cid], pd.DataFrame(rows), "quick")
     assert v["by_seed"]["jax"]["seed2"] == "not reproduced"
     assert v["verdict"] in ("partly", "inconclusive") and v["verdict"] != "reproduced"
 
 
 def test_every_seed_agreeing_keeps_reproduced():
-    v = judge(CLAIMS["init_study"], _units("init_study", True), "quick")
+    v = judge(CLAIMS["dp_energy"], _units("dp_energy", True), "quick")
     assert v["verdict"] == "reproduced" and "3/3" in v["reason"]
+
+
+def _shares(cid, hits: dict, n=8):
+    """Rows of a pooled claim: model -> how many of its n seeds left the plateau."""
+    return pd.DataFrame([_row(cid, m, k, {"left_plateau": float(k < hits.get(m, 0)), "heldout_l1": 1.0})
+                         for m in CLAIMS[cid].labels("quick") for k in range(n)])
+
+
+def test_a_share_over_seeds_is_decided_by_its_interval_not_by_each_seed():
+    cid, ours = "init_study", "lnn_init-cranmer2020"
+    v = judge(CLAIMS[cid], _shares(cid, {ours: 8}), "quick")
+    assert v["verdict"] == "reproduced" and "8/8 [0.68, 1.00]" in v["reason"], v["reason"]
+    # 2 of 8 against 0 of 8: the intervals overlap, so a small sample decides nothing
+    v = judge(CLAIMS[cid], _shares(cid, {ours: 2}), "quick")
+    assert v["verdict"] == "inconclusive" and "overlap" in v["reason"], v["reason"]
+    # nobody left the plateau: nothing to compare
+    v = judge(CLAIMS[cid], _shares(cid, {}), "quick")
+    assert v["verdict"] == "inconclusive" and "no seed of any model" in v["reason"], v["reason"]
+    # another init clearly ahead
+    v = judge(CLAIMS[cid], _shares(cid, {"lnn_init-xavier": 8}), "quick")
+    assert v["verdict"] == "not reproduced", v["reason"]
+
+
+def test_wilson_interval_matches_reference_values():
+    from replication.claims.rules import wilson
+
+    lo, hi = wilson(0, 10)
+    assert lo == 0.0 and abs(hi - 0.2775) < 1e-4      # the textbook 0/10 upper bound
+    lo, hi = wilson(5, 10)
+    assert abs(lo - 0.2366) < 1e-4 and abs(hi - 0.7634) < 1e-4
 
 
 def test_frameworks_that_disagree_never_reproduce():
