@@ -104,7 +104,7 @@ class Claim:
                 "metric": self.metric, "metric_label": self.metric_label,
                 "published": {k: p.to_dict() for k, p in self.published.items()},
                 "verdict_rule": self.verdict_rule, "bars": [b.describe() for b in self.bars],
-                "key": self.key_model, "seeds": dict(self.seeds),
+                "key": self.key_model, "seeds": dict(self.seeds), "pooled": self.pooled,
                 "protocol": {p: pr.to_dict() for p, pr in self.protocols.items()}}
 
     @property
