@@ -4,9 +4,10 @@ reached the competence bar (claims 6 and 7).
 `eval_pace(ctx)` adds to the held-out metrics (`evaluate.eval_heldout`), per level (`LEVELS`: a fraction
 of the null predictor's held-out L1):
 - ``left_plateau`` / ``reached_bar``: 1 if the held-out L1 is at most that level after the budget, else 0.
-  Over a claim's seeds their mean is a share (`rules.share_highest` reads it with a Wilson interval);
+  Over a claim's seeds their mean is a share (`rules.faster` reports it with a Wilson interval);
 - ``samples_to_leave`` / ``samples_to_bar``: training samples until the logged training loss first stays
-  at or below the level for `RUN` consecutive log rows (one lucky batch does not count); +inf if never.
+  at or below the level for `RUN` consecutive log rows (one lucky batch does not count); +inf if never
+  (`rules.faster` compares them between models).
 """
 from __future__ import annotations
 

@@ -20,9 +20,9 @@ from replication import environment as env
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
+from replication.estimate import describe, estimate
 from replication.evaluations import EVALUATION_VERSION
 from replication.executor import run_units
-from replication.estimate import describe, estimate
 from replication.units import Unit
 from replication.verdicts import write_summary
 

@@ -15,9 +15,9 @@ value itself, so the per-seed verdicts that ``replication.verdicts`` takes read 
 - ``fails(bad, goods, factor, metric)``: bad above factor x every good, separated (partly: above all).
 - ``bound(metric, upper=, lower=, models=)``: every seed of the models inside the bounds (exact results,
   tolerances, a property such as a positive definite mass matrix; no ordering).
-- ``share_highest(ours, others, metric)``: a share over seeds (1/0 per seed, e.g. reached the competence
-  bar), ours' Wilson interval above every other's (partly: above some); the seeds are a sample, not
-  separate replications (the claim sets ``pooled``).
+- ``faster(ours, others, pace)``: samples to reach a level per seed (+inf if never), ours faster than every
+  other by a one-sided Mann-Whitney test with Bonferroni (partly: than some), with the share that got there
+  and its Wilson interval beside; the seeds are a sample, not separate replications (``pooled``).
 - ``all_parts(*rules)``: a conjunction (every part reproduced).
 """
 from __future__ import annotations
@@ -182,40 +182,56 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return max(0.0, mid - half), min(1.0, mid + half)
 
 
-def share_highest(ours: str, others: tuple, metric: str = "left_plateau", pace: str = "samples_to_leave"):
-    """A statistical ordering over seeds: ``metric`` is 1/0 per seed (reached the bar or not), its share's
-    Wilson interval decides. Reproduced if ours' interval lies above every other's, partly above some;
-    not reproduced if another's lies above ours; inconclusive where they overlap, and when no seed of any
-    model got there (a study of which trains faster needs one that trained). The median ``pace`` of the
-    seeds that got there is reported beside."""
+def _one_sided_p(x, y) -> float:
+    """Mann-Whitney U p-value that x tends to be smaller than y (inf = never, ties allowed); 1 when every
+    value is the same."""
+    if len(set(x) | set(y)) == 1:
+        return 1.0
+    from scipy.stats import mannwhitneyu
+
+    big = 1e300   # inf ranks as the largest value, tied with the other infs
+    return float(mannwhitneyu([min(a, big) for a in x], [min(b, big) for b in y], alternative="less").pvalue)
+
+
+def faster(ours: str, others: tuple, pace: str = "samples_to_leave", share: str = "left_plateau",
+           alpha: float = 0.05):
+    """A statistical ordering of training speed over seeds: ``pace`` per seed (samples to reach a level,
+    +inf if never: a censored time), compared with a one-sided Mann-Whitney U test against each other
+    model at ``alpha`` / (number of others) (Bonferroni). Reproduced if ours is faster than every other,
+    partly than some; not reproduced if another is faster than ours; inconclusive if no difference is
+    significant, or when no seed of any model got there (a study of which trains faster needs one that
+    trained). The ``share`` that got there within the budget (with its 95 % Wilson interval) and the
+    median pace are reported beside. The seeds are a sample, not separate replications (``pooled``)."""
     def rule(v):
-        if (m := _missing(v, (ours,), metric)) is not None:
+        if (m := _missing(v, (ours,), pace)) is not None:
             return m
-        labels = [ours, *[k for k in others if _get(v, k, metric) is not None]]
-        if len(labels) == 1:
+        rest = [k for k in others if _get(v, k, pace) is not None]
+        if not rest:
             return "not run", "nothing to compare with"
-        ci, parts = {}, []
-        for k in labels:
-            vals = _get(v, k, metric).values
-            hits = int(sum(x >= 0.5 for x in vals))
-            ci[k] = wilson(hits, len(vals))
-            p = _get(v, k, pace)
-            fast = sorted(x for x in (p.values if p else ()) if math.isfinite(x))
-            when = f", median {fast[len(fast) // 2]:.3g} samples" if fast else ""
-            parts.append(f"{k} {hits}/{len(vals)} [{ci[k][0]:.2f}, {ci[k][1]:.2f}]{when}")
-        text = f"share of seeds with {metric} (95 % Wilson interval): " + "; ".join(parts)
-        if not any(x >= 0.5 for k in labels for x in _get(v, k, metric).values):
-            return "inconclusive", text + f": no seed of any model has {metric}"
-        rest = labels[1:]
-        above = [k for k in rest if ci[ours][0] > ci[k][1]]
-        below = [k for k in rest if ci[k][0] > ci[ours][1]]
-        if below:
-            return "not reproduced", f"{text}: {', '.join(below)} higher"
-        if len(above) == len(rest):
-            return "reproduced", f"{text}: {ours} highest, intervals apart"
-        if above:
-            return "partly", f"{text}: {ours} above {', '.join(above)} only"
-        return "inconclusive", f"{text}: the intervals overlap"
+        parts = []
+        for k in (ours, *rest):
+            vals = _get(v, k, pace).values
+            hits = sorted(x for x in vals if math.isfinite(x))
+            lo, hi = wilson(len(hits), len(vals))
+            med = f"median {hits[len(hits) // 2]:.3g}" if hits else "never"
+            parts.append(f"{k} {len(hits)}/{len(vals)} [{lo:.2f}, {hi:.2f}], {med}")
+        text = f"{pace} (seeds that got there, 95 % Wilson interval, median): " + "; ".join(parts)
+        if not any(math.isfinite(x) for k in (ours, *rest) for x in _get(v, k, pace).values):
+            return "inconclusive", text + ": no seed of any model got there"
+        level = alpha / len(rest)
+        mine = _get(v, ours, pace).values
+        p_fast = {k: _one_sided_p(mine, _get(v, k, pace).values) for k in rest}
+        p_slow = {k: _one_sided_p(_get(v, k, pace).values, mine) for k in rest}
+        text += "; one-sided Mann-Whitney p (ours faster): " + ", ".join(f"{k} {p:.2g}" for k, p in p_fast.items())
+        quicker = [k for k in rest if p_fast[k] < level]
+        slower = [k for k in rest if p_slow[k] < level]
+        if slower:
+            return "not reproduced", f"{text}: {', '.join(slower)} faster (p < {level:.2g})"
+        if len(quicker) == len(rest):
+            return "reproduced", f"{text}: {ours} faster than every other (p < {level:.2g})"
+        if quicker:
+            return "partly", f"{text}: faster than {', '.join(quicker)} only"
+        return "inconclusive", f"{text}: no difference significant at {level:.2g}"
     return rule
 
 

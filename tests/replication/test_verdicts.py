@@ -23,12 +23,12 @@ def _metrics(cid, label, good: bool) -> dict:
         return {"transfer_ratio": 1.2 if good else 10.0, "energy_err_max": 0.01 if good else 0.5}
     if cid == "appendix_b":
         return {"max_abs_err": 1e-15 if good else 1e-6}
-    if cid == "init_study":   # a share over seeds: every seed of the winner off the plateau, none of the others
-        return {"left_plateau": float((label == "lnn_init-cranmer2020") == good)}
+    if cid == "init_study":   # samples to leave the plateau, per seed: the winner's all fewer
+        return {"samples_to_leave": 1e3 * (win if label == "lnn_init-cranmer2020" else lose)}
     if cid == "activation_study":
         if label == "lnn_act-relu":
-            return {"heldout_l1": 100.0 if good else 1.0, "left_plateau": 0.0}
-        return {"heldout_l1": win, "left_plateau": float((label == "lnn_act-softplus") == good)}
+            return {"heldout_l1": 100.0 if good else 1.0, "samples_to_leave": float("inf")}
+        return {"heldout_l1": win, "samples_to_leave": 1e3 * (win if label == "lnn_act-softplus" else lose)}
     if cid == "delan_table1":
         return {"heldout_l1": win if label.startswith("lnn") else lose}
     if cid == "delan_arm":
@@ -101,25 +101,28 @@ def test_every_seed_agreeing_keeps_reproduced():
     assert v["verdict"] == "reproduced" and "3/3" in v["reason"]
 
 
-def _shares(cid, hits: dict, n=8):
-    """Rows of a pooled claim: model -> how many of its n seeds left the plateau."""
-    return pd.DataFrame([_row(cid, m, k, {"left_plateau": float(k < hits.get(m, 0)), "heldout_l1": 1.0})
+def _paces(cid, paces: dict, n=8):
+    """Rows of a pooled claim: model -> its n seeds' samples to leave the plateau (default: never)."""
+    return pd.DataFrame([_row(cid, m, k, {"samples_to_leave": paces.get(m, [float("inf")] * n)[k],
+                                          "heldout_l1": 1.0})
                          for m in CLAIMS[cid].labels("quick") for k in range(n)])
 
 
-def test_a_share_over_seeds_is_decided_by_its_interval_not_by_each_seed():
-    cid, ours = "init_study", "lnn_init-cranmer2020"
-    v = judge(CLAIMS[cid], _shares(cid, {ours: 8}), "quick")
+def test_training_pace_over_seeds_is_a_rank_test_not_each_seed():
+    cid, ours, inf = "init_study", "lnn_init-cranmer2020", float("inf")
+    fast, slow = [1e4 + i for i in range(8)], [5e4 + i for i in range(8)]
+    others = {m: slow for m in CLAIMS[cid].labels("quick") if m != ours}
+    v = judge(CLAIMS[cid], _paces(cid, {ours: fast, **others}), "quick")
     assert v["verdict"] == "reproduced" and "8/8 [0.68, 1.00]" in v["reason"], v["reason"]
-    # 2 of 8 against 0 of 8: the intervals overlap, so a small sample decides nothing
-    v = judge(CLAIMS[cid], _shares(cid, {ours: 2}), "quick")
-    assert v["verdict"] == "inconclusive" and "overlap" in v["reason"], v["reason"]
+    # two of eight leaving against none: a small sample decides nothing
+    v = judge(CLAIMS[cid], _paces(cid, {ours: [1e4, 1e4] + [inf] * 6}), "quick")
+    assert v["verdict"] == "inconclusive" and "no difference significant" in v["reason"], v["reason"]
     # nobody left the plateau: nothing to compare
-    v = judge(CLAIMS[cid], _shares(cid, {}), "quick")
-    assert v["verdict"] == "inconclusive" and "no seed of any model" in v["reason"], v["reason"]
-    # another init clearly ahead
-    v = judge(CLAIMS[cid], _shares(cid, {"lnn_init-xavier": 8}), "quick")
-    assert v["verdict"] == "not reproduced", v["reason"]
+    v = judge(CLAIMS[cid], _paces(cid, {}), "quick")
+    assert v["verdict"] == "inconclusive" and "no seed of any model got there" in v["reason"], v["reason"]
+    # another init clearly faster, every run of ours left later (or never)
+    v = judge(CLAIMS[cid], _paces(cid, {ours: slow[:4] + [inf] * 4, "lnn_init-kaiming": fast}), "quick")
+    assert v["verdict"] == "not reproduced" and "lnn_init-kaiming faster" in v["reason"], v["reason"]
 
 
 def test_wilson_interval_matches_reference_values():
