@@ -90,12 +90,16 @@ def _rollout_table(units) -> pd.DataFrame | None:
 
 def parity(units, path: Path) -> bool:
     """Prediction against data of each model on its main evaluation rows, one panel per output component."""
-    found = {}
+    found, names = {}, []
     for u in units:
         arr = u.arrays() or {}
         where = (u.result.get("counters") or {}).get("primary")
         if f"{where}_target" in arr and f"{where}_pred" in arr:
             found[_name(u) + ("" if u.claim == "fit" else " [evaluate]")] = (arr[f"{where}_target"], arr[f"{where}_pred"])
+            one = u.table("one_step.csv")
+            if not names and one is not None and {"set", "quantity", "component"} <= set(one.columns):
+                rows = one[one["set"] == where]
+                names = [f"{q}{c}" for q, c in zip(rows["quantity"], rows["component"], strict=True)]
     if not found:
         return False
     k = min(next(iter(found.values()))[0].shape[1], 4)
@@ -108,7 +112,7 @@ def parity(units, path: Path) -> bool:
             ax.scatter(t[:, j], p[:, j], s=4, alpha=0.5, color=F.colour(i), marker=F.MARKERS[i % 6], label=name)
             lo, hi = min(lo, np.nanmin(t[:, j])), max(hi, np.nanmax(t[:, j]))
         ax.plot([lo, hi], [lo, hi], color="k", lw=0.8, label="prediction = data")
-        ax.set_title(f"output {j}", fontsize=9)
+        ax.set_title(names[j] if j < len(names) else f"output {j}", fontsize=9)
         ax.set_xlabel("data")
         ax.set_ylabel("prediction")
     axes[0].legend(fontsize=6)
