@@ -28,6 +28,7 @@ from reports.document import NOT_RUN, Bullets, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results, Unit
 from reports.sections_speed import _bench_table
+from reports.tables import claim_models
 
 START_TOL = 1e-4   # relative difference of the first logged training loss from identical weights
 PART = 1e-2        # relative difference of the training losses from which two curves count as parted
@@ -74,7 +75,7 @@ def training_curves_table(res: Results) -> pd.DataFrame | None:
         by_key: dict = {}
         for u in res.usable(claim["id"]):
             by_key.setdefault((u.model, u.seed), {})[u.framework] = u
-        for model in dict.fromkeys(m for m, _ in sorted(by_key)):
+        for model in claim_models(res, claim):
             for fw in fws[1:]:
                 pairs = [(d[ref], d[fw]) for (m, _), d in sorted(by_key.items()) if m == model and ref in d and fw in d]
                 found = [(c, ua, ub) for ua, ub in pairs
