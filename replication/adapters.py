@@ -43,6 +43,19 @@ def _join(parts):
     return np.concatenate(parts, axis=0)
 
 
+_JITTED: dict = {}
+
+
+def _jitted(name: str):
+    """One compiled call of the model method `name` per process: equinox caches it by the model's structure,
+    so adapters of many parameter sets of one spec (seeds, held-out checks during training) compile once."""
+    if name not in _JITTED:
+        import equinox as eqx
+
+        _JITTED[name] = eqx.filter_jit(lambda m, *a: getattr(m, name)(*a))
+    return _JITTED[name]
+
+
 class JaxAdapter(_Adapter):
     def __init__(self, spec, params):
         super().__init__(spec, params)
@@ -54,10 +67,8 @@ class JaxAdapter(_Adapter):
         self.model = models.jax.build(spec, params)
 
     def _compile(self, name):
-        import equinox as eqx
-
         jnp, dtype = self._jnp, self._jnp.dtype(self.spec.dtype)
-        f = eqx.filter_jit(lambda m, *a: getattr(m, name)(*a))
+        f = _jitted(name)
 
         def run(*args):
             a = [None if x is None else jnp.asarray(x, dtype) for x in args]

@@ -22,7 +22,7 @@ TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
 SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr")
-OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("cohort",)   # omitted from to_dict while 0 (off), so older keys hold
+OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("cohort", "track_every")   # omitted from to_dict while 0 (off), so older keys hold
 
 
 @dataclass(frozen=True)
@@ -54,6 +54,9 @@ class Protocol:
                seeds g*cohort .. g*cohort + cohort - 1 side by side, each its own init, batches, guard and
                stop); each seed's numbers are those of its own run (up to floating-point reassociation).
                0 or 1 = one seed at a time; not combined with scouts. Left out of `to_dict` while 0.
+    track_every: every so many steps, the held-out loss on a subset (`replication.tracking`), for
+               work-precision curves; a multiple of log_every; 0 = off (left out of `to_dict`). It reads
+               the model and changes no training number.
     """
 
     data: str
@@ -83,6 +86,7 @@ class Protocol:
     scout_batch: int = 0
     scout_lr: float = 0.0
     cohort: int = 0
+    track_every: int = 0
     dtype: str = "float32"
     log_every: int = 50
     eval: dict = field(default_factory=dict, hash=False, compare=True)
@@ -104,7 +108,7 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
-        for name in ("scouts", "scout_steps", "scout_batch", "cohort"):
+        for name in ("scouts", "scout_steps", "scout_batch", "cohort", "track_every"):
             v = getattr(self, name)
             if not (v == 0 or _positive_integer(v)):
                 raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")

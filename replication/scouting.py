@@ -88,7 +88,10 @@ def choose(tails) -> int | None:
     return min(finite, key=lambda i: tails[i]) if finite else None
 
 
-def train_scouted(trainer, spec, protocol, seed: int, on_log=None):
+def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None):
+    """Scouts, then the chosen one's continuation; `track(protocol, offset_steps, offset_samples,
+    offset_seconds)` may give a held-out tracking hook for the continuation (`training.tracker_for`): the
+    scouts' samples and step time count."""
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
     done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps
 
@@ -109,9 +112,12 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None):
     def shifted(row):
         if on_log:
             on_log({**row, "step": row["step"] + done})
+    t = track(p, done, len(seeds) * per * outcomes[0].batch, outcomes[0].step_seconds) if track else None
     out = trainer.train(spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
-                        on_log=shifted)
+                        on_log=shifted, hooks=(t,) if t else ())
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
+    if t:
+        t.merge([out.log])
     out.samples = out.steps_done * out.batch + len(seeds) * per * outcomes[0].batch
     out.steps_done += len(seeds) * per
     out.train_time_s += outcomes[best].train_time_s

@@ -18,6 +18,7 @@ from replication import results as R
 from replication.data import BatchStream, targets_version
 from replication.outcome import TrainOutcome, log_frame
 from replication.scouting import train_scouted
+from replication.tracking import Tracker
 
 log = logging.getLogger("lagbench")
 
@@ -42,13 +43,28 @@ def trainer(framework):
     return module
 
 
+def tracker_for(framework, spec):
+    """`make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0) -> Tracker | None`: the tracking hook of a
+    protocol with `track_every` (`replication.tracking`), else None."""
+    def make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0.0):
+        if not protocol.track_every:
+            return None
+        return Tracker(framework, spec, protocol, offset_steps, offset_samples, offset_seconds)
+    return make
+
+
 def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
     """One run of a protocol from the init of `seed`; with `protocol.scouts` > 1, restarts over inits
     (`replication.scouting`)."""
+    track = tracker_for(framework, spec)
     if protocol.scouts > 1:
-        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log)
-    return trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
-                                    on_log=on_log)
+        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track)
+    t = track(protocol)
+    out = trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
+                                   on_log=on_log, hooks=(t,) if t else ())
+    if t:
+        t.merge([out.log])
+    return out
 
 
 def cohort_seeds(protocol, seed: int) -> list[int]:
@@ -71,8 +87,12 @@ def train_cohort(framework, spec, protocol, seeds, on_log=None) -> list[TrainOut
     def first(row):
         if on_log and row.get("member", 0) == 0:
             on_log(row)
+    t = tracker_for(framework, spec)(protocol)
     outcomes = trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
-                                                [BatchStream(protocol, s) for s in seeds], on_log=first)
+                                                [BatchStream(protocol, s) for s in seeds], on_log=first,
+                                                hooks=(t,) if t else ())
+    if t:
+        t.merge([o.log for o in outcomes])
     for o in outcomes:
         o.cohort = {"seeds": list(seeds)}
     return outcomes

@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from reports import figures as F
+from reports import figures_precision as FP
 from reports import figures_speed as FS
 from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell, num
@@ -110,6 +111,8 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
          "Data efficiency: error against training samples (bars: seed range)", "result.json"),
         ("training", F.training_curves, "Training curves (mean over seeds)", "train_log.csv"),
+        ("work_precision", FP.work_precision, "Work-precision: held-out loss against training samples and "
+         "against training time (line: mean over seeds, band: seed range)", "train_log.csv"),
     ]
     for kind, fn, caption, file in figs:
         rel = f"figures/{slug(cid)}_{kind}.png"

@@ -49,16 +49,16 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 # 3.9 near-physical (the others 13-18); the continuation 3.3 -> 0.58 (8e6 continuation samples: 0.30).
 _guard = {"grad_clip": 100.0, "spike_skip": 10.0}
 PROTOCOLS = {
-    "smoke": _base.replace(scouts=2, scout_steps=10, scout_batch=16, **_guard),
+    "smoke": _base.replace(scouts=2, scout_steps=10, scout_batch=16, track_every=5, **_guard),
     "quick": _base.replace(steps=15_625, batch=256, n_train=256 * 1000, n_heldout=20_000, log_every=250, lr=2e-3,
-                           scouts=8, scout_steps=15_625, scout_batch=32, scout_lr=1e-3, **_guard),
+                           scouts=8, scout_steps=15_625, scout_batch=32, scout_lr=1e-3, track_every=1000, **_guard),
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
 # full: the same scouts, the continuation for 3e7 samples in all (the train-to-target study's `restarts_fast`
 # at 3 x 128 reached held-out L1 0.075 on 1e5 states with this budget, one thread, 22 min), judged on the
 # paper's 1e5 held-out states
 PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=(30_000_000 - 8 * 15_625 * 32) // 256, n_heldout=100_000,
-                                               log_every=1000)
+                                               log_every=1000, track_every=5000)
 
 SEEDS = {"smoke": 1, "quick": 3, "paper": 3}
 

@@ -30,8 +30,8 @@ MODELS = tuple(ModelEntry(f"lnn_init-{i}", {"kind": "lnn", "activation": "softpl
 PACE_STEPS = 5000
 _scout = scout_protocol(dp.PROTOCOLS["quick"])   # the claims 1-2 scouts: batch 32, peak 1e-3, guard
 PROTOCOLS = {"smoke": scout_protocol(dp.PROTOCOLS["smoke"]).replace(cohort=2),
-             "quick": _scout.replace(steps=PACE_STEPS, n_heldout=10_000, log_every=100, cohort=8),
-             "full": _scout.replace(n_heldout=20_000, log_every=100, cohort=8),
+             "quick": _scout.replace(steps=PACE_STEPS, n_heldout=10_000, log_every=100, cohort=8, track_every=500),
+             "full": _scout.replace(n_heldout=20_000, log_every=100, cohort=8, track_every=500),
              "paper": dp.PROTOCOLS["paper"].replace(steps=40_000)}
 SEEDS = {"smoke": 2, "quick": 8, "full": 16, "paper": 3}
 

@@ -32,7 +32,7 @@ _base = Protocol(data="relativistic_iid", steps=20, batch=32, n_train=640, n_hel
 _SRC = "original code, SpecialRelativity notebooks, weighted-L1 training loss: "
 PROTOCOLS = {
     "smoke": _base,
-    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50),
+    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50, track_every=100),
     "paper": _base.replace(steps=300_000, batch=512, n_train=512 * 3000, n_heldout=100_000, log_every=1000),
 }
 # full: 13x quick's samples (5.1e6), judged on 1e5 held-out states. The original LNN sat on the
@@ -40,7 +40,7 @@ PROTOCOLS = {
 # trials (JAX, 3 x 128, seed 0) it stayed at the null's 0.410 after 5.1e6 samples, with the original input
 # scaling and with q unscaled, and after MSE warm-ups: the weighted L1 pulls every near-c prediction to 0
 # (their targets are ~0 and their weights up to 224) until the velocity Hessian grows like (1-qdot^2)^(-5/2).
-PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, n_heldout=100_000, log_every=500)
+PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, n_heldout=100_000, log_every=500, track_every=2000)
 
 
 CLAIM = Claim(

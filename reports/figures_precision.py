@@ -1,0 +1,63 @@
+"""Work-precision: each model's held-out loss against the training samples it used and the training time
+it took (the SciML work-precision view of speed against error).
+
+``work_precision(units, path)`` reads the tracked rows of ``train_log.csv`` (``samples``, ``train_s``,
+``heldout_loss``: `replication.tracking`, present where the protocol sets ``track_every``). Per model and
+framework, the seeds share their tracking steps: the line is the mean over seeds of the held-out loss
+(plotted against the samples, and against the mean training seconds), the band the seed range.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.ticker import NullFormatter
+
+from reports.figures import LINESTYLES, _groups, colour, new_figure, save, style_index
+from reports.load import Unit
+
+COLUMNS = {"samples", "train_s", "heldout_loss"}
+
+
+def tracked(units: list[Unit]) -> dict[tuple[str, str], pd.DataFrame]:
+    """{(model, framework): rows per tracking step: samples, train_s (mean), loss mean, lo, hi, n seeds}."""
+    out = {}
+    for key, group in _groups(units).items():
+        frames = []
+        for u in group:
+            log = u.table("train_log.csv")
+            if log is not None and COLUMNS <= set(log.columns):
+                t = log.dropna(subset=["heldout_loss"])[["step", *sorted(COLUMNS)]]
+                if len(t):
+                    frames.append(t)
+        if frames:
+            g = pd.concat(frames).groupby("step")
+            out[key] = pd.DataFrame({"samples": g["samples"].mean(), "train_s": g["train_s"].mean(),
+                                     "mean": g["heldout_loss"].mean(), "lo": g["heldout_loss"].min(),
+                                     "hi": g["heldout_loss"].max(), "n": g["heldout_loss"].count()})
+    return out
+
+
+def work_precision(units: list[Unit], path: Path) -> bool:
+    curves = tracked(units)
+    if not curves:
+        return False
+    fig, axes = new_figure(ncols=2, width=9.0, height=3.6)
+    models = style_index([k[0] for k in curves])
+    fws = style_index([k[1] for k in curves])
+    for ax, x, label in ((axes[0], "samples", "training samples"), (axes[1], "train_s", "training time (s)")):
+        for (model, fw), d in curves.items():
+            d = d[(d[x] > 0) & np.isfinite(d["mean"]) & (d["mean"] > 0)]
+            if not len(d):
+                continue
+            c = colour(models[model])
+            ax.plot(d[x], d["mean"], color=c, ls=LINESTYLES[fws[fw] % 4], label=f"{model} ({fw})")
+            ax.fill_between(d[x], d["lo"], d["hi"], color=c, alpha=0.15, lw=0)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel(label)
+    axes[0].set_ylabel("held-out loss")
+    axes[0].legend(fontsize=7)
+    return save(fig, path)
