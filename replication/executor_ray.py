@@ -141,7 +141,8 @@ def _submit(ray, todo, out, retries, board):
     env = {"env_vars": task_env(os.environ)}
     refs = {}
     for chain in chains(todo):
-        prev, before = {"cache": trained_entry(out, chain[0])}, None
+        # what the driver's cache already holds of the chain's trainings (a cohort's seeds each have one)
+        prev, before = {"cache": {k: v for u in chain for k, v in trained_entry(out, u).items()}}, None
         for u in chain:
             r = task.options(**resources(u, gpus), max_retries=retries, retry_exceptions=False,
                              runtime_env=env, name=f"lagbench {u.name}").remote(ref(u), prev, board)
