@@ -14,6 +14,7 @@ from reports.load import Results, load_results
 from reports.sections_frameworks import (
     PART,
     START_TOL,
+    _flag,
     curve_agreement,
     frameworks_sections,
     training_curves_table,
@@ -107,6 +108,17 @@ def test_a_diverged_seed_in_one_framework_is_flagged(edited):
     # every row the table flags beyond the spread is listed too
     beyond = {f"{c} / {m} " for (c, m), r in table.iterrows() if r["beyond spread"] == "yes"}
     assert all(any(b.startswith(x) for b in bullets.items) for x in beyond)
+
+
+def test_what_a_claim_metric_row_flags():
+    row = {"claim": "c", "model": "m", "metric": "x", "rel. diff of means": "0.1", "beyond spread": "no",
+           "max per-seed abs. diff": "0.5", "seed spread (std)": "1", "non-finite seeds": "none"}
+    assert _flag(row) == ""
+    assert "beyond the seed spread" in _flag({**row, "beyond spread": "yes"})
+    assert "a paired seed differs by 2, more than the seed spread 1" in _flag({**row, "max per-seed abs. diff": "2"})
+    assert _flag({**row, "max per-seed abs. diff": "not run", "seed spread (std)": "not run"}) == ""
+    assert "non-finite seeds differ" in _flag({**row, "non-finite seeds": "jax 1, torch 0"})
+    assert _flag({**row, "non-finite seeds": "jax 1, torch 1"}) == ""
 
 
 def test_curve_agreement_needs_the_curves_to_stay_apart():
