@@ -3,8 +3,8 @@ a unit across processes.
 
 `run_one(unit, out, on_log=None) -> (failure or None, error or None)`: run and write one unit; an
 exception becomes an error string ("<unit>: <Type>: <message>"), never lost to the rest of the run.
-`chains(todo) -> [[Unit]]`: the units grouped by the model they train (`training.train_key`; untrained
-units alone), longest chain first by `cost` (training samples x model width x framework factor), so the
+`chains(todo) -> [[Unit]]`: the units grouped by the training program they need (`training.group_key`: a
+cohort of seeds is one program; untrained units alone), longest chain first by `cost` (training samples x model width x framework factor), so the
 long ones do not start last. A chain runs in order: its first unit trains, the others read the training
 from the cache.
 `ref(unit) -> tuple` and `unit_of(ref) -> Unit`: a unit as plain values and back (a claim's rules are

@@ -7,7 +7,8 @@ of units whose training failed (a result is written), errors: "<unit>: <exceptio
 jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N worker processes (spawned,
 so each starts clean), each given one CPU thread for JAX (XLA's Eigen pool off) and for PyTorch and
 OpenMP, so that N workers share N cores instead of each spreading over all of them. Units that train the
-same model (a claim pair sharing a trained model, `training.train_key`) form one *chain*
+same model (a claim pair sharing a trained model; a cohort of seeds trained as one program: `training.group_key`)
+form one *chain*
 (`replication.chains`, shared with the Ray executor, `replication.executor_ray`) run by one worker in order, so the model is trained once and the others read it from the cache; chains go out
 longest first (estimated from the training budget in samples, the model's width and the framework), so
 that the long ones do not start last. Every unit writes its own files as in a serial run, so a run is
