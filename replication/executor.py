@@ -8,8 +8,7 @@ jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N w
 so each starts clean), each given one CPU thread for JAX (XLA's Eigen pool off) and for PyTorch and
 OpenMP, so that N workers share N cores instead of each spreading over all of them. Units that train the
 same model (a claim pair sharing a trained model; a cohort of seeds trained as one program: `training.group_key`)
-form one *chain*
-(`replication.chains`, shared with the Ray executor, `replication.executor_ray`) run by one worker in order, so the model is trained once and the others read it from the cache; chains go out
+form one *chain* (`replication.chains`, shared with the Ray executor, `replication.executor_ray`) run by one worker in order, so the model is trained once and the others read it from the cache; chains go out
 longest first (estimated from the training budget in samples, the model's width and the framework), so
 that the long ones do not start last. Every unit writes its own files as in a serial run, so a run is
 resumable and gives the same numbers either way (training is deterministic given the seed; only wall
