@@ -103,9 +103,9 @@ def in_float32(row: Row, steps: int = F32_STEPS, slow: bool | None = None) -> Ro
                                protocol=p, slow=row.slow if slow is None else slow)
 
 
-# float32 in the default run but for the slow rows' and the members' (their float64 rows show the mechanics;
-# in float32 they are the chaotic LNN again, at the price of two more compiles)
-F32_SLOW = ("lnn_members", "lnn_scouted", "lnn_relu2")
+# float32 in the default run but for these (each a compile of its own, 5-15 s; their float64 rows show the
+# mechanics): the members and scouted rows (the chaotic LNN again), the LGN's and the paper LNN's
+F32_SLOW = ("lnn_members", "lnn_scouted", "lnn_relu2", "lnn_paper", "lgn_banded", "lgn_dense")
 F32 = [in_float32(r, slow=r.slow or r.name in F32_SLOW) for r in F64]
 # float64 over LONG_STEPS, slow: the kinds whose float64 runs do not part (the double-pendulum LNN's do,
 # after about 100 steps: `test_float32_parting`)
