@@ -103,8 +103,7 @@ def test_an_exact_fit_has_the_same_l1_gradient(loss):
     assert not mismatches and max(diffs[k] for k in ("loss", "grad_norm", "params")) < 1e-12, diffs
 
 
-@pytest.mark.parametrize("kind,activation,formulation", [("baseline", "relu", "fast"), ("lnn", "relu2", "fast"),
-                                                         ("lnn", "relu2", "paper"), ("hnn", "relu", "fast")])
+@pytest.mark.parametrize("kind,activation,formulation", [("baseline", "relu", "fast"), ("hnn", "relu", "fast")])
 def test_relu_at_zero_has_the_same_derivative(kind, activation, formulation):
     """A sample whose inputs are all 0 meets zero biases (every init but pytorch_default's) at pre-activations
     exactly 0, where relu's slope (and relu2's curvature) are the frameworks' conventions: the same in both
