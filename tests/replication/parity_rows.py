@@ -88,7 +88,8 @@ F64 = [
         _p("wave_iid", **WAVE, schedule="step", lr_step_every=5, lr_step_gamma=0.5)),
     Row("lgn_dense", _s("lgn", 10, formulation="dense"), _p("wave_iid", **WAVE)),
     Row("lgn_paper", _s("lgn", 10, formulation="paper"), _p("wave_iid", **WAVE), slow=True),
-    # K = 4 inits as one program; the scouted row's scouts are the same program (its scout phase: 4 x 10
+    # K = 4 seeds as one program, each its own init and batches (what `Protocol.cohort` runs,
+    # `replication.training.train_cohort`); the scouted row's scouts are the same program (its scout phase: 4 x 10
     # steps at batch 8), its continuation the guarded row's step
     Row("lnn_members", LNN, MEMBERS, mode="members", seeds=(3, 4, 5, 6), **C),
     Row("lnn_scouted", LNN, SCOUTED, mode="scouted", seeds=(1,), **C),
