@@ -26,9 +26,6 @@ import math
 
 import numpy as np
 
-from models import init_params
-from replication.data import BatchStream
-
 SCOUT_SAMPLES = 500_000   # samples per scout when the protocol does not say (at most half the budget in all)
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
 CONTINUATION_STREAM = 1000  # the chosen init seed + this: the continuation's batch stream
@@ -70,6 +67,9 @@ def continuation_protocol(protocol):
 def scout(trainer, spec, protocol, seeds, on_log=None, hooks=()):
     """Phase 1: (outcomes, tail losses), one per init seed in `seeds`, trained as one program for
     `scout_protocol(protocol).steps`; the tail loss is inf for a scout that stopped."""
+    from models import init_params  # here, not at import: claims read scout_protocol without
+    from replication.data import BatchStream  # the models or the data (reports import the claims)
+
     p = scout_protocol(protocol)
     losses = []
 
@@ -92,6 +92,8 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None):
     """Scouts, then the chosen one's continuation; `track(protocol, offset_steps, offset_samples,
     offset_seconds)` may give a held-out tracking hook for the continuation (`training.tracker_for`): the
     scouts' samples and step time count."""
+    from replication.data import BatchStream
+
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
     done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps
 
