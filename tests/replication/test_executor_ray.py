@@ -166,6 +166,8 @@ def interrupt_when_written(worker, out, target, held, done):
         signal.pthread_kill(target, signal.SIGINT)
 
 
+@pytest.mark.slow   # on a loaded machine Ray's keepalive watchdog declares the held (stopped) worker dead and
+# retries its unit before the interrupt lands (seen once: 458 s, no KeyboardInterrupt)
 def test_an_interrupted_driver_leaves_a_folder_that_resumes(cluster, local, tmp_path):
     held, done = [], threading.Event()
     t = threading.Thread(target=interrupt_when_written,
