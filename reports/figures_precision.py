@@ -47,16 +47,19 @@ def work_precision(units: list[Unit], path: Path) -> bool:
     models = style_index([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
     for ax, x, label in ((axes[0], "samples", "training samples"), (axes[1], "train_s", "training time (s)")):
+        xs = []
         for (model, fw), d in curves.items():
             d = d[(d[x] > 0) & np.isfinite(d["mean"]) & (d["mean"] > 0)]
             if not len(d):
                 continue
+            xs.extend(d[x])
             c = colour(models[model])
             ax.plot(d[x], d["mean"], color=c, ls=LINESTYLES[fws[fw] % 4], label=f"{model} ({fw})")
             ax.fill_between(d[x], d["lo"], d["hi"], color=c, alpha=0.15, lw=0)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.xaxis.set_minor_formatter(NullFormatter())
+        if xs and max(xs) >= 10 * min(xs):   # within one decade the minor ticks carry the only labels
+            ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(label)
     axes[0].set_ylabel("held-out loss")
     axes[0].legend(fontsize=7)
