@@ -67,17 +67,6 @@ def cmd_report(args):
         print(f"{k}: {len(v)} files in {Path(args.out) / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
 
-def widths(text: str, option: str = "--hidden") -> tuple:
-    """Layer widths from "128,128"; a ValueError naming `option` otherwise."""
-    try:
-        out = tuple(int(x) for x in text.split(","))
-    except ValueError:
-        out = ()
-    if not out or min(out) < 1:
-        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
-    return out
-
-
 def cmd_bench(args):
     from replication.bench import run_bench
     from replication.bench.device import NoGPUError
@@ -101,6 +90,8 @@ def cmd_train_target(args):
     if args.heldout < 1 or args.seed < 0:
         raise ValueError(f"--heldout takes an integer >= 1 and --seed one >= 0; got {args.heldout} and {args.seed}")
     names = _csv(args.protocols)
+    from replication.cli_fit import widths
+
     hidden = list(widths(args.hidden))
     table = train_target.protocols(1000, 1)
     unknown = sorted(set(names or ()) - set(table))

@@ -23,10 +23,15 @@ def _show_defaults(parser) -> None:
         action.help = text + (" (default: none)" if action.default is None else " (default: %(default)s)")
 
 
-def _widths(text: str, option: str) -> tuple:
-    from replication.cli import widths
-
-    return widths(text, option)
+def widths(text: str, option: str = "--hidden") -> tuple:
+    """Layer widths from "128,128"; a ValueError naming `option` otherwise (also `lagbench train-target`'s)."""
+    try:
+        out = tuple(int(x) for x in text.split(","))
+    except ValueError:
+        out = ()
+    if not out or min(out) < 1:
+        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
+    return out
 
 
 def _scale(text: str):
@@ -67,7 +72,7 @@ def cmd_fit(args):
 
     try:
         d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
-                hidden=_widths(args.hidden, "--hidden"), batch=args.batch, lr=args.lr, seed=args.seed, loss=args.loss,
+                hidden=widths(args.hidden, "--hidden"), batch=args.batch, lr=args.lr, seed=args.seed, loss=args.loss,
                 activation=args.activation, weight_decay=args.weight_decay, schedule=args.schedule,
                 lr_min_ratio=args.lr_final, delan_eps=args.delan_eps, delan_offset=args.delan_offset,
                 angle_wrap=args.angle_wrap, input_scale=_scale(args.input_scale), split=args.split,
