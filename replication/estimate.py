@@ -31,23 +31,24 @@ def _per_step(rows) -> float:
 
 def _plain_step(framework, spec, protocol) -> float:
     p = continuation_protocol(protocol).replace(steps=PROBE_STEPS, log_every=1, schedule="constant",
-                                                n_train=protocol.batch * PROBE_STEPS)
+                                                n_train=protocol.batch * PROBE_STEPS, track_every=0)
     return _per_step(run_training(framework, spec, p, 0).log)
 
 
 def _members_step(framework, spec, protocol, k: int) -> float:
     """Seconds per step of `k` members side by side (scouts, or a cohort of seeds)."""
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
-                         cohort=0)
+                         cohort=0, track_every=0)
     rows = []
     trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in range(k)], p,
                                      [BatchStream(p, s) for s in range(k)], on_log=rows.append)
     return _per_step(rows)
 
 
-# what does not change the cost of a step: the init, the step counts, the rates and the pool sizes
+# what does not change the cost of a step: the init, the step counts, the rates and the pool sizes (the
+# probes leave held-out tracking off: its evaluations, the first one compiling, would count as step time)
 _FREE = ("steps", "scout_steps", "lr", "scout_lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start",
-         "lr_step_every", "lr_step_gamma")
+         "lr_step_every", "lr_step_gamma", "track_every")
 
 
 def _shape(framework, spec, protocol) -> str:
