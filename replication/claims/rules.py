@@ -193,15 +193,14 @@ def _one_sided_p(x, y) -> float:
     return float(mannwhitneyu([min(a, big) for a in x], [min(b, big) for b in y], alternative="less").pvalue)
 
 
-def faster(ours: str, others: tuple, pace: str = "samples_to_leave", share: str = "left_plateau",
-           alpha: float = 0.05):
+def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: float = 0.05):
     """A statistical ordering of training speed over seeds: ``pace`` per seed (samples to reach a level,
     +inf if never: a censored time), compared with a one-sided Mann-Whitney U test against each other
     model at ``alpha`` / (number of others) (Bonferroni). Reproduced if ours is faster than every other,
     partly than some; not reproduced if another is faster than ours; inconclusive if no difference is
     significant, or when no seed of any model got there (a study of which trains faster needs one that
-    trained). The ``share`` that got there within the budget (with its 95 % Wilson interval) and the
-    median pace are reported beside. The seeds are a sample, not separate replications (``pooled``)."""
+    trained). The share of seeds whose pace is finite (they got there within the budget), with its 95 %
+    Wilson interval, and the median pace are reported beside. The seeds are a sample, not separate replications (``pooled``)."""
     def rule(v):
         if (m := _missing(v, (ours,), pace)) is not None:
             return m
