@@ -4,8 +4,7 @@
 trained model, such as claims 1 and 2, train it once; a training already in `OUT/trained/` costs
 nothing), times three steps of each distinct configuration on this machine after one step to compile
 (the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K members side by
-side), and scales up
-by the protocol's steps. Evaluation time is not included. The wall time assumes the trainings spread
+side), and scales up by the protocol's steps. Evaluation time is not included. The wall time assumes the trainings spread
 evenly over `jobs` workers, and is never below the longest single training.
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
@@ -16,10 +15,8 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
-from models import init_params
-from replication.data import BatchStream
 from replication.scouting import continuation_protocol, scout_protocol
-from replication.training import group_key, run_training, train_key, trainer
+from replication.training import group_key, run_training, train_cohort, train_key
 
 PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
 
@@ -40,8 +37,7 @@ def _members_step(framework, spec, protocol, k: int) -> float:
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
                          cohort=0, track_every=0)
     rows = []
-    trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in range(k)], p,
-                                     [BatchStream(p, s) for s in range(k)], on_log=rows.append)
+    train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
     return _per_step(rows)
 
 
