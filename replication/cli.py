@@ -35,7 +35,7 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from replication.runner import run
+    from replication.run.runner import run
 
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
@@ -68,8 +68,8 @@ def cmd_report(args):
 
 
 def cmd_bench(args):
-    from replication.bench import run_bench
-    from replication.bench.device import NoGPUError
+    from speedstudy import run_bench
+    from speedstudy.device import NoGPUError
 
     write_folder(Path(args.out))
     try:
@@ -84,13 +84,13 @@ def cmd_train_target(args):
     import pandas as pd
     from tqdm.auto import tqdm
 
-    from replication.bench import train_target
     from replication.results import write_csv
+    from speedstudy import train_target
 
     if args.heldout < 1 or args.seed < 0:
         raise ValueError(f"--heldout takes an integer >= 1 and --seed one >= 0; got {args.heldout} and {args.seed}")
     names = _csv(args.protocols)
-    from replication.cli_fit import widths
+    from replication.fit.cli import widths
 
     hidden = list(widths(args.hidden))
     table = train_target.protocols(1000, 1)
@@ -131,7 +131,7 @@ def cmd_stiff(args):
 
     import systems
     from replication.results import write_csv, write_json
-    from replication.stiff_study import stiff_study
+    from replication.studies.stiff_solvers import stiff_study
 
     systems.get(args.system)  # an unknown name fails here, listing the valid ones
     folder = write_folder(Path(args.out) / "stiff")
@@ -177,7 +177,7 @@ def build_parser():
                    "stiff, train-target) (default: results/quick)")
     s.add_argument("--out", default="report/quick", help="the report folder (default: report/quick)")
     s.set_defaults(func=cmd_report)
-    from replication.cli_fit import add_commands
+    from replication.fit.cli import add_commands
 
     add_commands(sub)  # simulate, fit, evaluate
     s = sub.add_parser("bench", help="the speed study (writes OUT/bench/*.csv for the report)",

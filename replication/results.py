@@ -1,4 +1,4 @@
-"""Result files: atomic writes, checksums, and the unit layout of `replication/RESULTS.md`.
+"""Result files: atomic writes, checksums, and the unit layout of `docs/RESULTS.md`.
 
 Every file is written to a temporary name in the same folder and renamed into place, so a killed
 run never leaves a half-written file under a final name, and never through a symlink; files get the

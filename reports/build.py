@@ -1,6 +1,6 @@
 """Entry point: ``build_report(results_dir, out_dir) -> dict`` (what ``lagbench report`` calls).
 
-Reads only the result files of ``replication/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
+Reads only the result files of ``docs/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
 training code. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
 ``figures/*.png``. Returns ``{"markdown": Path, "typst": Path, "pdf": Path, "figures": [Path, ...]}``.
 An empty or missing results folder still yields a report that says nothing was run (the command line

@@ -1,4 +1,4 @@
-"""Read and validate a results folder (layout in ``replication/RESULTS.md``); never raises on bad data.
+"""Read and validate a results folder (layout in ``docs/RESULTS.md``); never raises on bad data.
 
 ``load_results(root) -> Results``. Every unit folder ``units/<claim>/<framework>/<model>/seed<k>/`` with a
 ``result.json`` becomes a :class:`Unit` whose ``status`` is ``"ok"``, ``"failed"`` (the runner's own
@@ -6,7 +6,7 @@ verdict) or ``"corrupt"`` (unreadable JSON, wrong schema, path mismatch, checksu
 mismatch; see :mod:`reports.integrity`). Only ``ok`` units feed numbers into the report. Missing files
 leave ``None``/empty fields; problems are collected as human-readable strings in ``Results.problems``.
 
-Verdicts are recomputed from the verified units by ``replication.verdicts.judge`` (the function the
+Verdicts are recomputed from the verified units by ``replication.claims.verdicts.judge`` (the function the
 runner uses; it imports no framework and no training code), so a deleted or corrupted unit never leaves
 a stale verdict; ``summary/verdicts.json`` is only compared with them. ``run.json``'s planned units
 that have no result are listed in ``Results.planned_missing``, and ``Results.unfinished`` is true when
@@ -248,7 +248,7 @@ def load_results(root: str | Path) -> Results:
 def _recompute_verdicts(res: Results) -> None:
     """Verdicts from the verified unit files, by the runner's own function; stored ones only compared."""
     from replication.claims import CLAIMS
-    from replication.verdicts import frame, judge
+    from replication.claims.verdicts import frame, judge
 
     profile = (res.run or {}).get("profile") or res.verdict_profile
     df = frame([u.result for u in res.units if u.status in ("ok", "failed")])

@@ -66,7 +66,7 @@ def scorecard_table(res: Results) -> pd.DataFrame:
 def scorecard_section(res: Results) -> Section:
     s = Section("Scorecard")
     s.add(Para("One line per claim. The verdict is recomputed from the unit files by the runner's own rule "
-               "(replication/verdicts.py): a model below its competence bar (held-out error at most a set "
+               "(replication/claims/verdicts.py): a model below its competence bar (held-out error at most a set "
                "fraction of a null predictor's, rollouts that do not diverge) makes a claim 'inconclusive'; "
                "an ordering needs the seed ranges apart. A published number is 'like for like' only when it "
                "is the same kind of number (training loss, held-out error, energy error) measured under the "

@@ -151,7 +151,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
     s.add(Para(f"{len(res.units)} fitted or evaluated models found, {len(units)} usable (status ok, checksums "
                f"verified). One-step errors are in the quantity trained (q̈, or τ for inverse dynamics) on the "
                f"held-out rows of the training file and on the test file; rollouts start from each test "
-               f"trajectory's first state (replication/fit_evaluate.py)."))
+               f"trajectory's first state (replication/fit/evaluate.py)."))
     bad = problem_units_table(res)
     if bad is not None:
         s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))

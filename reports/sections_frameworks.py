@@ -7,7 +7,7 @@ first one (``res.frameworks[0]``):
      flagged rows listed under it (also a paired seed beyond the spread, and non-finite seeds in one only);
   2. the verdict judged on each framework's units alone (``res.verdicts[claim]["by_framework"]``);
   3. the training curves of paired units (same claim, model and seed: the same initial weights and batches,
-     `replication.protocol`), from ``train_log.csv``: the relative difference of the first logged loss
+     `replication.training.protocol`), from ``train_log.csv``: the relative difference of the first logged loss
      (the same weights: rounding only; above ``START_TOL`` flagged, the frameworks compute different
      losses), the first logged step from which the losses stay parted by more than ``PART`` (float32
      training of a chaotic model parts legitimately, `tests/replication/test_training_parity.py`), the
@@ -170,7 +170,7 @@ def frameworks_sections(res: Results) -> list[Section]:
     verdicts = verdicts_table(res)
     if verdicts is not None:
         s.add(Table("Verdict per framework", verdicts, ["units/*/*/*/seed*/result.json"],
-                    note="Each framework's units judged alone by the claim's rule (`replication.verdicts`)."))
+                    note="Each framework's units judged alone by the claim's rule (`replication.claims.verdicts`)."))
     curves = training_curves_table(res)
     if curves is not None:
         s.add(Table("Training curves of paired units", curves, ["units/*/*/*/seed*/train_log.csv"],

@@ -2,7 +2,7 @@
 training and at evaluation, how often the `fast` solve fell back to pinv, and the largest acceleration.
 
 ``hessian_sections(res) -> list[Section]`` reads each unit's ``train_log.csv`` probe columns (written by
-``replication.hessian_probe``) and ``result.json`` counters; failed units are included (a blow-up is
+``replication.training.hessian_probe``) and ``result.json`` counters; failed units are included (a blow-up is
 where the Hessian matters most), corrupt ones are not.
 """
 

@@ -163,7 +163,7 @@ TRAIN_TARGET_NOTE = (
     "256 and peak 2e-3 (the quick profile's double-pendulum protocol). baseline_reference: the plain MLP on the variant's protocol, for "
     "scale. hessian_rel_err: median relative distance of the final LNN's velocity Hessian from the true mass "
     "matrix times one best scale (0: the true Lagrangian up to its symmetries). skipped_steps: steps the "
-    "gradient-spike guard skipped (`replication.spike_guard`).")
+    "gradient-spike guard skipped (`replication.training.spike_guard`).")
 
 
 def _targets_table(path: Path) -> pd.DataFrame | None:

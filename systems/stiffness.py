@@ -6,7 +6,7 @@ or (dof,)).
 
 ``pick_solver(system, q0, qdot0, t_end, tol=1e-10, **params) -> SolverChoice``: the solver, tolerances,
 stiffness ratio, expected explicit step count and the reason; ``choice.kwargs()`` goes straight into
-``systems.trajectories.integrate``. The rule (measured on ``stiff_chain``: see replication/stiff_study.py):
+``systems.trajectories.integrate``. The rule (measured on ``stiff_chain``: see replication/studies/stiff_solvers.py):
 
 - stiffness ratio r = max |lambda| / min |lambda| over the non-zero eigenvalues (worst initial state);
   the decay rate of the fastest mode is -Re lambda; "dissipative" means the fast modes decay

@@ -6,7 +6,7 @@ through each framework's Euler-Lagrange routine, in both formulations, in float6
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.published import Published
 from replication.claims.rules import bound
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 MODELS = (ModelEntry("lnn_exact_paper", {"kind": "lnn", "formulation": "paper"}, train=False),
           ModelEntry("lnn_exact_fast", {"kind": "lnn", "formulation": "fast"}, train=False))

@@ -3,7 +3,7 @@
 A ``Bar`` names the models it covers, an error metric measured on the model's own training
 distribution, and the null predictor's value of that metric that each unit records beside it
 (``null_<metric>``: the better of predicting zero and predicting the held-out mean target, see
-``replication.metrics.null_errors``; for the wave pulse, the pulse left where it started). A model
+``replication.evaluation.metrics.null_errors``; for the wave pulse, the pulse left where it started). A model
 passes when its seed mean is at most ``fraction`` x the null's. ``max_diverged`` bounds the number of
 diverged rollouts (metric ``n_diverged``, summed over seeds) for claims that read rollouts; with
 ``metric=None`` that is all the bar checks. ``need="any"`` asks only one of the models to pass (a study of

@@ -2,11 +2,11 @@
 
 A `Claim` names a paper result and everything needed to check it: the system, the models (each a
 `ModelEntry`: a label, ModelSpec fields, protocol overrides), the protocol per profile, the
-evaluation routine (a name in `replication.evaluate.EVALUATIONS`), the metric the verdict reads,
+evaluation routine (a name in `replication.evaluation.routines.EVALUATIONS`), the metric the verdict reads,
 the published values (`published.Published`, each with what it is), the competence bars its models
 must pass (`bars.Bar`), and the verdict rule (built from `rules`: a function of
 {model label: {metric: Stat}} for one framework, returning (verdict, reason)). Where a verdict is
-decided: `replication.verdicts.judge` (bars, then the rule, on seed means and on every seed).
+decided: `replication.claims.verdicts.judge` (bars, then the rule, on seed means and on every seed).
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from replication.claims.rules import VERDICTS
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 PROFILES = ("smoke", "quick", "full", "paper")
 # a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`

@@ -10,7 +10,7 @@ from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.published import Published
 from replication.claims.rules import all_parts, better_by, bound
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (64, 64), "paper": (64, 64)}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}

@@ -4,7 +4,7 @@ charged particle in a magnetic field); the LNN can."""
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.rules import all_parts, better_by
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (128, 128), "paper": (256, 256, 256)}
 REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),)}

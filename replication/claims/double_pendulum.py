@@ -11,7 +11,7 @@ before they are compared.
 """
 from replication.claims.bars import Bar
 from replication.claims.base import ModelEntry
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 PAPER_W, QUICK_W, SMOKE_W = (600, 600, 600), (64, 64, 64), (16, 16)
 PLAIN_QUICK_W = (128, 128, 128)   # the quick width of the side studies (precision, init, activation)
@@ -19,7 +19,7 @@ FULL_W = (128, 128, 128)          # full: the train-to-target study's width that
 WIDTHS = {"smoke": SMOKE_W, "quick": QUICK_W, "full": FULL_W, "paper": PAPER_W}
 
 # quick: the MLP's velocity inputs scaled by 0.3 (velocities are U[-10, 10], angles wrapped to [-pi, pi)),
-# as in the train-to-target variant (`replication/bench/train_target_trials.md`); both models alike
+# as in the train-to-target variant (`docs/train_target_trials.md`); both models alike
 VELOCITY_SCALE = {"smoke": {"input_scale": (1.0, 1.0, 0.3, 0.3)}, "quick": {"input_scale": (1.0, 1.0, 0.3, 0.3)},
                   "paper": {}}
 
@@ -41,7 +41,7 @@ PLAIN_SMOKE = _base
 PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout=20_000, log_every=50, lr=3e-3,
                             schedule="step", lr_step_every=2500, lr_step_gamma=0.1)
 
-# Restarts (`replication.scouting`) with the gradient-spike guard, for the LNN and the baseline alike (the
+# Restarts (`replication.training.scouting`) with the gradient-spike guard, for the LNN and the baseline alike (the
 # same budget and selection): 8 inits scouted for 5e5 samples each at batch 32, peak 1e-3 (which init finds
 # a near-physical Lagrangian is luck; its training loss tells, trials section 5), the best continued at
 # batch 256, peak 2e-3, for 4e6 samples (one-cycle, fresh Adam). 8e6 samples in all, a thirty-seventh of

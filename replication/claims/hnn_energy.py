@@ -4,7 +4,7 @@ mass-spring and the pendulum. HNN on canonical (q, p) with targets (qdot, pdot);
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.rules import all_parts, better_by
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (128, 128), "paper": (200, 200)}
 _hnn = {"kind": "hnn", "activation": "tanh", "init": "xavier"}

@@ -15,7 +15,7 @@ the spike guard) for PACE_STEPS steps; full: 16 seeds for the scouts' whole 15 6
 from replication.claims import double_pendulum as dp
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.rules import faster
-from replication.scouting import scout_protocol
+from replication.training.scouting import scout_protocol
 
 INITS = ("cranmer2020", "xavier", "kaiming", "pytorch_default")
 W = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "paper": dp.PAPER_W}

@@ -13,7 +13,7 @@ from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.published import Published
 from replication.claims.rules import fails
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "paper": (500, 500, 500, 500)}
 MODELS = (

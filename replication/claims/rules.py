@@ -6,7 +6,7 @@ metric's values over seeds; ``values`` may hold +inf (a diverged rollout), never
 
 Orderings ("a beats b") need more than a smaller mean: the seed ranges must not overlap
 (``separated``), else the verdict is "inconclusive" (noise decides). With one seed the range is the
-value itself, so the per-seed verdicts that ``replication.verdicts`` takes read as plain comparisons.
+value itself, so the per-seed verdicts that ``replication.claims.verdicts`` takes read as plain comparisons.
 
 - ``better_by(a, b, factor, metric)``: reproduced if mean(a) x factor < mean(b) and the ranges are
   separated; partly if a < b separated but not by the factor; not reproduced if b < a separated.

@@ -8,7 +8,7 @@ dx = 0.1); density MLP on 3 neighbours, 3x400 softplus, empirical init; i.i.d. w
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
 from replication.claims.rules import all_parts, bound
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (64, 64, 64), "paper": (400, 400, 400)}
 MODELS = (ModelEntry("lgn", {"kind": "lgn", "activation": "softplus", "init": "cranmer2020",

@@ -13,7 +13,7 @@ from models.graph import periodic_neighbours
 from models.torch.compiled import compile_batched, trace_flat
 from models.torch.lgn import _neighbours
 from models.torch.lnn import solve_with_fallback
-from replication.bench.evaluators import make_evaluator
+from speedstudy.evaluators import make_evaluator
 
 RNG = np.random.default_rng(5)
 

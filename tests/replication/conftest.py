@@ -1,7 +1,7 @@
 """One smoke run of every claim in both frameworks, shared by the replication and integration tests."""
 import pytest
 
-from replication.runner import run
+from replication.run.runner import run
 
 
 @pytest.fixture(scope="session")

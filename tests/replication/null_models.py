@@ -1,5 +1,5 @@
 """Models that learned nothing, as NumPy adapters with the trained models' interface (see
-`replication.adapters`): `Zero` predicts 0 for everything, `Diverging` predicts accelerations and
+`replication.evaluation.adapters`): `Zero` predicts 0 for everything, `Diverging` predicts accelerations and
 time derivatives that blow up in finite time (any rollout reaches inf within a few steps)."""
 from __future__ import annotations
 

@@ -24,8 +24,8 @@ import sys
 import numpy as np
 
 from models import init_params
-from replication import loop, scouting, train_jax, train_torch
-from replication.data import BatchStream
+from replication.training import loop, scouting, train_jax, train_torch
+from replication.training.data import BatchStream
 
 _JAX_STEPS: dict = {}
 

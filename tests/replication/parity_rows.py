@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from models import ModelSpec
-from replication.protocol import Protocol
+from replication.training.protocol import Protocol
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
@@ -89,7 +89,7 @@ F64 = [
     Row("lgn_dense", _s("lgn", 10, formulation="dense"), _p("wave_iid", **WAVE)),
     Row("lgn_paper", _s("lgn", 10, formulation="paper"), _p("wave_iid", **WAVE), slow=True),
     # K = 4 seeds as one program, each its own init and batches (what `Protocol.cohort` runs,
-    # `replication.training.train_cohort`); the scouted row's scouts are the same program (its scout phase: 4 x 10
+    # `replication.training.train.train_cohort`); the scouted row's scouts are the same program (its scout phase: 4 x 10
     # steps at batch 8), its continuation the guarded row's step
     Row("lnn_members", LNN, MEMBERS, mode="members", seeds=(3, 4, 5, 6), **C),
     Row("lnn_scouted", LNN, SCOUTED, mode="scouted", seeds=(1,), **C),

@@ -4,8 +4,8 @@ import json
 import pytest
 
 from replication.cli import build_parser, main
-from replication.estimate import describe, estimate
-from replication.runner import plan
+from replication.run.estimate import describe, estimate
+from replication.run.runner import plan
 
 
 def test_list_names_everything(capsys):
@@ -32,7 +32,7 @@ def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
     assert est["wall_s"] >= est["train_s"]          # one worker: the sum
     assert "dp_loss" in describe(units, units[:1]) and "(0 to run)" in describe(units, units[:1])
     # once the training is in OUT/trained it costs nothing
-    from replication.training import train_cached
+    from replication.training.train import train_cached
     u = units[0]
     train_cached(tmp_path, u.framework, u.spec(), u.protocol(), u.seed)
     again = estimate(units, tmp_path)
@@ -69,8 +69,8 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     params = load_npz(out / "train_target" / "variant.npz")
     assert spec.kind == "lnn" and spec.hidden == (8, 8)
     import models.jax
-    from replication.bench import train_target as TT
-    from replication.bench.target_loop import heldout_l1
+    from speedstudy import train_target as TT
+    from speedstudy.target_loop import heldout_l1
 
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
     l1 = heldout_l1(spec, proto)(models.jax.build(spec, params))

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from parity_rows import BY_NAME
 
-from replication import scouting, training
-from replication.protocol import Protocol
+from replication.training import scouting
+from replication.training import train as training
+from replication.training.protocol import Protocol
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PROTOCOL = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=8, log_every=1, cohort=2)

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from replication.evaluate import pdot_to_qddot, system_of
-from replication.protocol import Protocol
+from replication.evaluation.routines import pdot_to_qddot, system_of
+from replication.training.protocol import Protocol
 
 
 @pytest.mark.parametrize("data", ["relativistic_iid", "charged_magnetic_iid", "double_pendulum_iid"])

@@ -3,8 +3,8 @@ claims trained once (its units form one chain)."""
 import pandas as pd
 import pytest
 
-from replication import executor, runner
-from replication.environment import one_thread_env
+from replication.run import executor, runner
+from replication.run.environment import one_thread_env
 
 CLAIMS = ["dp_loss", "dp_energy", "appendix_b"]
 

@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 import ray
 
-from replication import executor_ray, runner
+from replication.run import executor_ray, runner
 
 KW = dict(profile="smoke", claims=["dp_loss", "dp_energy", "appendix_b"], models=["baseline", "lnn_exact_fast"],
           frameworks=("torch",), progress=False)

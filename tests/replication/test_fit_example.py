@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from replication.cli import main
-from replication.fitted import load_fitted
+from replication.fit.load import load_fitted
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 MARKER = "<!-- worked example: tests/replication/test_fit_example.py runs this block -->"

@@ -6,7 +6,7 @@ import pytest
 
 from replication import results as R
 from replication.cli import main
-from replication.fit import fit
+from replication.fit.task import fit
 
 FAST = {"model": "baseline", "steps": 4, "hidden": (8,), "batch": 16}
 
@@ -34,8 +34,7 @@ def test_changed_data_is_trained_afresh_and_the_old_fit_is_kept(tmp_path):
 
 
 def test_a_file_edited_after_setup_is_refused(tmp_path):
-    from replication import userdata
-
+    from replication.fit import userdata
     data = _pendulum(tmp_path / "d.npz")
     digest, _ = userdata.read(str(data))
     _pendulum(data, scale=2.0)

@@ -4,10 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication import userdata
 from replication.cli import build_parser, main
-from replication.fit import fit
-from replication.fitted import load_fitted
+from replication.fit import userdata
+from replication.fit.load import load_fitted
+from replication.fit.task import fit
 
 TINY = {"steps": 6, "hidden": (8,), "batch": 32}
 
@@ -78,7 +78,7 @@ def test_an_inverse_dynamics_baseline_and_a_damaged_fit(tmp_path):
 
 
 def test_the_metric_is_named_for_the_loss_and_the_rows():
-    from replication.fit import metric_of
+    from replication.fit.task import metric_of
 
     assert metric_of({"train": 9, "heldout": 1}, False, "mse") == ("heldout_mse", "held-out MSE")
     assert metric_of({"train": 9, "heldout": 1}, True, "l1") == ("test_l1", "test L1")
@@ -97,7 +97,7 @@ def test_every_fit_option_shows_its_default():
 
 
 def test_a_users_energy_function_is_imported_and_checked_before_any_work(tmp_path, monkeypatch):
-    from replication.fit_evaluate import energy_function
+    from replication.fit.evaluate import energy_function
 
     (tmp_path / "my_energy.py").write_text("def pendulum(q, qdot):\n    return 0.5 * (qdot**2).sum(-1) - 3 * __import__('numpy').cos(q).sum(-1)\n"
                                            "def wrong(q, qdot):\n    return q\n")

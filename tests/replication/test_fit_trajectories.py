@@ -5,7 +5,8 @@ import pandas as pd
 import pytest
 from scipy.signal import savgol_coeffs
 
-from replication import fit_data, trajectories, userdata
+from replication.fit import rows as fit_data
+from replication.fit import trajectories, userdata
 
 H = 0.02  # 50 samples per second
 W, P = trajectories.WINDOW, trajectories.POLYORDER

@@ -5,9 +5,9 @@ import pytest
 
 import systems
 from models import ModelSpec, init_params
-from replication import hessian_probe
-from replication.protocol import Protocol
-from replication.training import run_training
+from replication.training import hessian_probe
+from replication.training.protocol import Protocol
+from replication.training.train import run_training
 
 
 @pytest.mark.parametrize("framework", ["jax", "torch"])

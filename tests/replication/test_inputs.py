@@ -3,11 +3,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication import userdata
 from replication.cli import main
-from replication.fit import fit
-from replication.protocol import Protocol
-from replication.runner import plan
+from replication.fit import userdata
+from replication.fit.task import fit
+from replication.run.runner import plan
+from replication.training.protocol import Protocol
 
 
 @pytest.mark.parametrize("kwargs, words", [

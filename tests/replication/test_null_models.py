@@ -1,7 +1,7 @@
 """No claim is ever reproduced by a model that learned nothing.
 
 For every claim, each model of its smoke profile is replaced by a null model, evaluated by the claim's
-own evaluation routine, for three seeds, and the verdict path (`replication.verdicts.judge`) runs on the
+own evaluation routine, for three seeds, and the verdict path (`replication.claims.verdicts.judge`) runs on the
 resulting unit records: predicting zero, the untrained initialisation (the real init numbers, through
 the PyTorch adapter), and a model whose rollouts diverge. None may come out "reproduced" or "partly".
 Appendix B trains nothing: its null is an Euler-Lagrange routine that returns zero or inf.
@@ -12,12 +12,12 @@ from null_models import Diverging, NoisyOracle, Zero
 
 import models.torch.lnn as torch_lnn
 from models import init_params
-from replication.adapters import adapter
 from replication.claims import CLAIMS
-from replication.evaluate import Context, system_of
-from replication.evaluations import EVALUATIONS
-from replication.runner import plan
-from replication.verdicts import frame, judge
+from replication.claims.verdicts import frame, judge
+from replication.evaluation.adapters import adapter
+from replication.evaluation.registry import EVALUATIONS
+from replication.evaluation.routines import Context, system_of
+from replication.run.runner import plan
 
 SEEDS = (0, 1, 2)
 NULLS = ("zero", "untrained", "diverging")

@@ -10,9 +10,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import systems
-from replication import metrics, userdata
-from replication.protocol import Protocol
-from replication.schedules import learning_rate
+from replication.evaluation import metrics
+from replication.fit import userdata
+from replication.training.protocol import Protocol
+from replication.training.schedules import learning_rate
 
 CLEAN = (ValueError, TypeError, KeyError)
 FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

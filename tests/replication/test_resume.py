@@ -8,7 +8,7 @@ import sys
 import time
 
 from replication import results as R
-from replication.runner import run
+from replication.run.runner import run
 
 ARGS = ["--profile", "smoke", "--claims", "dp_loss", "--quiet"]
 
@@ -92,8 +92,7 @@ def test_compiled_code_is_released_after_every_unit(tmp_path, monkeypatch):
     a long run dies at the kernel's per-process limit (a 220-unit quick run did, at unit 202)."""
     import jax
 
-    from replication import runner
-
+    from replication.run import runner
     calls = []
     real = jax.clear_caches
     monkeypatch.setattr(jax, "clear_caches", lambda: (calls.append(1), real()))
@@ -117,8 +116,8 @@ def test_released_compilations_keep_the_memory_map_count_flat():
     import pytest
 
     from models import ModelSpec, init_params
-    from replication.adapters import adapter
-    from replication.executor import release_compiled
+    from replication.evaluation.adapters import adapter
+    from replication.run.executor import release_compiled
 
     if not os.path.exists("/proc/self/maps"):
         pytest.skip("no /proc/self/maps on this system")

@@ -5,8 +5,8 @@ import json
 
 import pytest
 
-from replication import runner, units
 from replication.cli import main
+from replication.run import runner, units
 
 ONE = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--models", "baseline", "--quiet"]
 

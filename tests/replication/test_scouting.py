@@ -1,13 +1,13 @@
-"""Restarts over initialisations as a protocol option (`Protocol.scouts`, `replication.scouting`)."""
+"""Restarts over initialisations as a protocol option (`Protocol.scouts`, `replication.training.scouting`)."""
 import numpy as np
 import pytest
 from parity_kit import Recorder
 from parity_rows import BY_NAME
 
 from models import init_params
-from replication import scouting
-from replication.data import BatchStream
-from replication.protocol import Protocol
+from replication.training import scouting
+from replication.training.data import BatchStream
+from replication.training.protocol import Protocol
 
 # the parity table's scouted row (JAX against PyTorch there), longer: the same compiled steps
 SPEC = BY_NAME["lnn_scouted"].spec

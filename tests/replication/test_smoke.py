@@ -39,7 +39,7 @@ def test_frameworks_agree_on_the_exact_lagrangian(smoke_results):
 
 
 def test_a_rerun_skips_finished_units(smoke_results):
-    from replication.runner import run
+    from replication.run.runner import run
 
     out, _ = smoke_results
     before = {p: p.stat().st_mtime_ns for p in out.glob("units/*/*/*/seed*/result.json")}

@@ -9,10 +9,10 @@ import pytest
 
 import models.jax
 from models import ModelSpec, init_params
-from replication import train_jax
-from replication.data import BatchStream
-from replication.protocol import Protocol
-from replication.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
+from replication.training import train_jax
+from replication.training.data import BatchStream
+from replication.training.protocol import Protocol
+from replication.training.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
 
 BASE = Protocol(data="double_pendulum_iid", steps=5, batch=8, n_train=32, dtype="float64", resample=True)
 

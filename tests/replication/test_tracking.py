@@ -1,15 +1,15 @@
-"""Held-out tracking during training (`Protocol.track_every`, `replication.tracking`): it reads the model
+"""Held-out tracking during training (`Protocol.track_every`, `replication.training.tracking`): it reads the model
 and changes no training number; its last point is the final model's held-out loss; the report draws it."""
 import numpy as np
 import pandas as pd
 import pytest
 from parity_rows import BY_NAME
 
-from replication import scouting
-from replication.adapters import adapter
-from replication.objective import loss_value, predict
-from replication.tracking import TRACK_STATES, Tracker
-from replication.training import run_training
+from replication.evaluation.adapters import adapter
+from replication.training import scouting
+from replication.training.objective import loss_value, predict
+from replication.training.tracking import TRACK_STATES, Tracker
+from replication.training.train import run_training
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PLAIN = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=9, log_every=2)

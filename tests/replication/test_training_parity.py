@@ -19,8 +19,8 @@ from parity_rows import BY_NAME, F32, F64, ROWS, Row
 
 from models import FORMULATIONS, KINDS, ModelSpec, init_params
 from replication.claims import rel_coords
-from replication.data import BatchStream
-from replication.protocol import DTYPES, LOSSES, SCHEDULES, Protocol
+from replication.training.data import BatchStream
+from replication.training.protocol import DTYPES, LOSSES, SCHEDULES, Protocol
 
 
 @pytest.mark.parametrize("row", [pytest.param(r, id=r.name, marks=[pytest.mark.slow] * r.slow) for r in ROWS])
@@ -86,7 +86,7 @@ class _Fixed:
 @pytest.mark.parametrize("loss", ["l1", "l1_gamma"])
 def test_an_exact_fit_has_the_same_l1_gradient(loss):
     """Where a residual is exactly 0, d|e|/de is 0 in both frameworks (JAX's abs alone says 1, PyTorch's 0:
-    `replication.objective.loss_value`): a model that predicts exactly 0 for a target component that is 0."""
+    `replication.training.objective.loss_value`): a model that predicts exactly 0 for a target component that is 0."""
     spec = ModelSpec(kind="baseline", dof=2, hidden=(8,), dtype="float64")
     params = init_params(spec, seed=0)
     params["mlp.1.weight"][:], params["mlp.1.bias"][:] = 0.0, 0.0

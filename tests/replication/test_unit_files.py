@@ -3,7 +3,7 @@ import pandas as pd
 import pytest
 
 from replication import results as R
-from replication import unit_files
+from replication.run import unit_files
 
 
 def unit_folder(root, name="units/c/jax/m/seed0"):

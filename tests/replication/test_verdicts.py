@@ -1,11 +1,11 @@
-"""Every claim's verdict rule, through `replication.verdicts.judge`: a case that reproduces and a case that
+"""Every claim's verdict rule, through `replication.claims.verdicts.judge`: a case that reproduces and a case that
 fails, on synthetic unit rows whose models all pass their bars; then what judge does with failed units,
 missing models, seeds that disagree and frameworks that disagree."""
 import pandas as pd
 import pytest
 
 from replication.claims import CLAIMS
-from replication.verdicts import judge
+from replication.claims.verdicts import judge
 
 NULL = 1000.0   # every null predictor's error: every model below is far under its bar
 

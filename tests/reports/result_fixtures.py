@@ -1,4 +1,4 @@
-"""Hand-made result files following replication/RESULTS.md exactly, checksums included (used by the
+"""Hand-made result files following docs/RESULTS.md exactly, checksums included (used by the
 conftest.py fixtures and the tests).
 
 ``write_results(root)`` writes run.json, claims.json (the ten claims), units for every claim except

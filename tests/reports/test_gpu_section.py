@@ -1,5 +1,5 @@
 """The report's GPU section reads ROOT/bench_gpu/ (`lagbench bench --gpu`); fed here the H100 measurements
-kept in replication/bench/measured/gpu_h100/, so that they stay loadable."""
+kept in docs/speed/gpu_h100/, so that they stay loadable."""
 import shutil
 from pathlib import Path
 

@@ -12,11 +12,11 @@ from result_fixtures import CLAIMS, CORRUPT, NOT_RUN_CLAIM, write_json
 from reports import build_report
 from reports.pdf import page_count
 
-# the report recomputes verdicts with replication.verdicts and the claim records (pure NumPy/pandas);
+# the report recomputes verdicts with replication.claims.verdicts and the claim records (pure NumPy/pandas);
 # it never loads a framework, the systems or models, or the training and evaluation code
-HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication.training",
-         "replication.train_jax", "replication.train_torch", "replication.evaluate", "replication.units",
-         "replication.runner", "replication.data"]
+HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication.training.train",
+         "replication.training.train_jax", "replication.training.train_torch", "replication.evaluation.routines", "replication.run.units",
+         "replication.run.runner", "replication.training.data"]
 
 
 def table_rows(md: str, title: str) -> dict[str, list[str]]:

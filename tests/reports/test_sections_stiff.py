@@ -1,7 +1,7 @@
 """The stiff-solver study's output reaches the report, with the picked solver marked."""
 import json
 
-from replication.stiff_study import stiff_study
+from replication.studies.stiff_solvers import stiff_study
 from reports.load import load_results
 from reports.sections_stiff import stiff_sections
 

@@ -1,0 +1,87 @@
+"""The precision evaluation: the energy-rollout evaluation plus the ground truth's own drift in the unit's dtype.
+
+`eval_precision(ctx)` runs `eval_energy_rollout` (held-out L1, energy error of the learned model against
+the float64 truth) and adds `truth_energy_drift_final` / `truth_energy_drift_max`: the exact equations of
+motion rolled out from the same initial conditions with the state, the time step and every evaluation held
+in the protocol's dtype (float32 or float64), |E(t) - E(0)| / energy_scale at the final time (and the max
+over time), averaged over initial conditions. The integrator (`truth_integrator` in the evaluation config)
+is "dopri5": adaptive Dormand-Prince 5(4) in diffrax at rtol = atol = `truth_tol` (the original code's
+odeint, default 1e-10, unattainable in float32), capped at `truth_max_steps`; or "rk4": fixed-step RK4 at
+the config's `dt` in NumPy (no compilation; the smoke profile). `truth_energy_drift_f64ref` is the drift
+of the float64 ground truth used everywhere else (systems.trajectories), for comparison.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from replication.evaluation.rollout import rk4_step
+from replication.evaluation.routines import _truth, eval_energy_rollout
+
+
+def _rk4_in_dtype(s, y0, t, dt, dtype):
+    """Fixed-step RK4 (`replication.evaluation.rollout.rk4_step`) with the state, the step and the equations of
+    motion all in ``dtype``."""
+    dof, y, h = s.dof, y0.astype(dtype), np.asarray(dt, dtype)
+    f = lambda z: np.concatenate([z[:, dof:], s.acceleration(z[:, :dof], z[:, dof:]).astype(dtype)], 1)  # noqa: E731
+    out = [y]
+    for j in range(1, t.size):
+        for _ in range(max(1, int(round((t[j] - t[j - 1]) / dt)))):
+            y = rk4_step(f, y, h)
+        out.append(y)
+    return np.stack(out, 1).astype(np.float64)
+
+
+@lru_cache(maxsize=8)
+def truth_drift_in_dtype(name, params, cfg_items, dtype: str):
+    """(final, max) drift per initial condition, (B,) arrays, of the truth integrated in ``dtype``."""
+    cfg = dict(cfg_items)
+    s, t, q, qd, _, _ = _truth(name, params, cfg_items)
+    y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
+    if cfg.get("truth_integrator", "dopri5") == "rk4":
+        ys = _rk4_in_dtype(s, y0, t, cfg["dt"], np.dtype(dtype))
+    else:
+        ys = _dopri5_in_dtype(s, y0, t, cfg, dtype)
+    e = s.energy(ys[..., :s.dof], ys[..., s.dof:])
+    d = np.abs(e - e[:, :1]) / cfg["energy_scale"]
+    return d[:, -1], np.max(d, axis=1)
+
+
+def _dopri5_in_dtype(s, y0, t, cfg, dtype):
+    import diffrax
+    import jax
+    import jax.numpy as jnp
+
+    dt_ = jnp.dtype(dtype)
+    dof = s.dof
+    tol = float(cfg.get("truth_tol", 1e-10))
+
+    def field(tt, y, args):
+        return jnp.concatenate([y[dof:], s.acceleration(y[:dof], y[dof:], backend="jax")]).astype(dt_)
+
+    def solve(y0):
+        sol = diffrax.diffeqsolve(
+            diffrax.ODETerm(field), diffrax.Dopri5(), t0=jnp.asarray(t[0], dt_), t1=jnp.asarray(t[-1], dt_),
+            dt0=jnp.asarray(cfg["dt"], dt_), y0=y0, saveat=diffrax.SaveAt(ts=jnp.asarray(t, dt_)),
+            stepsize_controller=diffrax.PIDController(rtol=tol, atol=tol, dtmin=None),
+            max_steps=int(cfg.get("truth_max_steps", 200_000)), throw=False)
+        return sol.ys
+
+    return np.asarray(jax.jit(jax.vmap(solve))(jnp.asarray(y0, dt_)), dtype=np.float64)
+
+
+def eval_precision(ctx):
+    out = eval_energy_rollout(ctx)
+    name = ctx.protocol.data.removesuffix("_iid")
+    key = (name, tuple(sorted(ctx.protocol.system_params)), tuple(sorted(ctx.cfg.items())))
+    final, mx = truth_drift_in_dtype(*key, ctx.protocol.dtype)
+    ok = np.isfinite(final)
+    out.metrics["truth_energy_drift_final"] = float(np.mean(final[ok])) if ok.any() else float("nan")
+    out.metrics["truth_energy_drift_max"] = float(np.mean(mx[ok])) if ok.any() else float("nan")
+    out.metrics["truth_energy_drift_worst"] = float(np.max(final[ok])) if ok.any() else float("nan")
+    out.counters["truth_failed"] = int((~ok).sum())
+    s, t, q, qd, _, _ = _truth(*key)
+    e = s.energy(q, qd)
+    out.metrics["truth_energy_drift_f64ref"] = float(np.mean(np.abs(e[:, -1] - e[:, 0]))) / ctx.cfg["energy_scale"]
+    return out

@@ -1,0 +1,164 @@
+"""Evaluation routines named by claims: each maps a trained model to metrics, tables and arrays.
+
+`EVALUATIONS[name](ctx) -> Evaluation`. `ctx` is a `Context` (claim, entry, framework, spec,
+params, protocol, profile, evaluation config, and `model`: a NumPy adapter of the trained model,
+see `replication.evaluation.adapters`). Everything here is NumPy and framework-neutral, so both frameworks
+are judged by the same code; ground truth comes from `systems` in float64.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+import pandas as pd
+
+import systems
+import systems.trajectories
+from replication.evaluation.metrics import (
+    bounded_relative_error,
+    energy_errors,
+    geometric_mean_over_time,
+    heldout_errors,
+    null_errors,
+)
+from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
+from replication.training import data as datamod
+from replication.training.objective import predict
+
+
+@dataclass
+class Context:
+    claim: object
+    entry: object
+    framework: str
+    spec: object
+    params: dict
+    protocol: object
+    profile: str
+    cfg: dict
+    model: object = None
+    log: list | None = None   # the training log rows (`TrainOutcome.log`), for routines that read the pace
+
+
+@dataclass
+class Evaluation:
+    metrics: dict = field(default_factory=dict)
+    counters: dict = field(default_factory=dict)
+    tables: dict = field(default_factory=dict)   # file name -> DataFrame
+    arrays: dict = field(default_factory=dict)   # name -> ndarray (written to arrays.npz)
+
+
+def system_of(protocol, **extra):
+    name = protocol.data.removesuffix("_iid")
+    return systems.get(name, **{**dict(protocol.system_params), **extra})
+
+
+def pdot_to_qddot(protocol, q, qdot, pdot):
+    """q-double-dot from a predicted pdot along the motion, pdot = dp/dq qdot + dp/dqdot qdd: with the
+    truth's own rate r = dp/dq qdot + dp/dqdot qdd_true, qdd = qdd_true + (d2L/dqdot2)^-1 (pdot - r)."""
+    s = system_of(protocol)
+    gap = (pdot - s.canonical_momentum_rate(q, qdot))[..., None]
+    return s.acceleration(q, qdot) + np.linalg.solve(s.velocity_hessian(q, qdot), gap)[..., 0]
+
+
+def eval_heldout(ctx) -> Evaluation:
+    p, m = ctx.protocol, ctx.model
+    batch = datamod.heldout(p)
+    pred = predict(m, ctx.spec.kind, p.task, batch, np.concatenate)
+    w = batch.get("weight")
+    e = heldout_errors(pred, batch["target"], w)
+    null = null_errors(batch["target"], w)
+    out = Evaluation(metrics={"heldout_l1": e["l1"], "heldout_mse": e["mse"],
+                              "null_heldout_l1": null["l1"], "null_heldout_mse": null["mse"]})
+    if p.task == "hamiltonian":
+        d = batch["q"].shape[-1]
+        ydot = pred[:, d:]
+        qdd = ydot if p.coords == "qqdot" else pdot_to_qddot(p, batch["q"], _qdot(batch, p), ydot)
+    elif p.task == "acceleration":
+        qdd = pred
+    else:
+        qdd = None
+    if qdd is not None:
+        out.metrics["heldout_l1_qddot"] = heldout_errors(qdd, batch["qddot"], w)["l1"]
+        out.metrics["null_heldout_l1_qddot"] = null_errors(batch["qddot"], w)["l1"]
+    if ctx.spec.kind == "lnn":
+        _, n_fb = m.acceleration_info(batch["q"], batch["qdot"], batch.get("extra"))
+        out.counters["hessian_fallbacks"] = int(n_fb)
+        out.counters["hessian_fallback_fraction"] = float(n_fb) / len(batch["q"])
+        eig = np.linalg.eigvalsh(m.velocity_hessian(batch["q"], batch["qdot"], batch.get("extra")))
+        out.counters["hessian_indefinite_fraction"] = float(np.mean((eig[:, 0] < 0) & (eig[:, -1] > 0)))
+    return out
+
+
+def _qdot(batch, p):
+    """The true velocity of a held-out batch (for canonical coordinates the batch holds p)."""
+    return batch["target"][:, : batch["q"].shape[-1]] if p.task == "hamiltonian" else batch["qdot"]
+
+
+def _initial_states(s, cfg, rng):
+    n = cfg["n_ics"]
+    st = s.sample_states(n, rng)
+    q, qdot = st["q"], st["qdot"]
+    if cfg.get("near_rest", s.name == "double_pendulum"):
+        qdot = rng.uniform(0.0, 0.1, size=qdot.shape)
+    return q, qdot
+
+
+@lru_cache(maxsize=16)
+def _truth(name, params, cfg_items):
+    cfg = dict(cfg_items)
+    s = systems.get(name, **dict(params))
+    rng = np.random.default_rng(cfg.get("ic_seed", 0))
+    q0, qd0 = _initial_states(s, cfg, rng)
+    t = np.linspace(0.0, cfg["t_end"], cfg["n_t"])
+    q, qd = systems.trajectories.integrate(s, q0, qd0, t)
+    qc, qdc = systems.trajectories.integrate(s, q0 + 1e-4, qd0, t)
+    return s, t, q, qd, qc, qdc
+
+
+def _model_rollout(ctx, s, q0, qd0, t):
+    p, m, d = ctx.protocol, ctx.model, s.dof
+    if p.task == "hamiltonian" and p.coords == "qp":
+        p0 = s.canonical_momentum(q0, qd0, backend="numpy")
+        z = rollout(hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d),
+                    np.concatenate([q0, p0], 1), t, ctx.cfg["dt"])
+        q, pp = z[..., :d], z[..., d:]
+        Mq = s.mass_matrix(np.nan_to_num(q), backend="numpy")
+        qd = np.where(np.isfinite(pp), np.linalg.solve(Mq, np.nan_to_num(pp)[..., None])[..., 0], np.nan)
+        return q, qd
+    if p.task == "hamiltonian":
+        f = hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d)
+    else:
+        f = lagrangian_field(lambda q, qd: m.acceleration(q, qd, None), d)
+    z = rollout(f, np.concatenate([q0, qd0], 1), t, ctx.cfg["dt"])
+    return z[..., :d], z[..., d:]
+
+
+def eval_energy_rollout(ctx) -> Evaluation:
+    out = eval_heldout(ctx)
+    cfg = ctx.cfg
+    name = ctx.protocol.data.removesuffix("_iid")
+    s, t, q, qd, qc, qdc = _truth(name, tuple(sorted(ctx.protocol.system_params)), tuple(sorted(cfg.items())))
+    qp, qdp = _model_rollout(ctx, s, q[:, 0], qd[:, 0], t)
+    E_true, E_pred = s.energy(q, qd, backend="numpy"), s.energy(qp, qdp, backend="numpy")
+    out.metrics.update(energy_errors(E_pred, E_true, cfg["energy_scale"]))
+    z_true, z_pred = np.concatenate([q, qd], -1), np.concatenate([qp, qdp], -1)
+    err = bounded_relative_error(z_pred, z_true)
+    floor = bounded_relative_error(np.concatenate([qc, qdc], -1), z_true)
+    out.metrics["rollout_gmean_err"] = float(np.nanmean(geometric_mean_over_time(err)))
+    out.metrics["chaos_floor_gmean_err"] = float(np.mean(geometric_mean_over_time(floor)))
+    idx = np.unique(np.linspace(0, t.size - 1, min(t.size, 200)).astype(int))
+    rows = []
+    for b in range(q.shape[0]):
+        for qty, series in (("energy_err", (E_pred[b] - E_true[b]) / cfg["energy_scale"]),
+                            ("state_err", err[b]), ("chaos_floor", floor[b])):
+            rows.append(pd.DataFrame({"traj": b, "t": t[idx], "quantity": qty, "value": series[idx]}))
+    out.tables["timeseries.csv"] = pd.concat(rows, ignore_index=True)
+    out.tables["rollouts.csv"] = pd.DataFrame({
+        "traj": np.arange(q.shape[0]), "energy_err_final": np.abs(E_pred[:, -1] - E_true[:, -1]) / cfg["energy_scale"],
+        "energy_err_max": np.max(np.abs(E_pred - E_true), 1) / cfg["energy_scale"],
+        "diverged": ~np.all(np.isfinite(E_pred), axis=1),
+        "gmean_err": geometric_mean_over_time(err), "chaos_floor_gmean_err": geometric_mean_over_time(floor)})
+    out.arrays = {"t": t, "q_true": q[:3], "q_pred": qp[:3]}
+    return out

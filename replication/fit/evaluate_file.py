@@ -1,0 +1,81 @@
+"""`lagbench evaluate --model DIR --data FILE`: fitted models judged on a new data file.
+
+`evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
+energy=None)`
+-> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
+in it, side by side). Each model is loaded by `fitted.load_fitted` (checksums verified; in `framework`,
+default the one it was trained in: parameters load in either), the data file is prepared as a test file
+(`fit_data.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
+polyorder unless given) and evaluated by the fit routine (`fit_evaluate.eval_fit`: one-step errors per
+component, rollouts, energies with `system` or `energy` ("module:function"), DeLaN's decomposition). Written as units of a claim
+"evaluate": `OUT/units/evaluate/<framework>/<model>/seed<k>/` (result.json, one_step.csv, rollouts.csv,
+timeseries.csv, arrays.npz; `lagbench report` renders them) and OUT/data/ (the prepared rows). A verified
+earlier evaluation of the same model, data and options is returned as is; another one there is kept,
+renamed `superseded-<time>-seed<k>`. Every option and every model is checked before anything is written.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from replication import results as R
+from replication.claims.base import Claim, ModelEntry
+from replication.fit import rows as fit_data
+from replication.fit import trajectories, userdata
+from replication.fit.load import fitted_folders, load_fitted
+from replication.fit.task import FRAMEWORKS, LOSS_NAMES, check_options
+from replication.run.units import Unit, run_unit
+
+
+def _check(framework, system, substeps, window, polyorder):
+    if framework is not None and framework not in FRAMEWORKS:
+        raise ValueError(f"--framework: {framework!r} is not valid; expected one of {', '.join(FRAMEWORKS)}")
+    check_options("lnn", "jax", 1, (1,), 1, 1.0, 0, "l1", substeps=substeps or 1, system=system)
+    if window is not None or polyorder is not None:
+        trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
+
+
+def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
+             polyorder=None, energy=None) -> list[dict]:
+    _check(framework, system, substeps, window, polyorder)
+    path = str(Path(data).resolve())
+    has_tau = "tau" in userdata.read(path)[1]
+    fits = [load_fitted(f) for f in fitted_folders(model)]
+    if energy:
+        from replication.fit.evaluate import energy_function
+
+        energy_function({"energy": energy}, fits[0].spec.dof)
+    for f in fits:
+        if (f.task == "inverse_dynamics") != has_tau:
+            raise ValueError(f"--data {data}: {'has' if has_tau else 'lacks'} tau columns, but the fit in {f.folder} "
+                             f"was trained {'with' if f.task == 'inverse_dynamics' else 'without'} them")
+    out = R.output_folder(out, "--out")
+    from replication.run.runner import is_current
+
+    done = []
+    for f in fits:
+        r = f.result
+        deriv = (r.get("eval_config") or {}).get("derivatives") or {}
+        w = window or deriv.get("window", trajectories.WINDOW)
+        p = polyorder or deriv.get("polyorder", trajectories.POLYORDER)
+        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test")
+        if prep.dof != f.spec.dof:
+            raise ValueError(f"--data {data}: has {prep.dof} degrees of freedom, the model in {f.folder} {f.spec.dof}")
+        fields = {k: v for k, v in r["model_spec"].items() if k not in ("hidden", "dtype")}
+        entry = ModelEntry(r["model"], fields, hidden=tuple(f.spec.hidden), train=False)
+        fcfg = r.get("eval_config") or {}
+        cfg = {"heldout": False, "test": prep.reference, "system": system or fcfg.get("system"),
+               "energy": energy or fcfg.get("energy"),
+               "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
+               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p},
+               "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
+        loss = f.protocol.loss if f.protocol.loss in LOSS_NAMES else "l1"
+        claim = Claim(id="evaluate", number=0, paper="user", section="-", title=f"{r['model']} on {Path(data).name}",
+                      system=cfg["system"] or Path(data).name, models=(entry,), protocols={"quick": f.protocol},
+                      evaluate="fit", metric=f"test_{loss}", metric_label=f"test {LOSS_NAMES[loss]}", published={},
+                      verdict_rule="none", verdict=lambda v: ("not run", "user data"), eval_config={"quick": cfg})
+        unit = Unit(claim, entry, framework or r["framework"], int(r["seed"]), "quick")
+        if is_current(unit, out):
+            done.append(dict(R.load_result(unit.folder(out)), reused=True, folder=str(unit.folder(out))))
+        else:
+            done.append(dict(run_unit(unit, out), folder=str(unit.folder(out))))
+    return done

@@ -1,0 +1,87 @@
+"""What every executor shares: running one unit, chains of units that share a trained model, and naming
+a unit across processes.
+
+`run_one(unit, out, on_log=None) -> (failure or None, error or None)`: run and write one unit; an
+exception becomes an error string ("<unit>: <Type>: <message>"), never lost to the rest of the run.
+`chains(todo) -> [[Unit]]`: the units grouped by the training program they need (`training.group_key`: a
+cohort of seeds is one program; untrained units alone), longest chain first by `cost` (training samples x model width x framework factor), so the
+long ones do not start last. A chain runs in order: its first unit trains, the others read the training
+from the cache.
+`ref(unit) -> tuple` and `unit_of(ref) -> Unit`: a unit as plain values and back (a claim's rules are
+closures: they do not pickle, so worker processes and Ray tasks receive refs).
+`run_chain(refs, out) -> [(name, failure, error)]`: a chain's units in order, in a worker.
+`release_compiled()`: drop JAX's compiled executables after a unit.
+"""
+from __future__ import annotations
+
+import gc
+import logging
+import sys
+
+log = logging.getLogger("lagbench")
+TORCH_COST = 3.0   # PyTorch's eager LNN step against JAX's compiled one, per sample (measured, 3 x 64 and 3 x 128)
+
+
+def release_compiled() -> None:
+    """Drop JAX's compiled executables after a unit. Every unit compiles its own model's functions, and
+    XLA's CPU code is mapped into memory piece by piece: about 190 mappings per model and unit, never
+    given back, so a 220-unit quick run exceeded the kernel's 65 530 mappings per process at unit 202 and
+    died in LLVM ("Cannot allocate memory"). Cleared, the count stays flat (measured); a unit never
+    reuses another's compilations, so nothing is lost."""
+    if "jax" in sys.modules:
+        sys.modules["jax"].clear_caches()
+    gc.collect()
+
+
+def run_one(unit, out, on_log=None):
+    """(failure or None, error or None) of running one unit."""
+    from replication.run.units import run_unit
+
+    try:
+        d = run_unit(unit, out, on_log=on_log)
+    except Exception as e:  # noqa: BLE001 - one unit's error must not lose the rest of the run
+        log.exception("%s failed", unit.name)
+        return None, f"{unit.name}: {type(e).__name__}: {e}"
+    finally:
+        release_compiled()
+    return (None if d["status"] == "ok" else f"{unit.name}: {d['failure']['message']}"), None
+
+
+def chains(todo) -> list[list]:
+    """The units grouped by the model they train (untrained units alone), longest chain first."""
+    from replication.training.train import group_key
+
+    groups: dict = {}
+    for u in todo:   # a cohort's seeds (`Protocol.cohort`) train in one program: one chain
+        key = group_key(u.framework, u.spec(), u.protocol(), u.seed) if u.entry.train else u.name
+        groups.setdefault(key, []).append(u)
+    return sorted(groups.values(), key=cost, reverse=True)
+
+
+def cost(chain) -> float:
+    from replication.training.scouting import budget_samples
+
+    u = chain[0]
+    if not u.entry.train:
+        return 0.0
+    width = sum(u.spec().hidden) or 1
+    return budget_samples(u.protocol()) * width * (TORCH_COST if u.framework == "torch" else 1.0)
+
+
+def ref(u) -> tuple:
+    """What names a unit across processes (a claim's rules are closures: they do not pickle)."""
+    return u.claim.id, u.entry.label, u.framework, u.seed, u.profile
+
+
+def unit_of(r):
+    from replication.claims import get as get_claim
+    from replication.run.units import Unit
+
+    claim_id, label, framework, seed, profile = r
+    claim = get_claim(claim_id)
+    return Unit(claim, next(e for e in claim.models if e.label == label), framework, seed, profile)
+
+
+def run_chain(refs, out):
+    """In a worker: the chain's units in order -> [(name, failure, error)]."""
+    return [(u.name, *run_one(u, out)) for u in map(unit_of, refs)]

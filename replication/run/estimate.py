@@ -1,0 +1,98 @@
+"""How long a run will take, told before it starts: each distinct training is probed for a few steps.
+
+`estimate(units, out, jobs)` counts every training the run still has to do once (units that share a
+trained model, such as claims 1 and 2, train it once; a training already in `OUT/trained/` costs
+nothing), times three steps of each distinct configuration on this machine after one step to compile
+(the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K members side by
+side), and scales up by the protocol's steps. Evaluation time is not included. The wall time assumes the trainings spread
+evenly over `jobs` workers, and is never below the longest single training.
+
+`describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
+"""
+from __future__ import annotations
+
+import json
+from collections import Counter, defaultdict
+from pathlib import Path
+
+from replication.training.scouting import continuation_protocol, scout_protocol
+from replication.training.train import group_key, run_training, train_cohort, train_key
+
+PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
+
+
+def _per_step(rows) -> float:
+    walls = [r["wall_s"] for r in rows if r.get("member", 0) == 0]
+    return (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
+
+
+def _plain_step(framework, spec, protocol) -> float:
+    p = continuation_protocol(protocol).replace(steps=PROBE_STEPS, log_every=1, schedule="constant",
+                                                n_train=protocol.batch * PROBE_STEPS, track_every=0)
+    return _per_step(run_training(framework, spec, p, 0).log)
+
+
+def _members_step(framework, spec, protocol, k: int) -> float:
+    """Seconds per step of `k` members side by side (scouts, or a cohort of seeds)."""
+    p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
+                         cohort=0, track_every=0)
+    rows = []
+    train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
+    return _per_step(rows)
+
+
+# what does not change the cost of a step: the init, the step counts, the rates and the pool sizes (the
+# probes leave held-out tracking off: its evaluations, the first one compiling, would count as step time)
+_FREE = ("steps", "scout_steps", "lr", "scout_lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start",
+         "lr_step_every", "lr_step_gamma", "track_every")
+
+
+def _shape(framework, spec, protocol) -> str:
+    p = {k: v for k, v in protocol.to_dict().items() if k not in _FREE}
+    return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
+
+
+def estimate(units, out, jobs: int = 1) -> dict:
+    """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
+    "probes": configurations timed}."""
+    per_step, todo, cached = {}, {}, 0
+    for u in units:
+        if not u.entry.train:
+            continue
+        p, spec = u.protocol(), u.spec()
+        group = group_key(u.framework, spec, p, u.seed)   # a cohort of seeds trains as one program
+        if group in todo:
+            continue
+        if (Path(out) / "trained" / u.framework / train_key(u.framework, spec, p, u.seed) / "result.json").exists():
+            cached += 1
+            todo[group] = 0.0
+            continue
+        shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
+        if shape not in per_step:
+            if p.cohort > 1:
+                per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), 0.0)
+            else:
+                per_step[shape] = (_plain_step(u.framework, spec, p), _members_step(
+                    u.framework, spec, scout_protocol(p), p.scouts) if p.scouts > 1 else 0.0)
+        plain, scouts = per_step[shape]
+        todo[group] = plain * p.steps + (scouts * scout_protocol(p).steps if p.scouts > 1 else 0.0)
+    total = sum(todo.values())
+    longest = max(todo.values(), default=0.0)
+    return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),
+            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step)}
+
+
+def describe(units, todo) -> str:
+    """One line per claim: models, seeds and frameworks planned, and how many units remain to run."""
+    left = Counter(u.claim.id for u in todo)
+    by = defaultdict(list)
+    for u in units:
+        by[u.claim.id].append(u)
+    lines = []
+    for cid, us in by.items():
+        models = sorted({u.entry.label for u in us})
+        fws = sorted({u.framework for u in us})
+        seeds = len({u.seed for u in us})
+        lines.append(f"  {cid:<17} {len(us):>3} units ({left[cid]} to run): {', '.join(models)}; "
+                     f"{seeds} seed{'s' if seeds != 1 else ''}; {', '.join(fws)}")
+    return "\n".join(lines)

@@ -1,0 +1,202 @@
+"""`lagbench run`: enumerate units, skip finished ones, run the rest with progress bars, summarise.
+
+A unit is finished when its result.json verifies (checksum and file hashes); anything else (absent,
+half-written, corrupt) is (re)run. Units are independent and deterministic given their seed, so an
+interrupted run resumes where it stopped and ends with the same numbers as an uninterrupted one.
+
+Nothing is silent or lost: every option is checked (`plan`) and the output folder made before any
+work; a unit redone because its folder held a damaged or half-written result is named in a warning
+and in run.json's "repaired"; an earlier invocation's run.json is kept as `runs/run-<start>.json`;
+Ctrl-C records "interrupted" in run.json before it propagates.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import time
+from pathlib import Path
+
+from replication import results as R
+from replication.claims import CLAIMS, PROFILES
+from replication.claims import get as get_claim
+from replication.claims.verdicts import write_summary
+from replication.evaluation.registry import EVALUATION_VERSION
+from replication.run import environment as env
+from replication.run.estimate import describe, estimate
+from replication.run.executor import run_units
+from replication.run.units import Unit
+
+log = logging.getLogger("lagbench")
+FRAMEWORKS = ("jax", "torch")
+LONG_PROFILES = ("full", "paper")   # profiles that print their units and an estimated duration first
+
+
+def _once(option: str, values) -> None:
+    twice = sorted({v for v in values if list(values).count(v) > 1})
+    if twice:
+        raise ValueError(f"{option}: {', '.join(twice)} given more than once; name each at most once")
+
+
+def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None) -> list:
+    """The units of a run; a ValueError naming the option if any is invalid or nothing would run."""
+    if profile not in PROFILES:
+        raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
+    for fw in frameworks:
+        if fw not in FRAMEWORKS:
+            raise ValueError(f"unknown framework {fw!r}; valid: {', '.join(FRAMEWORKS)}")
+    if not frameworks:
+        raise ValueError(f"--frameworks: none given; valid: {', '.join(FRAMEWORKS)}")
+    _once("--frameworks", frameworks)
+    _once("--claims", claims or ())
+    _once("--models", models or ())
+    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1):
+        raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer >= 1 (or leave it out for "
+                         f"the profile's)")
+    chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
+    labels = sorted({e.label for c in chosen for e in c.models})
+    unknown = sorted(set(models or ()) - set(labels))
+    if unknown:
+        raise ValueError(f"--models: unknown {', '.join(unknown)} for the chosen claims; valid: {', '.join(labels)}")
+    units = []
+    for claim in chosen:
+        n = claim.n_seeds(profile)
+        if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
+            n = seeds if max(claim.seeds.values()) > 1 else 1
+        for entry in claim.models:
+            if (models and entry.label not in models) or not entry.runs_in(profile):
+                continue
+            for fw in frameworks:
+                for seed in range(n):
+                    units.append(Unit(claim, entry, fw, seed, profile))
+    if not units:
+        raise ValueError(f"nothing to run: no model of the chosen claims and --models runs under profile "
+                         f"{profile!r}; see `lagbench list`")
+    return units
+
+
+def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = True) -> bool:
+    """True if the unit's folder holds a verified result of this very protocol, model spec, evaluation
+    config and evaluation version. A folder that holds no verified result is redone; with `repairs`,
+    one that exists (damaged or interrupted) is logged and listed there. A verified result of another one (the claim or an evaluation routine
+    was edited) is kept, renamed `superseded-<time>-seed<k>`, and the unit is rerun (its training comes
+    from the cache when the protocol is unchanged): nothing finished is lost or silently overwritten."""
+    folder = unit.folder(out)
+    try:
+        d = R.load_result(folder)
+    except R.CorruptResult as e:
+        if folder.exists() and repairs is not None:  # half-written or damaged: named, then redone
+            reason = str(e) if (folder / "result.json").exists() else "interrupted (no result.json)"
+            log.warning("lagbench: redoing %s: %s", unit.name, reason)
+            repairs.append(f"{unit.name}: {reason}")
+        return False
+    cfg = unit.claim.evaluation_config(unit.profile)
+    # a result that records no evaluation config or version predates them: stale, re-evaluated
+    same_eval = (d.get("eval_config") == json.loads(json.dumps(cfg))
+                 and d.get("evaluation_version") == EVALUATION_VERSION)
+    if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
+        return True
+    if not set_stale_aside:   # a look only (--dry-run): nothing renamed
+        return False
+    kept = set_aside(folder)
+    log.warning("lagbench: %s: its result was made under another protocol, spec or data; kept as %s "
+                "and rerun", unit.name, kept.name)
+    return False
+
+
+def set_aside(folder: Path) -> Path:
+    """Rename `folder` to `superseded-<time>-<name>` (with a counter if that exists): never clobbered."""
+    stamp = env.now().replace(":", "").replace("-", "")
+    for i in range(1000):
+        target = folder.with_name(f"superseded-{stamp}{f'.{i}' if i else ''}-{folder.name}")
+        if not target.exists():
+            folder.rename(target)
+            return target
+    raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
+
+
+def announce(profile, units, todo, out, jobs) -> dict:
+    """Print the units a long profile will run and its estimated duration (`replication.run.estimate`)."""
+    print(f"lagbench: profile {profile}: {len(units)} units, {len(todo)} to run:\n{describe(units, todo)}", flush=True)
+    print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
+    est = estimate(todo, out, jobs)
+    hw = env.hardware()
+    print(f"lagbench: {est['trainings']} trainings to do ({est['cached']} reused from OUT/trained), estimated "
+          f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
+          f"worker{'s' if jobs != 1 else ''} (evaluation not included; {hw['cpu']}, GPU: {hw['gpu']}). "
+          f"Interrupt at any time: the run resumes where it stopped.", flush=True)
+    return est
+
+
+def keep_previous_record(out: Path) -> Path | None:
+    """Copy an earlier invocation's run.json to `runs/run-<its start>.json` before it is replaced, so
+    the record of every attempt (what it planned, repaired, failed, or that it was interrupted) stays."""
+    try:
+        raw = (out / "run.json").read_bytes()
+        started = str(json.loads(raw).get("started") or env.now())
+    except (OSError, ValueError, AttributeError):
+        return None
+    stamp = "".join(ch for ch in started if ch.isalnum())
+    for i in range(1000):
+        target = out / "runs" / f"run-{stamp}{f'.{i}' if i else ''}.json"
+        if not target.exists():
+            R.atomic_write_bytes(target, raw)
+            return target
+    return None
+
+
+def executor_of(executor, jobs, address):
+    """`(todo, out, profile, progress) -> (failures, errors)` of --executor (checked before any work)."""
+    if executor == "local":
+        if address is not None:
+            raise ValueError("--address is for --executor ray; the local executor runs on this machine")
+        return lambda todo, out, profile, progress: run_units(todo, out, profile, progress, jobs)
+    if executor == "ray":
+        from replication.run.executor_ray import check_address, require_ray, run_units_ray
+
+        if jobs != 1:
+            raise ValueError("--jobs is for the local executor; with --executor ray every unit is a task on "
+                             "the Ray cluster's CPUs")
+        require_ray()
+        check_address(address)
+        return lambda todo, out, profile, progress: run_units_ray(todo, out, profile, progress, address)
+    raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
+
+
+def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
+        progress=True, jobs=1, executor="local", address=None, dry_run=False) -> dict:
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
+    execute = executor_of(executor, jobs, address)
+    units = plan(profile, claims, frameworks, seeds, models)
+    if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
+        todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
+        return {"dry_run": True, "units": len(units), "todo": len(todo),
+                "estimate": announce(profile, units, todo, out, jobs) if todo else None}
+    out = R.output_folder(out, "--out")
+    R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
+    manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
+                "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
+                # the units this run plans: the report names any that have no result (an unfinished run)
+                "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
+                "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
+    keep_previous_record(out)
+    R.write_json(out / "run.json", manifest)
+    repairs: list = []
+    todo = [u for u in units if not is_current(u, out, repairs)]
+    manifest["repaired"] = repairs
+    if profile in LONG_PROFILES and todo:
+        manifest["estimate"] = announce(profile, units, todo, out, jobs)
+        R.write_json(out / "run.json", manifest)
+    log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
+    t0 = time.perf_counter()
+    try:
+        failures, errors = execute(todo, out, profile, progress)
+    except KeyboardInterrupt:
+        manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
+        R.write_json(out / "run.json", manifest)
+        raise
+    summary = write_summary(out, profile)
+    manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
+                    units_run=len(todo), failures=failures, errors=errors)
+    R.write_json(out / "run.json", manifest)
+    return dict(summary, errors=errors, repaired=repairs)

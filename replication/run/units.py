@@ -1,0 +1,82 @@
+"""Units of work: claim x framework x model x seed, and how one unit is run and written."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from models import ModelSpec
+from replication import results as R
+from replication.evaluation.adapters import adapter
+from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
+from replication.evaluation.routines import Context, system_of
+from replication.run import environment as env
+from replication.training import hessian_probe
+from replication.training.outcome import log_frame
+from replication.training.train import train_cached
+
+
+@dataclass(frozen=True)
+class Unit:
+    claim: object
+    entry: object
+    framework: str
+    seed: int
+    profile: str
+
+    @property
+    def name(self) -> str:
+        return f"{self.claim.id}/{self.framework}/{self.entry.label}/seed{self.seed}"
+
+    def protocol(self):
+        return self.entry.protocol(self.claim.protocol(self.profile), self.profile)
+
+    def spec(self):
+        p = self.protocol()
+        fields = self.entry.spec_fields(self.profile)
+        dof = fields.pop("dof", None) or system_of(p).dof
+        return ModelSpec(dof=dof, hidden=self.entry.widths(self.profile) or (8,), dtype=p.dtype, **fields)
+
+    def folder(self, out) -> Path:
+        return R.unit_dir(out, self.claim.id, self.framework, self.entry.label, self.seed)
+
+
+def run_unit(unit: Unit, out, on_log=None) -> dict:
+    """Train (or reuse the cached training), evaluate, and write the unit's files; result.json last."""
+    t0 = time.perf_counter()
+    protocol, spec = unit.protocol(), unit.spec()
+    folder = unit.folder(out)
+    files, failure, outcome = {}, None, None
+    if unit.entry.train:
+        outcome = train_cached(out, unit.framework, spec, protocol, unit.seed, on_log=on_log)
+        failure, params = outcome.failure, outcome.params
+        files["train_log.csv"] = R.write_csv(folder / "train_log.csv", log_frame(outcome.log))
+        files["checkpoint.npz"] = R.write_npz(folder / "checkpoint.npz", params)
+    else:
+        params = None
+    ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
+                  protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile))
+    if params is not None:
+        ctx.model = adapter(unit.framework, spec, params)
+        ctx.log = outcome.log
+    ev = EVALUATIONS[unit.claim.evaluate](ctx)
+    for name, df in ev.tables.items():
+        files[name] = R.write_csv(folder / name, df)
+    if ev.arrays:
+        files["arrays.npz"] = R.write_npz(folder / "arrays.npz", ev.arrays)
+    record = {
+        "schema": R.SCHEMA, "claim": unit.claim.id, "framework": unit.framework, "model": unit.entry.label,
+        "seed": unit.seed, "profile": unit.profile, "status": "ok" if failure is None else "failed",
+        "failure": failure, "metrics": ev.metrics, "counters": {**ev.counters, **(hessian_probe.summarize(outcome.log) if outcome else {})},
+        "model_spec": spec.to_dict(),
+        "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "evaluation_version": EVALUATION_VERSION, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
+        "train_time_s": outcome.train_time_s if outcome else 0.0,
+        "train_steps": outcome.steps_done if outcome else 0,
+        "train_samples_per_s": outcome.samples_per_s if outcome else None,
+        "final_train_loss": outcome.log[-1]["loss"] if outcome and outcome.log else None,
+        "scouting": outcome.scouting if outcome else None,
+        "cohort": outcome.cohort if outcome else None,
+        "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
+        "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
+    }
+    return R.write_json(folder / "result.json", record, checksum=True)

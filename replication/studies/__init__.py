@@ -1,0 +1,1 @@
+"""Side studies that are not claims: the velocity-Hessian study and the stiff-solver study."""

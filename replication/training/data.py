@@ -1,0 +1,146 @@
+"""Training and held-out data for a protocol, in NumPy float64, shared by both frameworks.
+
+A *recipe* (`RECIPES[name]`) turns (system, n, rng) into a batch dict of float64 arrays:
+  "q", "qdot"  the model's two inputs, (N, dof); for canonical coordinates "qdot" holds p
+  "extra"      optional extra inputs (N, e): a per-sample field strength, or q-double-dot for an
+               inverse-dynamics model
+  "target"     what the model must predict, (N, k)
+  "weight"     optional per-sample loss weight (N,)
+  "qddot"      the true acceleration (N, dof), kept for evaluation
+`BatchStream` draws the pools and the batch order once from the seed, so the JAX and the PyTorch
+loop given the same protocol and seed see the same batches in the same order.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+import systems
+
+HELDOUT_SEED = 1_000_000_000  # the original code's PRNGKey(int(1e9)) test set, by analogy
+
+
+@lru_cache(maxsize=32)
+def _system(name: str, params: tuple):
+    return systems.get(name, **dict(params))
+
+
+def _states(name, params, n, rng):
+    s = _system(name, params)
+    st = s.sample_states(n, rng)
+    return s, st
+
+
+def _with_coords(s, st, protocol, qddot, extra=None, weight=None):
+    q, qdot = st["q"], st["qdot"]
+    out = {"qddot": qddot}
+    if protocol.task == "hamiltonian":
+        if protocol.coords == "qp":
+            kw = {k: v for k, v in st.items() if k not in ("q", "qdot")}
+            p = s.canonical_momentum(q, qdot, backend="numpy", **kw)
+            pdot = _pdot(s, q, qdot, qddot, kw)
+            out.update(q=q, qdot=p, target=np.concatenate([qdot, pdot], -1))
+        else:  # deliberately non-canonical: treat qdot as if it were the momentum
+            out.update(q=q, qdot=qdot, target=np.concatenate([qdot, qddot], -1))
+    else:
+        out.update(q=q, qdot=qdot, target=qddot)
+    if extra is not None:
+        out["extra"] = extra
+    if weight is not None:
+        out["weight"] = weight
+    return out
+
+
+def _pdot(s, q, qdot, qddot, kw):
+    """dp/dt along the true motion, exact: dL/dq (+ generalised forces), from `systems`. (A central
+    difference of p broke down near the speed of light: 0.47 % of relativistic targets came out 0.)"""
+    return s.canonical_momentum_rate(q, qdot, backend="numpy", **kw)
+
+
+def targets_version(protocol) -> str:
+    """What changed in a protocol's targets since its results were first cached ("" = nothing): part of
+    the training cache key, so a model trained on old targets is never reused."""
+    return "pdot-exact" if protocol.task == "hamiltonian" and protocol.coords == "qp" else ""
+
+
+def recipe_iid(protocol, n, rng):
+    """i.i.d. states from the system's declared distribution, exact targets."""
+    name = protocol.data.removesuffix("_iid")
+    params = tuple(sorted(protocol.system_params))
+    s, st = _states(name, params, n, rng)
+    fixed = dict(params)
+    kw = {k: v for k, v in st.items() if k not in ("q", "qdot") and k not in fixed}
+    st = {k: v for k, v in st.items() if k in ("q", "qdot") or k in kw}
+    qddot = s.acceleration(st["q"], st["qdot"], backend="numpy", **kw)
+    extra = np.stack([kw[k] for k in sorted(kw)], -1) if kw else None
+    weight = None
+    if protocol.loss == "l1_gamma":
+        weight = 1.0 + 1.0 / np.sqrt(1.0 - np.sum(st["qdot"] ** 2, -1))
+    return _with_coords(s, st, protocol, qddot, extra=extra, weight=weight)
+
+
+def recipe_arm(protocol, n, rng, kind="train"):
+    """Two-link arm inverse dynamics along smooth trajectories: inputs q, qdot, extra=qddot, target tau."""
+    from systems.datasets import arm_dataset
+
+    n_traj = max(1, n // 200)
+    d = arm_dataset(kind=kind, n_traj=n_traj, n_points=-(-n // n_traj), seed=int(rng.integers(2**31)))
+    q, qdot, qddot, tau = (np.asarray(d[k]).reshape(-1, 2)[:n] for k in ("q", "qdot", "qddot", "tau"))
+    return {"q": q, "qdot": qdot, "extra": qddot, "target": tau, "qddot": qddot}
+
+
+RECIPES = {"iid": recipe_iid, "arm": recipe_arm}
+
+
+def recipe_file(protocol, n, rng, kind="train"):
+    """A user's data file (see `replication.fit.userdata`): the train or held-out rows, as a batch dict."""
+    from replication.fit.userdata import split_rows
+
+    return split_rows(protocol.data.removeprefix("file:"), protocol.task, kind)
+
+
+def recipe_for(protocol):
+    if protocol.data.startswith("file:"):
+        return recipe_file
+    if protocol.data.endswith("_iid"):
+        return recipe_iid
+    if protocol.data.startswith("two_link_arm"):
+        return recipe_arm
+    raise ValueError(f"unknown data recipe {protocol.data!r}; valid: <system>_iid, two_link_arm")
+
+
+def heldout(protocol, **kw) -> dict:
+    """The fixed held-out set of a protocol (the same for every seed and model)."""
+    if protocol.data.startswith("file:"):
+        kw = {"kind": "heldout", **kw}
+    return recipe_for(protocol)(protocol, protocol.n_heldout, np.random.default_rng(HELDOUT_SEED), **kw)
+
+
+class BatchStream:
+    """Batches for step k of a protocol and seed: `stream.batch(k) -> dict of float64 arrays`."""
+
+    def __init__(self, protocol, seed: int):
+        self.p = protocol
+        self.seed = int(seed)
+        self.per_epoch = protocol.n_train // protocol.batch
+        self._epoch = None
+        self._pool = None
+        self._order = None
+        self._fixed = None
+
+    def _load_epoch(self, epoch):
+        if self.p.resample or self._fixed is None:
+            rng = np.random.default_rng([self.seed, 7919, epoch if self.p.resample else 0])
+            self._pool = recipe_for(self.p)(self.p, self.p.n_train, rng)
+            if not self.p.resample:
+                self._fixed = self._pool
+        self._order = np.random.default_rng([self.seed, 104729, epoch]).permutation(self.p.n_train)
+        self._epoch = epoch
+
+    def batch(self, step: int) -> dict:
+        epoch, i = divmod(int(step), self.per_epoch)
+        if epoch != self._epoch:
+            self._load_epoch(epoch)
+        idx = self._order[i * self.p.batch:(i + 1) * self.p.batch]
+        return {k: v[idx] for k, v in self._pool.items()}

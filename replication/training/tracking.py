@@ -1,0 +1,62 @@
+"""Held-out error during training, for work-precision curves (error against samples and training time).
+
+`Tracker(framework, spec, protocol)` is a loop hook (`replication.training.loop`): every `protocol.track_every`
+steps and at the last, it evaluates each member's data loss (the protocol's own loss, no L2 term) on the
+first `TRACK_STATES` held-out states through a NumPy adapter (`replication.evaluation.adapters`; JAX compiles it once
+per spec). It records step, samples, the training seconds so far (the loop's `step_seconds`: optimiser
+steps only, the first compiling step and these evaluations left out) and `heldout_loss`. `merge(logs)`
+writes them into the training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of
+the same step (a tracking step is also a log step: `track_every` is a multiple of `log_every`).
+The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from replication.evaluation.adapters import adapter
+from replication.training import data as datamod
+from replication.training.objective import loss_value, predict
+
+TRACK_STATES = 2000
+
+
+class Tracker:
+    def __init__(self, framework, spec, protocol, offset_steps: int = 0, offset_samples: int = 0,
+                 offset_seconds: float = 0.0):
+        if protocol.track_every % protocol.log_every:
+            raise ValueError(f"protocol track_every {protocol.track_every} is not a multiple of log_every "
+                             f"{protocol.log_every}")
+        held = datamod.heldout(protocol)
+        self.batch = {k: v[:TRACK_STATES] if hasattr(v, "shape") and v.ndim else v for k, v in held.items()}
+        self.framework, self.spec, self.protocol = framework, spec, protocol
+        self.offset_steps, self.offset_samples, self.offset_seconds = offset_steps, offset_samples, offset_seconds
+        self.rows: list[list[dict]] = []
+
+    def _loss(self, params) -> float:
+        m = adapter(self.framework, self.spec, params)
+        pred = predict(m, self.spec.kind, self.protocol.task, self.batch, np.concatenate)
+        return float(loss_value(np.asarray(pred, np.float64), self.batch["target"], self.batch.get("weight"),
+                                self.protocol.loss))
+
+    def __call__(self, k, stepper, info) -> bool:
+        p = self.protocol
+        if k % p.track_every and k != p.steps - 1:
+            return False
+        params = stepper.params()
+        members = params if isinstance(params, list) else [params]
+        while len(self.rows) < len(members):
+            self.rows.append([])
+        for i, theta in enumerate(members):
+            with np.errstate(all="ignore"):
+                loss = self._loss(theta)
+            self.rows[i].append({"step": k + self.offset_steps, "heldout_loss": loss,
+                                 "train_s": float(info["step_seconds"]) + self.offset_seconds,
+                                 "samples": (k + 1) * p.batch + self.offset_samples})
+        return False
+
+    def merge(self, logs: list[list[dict]]) -> None:
+        """Add the tracked columns to each member's log rows of the same step (in place)."""
+        for log, rows in zip(logs, self.rows, strict=False):
+            at = {r["step"]: r for r in rows}
+            for row in log:
+                row.update({k: v for k, v in at.get(row["step"], {}).items() if k != "step"})

@@ -1,0 +1,142 @@
+"""Train one (framework, spec, protocol, seed), with a cache so that claims sharing a model train it once.
+
+`train_cached(out, framework, spec, protocol, seed)` -> TrainOutcome. The cache folder
+`OUT/trained/<framework>/<key>/` holds checkpoint.npz (last good parameters), train_log.csv and
+train.json (timings, failure, file checksums); a corrupt entry is retrained, never trusted.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+from pathlib import Path
+
+import pandas as pd
+
+from models import init_params
+from replication import results as R
+from replication.training.data import BatchStream, targets_version
+from replication.training.outcome import TrainOutcome, log_frame
+from replication.training.scouting import train_scouted
+from replication.training.tracking import Tracker
+
+log = logging.getLogger("lagbench")
+
+
+def train_key(framework, spec, protocol, seed) -> str:
+    key = {"fw": framework, "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed}
+    targets = targets_version(protocol)
+    if targets:
+        key["targets"] = targets
+    blob = json.dumps(key, sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:20]
+
+
+def trainer(framework):
+    """The framework's training module (`train_jax` or `train_torch`: `train`, `train_members`)."""
+    if framework == "jax":
+        from replication.training import train_jax as module
+    elif framework == "torch":
+        from replication.training import train_torch as module
+    else:
+        raise ValueError(f"unknown framework {framework!r}; valid: jax, torch")
+    return module
+
+
+def tracker_for(framework, spec):
+    """`make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0) -> Tracker | None`: the tracking hook of a
+    protocol with `track_every` (`replication.training.tracking`), else None."""
+    def make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0.0):
+        if not protocol.track_every:
+            return None
+        return Tracker(framework, spec, protocol, offset_steps, offset_samples, offset_seconds)
+    return make
+
+
+def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    """One run of a protocol from the init of `seed`; with `protocol.scouts` > 1, restarts over inits
+    (`replication.training.scouting`)."""
+    track = tracker_for(framework, spec)
+    if protocol.scouts > 1:
+        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track)
+    t = track(protocol)
+    out = trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
+                                   on_log=on_log, hooks=(t,) if t else ())
+    if t:
+        t.merge([out.log])
+    return out
+
+
+def cohort_seeds(protocol, seed: int) -> list[int]:
+    """The seeds trained together with `seed` (`protocol.cohort`: groups g*K .. g*K + K - 1; else itself)."""
+    k = int(protocol.cohort)
+    if k <= 1:
+        return [seed]
+    return list(range(seed // k * k, seed // k * k + k))
+
+
+def group_key(framework, spec, protocol, seed) -> str:
+    """The key of the training program that makes `seed`'s model: units sharing it run in one chain."""
+    return train_key(framework, spec, protocol, cohort_seeds(protocol, seed)[0])
+
+
+def train_cohort(framework, spec, protocol, seeds, on_log=None) -> list[TrainOutcome]:
+    """The seeds' runs of `protocol` as one vectorised program (`train_members`): each its own init and
+    batch stream, as when run alone. `on_log` sees the first seed's rows; every outcome's `train_time_s` is
+    the program's (shared by the cohort)."""
+    def first(row):
+        if on_log and row.get("member", 0) == 0:
+            on_log(row)
+    t = tracker_for(framework, spec)(protocol)
+    outcomes = trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
+                                                [BatchStream(protocol, s) for s in seeds], on_log=first,
+                                                hooks=(t,) if t else ())
+    if t:
+        t.merge([o.log for o in outcomes])
+    for o in outcomes:
+        o.cohort = {"seeds": list(seeds)}
+    return outcomes
+
+
+def _cached(folder: Path) -> TrainOutcome | None:
+    try:
+        meta = R.load_result(folder) if (folder / "result.json").exists() else None
+    except R.CorruptResult as e:
+        log.warning("retraining: %s", e)
+        return None
+    if meta is None:
+        return None
+    return TrainOutcome(params=R.load_npz(folder / "checkpoint.npz"),
+                        log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
+                        failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
+                        batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
+                        cohort=meta.get("cohort"))
+
+
+def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
+    files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
+             "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
+    R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
+                                          "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
+                                          "scouting": outcome.scouting, "samples": outcome.samples,
+                                          "cohort": outcome.cohort, "spec": spec.to_dict(),
+                                          "protocol": protocol.to_dict(), "seed": seed},
+                 checksum=True)
+
+
+def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+    """`seed`'s training, from `OUT/trained/` when it is there; a cohort protocol trains (and stores) its
+    whole group of seeds at once."""
+    def folder(s):
+        return Path(out) / "trained" / framework / train_key(framework, spec, protocol, s)
+    done = _cached(folder(seed))
+    if done is not None:
+        return done
+    seeds = cohort_seeds(protocol, seed)
+    if len(seeds) > 1:
+        outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log)
+    else:
+        outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log)]
+    for s, o in zip(seeds, outcomes, strict=True):
+        _store(folder(s), o, spec, protocol, s)
+    return outcomes[seeds.index(seed)]

@@ -1,0 +1,165 @@
+"""The JAX optimiser step (equinox + optax) for the one training loop `replication.training.loop`. Mirrors
+`train_torch.py` line for line.
+
+`Stepper(spec, params, protocol, step=None)`: an Adam step (optax.scale_by_adam, scaled by the learning
+rate the loop passes; clipped to `protocol.grad_clip` and skipped above the spike guard's bound inside the
+compiled step, `replication.training.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
+`make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
+stream, on_log=None, hooks=()) -> TrainOutcome`: `replication.training.loop.train` with this stepper.
+
+`Members(spec, params_list, protocol, step=None)`: K models of one spec trained as one program (the
+stepper of `replication.training.loop.train_members`): the parameters and Adam states stacked along a leading axis
+and the same compiled step `eqx.filter_vmap`-ed over them and over the K batches (`make_members_step`);
+each member's numbers are those of its own `Stepper` run (`tests/replication/test_members_parity.py`).
+`train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> [TrainOutcome]`.
+"""
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+import models.jax
+from replication.training import hessian_probe, loop
+from replication.training.objective import loss_value, predict
+from replication.training.outcome import TrainOutcome
+
+
+def _to_jax(batch: dict, dtype) -> dict:
+    return {k: jnp.asarray(v, dtype=dtype) for k, v in batch.items()}
+
+
+def make_loss(spec, protocol):
+    def loss_fn(model, batch):
+        pred = predict(model, spec.kind, protocol.task, batch, jnp.concatenate)
+        loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss)
+        if protocol.l2:
+            leaves = jax.tree_util.tree_leaves(eqx.filter(model, eqx.is_inexact_array))
+            loss = loss + protocol.l2 * sum(jnp.sum(p * p) for p in leaves)
+        return loss
+    return loss_fn
+
+
+def make_step(spec, protocol):
+    """(optax transform, step). step(model, opt_state, batch, lr, skip_above=inf) -> (model, opt_state, loss,
+    gnorm): one Adam step on the gradient clipped to protocol.grad_clip (if set); not taken (model and state
+    returned unchanged) when gnorm >= skip_above (`replication.training.spike_guard`)."""
+    loss_fn = make_loss(spec, protocol)
+    opt = optax.scale_by_adam(b1=protocol.b1, b2=protocol.b2, eps=protocol.eps)
+    clip = protocol.grad_clip
+
+    @eqx.filter_jit
+    def step(model, opt_state, batch, lr, skip_above=jnp.inf):
+        loss, grads = eqx.filter_value_and_grad(loss_fn)(model, batch)
+        gnorm = optax.global_norm(grads)
+        if clip > 0:
+            scale = jnp.where(gnorm > clip, clip / gnorm, 1.0)
+            grads = jax.tree_util.tree_map(lambda g: g * scale.astype(g.dtype), grads)
+        updates, new_state = opt.update(grads, opt_state)
+        take = gnorm < skip_above
+        updates = jax.tree_util.tree_map(lambda u: jnp.where(take, -lr * u, jnp.zeros_like(u)), updates)
+        new_state = jax.tree_util.tree_map(lambda a, b: jnp.where(take, a, b), new_state, opt_state)
+        return eqx.apply_updates(model, updates), new_state, loss, gnorm
+
+    return opt, step
+
+
+def make_probe(spec, protocol):
+    """batch -> the `hessian_probe` columns (None for models without a velocity Hessian)."""
+    if not hessian_probe.wanted(spec, protocol):
+        return None
+
+    @eqx.filter_jit
+    def look(model, batch):
+        q, qdot, extra = batch["q"], batch["qdot"], batch.get("extra")
+        hess = model.velocity_hessian(q, qdot, extra) if hasattr(model, "velocity_hessian") else None
+        return (*model.acceleration_info(q, qdot, extra), hess)
+
+    def run(model, batch):
+        qdd, n_fb, hess = look(model, batch)
+        return hessian_probe.probe(np.asarray(qdd), int(n_fb), None if hess is None else np.asarray(hess),
+                                   protocol.dtype)
+    return run
+
+
+class Stepper:
+    def __init__(self, spec, params, protocol, step=None):
+        self.dtype = jnp.dtype(protocol.dtype)
+        self.model = models.jax.build(spec, params)
+        self.opt, self.step = step or make_step(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt_state = self.opt.init(eqx.filter(self.model, eqx.is_inexact_array))
+        self._next = None
+
+    def propose(self, batch, lr, bound):
+        batch = self._batch = _to_jax(batch, self.dtype)
+        model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
+                                              jnp.asarray(bound, self.dtype))
+        self._next = (model, state)
+        return float(loss), float(gnorm)
+
+    def commit(self, taken, scale):
+        # the compiled step has clipped, and left model and state unchanged where the bound skipped it
+        self.model, self.opt_state = self._next
+
+    def probe(self):
+        return None if self.look is None else self.look(self.model, self._batch)
+
+    def params(self) -> dict:
+        return models.jax.to_params(self.model)
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)
+
+
+def _stack(trees):
+    return jax.tree_util.tree_map(lambda *a: jnp.stack(a), *trees)
+
+
+def make_members_step(spec, protocol):
+    """(optax transform, the `make_step` step vmapped over stacked models, states, batches and bounds)."""
+    opt, step = make_step(spec, protocol)
+    return opt, eqx.filter_jit(eqx.filter_vmap(step, in_axes=(0, 0, 0, None, 0)))
+
+
+class Members:
+    def __init__(self, spec, params_list, protocol, step=None):
+        self.dtype = jnp.dtype(protocol.dtype)
+        built = [models.jax.build(spec, p) for p in params_list]
+        self.static = eqx.filter(built[0], eqx.is_array, inverse=True)
+        self.model = eqx.combine(_stack([eqx.filter(m, eqx.is_array) for m in built]), self.static)
+        self.opt, self.step = step or make_members_step(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt_state = eqx.filter_vmap(self.opt.init)(eqx.filter(self.model, eqx.is_inexact_array))
+        self.n, self._next = len(built), None
+
+    def member(self, i: int):
+        return eqx.combine(jax.tree_util.tree_map(lambda a: a[i], eqx.filter(self.model, eqx.is_array)),
+                           self.static)
+
+    def propose(self, batches, lr, bounds):
+        batch = self._batch = _to_jax({k: np.stack([b[k] for b in batches]) for k in batches[0]}, self.dtype)
+        model, state, loss, gnorm = self.step(self.model, self.opt_state, batch, jnp.asarray(lr, self.dtype),
+                                              jnp.asarray(bounds, self.dtype))
+        self._next = (model, state)
+        return np.asarray(loss, np.float64), np.asarray(gnorm, np.float64)
+
+    def commit(self, taken, scale):
+        # as Stepper: the compiled step has clipped each member and skipped those above their bound
+        self.model, self.opt_state = self._next
+
+    def probe(self):
+        if self.look is None:
+            return None
+        return [self.look(self.member(i), {k: v[i] for k, v in self._batch.items()})
+                for i in range(self.n)]
+
+    def params(self) -> list[dict]:
+        return [models.jax.to_params(self.member(i)) for i in range(self.n)]
+
+
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
+    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks)

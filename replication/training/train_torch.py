@@ -1,0 +1,181 @@
+"""The PyTorch optimiser step (torch.optim.Adam) for the one training loop `replication.training.loop`. Mirrors
+`train_jax.py` line for line.
+
+`Stepper(spec, params, protocol)`: the gradient and its global norm in `propose` (the learning rate set on
+the optimiser there); in `commit`, if the spike guard takes the step, the gradient scaled by the clip
+factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome`:
+`replication.training.loop.train` with this stepper.
+
+`Members(spec, params_list, protocol)`: K models of one spec trained as one program (the stepper of
+`replication.training.loop.train_members`): the parameters stacked by `torch.func.stack_module_state`, the K losses
+from `torch.func.functional_call` under `torch.func.vmap` over parameters and batches, one backward pass
+of their sum (the members share nothing, so each gets its own gradient), and Adam written out per member
+(`_adam`: torch.optim.Adam's single-tensor arithmetic, with a step count per member, so that a member the
+guard skips keeps its state exactly). Each member's numbers are those of its own `Stepper` run
+(`tests/replication/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
+on_log=None, hooks=()) -> [TrainOutcome]`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch import nn
+from torch.func import functional_call, stack_module_state, vmap
+
+import models.torch
+from replication.training import hessian_probe, loop
+from replication.training.objective import loss_value, predict
+from replication.training.outcome import TrainOutcome
+
+
+def _to_torch(batch: dict, dtype) -> dict:
+    return {k: torch.as_tensor(v, dtype=dtype) for k, v in batch.items()}
+
+
+def make_loss(spec, protocol):
+    def loss_fn(model, batch):
+        pred = predict(model, spec.kind, protocol.task, batch, torch.cat)
+        loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss)
+        if protocol.l2:
+            loss = loss + protocol.l2 * sum((p * p).sum() for p in model.parameters())
+        return loss
+    return loss_fn
+
+
+def make_probe(spec, protocol):
+    """batch -> the `hessian_probe` columns (None for models without a velocity Hessian)."""
+    if not hessian_probe.wanted(spec, protocol):
+        return None
+
+    def run(model, batch):
+        q, qdot, extra = batch["q"], batch["qdot"], batch.get("extra")
+        with torch.no_grad():
+            hess = model.velocity_hessian(q, qdot, extra) if hasattr(model, "velocity_hessian") else None
+            qdd, n_fb = model.acceleration_info(q, qdot, extra)
+        return hessian_probe.probe(qdd.numpy(), int(n_fb), None if hess is None else hess.numpy(),
+                                   protocol.dtype)
+    return run
+
+
+class Stepper:
+    def __init__(self, spec, params, protocol):
+        self.dtype = getattr(torch, protocol.dtype)
+        self.model = models.torch.build(spec, params)
+        self.loss_fn = make_loss(spec, protocol)
+        self.look = make_probe(spec, protocol)
+        self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
+                                    eps=protocol.eps, weight_decay=0.0, foreach=False)
+        self.clip_to, self._grads = float(protocol.grad_clip), []
+
+    def propose(self, batch, lr, bound):
+        batch = self._batch = _to_torch(batch, self.dtype)
+        for group in self.opt.param_groups:
+            group["lr"] = lr
+        self.opt.zero_grad(set_to_none=True)
+        loss = self.loss_fn(self.model, batch)
+        loss.backward()
+        self._grads = [p.grad for p in self.model.parameters() if p.grad is not None]
+        self._gnorm = torch.sqrt(sum((g * g).sum() for g in self._grads))
+        return float(loss.detach()), float(self._gnorm)
+
+    def commit(self, taken, scale):
+        if not taken:
+            return
+        if scale != 1.0:   # clip: the norm as a tensor, as the JAX step scales inside its graph
+            for g in self._grads:
+                g.mul_(self.clip_to / self._gnorm)
+        self.opt.step()
+
+    def probe(self):
+        return None if self.look is None else self.look(self.model, self._batch)
+
+    def params(self) -> dict:
+        return models.torch.to_params(self.model)
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)
+
+
+class _Objective(nn.Module):
+    """batch -> the protocol's loss of one model (what `Members` maps over the stacked parameters)."""
+
+    def __init__(self, model, loss_fn):
+        super().__init__()
+        self.model, self.loss_fn = model, loss_fn
+
+    def forward(self, batch):
+        return self.loss_fn(self.model, batch)
+
+
+def _adam(p, g, m, v, t, lr, protocol):
+    """torch.optim.Adam's single-tensor update of stacked (K, ...) tensors, t (K,) the step counts after
+    this step: (new p, new m, new v)."""
+    m = torch.lerp(m, g, 1 - protocol.b1)
+    v = v * protocol.b2 + (1 - protocol.b2) * g * g
+    shape = (-1,) + (1,) * (p.dim() - 1)
+    t = t.to(torch.float64)
+    step_size = (lr / (1 - protocol.b1 ** t)).to(p.dtype).reshape(shape)
+    bc2_sqrt = ((1 - protocol.b2 ** t) ** 0.5).to(p.dtype).reshape(shape)
+    return p - step_size * (m / (v.sqrt() / bc2_sqrt + protocol.eps)), m, v
+
+
+class Members:
+    def __init__(self, spec, params_list, protocol):
+        self.dtype, self.protocol = getattr(torch, protocol.dtype), protocol
+        loss_fn = make_loss(spec, protocol)
+        objectives = [_Objective(models.torch.build(spec, p), loss_fn) for p in params_list]
+        self.base, self.spec = objectives[0], spec
+        self.stacked, self.buffers = stack_module_state(objectives)
+        self.moments = {k: (torch.zeros_like(p), torch.zeros_like(p)) for k, p in self.stacked.items()}
+        self.count = torch.zeros(len(objectives), dtype=torch.int64)
+        self.look = make_probe(spec, protocol)
+        self.clip_to, self.n = float(protocol.grad_clip), len(objectives)
+
+    def _loss(self, params, buffers, batch):
+        return functional_call(self.base, (params, buffers), (batch,))
+
+    def propose(self, batches, lr, bounds):
+        batch = self._batch = _to_torch({k: np.stack([b[k] for b in batches]) for k in batches[0]}, self.dtype)
+        for p in self.stacked.values():
+            p.grad = None
+        losses = vmap(self._loss)(self.stacked, self.buffers, batch)
+        losses.sum().backward()
+        self._lr = lr
+        # a parameter the loss does not reach (the LNN's last bias) has no gradient; Adam leaves it, as in Stepper
+        self._with_grad = {k: p for k, p in self.stacked.items() if p.grad is not None}
+        self._gnorm = torch.sqrt(sum((p.grad * p.grad).flatten(1).sum(1) for p in self._with_grad.values()))
+        return losses.detach().double().numpy(), self._gnorm.double().numpy()
+
+    def commit(self, taken, scale):
+        take = torch.as_tensor(taken)
+        if not take.any():
+            return
+        clip = torch.as_tensor(scale != 1.0)
+        factor = torch.where(clip, self.clip_to / self._gnorm, torch.ones_like(self._gnorm))
+        count = self.count + take.to(torch.int64)
+        with torch.no_grad():
+            for k, p in self._with_grad.items():
+                shape = (-1,) + (1,) * (p.dim() - 1)
+                g = torch.where(clip.reshape(shape), p.grad * factor.reshape(shape), p.grad)
+                new_p, m, v = _adam(p, g, *self.moments[k], count.clamp(min=1), self._lr, self.protocol)
+                keep = take.reshape(shape)
+                p.copy_(torch.where(keep, new_p, p))
+                self.moments[k] = (torch.where(keep, m, self.moments[k][0]), torch.where(keep, v, self.moments[k][1]))
+        self.count = count
+
+    def _params_of(self, i: int) -> dict:
+        return {k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
+
+    def probe(self):
+        if self.look is None:
+            return None
+        return [self.look(models.torch.build(self.spec, self._params_of(i)), {k: v[i] for k, v in self._batch.items()})
+                for i in range(self.n)]
+
+    def params(self) -> list[dict]:
+        return [self._params_of(i) for i in range(self.n)]
+
+
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
+    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks)

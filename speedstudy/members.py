@@ -1,0 +1,78 @@
+"""Many seeds for the price of one: K models trained side by side as one program (`loop.train_members`:
+JAX `eqx.filter_vmap`, PyTorch `torch.func.vmap` over stacked parameters) against one model alone.
+
+The case is the restarts protocol's scouting phase: the double-pendulum LNN (softplus, the code's init,
+angles wrapped, velocity inputs x 0.3) at `sizes.members_hidden` (quick: 3 x 128), batch 32, the spike
+guard on, `sizes.members_steps` steps per round. Per framework, rounds alternate one model and K members
+(`members_rounds` of each, interleaved, so that load on the shared machine falls on both alike); each keeps
+its fastest round. The compiled step is built once per case and warmed up before the first round.
+
+`members_rows(sizes) -> rows` {framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s,
+cost_vs_one, step_cost_vs_one}: wall_s is the whole loop (batches drawn in NumPy, the guard, the step),
+step_s the optimiser steps alone (`TrainOutcome.step_seconds`); cost_vs_one = the K members' wall over one
+model's (K scouts run one after another would cost K). The issue's bound, K = 8 at most 2.5x one model's
+wall time per framework, is checked in `speedstudy.targets`.
+"""
+from __future__ import annotations
+
+from models import ModelSpec, init_params
+from replication.claims.double_pendulum import MODELS, PROTOCOLS
+from replication.training import loop, scouting, train_jax, train_torch
+from replication.training.data import BatchStream
+
+MEMBERS = 8
+
+
+def _case(sizes):
+    lnn = next(m for m in MODELS if m.label == "lnn")
+    spec = ModelSpec(dof=2, hidden=tuple(sizes.members_hidden), dtype="float32", **lnn.spec_fields("quick"))
+    scout = scouting.scout_protocol(PROTOCOLS["quick"])   # a scout of the quick double-pendulum protocol
+    return spec, scout.replace(steps=sizes.members_steps, n_train=scout.batch * 1000, log_every=10**9)
+
+
+def _make_step(framework, spec, protocol, k):
+    if framework != "jax":
+        return None
+    return train_jax.make_step(spec, protocol) if k == 1 else train_jax.make_members_step(spec, protocol)
+
+
+def _round(framework, spec, protocol, k, step):
+    """(wall, step seconds) of one round: one model through its own stepper (what a lone scout runs), or k
+    members as one program."""
+    module = train_jax if framework == "jax" else train_torch
+    kw = {"step": step} if framework == "jax" else {}
+    if k == 1:
+        out = loop.train(module.Stepper(spec, init_params(spec, seed=0), protocol, **kw), protocol,
+                         BatchStream(protocol, 0), compiled=True)
+    else:
+        out = loop.train_members(module.Members(spec, [init_params(spec, seed=s) for s in range(k)], protocol, **kw),
+                                 protocol, [BatchStream(protocol, s) for s in range(k)], compiled=True)[0]
+    return out.train_time_s, out.step_seconds
+
+
+def members_rows(sizes, bar=None) -> list[dict]:
+    spec, protocol = _case(sizes)
+    rows = []
+    for fw in ("jax", "torch"):
+        steps = {k: _make_step(fw, spec, protocol, k) for k in (1, MEMBERS)}
+        best = {}
+        for k in (1, MEMBERS):   # warm-up: compile, first batches
+            _round(fw, spec, protocol.replace(steps=2), k, steps[k])
+        for _ in range(sizes.members_rounds):
+            for k in (1, MEMBERS):
+                wall, step_s = _round(fw, spec, protocol, k, steps[k])
+                old = best.get(k, (float("inf"), float("inf")))
+                best[k] = (min(old[0], wall), min(old[1], step_s))
+        for k in (1, MEMBERS):
+            wall, step_s = best[k]
+            rows.append({"framework": fw, "members": k, "hidden": "x".join(map(str, spec.hidden)),
+                         "batch": protocol.batch, "steps": protocol.steps, "wall_s": wall, "step_s": step_s,
+                         "samples_per_s": k * protocol.steps * protocol.batch / wall,
+                         "cost_vs_one": wall / best[1][0], "step_cost_vs_one": step_s / best[1][1]})
+        if bar is not None:
+            bar.update(1)
+    return rows
+
+
+def n_cases(sizes) -> int:
+    return 2 if sizes.members_steps else 0

@@ -1,0 +1,42 @@
+"""The speed study's tiny preset, run once per session and shared by the tests that read its files
+(`test_speed_study.py`) and those that resume from its checkpoints (`test_bench_resume.py`, on copies).
+Tests must not write into it."""
+import json
+
+import pytest
+
+from models import ModelSpec, init_params
+from replication.results import write_npz
+from speedstudy import run_bench
+
+
+def _fake_trained_unit(out):
+    """A double-pendulum unit as `lagbench run` leaves it: result.json with model_spec + checkpoint.npz."""
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
+    unit = out / "units" / "dp_loss" / "jax" / "lnn" / "seed0"
+    unit.mkdir(parents=True)
+    write_npz(unit / "checkpoint.npz", init_params(spec, seed=3))
+    (unit / "result.json").write_text(json.dumps({
+        "claim": "dp_loss", "framework": "jax", "model": "lnn", "seed": 0, "status": "ok",
+        "model_spec": spec.to_dict(), "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+
+
+def _fake_training_cache(out):
+    """An LNN in the training cache (OUT/trained/jax/<key>/) as `replication.training.train` leaves it; the
+    baseline is missing, so the rollout study trains a tiny one."""
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), angle_wrap=True)
+    folder = out / "trained" / "jax" / "fakekey"
+    folder.mkdir(parents=True)
+    write_npz(folder / "checkpoint.npz", init_params(spec, seed=4))
+    (folder / "result.json").write_text(json.dumps({
+        "failure": None, "steps_done": 10, "batch": 8, "spec": spec.to_dict(), "seed": 0,
+        "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+
+
+@pytest.fixture(scope="session")
+def bench_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench")
+    _fake_trained_unit(out)
+    _fake_training_cache(out)
+    targets = run_bench(out, tiny=True, progress=False)
+    return out, targets
