@@ -1,5 +1,6 @@
-"""The replication: protocols, the mirrored JAX and PyTorch training loops, the claims, evaluation,
-the resumable runner and the `lagbench` command line. Result files: see RESULTS.md beside this file."""
+"""The replication, a folder per job: training/ (protocols, the one loop, JAX and PyTorch steps), evaluation/,
+claims/ (records, rules, verdicts), run/ (units, runner, executors), fit/ (a user's data), studies/, and the
+`lagbench` command line (cli.py). Result files: results.py, layout in docs/RESULTS.md."""
 import os as _os
 
 _os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # busy-waiting OpenMP threads stall a loaded CPU (CONTRIBUTING)
