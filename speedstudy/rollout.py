@@ -5,8 +5,8 @@ ground truth and for learned models.
 wall_s, state_err, energy_err, n_ics, t_end}`:
   kind "truth": diffrax Tsit5 / Dopri5 / Dopri8 (`sizes.rollout_solvers`; adaptive, PID, atol = rtol,
     at most TRUTH_MAX_STEPS steps) at `sizes.rollout_rtols` (`field_solver` on the generated JAX accelerations,
-    the same code as the learned rows; rtol is traced, so one compilation per solver), and a fixed-step classical RK4 (jax.lax.scan over the generated
-    JAX accelerations; solver "rk4", rtol empty, `dt` the step) at `sizes.rollout_dts`;
+    the same code as the learned rows; rtol is traced, so one compilation per solver), and a fixed-step classical RK4 (`replication.evaluation.rollout.rk4_scan`
+    over the generated JAX accelerations; solver "rk4", rtol empty, `dt` the step) at `sizes.rollout_dts`;
   kind "chaos_floor": the reference re-run from initial states perturbed by 1e-12 (relative): the state
     error any integrator must reach before its own error is distinguishable from chaotic divergence.
 Reference: Dopri8 at rtol = atol = 1e-13. `rollout_ics` initial states: angles U(-pi, pi), velocities
@@ -29,7 +29,7 @@ import numpy as np
 
 import systems
 from replication.claims.double_pendulum import ENERGY_SCALE
-from replication.evaluation.rollout import rk4_step
+from replication.evaluation.rollout import rk4_scan
 from speedstudy.timing import best_time
 from systems.trajectories import SOLVERS, integrate
 
@@ -50,11 +50,7 @@ def _rk4(system, dt, n_steps):
     def field(y):
         return jnp.concatenate([y[dof:], system.acceleration(y[:dof], y[dof:], backend="jax")])
 
-    def one(y0):
-        def body(y, _):
-            return rk4_step(field, y, dt), None
-        return jax.lax.scan(body, y0, None, length=n_steps)[0]
-    return jax.jit(jax.vmap(one))
+    return jax.jit(jax.vmap(lambda y0: rk4_scan(field, y0, dt, n_steps)))
 
 
 def field_solver(accel, solver: str, max_steps: int = MAX_STEPS):

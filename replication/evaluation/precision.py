@@ -7,8 +7,10 @@ in the protocol's dtype (float32 or float64), |E(t) - E(0)| / energy_scale at th
 over time), averaged over initial conditions. The integrator (`truth_integrator` in the evaluation config)
 is "dopri5": adaptive Dormand-Prince 5(4) in diffrax at rtol = atol = `truth_tol` (the original code's
 odeint, default 1e-10, unattainable in float32), capped at `truth_max_steps`; or "rk4": fixed-step RK4 at
-the config's `dt` in NumPy (no compilation; the smoke profile). `truth_energy_drift_f64ref` is the drift
-of the float64 ground truth used everywhere else (systems.trajectories), for comparison.
+the config's `dt` in NumPy (`replication.evaluation.rollout.rollout`, step "dt", the state, the step and
+the equations of motion in the dtype; no compilation; the smoke profile; a run that diverges is NaN from then
+on). `truth_energy_drift_f64ref` is the drift of the float64 ground truth used everywhere else
+(systems.trajectories), for comparison.
 """
 from __future__ import annotations
 
@@ -16,21 +18,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from replication.evaluation.rollout import rk4_step
+from replication.evaluation.rollout import lagrangian_field, rollout
 from replication.evaluation.routines import _truth, eval_energy_rollout
-
-
-def _rk4_in_dtype(s, y0, t, dt, dtype):
-    """Fixed-step RK4 (`replication.evaluation.rollout.rk4_step`) with the state, the step and the equations of
-    motion all in ``dtype``."""
-    dof, y, h = s.dof, y0.astype(dtype), np.asarray(dt, dtype)
-    f = lambda z: np.concatenate([z[:, dof:], s.acceleration(z[:, :dof], z[:, dof:]).astype(dtype)], 1)  # noqa: E731
-    out = [y]
-    for j in range(1, t.size):
-        for _ in range(max(1, int(round((t[j] - t[j - 1]) / dt)))):
-            y = rk4_step(f, y, h)
-        out.append(y)
-    return np.stack(out, 1).astype(np.float64)
 
 
 @lru_cache(maxsize=8)
@@ -40,7 +29,8 @@ def truth_drift_in_dtype(name, params, cfg_items, dtype: str):
     s, t, q, qd, _, _ = _truth(name, params, cfg_items)
     y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
     if cfg.get("truth_integrator", "dopri5") == "rk4":
-        ys = _rk4_in_dtype(s, y0, t, cfg["dt"], np.dtype(dtype))
+        accel = lambda q, qd: s.acceleration(q, qd).astype(dtype)  # noqa: E731
+        ys = rollout(lagrangian_field(accel, s.dof), y0, t, cfg["dt"], dtype=dtype, step="dt")
     else:
         ys = _dopri5_in_dtype(s, y0, t, cfg, dtype)
     e = s.energy(ys[..., :s.dof], ys[..., s.dof:])

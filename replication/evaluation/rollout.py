@@ -1,16 +1,26 @@
-"""A framework-neutral fixed-step RK4 integrator for learned models, batched over trajectories.
+"""The suite's one fixed-step RK4 integrator, batched over trajectories, in any dtype.
 
 Learned models of both frameworks are rolled out by this one integrator (float64 state, the model
 evaluated in its own dtype through a NumPy callable), so that a JAX and a PyTorch model are judged
-by the same numerics. Ground truth uses diffrax at tight tolerances (`systems.trajectories`).
+by the same numerics; the precision evaluation runs the exact equations of motion through it in float32
+(`replication.evaluation.precision`), and the speed study's jitted RK4 is `rk4_scan` (JAX). Ground truth
+uses diffrax at tight tolerances (`systems.trajectories`).
 
-`rollout(f, z0, t_eval, dt) -> (z, n_steps)`: z0 (B, k) first-order state, f(z) -> dz/dt (B, k);
-returns z (B, T, k) at the times `t_eval` (t_eval[0] is the start). A trajectory whose state turns
-non-finite is frozen at NaN from then on (reported as diverged, never silently).
+`rk4_step(f, z, h) -> z'`: one classical step; plain arithmetic, so NumPy (any dtype) and JAX arrays alike.
+`rollout(f, z0, t_eval, dt, *, dtype=float64, step="split") -> z`: z0 (B, k) first-order state,
+f(z) -> dz/dt (B, k); returns z (B, T, k) float64 at the times `t_eval` (t_eval[0] is the start), the
+state and the step held in `dtype` in between. step "split": each interval of t_eval in ceil(interval / dt)
+equal steps; step "dt": in max(1, round(interval / dt)) steps of exactly dt (a grid that is a multiple of
+dt). A trajectory whose state turns non-finite is frozen at NaN from then on (reported as diverged, never
+silently).
+`rk4_scan(f, y0, h, n_steps) -> y`: n_steps steps of size h under `jax.lax.scan` (traceable; JAX imported
+only when called).
 """
 from __future__ import annotations
 
 import numpy as np
+
+STEPS = ("split", "dt")
 
 
 def _guarded(f):
@@ -28,8 +38,7 @@ def _guarded(f):
 
 
 def rk4_step(f, z, h):
-    """One classical RK4 step of dz/dt = f(z): plain arithmetic, so NumPy (any dtype) and JAX arrays alike
-    (the speed study's jitted RK4 scans this same step)."""
+    """One classical RK4 step of dz/dt = f(z) (z and h in one dtype keep the step in it)."""
     k1 = f(z)
     k2 = f(z + 0.5 * h * k1)
     k3 = f(z + 0.5 * h * k2)
@@ -37,16 +46,25 @@ def rk4_step(f, z, h):
     return z + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def rollout(f, z0, t_eval, dt):
-    f = _guarded(f)
-    z = np.array(z0, dtype=np.float64)
+def _steps(interval, dt, step, dtype):
+    """(number of steps, step size in `dtype`) covering one interval of the output grid."""
+    if step == "dt":
+        return max(1, int(round(interval / dt))), np.asarray(dt, dtype)
+    n = max(1, int(np.ceil(interval / dt - 1e-9)))
+    return n, np.asarray(interval / n, dtype)
+
+
+def rollout(f, z0, t_eval, dt, *, dtype=np.float64, step: str = "split"):
+    if step not in STEPS:
+        raise ValueError(f"unknown step rule {step!r}; valid: {', '.join(STEPS)}")
+    f, dtype = _guarded(f), np.dtype(dtype)
+    z = np.array(z0, dtype=dtype)
     t_eval = np.asarray(t_eval, dtype=np.float64)
     out = np.full((z.shape[0], t_eval.size, z.shape[1]), np.nan)
     out[:, 0] = z
-    t, alive = t_eval[0], np.ones(z.shape[0], bool)
+    alive = np.ones(z.shape[0], bool)
     for j in range(1, t_eval.size):
-        n = max(1, int(np.ceil((t_eval[j] - t) / dt - 1e-9)))
-        h = (t_eval[j] - t) / n
+        n, h = _steps(t_eval[j] - t_eval[j - 1], dt, step, dtype)
         for _ in range(n):
             with np.errstate(all="ignore"):
                 z = rk4_step(f, z, h)
@@ -54,10 +72,18 @@ def rollout(f, z0, t_eval, dt):
             if bad.any():
                 alive &= ~bad
                 z[bad] = 0.0  # keep the batch finite; these trajectories are reported as diverged
-        t = t_eval[j]
         out[alive, j] = z[alive]
         out[~alive, j] = np.nan
     return out
+
+
+def rk4_scan(f, y0, h, n_steps: int):
+    """y(t0 + n_steps * h) from y0 by `rk4_step` in a `jax.lax.scan` (jit- and vmap-able)."""
+    import jax
+
+    def body(y, _):
+        return rk4_step(f, y, h), None
+    return jax.lax.scan(body, y0, None, length=n_steps)[0]
 
 
 def lagrangian_field(accel, dof):
