@@ -100,22 +100,35 @@ def _clean(obj):
 
 
 def canonical(d: dict) -> bytes:
+    """The checksummed form of `d`: JSON with keys sorted at every level, no spaces, ASCII (`\\u` escapes),
+    NaN and infinities as `NaN` / `Infinity` (json's defaults), encoded as UTF-8."""
     return json.dumps(d, sort_keys=True, separators=(",", ":")).encode()
 
 
 def sha256_bytes(data: bytes) -> str:
+    """sha256 of `data`, 64 lowercase hex digits."""
     return hashlib.sha256(data).hexdigest()
 
 
 def sha256_file(path: Path) -> str:
-    return sha256_bytes(Path(path).read_bytes())
+    """sha256 of a file's bytes (read in 1 MiB blocks), 64 lowercase hex digits."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def result_checksum(d: dict) -> str:
+    """The checksum a result.json carries: sha256 of `canonical` of `d` without its top-level "checksum"
+    key (nested keys named so are kept)."""
+    return sha256_bytes(canonical({k: v for k, v in d.items() if k != "checksum"}))
 
 
 def write_json(path: Path, d: dict, *, checksum: bool = False) -> dict:
     d = _clean(d)
     if checksum:
-        d.pop("checksum", None)
-        d["checksum"] = sha256_bytes(canonical(d))
+        d["checksum"] = result_checksum(d)
     atomic_write_bytes(Path(path), json.dumps(d, indent=1, sort_keys=True).encode())
     return d
 
@@ -160,8 +173,7 @@ def load_result(folder: Path) -> dict:
     folder = Path(folder)
     d = read_json(folder / "result.json")
     expected = d.get("checksum")
-    body = {k: v for k, v in d.items() if k != "checksum"}
-    if expected is None or sha256_bytes(canonical(body)) != expected:
+    if expected is None or result_checksum(d) != expected:
         raise CorruptResult(f"{folder / 'result.json'}: checksum mismatch")
     for name, digest in (d.get("files") or {}).items():
         f = folder / name

@@ -8,36 +8,24 @@ Canonical form of a ``result.json`` checksum (the writer must match it byte for 
 
 Only the top-level ``"checksum"`` key is dropped; nested keys are sorted too (``sort_keys`` is recursive).
 Every entry of ``result["files"]`` maps a path relative to the unit folder to the lowercase hex sha256
-of that file's bytes.
+of that file's bytes. The code that computes both is the writer's own (`replication.results`: `canonical`,
+`result_checksum`, `sha256_file`; NumPy only, no training code); this module adds the report's
+verification, which names what is wrong instead of raising.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 
-CHUNK = 1 << 20
+from replication.results import canonical, result_checksum
+from replication.results import sha256_file as file_sha256
+
+__all__ = ["canonical_json", "result_checksum", "file_sha256", "verify_unit"]
 
 
 def canonical_json(result: dict) -> str:
     """The canonical JSON text of ``result`` without its top-level ``"checksum"`` key."""
-    body = {k: v for k, v in result.items() if k != "checksum"}
-    return json.dumps(body, sort_keys=True, separators=(",", ":"))
-
-
-def result_checksum(result: dict) -> str:
-    """sha256 (hex) of :func:`canonical_json` encoded as UTF-8."""
-    return hashlib.sha256(canonical_json(result).encode("utf-8")).hexdigest()
-
-
-def file_sha256(path: Path) -> str:
-    """sha256 (hex) of a file's bytes."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(CHUNK), b""):
-            h.update(block)
-    return h.hexdigest()
+    return canonical({k: v for k, v in result.items() if k != "checksum"}).decode("utf-8")
 
 
 def verify_unit(unit_dir: Path, result: dict) -> str | None:
