@@ -12,6 +12,8 @@ Per kind, the MLP input width and output width (see `mlp_sizes`):
   lgn:      [q_nb, qdot_nb] of one node's 2r+1 neighbours (2*(2r+1)) -> 1
 Formulations: lnn "fast" | "paper"; lgn "banded" (alias "fast") | "dense" | "paper";
 other kinds ignore it.
+`CAPABILITIES[kind]` (`Capability`): the one table of kinds (class name, tasks, formulations, how PyTorch
+compiles it); `KINDS` is its keys, and `models.jax.build` / `models.torch.build` register from it.
 """
 from __future__ import annotations
 
@@ -20,35 +22,44 @@ from dataclasses import dataclass
 
 from models.activations import ACTIVATIONS
 
-KINDS = ("baseline", "lnn", "hnn", "delan", "lgn")
-
 
 @dataclass(frozen=True)
 class Capability:
-    """What a model kind can do; consumers read this table instead of keeping their own lists.
+    """One model kind: where its code is and what it can do. This table is the one list of kinds:
+    `KINDS`, both frameworks' `build` registries and every consumer read it instead of keeping their own.
 
-    tasks: the protocol tasks it trains on; lagrangian_hessian: its q-double-dot goes through a learned
-    velocity Hessian d2L/dqdot2 (the Hessian probe watches it); torch_compile: formulation -> how PyTorch
-    compiles it ahead of time: "aot" (torch.export + AOTInductor, any batch) or "traced" (torch.func
-    inside: make_fx, then compiled per batch size)."""
+    model_class: the class name in `models/jax/<kind>.py` and `models/torch/<kind>.py` (`build` imports it
+    by name). tasks: the protocol tasks it trains on; lagrangian_hessian: its q-double-dot goes through a
+    learned velocity Hessian d2L/dqdot2 (the Hessian probe watches it); torch_compile: formulation -> how
+    PyTorch compiles it ahead of time: "aot" (torch.export + AOTInductor, any batch) or "traced" (torch.func
+    inside: make_fx, then compiled per batch size). formulations: the spec formulations it accepts (empty:
+    it has one and ignores the field); extra_inputs: it takes extra MLP inputs; scalar_output: its MLP
+    ends in one output (n_out must be None or 1)."""
 
+    model_class: str
     tasks: tuple
     lagrangian_hessian: bool
     torch_compile: dict
+    formulations: tuple = ()
+    extra_inputs: bool = True
+    scalar_output: bool = True
 
 
 CAPABILITIES = {
-    "baseline": Capability(("acceleration", "inverse_dynamics"), False, {"-": "aot"}),
-    "lnn": Capability(("acceleration",), True, {"fast": "aot", "paper": "traced"}),
-    "hnn": Capability(("hamiltonian",), False, {"-": "aot"}),
-    "delan": Capability(("acceleration", "inverse_dynamics"), False, {"-": "aot"}),
-    "lgn": Capability(("acceleration",), True, {"banded": "aot", "dense": "traced"}),
+    "baseline": Capability("Baseline", ("acceleration", "inverse_dynamics"), False, {"-": "aot"},
+                           scalar_output=False),
+    "lnn": Capability("LNN", ("acceleration",), True, {"fast": "aot", "paper": "traced"},
+                      formulations=("fast", "paper")),
+    "hnn": Capability("HNN", ("hamiltonian",), False, {"-": "aot"}),
+    "delan": Capability("DeLaN", ("acceleration", "inverse_dynamics"), False, {"-": "aot"},
+                        extra_inputs=False, scalar_output=False),
+    "lgn": Capability("LGN", ("acceleration",), True, {"banded": "aot", "dense": "traced"},
+                      formulations=("fast", "banded", "dense", "paper"), extra_inputs=False),
 }
-assert set(CAPABILITIES) == set(KINDS)
+KINDS = tuple(CAPABILITIES)
 INITS = ("cranmer2020", "pytorch_default", "xavier", "kaiming")
 FORMULATIONS = ("fast", "paper", "dense", "banded")
 DTYPES = ("float32", "float64")
-_KIND_FORMULATIONS = {"lnn": ("fast", "paper"), "lgn": ("fast", "banded", "dense", "paper")}
 
 
 def _choices(what: str, value, valid) -> None:
@@ -92,8 +103,9 @@ class ModelSpec:
         _choices("init", self.init, INITS)
         _choices("dtype", self.dtype, DTYPES)
         _choices("formulation", self.formulation, FORMULATIONS)
-        if self.kind in _KIND_FORMULATIONS:
-            _choices(f"formulation for kind {self.kind!r}", self.formulation, _KIND_FORMULATIONS[self.kind])
+        cap = CAPABILITIES[self.kind]
+        if cap.formulations:
+            _choices(f"formulation for kind {self.kind!r}", self.formulation, cap.formulations)
         if isinstance(self.dof, bool) or not isinstance(self.dof, int) or self.dof < 1:
             raise ValueError(f"dof must be an int >= 1, got {self.dof!r}")
         hidden = tuple(self.hidden) if isinstance(self.hidden, (list, tuple)) else None
@@ -102,12 +114,12 @@ class ModelSpec:
         object.__setattr__(self, "hidden", hidden)
         if not isinstance(self.extra_inputs, int) or self.extra_inputs < 0:
             raise ValueError(f"extra_inputs must be an int >= 0, got {self.extra_inputs!r}")
-        if self.extra_inputs and self.kind in ("delan", "lgn"):
+        if self.extra_inputs and not cap.extra_inputs:
             raise ValueError(f"kind {self.kind!r} takes no extra_inputs (got {self.extra_inputs})")
         if self.n_out is not None:
             if not isinstance(self.n_out, int) or self.n_out < 1:
                 raise ValueError(f"n_out must be None or an int >= 1, got {self.n_out!r}")
-            if self.kind in ("lnn", "hnn", "lgn") and self.n_out != 1:
+            if cap.scalar_output and self.n_out != 1:
                 raise ValueError(f"kind {self.kind!r} has a scalar output; n_out must be None or 1")
         if not isinstance(self.lgn_radius, int) or self.lgn_radius < 1:
             raise ValueError(f"lgn_radius must be an int >= 1, got {self.lgn_radius!r}")
@@ -127,7 +139,7 @@ class ModelSpec:
         if self.kind == "lgn":
             return (2 * (2 * self.lgn_radius + 1), *self.hidden, 1)
         n_in = 2 * self.dof + self.extra_inputs
-        n_out = (self.n_out or self.dof) if self.kind == "baseline" else 1
+        n_out = 1 if CAPABILITIES[self.kind].scalar_output else (self.n_out or self.dof)
         return (n_in, *self.hidden, n_out)
 
     def to_dict(self) -> dict:

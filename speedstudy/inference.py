@@ -74,7 +74,7 @@ def model_spec(kind: str, formulation: str, dof: int, hidden: tuple, dtype: str,
     random DeLaN mass matrix singular in float32)."""
     act, init = ("relu", "xavier") if kind == "baseline" else ("softplus", "cranmer2020")
     init = "xavier" if kind == "delan" else init
-    form = formulation if kind in ("lnn", "lgn") else "fast"
+    form = formulation if CAPABILITIES[kind].formulations else "fast"
     return ModelSpec(kind=kind, dof=dof, hidden=tuple(hidden), activation=act, init=init, dtype=dtype,
                      formulation=form, **kw)
 
@@ -124,7 +124,8 @@ def trained_cases(out: Path, batches: tuple) -> list[Case]:
         if spec.dof != 2 or spec.extra_inputs:
             continue
         fw = res.get("framework", res_path.parts[-4])
-        cases.append(Case("double_pendulum", {}, spec.kind, spec.formulation if spec.kind == "lnn" else "-",
+        form = spec.formulation if CAPABILITIES[spec.kind].formulations else "-"
+        cases.append(Case("double_pendulum", {}, spec.kind, form,
                           fw, spec.dtype, batches, spec, load_npz(ckpt), source=f"trained:{res.get('claim')}",
                           extra={"hidden": "x".join(map(str, spec.hidden))}))
     return cases

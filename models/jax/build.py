@@ -1,18 +1,20 @@
-"""build(spec, params) -> the JAX model of spec.kind; to_params(model) -> the NumPy layout."""
+"""build(spec, params) -> the JAX model of spec.kind; to_params(model) -> the NumPy layout.
+
+CLASSES (kind -> class) is read off `models.spec.CAPABILITIES`: kind k's class is the one named
+`CAPABILITIES[k].model_class` in `models/jax/<k>.py`, imported by name.
+"""
 from __future__ import annotations
+
+import importlib
 
 import jax.numpy as jnp
 import numpy as np
 
-from models.jax.baseline import Baseline
-from models.jax.delan import DeLaN
-from models.jax.hnn import HNN
-from models.jax.lgn import LGN
-from models.jax.lnn import LNN
 from models.params import check_params
-from models.spec import ModelSpec
+from models.spec import CAPABILITIES, ModelSpec
 
-CLASSES = {"baseline": Baseline, "lnn": LNN, "hnn": HNN, "delan": DeLaN, "lgn": LGN}
+CLASSES = {kind: getattr(importlib.import_module(f"models.jax.{kind}"), cap.model_class)
+           for kind, cap in CAPABILITIES.items()}
 
 
 def build(spec: ModelSpec, params: dict):

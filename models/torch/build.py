@@ -1,15 +1,17 @@
-"""build(spec, params) -> the PyTorch model of spec.kind; to_params(model) -> the NumPy layout."""
+"""build(spec, params) -> the PyTorch model of spec.kind; to_params(model) -> the NumPy layout.
+
+CLASSES (kind -> class) is read off `models.spec.CAPABILITIES`: kind k's class is the one named
+`CAPABILITIES[k].model_class` in `models/torch/<k>.py`, imported by name (the mirror of `models.jax.build`).
+"""
 from __future__ import annotations
 
-from models.params import check_params
-from models.spec import ModelSpec
-from models.torch.baseline import Baseline
-from models.torch.delan import DeLaN
-from models.torch.hnn import HNN
-from models.torch.lgn import LGN
-from models.torch.lnn import LNN
+import importlib
 
-CLASSES = {"baseline": Baseline, "lnn": LNN, "hnn": HNN, "delan": DeLaN, "lgn": LGN}
+from models.params import check_params
+from models.spec import CAPABILITIES, ModelSpec
+
+CLASSES = {kind: getattr(importlib.import_module(f"models.torch.{kind}"), cap.model_class)
+           for kind, cap in CAPABILITIES.items()}
 
 
 def build(spec: ModelSpec, params: dict):

@@ -51,6 +51,28 @@ def test_layout_and_round_trip_through_both_frameworks(kind, init):
     np.testing.assert_array_equal(init_params(spec, seed=3)["mlp.0.weight"], params["mlp.0.weight"])
 
 
+def test_both_registries_come_from_the_capability_table():
+    """A kind is one row of `models.spec.CAPABILITIES`: both build registries list exactly its kinds, each
+    the class the row names from `models/<framework>/<kind>.py`; the kind-specific checks read the row."""
+    from models.jax.build import CLASSES as JAX_CLASSES
+    from models.spec import CAPABILITIES
+    from models.torch.build import CLASSES as TORCH_CLASSES
+
+    assert KINDS == tuple(CAPABILITIES) == ("baseline", "lnn", "hnn", "delan", "lgn")
+    for classes, fw in ((JAX_CLASSES, "jax"), (TORCH_CLASSES, "torch")):
+        assert tuple(classes) == KINDS
+        for kind, cls in classes.items():
+            assert (cls.__module__, cls.__name__) == (f"models.{fw}.{kind}", CAPABILITIES[kind].model_class)
+    for kind in ("delan", "lgn"):
+        with pytest.raises(ValueError, match="takes no extra_inputs"):
+            ModelSpec(kind=kind, dof=2, hidden=(8,), extra_inputs=1)
+    for kind in ("lnn", "hnn", "lgn"):
+        with pytest.raises(ValueError, match="scalar output"):
+            ModelSpec(kind=kind, dof=2, hidden=(8,), n_out=2)
+    assert ModelSpec(kind="baseline", dof=2, hidden=(8,), n_out=3).mlp_sizes() == (4, 8, 3)
+    assert ModelSpec(kind="delan", dof=2, hidden=(8,), formulation="paper").formulation == "paper"
+
+
 def test_delan_layout_names():
     spec = ModelSpec(kind="delan", dof=3, hidden=(8, 8))
     assert param_shapes(spec) == {
