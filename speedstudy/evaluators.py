@@ -6,7 +6,9 @@
   `ev.numpy(args)` returns it as float64 NumPy (for the error column).
 Models: "lnn" / "lgn" / "delan" (tau = 0) / "baseline" use `.acceleration`; "hnn" is used on the
 non-canonical (q, qdot) (its second output is q-double-dot); "truth" is the SymPy-generated system
-(`System.acceleration` with backend numpy | jax | torch). JAX calls are `jax.jit` of the model passed as
+(`System.acceleration` with backend numpy | jax | torch). A model is built by the suite's NumPy view
+(`replication.evaluation.adapters.adapter`) and mapped to q-double-dot by its `qddot`; what is timed
+and counted here is the speed study's own program of that call. JAX calls are `jax.jit` of the model passed as
 an argument (the weights are inputs of the compiled program, not folded constants), lowered and
 compiled ahead of time on the first call per shape (the same object serves `flops` and `ops`); PyTorch
 runs eagerly under `torch.no_grad()` (torch.func inside still differentiates), or with mode="aoti"
@@ -32,10 +34,10 @@ import jax.numpy as jnp
 import numpy as np
 import torch
 
-import models.jax
-import models.torch
+import models.jax  # noqa: F401 - float64 enabled on import (the evaluators' arrays may be float64)
 from models.row_blocks import rows_per_sample
 from models.torch.compiled import compile_batched
+from replication.evaluation.adapters import adapter, qddot
 from speedstudy.device import sync, to_numpy
 from speedstudy.timing import torch_thread_choices, torch_threads
 
@@ -46,10 +48,10 @@ def median_rel_error(pred, true) -> float:
     return float(np.median(num / den))
 
 
-def _qddot(obj, kind, q, qdot):
-    if kind == "hnn":
-        return obj.time_derivative(q, qdot)[1]
-    return obj.acceleration(q, qdot)
+def _model(framework: str, spec, params):
+    """The model object of the suite's NumPy view (`replication.evaluation.adapters.adapter`): the speed
+    study times the very model the evaluation judges, built in one place."""
+    return adapter(framework, spec, params).model
 
 
 FLOPS_ROWS = 16  # at most 2 * the smallest block (`models.jax.blocking.block_size` >= 8): one block
@@ -85,7 +87,7 @@ class JaxEvaluator:
 
     def __init__(self, model, kind, dtype):
         self.model, self.kind, self.dtype = model, kind, jnp.dtype(dtype)
-        self._fn = jax.jit(lambda m, q, qd: _qddot(m, kind, q, qd))
+        self._fn = jax.jit(lambda m, q, qd: qddot(m, kind, q, qd))
         self._compiled = {}
 
     def prepare(self, q, qdot):
@@ -137,7 +139,7 @@ class TorchEvaluator:
 
     def _call(self, args):
         with torch.no_grad():
-            return _qddot(self.model, self.kind, *args)
+            return qddot(self.model, self.kind, *args)
 
     def run(self, args):
         out = self._call(args)
@@ -256,21 +258,21 @@ def make_evaluator(framework: str, spec=None, params=None, kind=None, dtype="flo
         if kind == "truth":
             return TorchAotEvaluator(lambda q, qd: system.acceleration(q, qd, backend="torch"), system.dof,
                                      dtype, "truth")
-        model = models.torch.build(spec, params)
-        return TorchAotEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind,
+        model = _model("torch", spec, params)
+        return TorchAotEvaluator(lambda q, qd: qddot(model, spec.kind, q, qd), spec.dof, spec.dtype, spec.kind,
                                  rows_per_sample(spec))
     if mode == "traced":
         if framework != "torch" or kind == "truth":
             raise ValueError(f"mode 'traced' is for PyTorch models; got framework {framework!r}, kind {kind!r}")
-        model = models.torch.build(spec, params)
-        return TorchTracedEvaluator(lambda q, qd: _qddot(model, spec.kind, q, qd), spec.dof, spec.dtype,
+        model = _model("torch", spec, params)
+        return TorchTracedEvaluator(lambda q, qd: qddot(model, spec.kind, q, qd), spec.dof, spec.dtype,
                                     spec.kind, rows_per_sample(spec))
     if mode not in (None, "jit", "eager", "numpy"):
         raise ValueError(f"unknown evaluator mode {mode!r}; valid: jit, eager, numpy, aoti, traced")
     if kind == "truth":
         return {"jax": TruthJax, "torch": TruthTorch, "numpy": TruthNumpy}[framework](system, dtype)
     if framework == "jax":
-        return JaxEvaluator(models.jax.build(spec, params), spec.kind, spec.dtype)
+        return JaxEvaluator(_model("jax", spec, params), spec.kind, spec.dtype)
     if framework == "torch":
-        return TorchEvaluator(models.torch.build(spec, params), spec.kind, spec.dtype)
+        return TorchEvaluator(_model("torch", spec, params), spec.kind, spec.dtype)
     raise ValueError(f"unknown framework {framework!r}; valid: jax, torch (numpy for truth only)")

@@ -5,12 +5,25 @@
 `acceleration_info`, ...) taking and returning float64 NumPy arrays. Inputs are cast to the
 model's dtype; large batches are evaluated in chunks. JAX methods are jit-compiled once per method.
 So evaluation code (metrics, rollouts) is written once and judges both frameworks alike.
+`view.model` is the framework's model object (`models.jax.build` / `models.torch.build`).
+
+`qddot(model, kind, q, qdot)`: q-double-dot of any model kind, on a framework model or on a view: the
+acceleration, or for an HNN ("hnn") the second half of its time derivative on the non-canonical (q, qdot);
+`view.qddot(q, qdot)` is it in NumPy, (B, d) float64. The speed study's evaluators (`speedstudy.evaluators`)
+build their models here and time this same `qddot`.
 """
 from __future__ import annotations
 
 import numpy as np
 
 CHUNK = 32768   # one chunk (one compiled shape) for every quick held-out set; 4 at paper scale
+
+
+def qddot(model, kind: str, q, qdot):
+    """q-double-dot (B, d) of `model` (a framework model or a view) of model kind `kind`."""
+    if kind == "hnn":
+        return model.time_derivative(q, qdot)[1]
+    return model.acceleration(q, qdot)
 
 
 class _Adapter:
@@ -34,6 +47,9 @@ class _Adapter:
                 return tuple(_join([o[j] for o in outs]) for j in range(len(outs[0])))
             return _join(outs)
         return call
+
+    def qddot(self, q, qdot):
+        return qddot(self, self.kind, q, qdot)
 
 
 def _join(parts):
