@@ -146,7 +146,7 @@ def latency_rows(sizes, notes: list | None = None) -> list[dict]:
         arg = json.dumps({"hidden": list(sizes.hidden), "dtypes": list(sizes.latency_dtypes),
                           "seconds": sizes.latency_s, "sync": sync,
                           "methods": list(sizes.latency_methods), "torch_aot": sizes.torch_compile})
-        root = str(Path(__file__).resolve().parents[2])  # the project root, for an uninstalled checkout
+        root = str(Path(__file__).resolve().parents[1])  # the project root, for an uninstalled checkout
         env = {**os.environ, **one_thread_env(os.environ),
                "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)}
         proc = subprocess.run([sys.executable, "-m", "speedstudy.latency", arg], env=env,

@@ -59,7 +59,7 @@ def commit() -> str | None:
     if os.environ.get("LAGBENCH_COMMIT"):
         return os.environ["LAGBENCH_COMMIT"]
     try:
-        root = Path(__file__).resolve().parent.parent
+        root = Path(__file__).resolve().parents[2]  # the project root
         r = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
                            text=True, timeout=5)
         return r.stdout.strip() or None

@@ -10,7 +10,7 @@ from reports.compare import gpu_vs_cpu_table
 from reports.load import load_results
 from reports.sections_speed import speed_sections
 
-MEASURED = Path(__file__).resolve().parents[2] / "replication" / "bench" / "measured" / "gpu_h100"
+MEASURED = Path(__file__).resolve().parents[2] / "docs" / "speed" / "gpu_h100"
 
 
 def _cpu_inference(root):
