@@ -10,7 +10,7 @@ first one (``res.frameworks[0]``):
      `replication.training.protocol`), from ``train_log.csv``: the relative difference of the first logged loss
      (the same weights: rounding only; above ``START_TOL`` flagged, the frameworks compute different
      losses), the first logged step from which the losses stay parted by more than ``PART`` (float32
-     training of a chaotic model parts legitimately, `tests/replication/test_training_parity.py`), the
+     training of a chaotic model parts legitimately, `tests/replication/training/test_training_parity.py`), the
      relative difference of the last logged loss, and whether restarts chose the same initialisation;
   4. JAX against PyTorch speed per operation (``bench/ratios.csv``), where the speed study ran.
 Reads only the result files (no ML framework).

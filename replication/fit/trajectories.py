@@ -16,7 +16,7 @@ dropped: each trajectory keeps its samples window // 2 ... T - 1 - window // 2. 
 degree <= polyorder; with white noise of standard deviation s on q at spacing h, the noise in the k-th derivative
 scales as s / h^k / window^(k + 1/2): a wider window averages more noise away, but biases the estimate
 where q curves on the window's time scale (window * h well below the motion's shortest period).
-Checked against analytic trajectories with noise in tests/replication/test_fit_trajectories.py.
+Checked against analytic trajectories with noise in tests/replication/fit/test_fit_trajectories.py.
 
 Requirements (a ValueError naming the problem otherwise): an odd window >= polyorder + 2 >= 3 (so
 that the second derivative exists and the fit is overdetermined), at least window + 1 samples per

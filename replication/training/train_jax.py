@@ -10,7 +10,7 @@ stream, on_log=None, hooks=()) -> TrainOutcome`: `replication.training.loop.trai
 `Members(spec, params_list, protocol, step=None)`: K models of one spec trained as one program (the
 stepper of `replication.training.loop.train_members`): the parameters and Adam states stacked along a leading axis
 and the same compiled step `eqx.filter_vmap`-ed over them and over the K batches (`make_members_step`);
-each member's numbers are those of its own `Stepper` run (`tests/replication/test_members_parity.py`).
+each member's numbers are those of its own `Stepper` run (`tests/replication/training/test_members_parity.py`).
 `train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> [TrainOutcome]`.
 """
 from __future__ import annotations

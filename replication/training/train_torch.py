@@ -12,7 +12,7 @@ from `torch.func.functional_call` under `torch.func.vmap` over parameters and ba
 of their sum (the members share nothing, so each gets its own gradient), and Adam written out per member
 (`_adam`: torch.optim.Adam's single-tensor arithmetic, with a step count per member, so that a member the
 guard skips keeps its state exactly). Each member's numbers are those of its own `Stepper` run
-(`tests/replication/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
+(`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
 on_log=None, hooks=()) -> [TrainOutcome]`.
 """
 from __future__ import annotations

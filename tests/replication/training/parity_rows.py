@@ -17,7 +17,7 @@ from replication.training.protocol import Protocol
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
-# tests/replication/parity_kit.py`: 7.7e-7, 1.3e-5, 3.9e-5; the parameters' largest is an L1 loss whose
+# tests/replication/training/parity_kit.py`: 7.7e-7, 1.3e-5, 3.9e-5; the parameters' largest is an L1 loss whose
 # signs cancel on a bias, which Adam turns into a step of 0 or about lr). "float32 chaotic": the LNN on the
 # double pendulum, whose learned velocity Hessian is near-singular on some batches (gradient norms from 1e2
 # to 1e6 from one batch to the next) and amplifies float32 rounding (measured: 3.3e-3, 6.9e-3, 1.1e-6); the

@@ -2,7 +2,7 @@
 (`parity_rows.ROWS`: every model kind and formulation, loss, schedule, the spike guard, vectorised members
 and restarts, in float64 and float32): at every step the loss, the gradient norm and the parameters agree to
 the row's dtype tolerance, and the learning rate, the skipped-step count, the failures and the scout chosen
-are equal. `python tests/replication/parity_kit.py` prints the table with the differences reached.
+are equal. `python tests/replication/training/parity_kit.py` prints the table with the differences reached.
 
 Where the frameworks legitimately part: float32 training of the LNN on the double pendulum (near-singular
 learned Hessians amplify rounding, the model's dynamics are chaotic in the weights) parts within

@@ -13,8 +13,8 @@ import pytest
 from replication.cli import main
 from replication.fit.load import load_fitted
 
-README = Path(__file__).resolve().parents[2] / "README.md"
-MARKER = "<!-- worked example: tests/replication/test_fit_example.py runs this block -->"
+README = Path(__file__).resolve().parents[3] / "README.md"
+MARKER = "<!-- worked example: tests/replication/fit/test_fit_example.py runs this block -->"
 # the default run's smaller example (argparse takes the last of a repeated option)
 SMALL = {"simulate": ["--trajectories", "3", "--duration", "1.2"], "fit": ["--steps", "10", "--hidden", "8"]}
 

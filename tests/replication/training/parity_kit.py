@@ -14,7 +14,7 @@ and steps of the loss, the gradient norm and the parameters (all of them as one 
 `steps` (steps compared per member, phases summed); mismatches: what must be equal and is not (step
 counts, learning rates, skipped-step counts, failures, the scout chosen).
 
-`python tests/replication/parity_kit.py [ROW ...]` prints the parity table (every row, slow ones too).
+`python tests/replication/training/parity_kit.py [ROW ...]` prints the parity table (every row, slow ones too).
 """
 from __future__ import annotations
 
