@@ -11,8 +11,9 @@
   what a model blocks with: the LNN (both formulations) and the LGN's dense and paper paths carry
   dof + 1 tangent rows per sample; None for the models computed in one call (HNN, DeLaN, baseline, the
   banded LGN, whose band needs at most 8r + 2 tangents).
-Users: `models.jax.blocking` (lax.map over the blocks inside the model, CPU only) and
-`models.torch.compiled` (a compiled library called once per block; eager PyTorch gained nothing reliable).
+Users: `models.jax.blocking` (lax.map over the blocks inside the model, CPU only) and its mirror
+`models.torch.blocking` (a compiled library called once per block, `models.torch.compiled.BlockedMethod`;
+eager PyTorch gained nothing reliable).
 """
 from __future__ import annotations
 

@@ -5,7 +5,8 @@
   (B, ...) arrays) is the same as one call, computed by `lax.map` over the equal blocks of
   `models.row_blocks.block_plan` (the last padded with copies of sample 0; the padding is sliced off).
   Batches up to two blocks run as one call, and so does every batch on an accelerator (no cache to fit;
-  `lax.map` would only serialise the blocks). The same plan serves PyTorch's compiled calls.
+  `lax.map` would only serialise the blocks). Mirror: `models.torch.blocking` (around PyTorch's
+  compiled calls).
 Why: at batch 4096 the fast LNN's elementwise passes over the (B, d + 1, width) tangents run at memory
 bandwidth; in blocks they stay in cache. Measured (3 x 600 softplus, float32, batch 4096, 2-core EPYC, best of 5, one
 process per setting; unblocked -> BLOCK_ROWS 1024 (2048)): fast d=2 0.44 -> 0.23 (0.31) s, d=16

@@ -38,6 +38,7 @@ from torch.utils._pytree import tree_flatten, tree_unflatten
 
 from models.checks import n_required_inputs
 from models.row_blocks import block_plan
+from models.torch.blocking import in_row_blocks
 
 __all__ = ["BlockedMethod", "CompiledMethod", "compile_batched", "compile_single"]
 
@@ -83,11 +84,11 @@ class CompiledMethod:
 
 
 class BlockedMethod:
-    """A compiled function called once per row block (`models.row_blocks.block_plan`): the inputs are
-    padded with copies of sample 0 to equal blocks, each block is one call into `inner` (compiled for
-    that block size, or for any batch), and the outputs (tensors with the batch first) are joined and the
-    padding sliced off. Batches of at most two blocks go to `inner` in one call. The PyTorch side of
-    `models.jax.blocking`: the same samples per block, a Python loop instead of lax.map."""
+    """A compiled function called once per row block (`models.torch.blocking.in_row_blocks`, the mirror of
+    `models.jax.blocking`): the inputs are padded with copies of sample 0 to equal blocks, each block is
+    one call into `inner` (compiled for that block size, or for any batch), and the outputs (tensors with
+    the batch first) are joined and the padding sliced off. Batches of at most two blocks go to `inner`
+    in one call."""
 
     def __init__(self, inner: CompiledMethod, rows_per_sample: int, batch: int | None = None):
         self.inner, self.rows_per_sample, self.batch = inner, int(rows_per_sample), batch
@@ -96,17 +97,7 @@ class BlockedMethod:
 
     def __call__(self, *inputs):
         xs = _checked(self.method, inputs, self.in_shape, self.dtype, self.n_inputs)
-        n = xs[0].shape[0]
-        plan = block_plan(n, self.rows_per_sample)
-        if plan is None:
-            return self.inner(*xs)
-        n_blocks, block = plan
-        pad = n_blocks * block - n
-        padded = [torch.cat([x, x[:1].expand(pad, *x.shape[1:])]) if pad else x for x in xs]
-        outs = [tree_flatten(self.inner(*(x[k * block:(k + 1) * block] for x in padded)))
-                for k in range(n_blocks)]
-        leaves = [torch.cat([o[0][j] for o in outs])[:n] for j in range(len(outs[0][0]))]
-        return tree_unflatten(leaves, outs[0][1])
+        return in_row_blocks(self.inner, xs, self.rows_per_sample)
 
 
 class _Fn(torch.nn.Module):
@@ -152,8 +143,7 @@ def trace_flat(fn, example: tuple) -> torch.fx.GraphModule:
     """fn(*example) as a graph of plain ATen operators, traced by make_fx on the (real) example tensors:
     torch.func transforms (vmap, jacrev, hessian) come out flattened, which torch.export cannot do with
     them inside (torch 2.13). The graph is for the example's shapes; data-dependent branches must use
-    torch.cond while tracing (`get_proxy_mode()` tells a model it is traced, as in
-    `models.torch.lnn.solve_with_fallback`)."""
+    torch.cond while tracing (the models choose their traced variants in `models.torch.export_paths`)."""
     # torch.cond runs its branches through dynamo, which makes a size dynamic once it has seen two values
     # of it (another batch size traced in this process); the graph's export then fails on the size it
     # passes to the cond (torch 2.13). Each trace is for one batch size: keep sizes static.

@@ -9,7 +9,8 @@ Jacobians propagated forward as the DeLaN paper does), no autograd graph of its 
   Mdot qdot = Ldot u + Lc (Ldot^T qdot),  1/2 d(qdot^T M qdot)/dq_k = w_k . u,
   c = Mdot qdot - 1/2 d(qdot^T M qdot)/dq,  g = dV/dq.
 Mirrored line for line by `models.jax.delan`, except that under torch.export the forward model solves
-by `spd_solve_unrolled` (dof <= 8; same numbers, it compiles to fused kernels). Shapes: q, qdot, qddot, tau
+by `spd_solve_unrolled` (dof <= 8; same numbers, it compiles to fused kernels; chosen by
+`models.torch.export_paths.pick`). Shapes: q, qdot, qddot, tau
 (..., dof); M (..., dof, dof); V, L (...,).
 """
 from __future__ import annotations
@@ -19,6 +20,7 @@ from torch.nn.functional import linear as _lin
 
 from models.params import n_layers, tril_selection
 from models.torch.base import Model
+from models.torch.export_paths import pick
 from models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import ACT_DERIVS
 
@@ -30,6 +32,11 @@ def _mv(m, v):
 def _vm(v, m):
     """v^T m over the second-to-last axis of m: v (..., i), m (..., i, j) -> (..., j)."""
     return (v[..., None, :] @ m)[..., 0, :]
+
+
+def _linalg_solve(m, b):
+    """m^-1 b for m (..., d, d), b (..., d) by torch.linalg.solve (eager)."""
+    return torch.linalg.solve(m, b[..., None])[..., 0]
 
 
 def spd_solve_unrolled(m, b):
@@ -146,9 +153,8 @@ class DeLaN(Model):
         tau = torch.zeros_like(q) if extra is None else extra
         self._check("tau (extra)", tau, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
-        if torch.compiler.is_exporting() and self.spec.dof <= 8:
-            return spd_solve_unrolled(m, tau - c - g)
-        return torch.linalg.solve(m, (tau - c - g)[..., None])[..., 0]
+        solve = pick(_linalg_solve, exporting=spd_solve_unrolled if self.spec.dof <= 8 else None)
+        return solve(m, tau - c - g)
 
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration (..., dof), 0): M is positive definite, no fallback."""

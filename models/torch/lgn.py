@@ -8,12 +8,14 @@ Accelerations by spec.formulation:
   "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r), solved in O(n) by
             `models.torch.banded`. Samples whose solve is not finite take pinv of the same matrix made
             dense and are counted. Grids with n < 4r + 1 use the dense path.
-            `banded_terms(L_fn, ...)` gets the band of any L_fn by one reverse pass pushed forward along
-            <= 8r+1 coloured tangents plus the mixed-term tangent (`models.graph.band_coloring`), as the
-            JAX mirror does. `LGN` itself differentiates its density MLP by hand at every node instead
-            (`models.torch.mlp_derivatives`; k = 2r+1 velocity tangents and one mixed tangent per node,
-            the node terms shifted into place): same values, plain torch ops, so the banded LGN goes
-            through torch.export (`models.torch.compiled`), which torch.func does not.
+            `banded_euler_lagrange_info(L_fn, q, qdot, r)` (as in the JAX mirror) solves the band of any
+            L_fn, which `banded_terms(L_fn, ...)` gets by one reverse pass pushed forward along <= 8r+1
+            coloured tangents plus the mixed-term tangent (`models.graph.band_coloring`). `LGN` itself
+            differentiates its density MLP by hand at every node instead (`models.torch.mlp_derivatives`;
+            k = 2r+1 velocity tangents and one mixed tangent per node, the node terms shifted into place):
+            same values, plain torch ops, so the banded LGN goes through torch.export
+            (`models.torch.compiled`), which torch.func does not. Exported, the fallback gathers the bad
+            samples instead (chosen by `models.torch.export_paths.pick`).
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from models.graph import (
 )
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
+from models.torch.export_paths import pick
 from models.torch.lnn import euler_lagrange_info, pinv_solve
 from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
@@ -63,26 +66,41 @@ def dense_from_band(band):
     return dense.index_copy(1, flat, band.flatten(1)).unflatten(1, (n, n))
 
 
-def banded_solve_info(band, rhs, r):
-    """Flat band (B, n, 4r+1), rhs (B, n): (x (B, n), n_fallback). Samples whose banded solve is not
-    finite take pinv of the dense matrix (counted); they are solved again on an identity band first, so
-    no NaN reaches the gradient. Under torch.export (inference) the bad samples are gathered and only
-    they take pinv: an exported graph has no Python branch on data, and a torch.cond here fixed the
-    batch size to >= 2 (torch 2.13)."""
-    n = rhs.shape[-1]
-    layout = cyclic_band_layout(n, r)
+def _pinv_where_bad(band, rhs, x, bad, r, layout):
+    """Eager: if any sample's banded solve is not finite, those take pinv of the dense matrix, solved
+    again on an identity band first so that no NaN reaches the gradient."""
+    if not bool(torch.any(bad)):
+        return x
+    eye = torch.as_tensor(_identity_band(rhs.shape[-1], r), dtype=band.dtype, device=band.device)
+    safe = torch.where(bad[:, None, None], eye, band)
+    x_safe = solve_cyclic_banded(safe, rhs, layout)
+    return torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
+
+
+def _pinv_gathered(band, rhs, x, bad, r, layout):
+    """Exported (inference only): the bad samples are gathered and only they take pinv (a data-dependent
+    count): an exported graph has no Python branch on data, and a torch.cond here fixed the batch size to
+    >= 2 (torch 2.13)."""
+    idx = torch.nonzero(bad).squeeze(1)
+    return x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
+
+
+def _banded_solve_info(band, rhs, r):
+    """Flat band (B, n, 4r+1), rhs (B, n): (x (B, n), n_fallback); the bad samples take pinv of the
+    dense matrix (counted), by `_pinv_where_bad` or, under torch.export, `_pinv_gathered`."""
+    layout = cyclic_band_layout(rhs.shape[-1], r)
     x = solve_cyclic_banded(band, rhs, layout)
     bad = ~torch.all(torch.isfinite(x.detach()), dim=-1)
-
-    if torch.compiler.is_exporting():  # inference only: pinv on the bad samples (a data-dependent count)
-        idx = torch.nonzero(bad).squeeze(1)
-        x = x.index_put((idx,), pinv_solve(dense_from_band(band[idx]), rhs[idx], by_svd=True))
-    elif bool(torch.any(bad)):
-        eye = torch.as_tensor(_identity_band(n, r), dtype=band.dtype, device=band.device)
-        safe = torch.where(bad[:, None, None], eye, band)
-        x_safe = solve_cyclic_banded(safe, rhs, layout)
-        x = torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
+    x = pick(_pinv_where_bad, exporting=_pinv_gathered)(band, rhs, x, bad, r, layout)
     return x, torch.sum(bad)
+
+
+def banded_euler_lagrange_info(L_fn, q, qdot, r):
+    """(qddot (..., n), n_fallback) by the banded path for any L_fn (its band from `banded_terms`); see the
+    module doc. `LGN` solves its own hand-differentiated band the same way."""
+    n = q.shape[-1]
+    x, n_bad = _banded_solve_info(*banded_terms(L_fn, q.reshape(-1, n), qdot.reshape(-1, n), r), r)
+    return x.reshape(q.shape), n_bad
 
 
 def _neighbours(x, r):
@@ -141,7 +159,7 @@ class LGN(Model):
         form, n, r = self.spec.formulation, q.shape[-1], self.spec.lgn_radius
         if form in ("banded", "fast") and banded_supported(n, r):
             band, rhs = self._banded_terms(q.reshape(-1, n), qdot.reshape(-1, n))
-            x, n_bad = banded_solve_info(band, rhs, r)
+            x, n_bad = _banded_solve_info(band, rhs, r)
             return x.reshape(q.shape), n_bad
         return euler_lagrange_info(self._lagrangian, q, qdot, "paper" if form == "paper" else "fast")
 

@@ -7,15 +7,17 @@ that the solve at inference reuses the inverse of its condition estimate (`solve
 `euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None) -> (qddot (..., d), n_fallback)`,
 `euler_lagrange(...) -> qddot`, `velocity_hessian(L_fn, q, qdot, extra) -> (..., d, d)`.
 Outputs stay differentiable w.r.t. tensors L_fn closes over (the nn.Parameters): loss.backward() works.
+What runs differently in a captured graph (make_fx, torch.export) or under vmap is chosen by
+`models.torch.export_paths`.
 """
 from __future__ import annotations
 
 import torch
 from torch.func import grad, hessian, jacfwd, jacrev, jvp, vmap
-from torch.fx.experimental.proxy_tensor import get_proxy_mode
 
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
+from models.torch.export_paths import pick, replace_bad_rows
 from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
@@ -48,13 +50,13 @@ def paper_terms(L_fn, q, qdot, extra=None):
 
     Eager: the original code's three transforms (hessian(L, 1), jacrev(jacrev(L, 1), 0), grad(L, 0)), as
     the JAX mirror. Traced by make_fx (`models.torch.compiled.trace_flat`, the speed study's "traced"
-    mode): H and J as blocks of one full Hessian of L in x = [q, qdot], forward over the one reverse pass
-    that also gives dL/dq. Same values (float32: 1e-6 relative). Measured (3 x 600 softplus, batch 4096,
-    float32, 2 cores, interleaved rounds; traced): 6.3k -> 8.2k samples/s at d = 2, 1.02k -> 1.03k at
-    d = 16; 3 x 128, d = 2: batch 1 2.4k -> 3.0k, float64 batch 256 21.6k -> 24.9k. Eager the one
-    Hessian ran 2.1x (d = 2) to 2.6x (d = 16) slower at 3 x 600, batch 4096 (its unfused 2d-tangent
-    intermediates), so eager keeps the three. JAX's compiled program costs the same either way (XLA
-    merges the three transforms' shared passes)."""
+    mode; chosen by `models.torch.export_paths.pick`): H and J as blocks of one full Hessian of L in x =
+    [q, qdot], forward over the one reverse pass that also gives dL/dq. Same values (float32: 1e-6
+    relative). Measured (3 x 600 softplus, batch 4096, float32, 2 cores, interleaved rounds; traced): 6.3k
+    -> 8.2k samples/s at d = 2, 1.02k -> 1.03k at d = 16; 3 x 128, d = 2: batch 1 2.4k -> 3.0k, float64
+    batch 256 21.6k -> 24.9k. Eager the one Hessian ran 2.1x (d = 2) to 2.6x (d = 16) slower at 3 x 600,
+    batch 4096 (its unfused 2d-tangent intermediates), so eager keeps the three. JAX's compiled program
+    costs the same either way (XLA merges the three transforms' shared passes)."""
     d = q.shape[-1]
 
     def one_hessian(q1, qd1, e1):
@@ -71,7 +73,7 @@ def paper_terms(L_fn, q, qdot, extra=None):
         hess = hessian(f, 1)(q1, qd1)
         mixed = jacrev(jacrev(f, 1), 0)(q1, qd1)
         return hess, grad(f, 0)(q1, qd1) - mixed @ qd1
-    one = three if get_proxy_mode() is None else one_hessian
+    one = pick(three, traced=one_hessian)
     if extra is None:
         return vmap(lambda a, b: one(a, b, None))(q, qdot)
     return vmap(one)(q, qdot, extra)
@@ -112,18 +114,10 @@ def small_inverse(h):
     return torch.linalg.inv_ex(h)
 
 
-def _vmapped(x) -> bool:
-    """Whether x is batched by torch.func.vmap (the training of stacked members, `replication.ensemble`)."""
-    return torch._C._functorch.is_batchedtensor(x)
-
-
 def solve_with_fallback(hess, rhs):
-    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. A captured graph
-    has no Python branch on data: under torch.export, and under make_fx without gradients
-    (`models.torch.compiled.trace_flat`, the speed study's "traced" mode), the pinv is a torch.cond that
-    runs only where a sample is bad. Its operands are made contiguous: export of a make_fx graph whose
-    cond takes a strided view (the dense LGN's Hessian) failed in placeholder naming (torch 2.13). Traced
-    with gradients, every sample takes pinv and the bad ones keep it. Without gradients (inference) the
+    """(H^-1 rhs (B, d), n_fallback): pinv where H is singular/ill-conditioned, counted. The bad samples
+    take pinv through `models.torch.export_paths.replace_bad_rows` (eager: only if there are any; in a
+    captured graph or under vmap without a Python branch on data). Without gradients (inference) the
     well-conditioned samples use the inverse the condition estimate already needed (`small_inverse`)
     instead of a second, LU solve; with gradients they solve with H replaced by I on the bad samples, so
     that no inf reaches backward."""
@@ -137,17 +131,7 @@ def solve_with_fallback(hess, rhs):
         x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
     else:
         x = (inv @ rhs[..., None])[..., 0]
-    traced = get_proxy_mode() is not None
-    if traced and torch.is_grad_enabled():  # traced with gradients: pinv on every sample, the bad ones keep it
-        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
-    elif traced or torch.compiler.is_exporting():  # no Python branch on data in a captured graph
-        x = torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], pinv_solve(h, r), y),
-                       lambda h, r, b, y: y.clone(), (hess.contiguous(), rhs.contiguous(), bad, x.contiguous()))
-    elif _vmapped(hess):   # stacked members (torch.func.vmap): no branch on data; pinv on every sample
-        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
-    elif bool(torch.any(bad)):
-        x = torch.where(bad[:, None], pinv_solve(hess, rhs), x)
-    return x, torch.sum(bad)
+    return replace_bad_rows(x, bad, pinv_solve, hess, rhs), torch.sum(bad)
 
 
 def euler_lagrange_info(L_fn, q, qdot, formulation="fast", extra=None):

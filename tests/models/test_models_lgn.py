@@ -72,3 +72,22 @@ def test_singular_band_takes_the_counted_pinv_fallback_with_finite_gradients():
     np.testing.assert_allclose(a.detach().numpy(), 0.0, atol=1e-12)
     (a - 1.0).abs().sum().backward()
     assert all(torch.isfinite(p.grad).all() for p in m.parameters() if p.grad is not None)
+
+
+def test_banded_euler_lagrange_info_is_one_public_mirror():
+    """`banded_euler_lagrange_info(L_fn, q, qdot, r)` is in both frameworks' lgn.py with one contract:
+    on the model's own Lagrangian it gives the LGN's banded accelerations and fallback count."""
+    import jax.numpy as jnp
+
+    from models.jax.lgn import banded_euler_lagrange_info as jax_info
+    from models.torch.lgn import banded_euler_lagrange_info as torch_info
+
+    spec, params = spec_params(kind="lgn", dof=10, dtype="float64", formulation="banded")
+    x = make_inputs(spec, batch=3, seed=5, n=10)
+    mt, mj = models.torch.build(spec, params), models.jax.build(spec, params)
+    q, qdot = torch.tensor(x["q"]), torch.tensor(x["qdot"])
+    a_t, n_t = torch_info(mt._lagrangian, q, qdot, spec.lgn_radius)
+    a_j, n_j = jax_info(mj._lagrangian, jnp.asarray(x["q"]), jnp.asarray(x["qdot"]), spec.lgn_radius)
+    assert a_t.shape == a_j.shape == (3, 10) and int(n_t) == int(n_j) == 0
+    assert_rel(a_t.detach(), mt.acceleration(q, qdot).detach(), "float64", "torch L_fn vs model")
+    assert_rel(a_t.detach(), np.asarray(a_j), "float64", "torch vs jax")

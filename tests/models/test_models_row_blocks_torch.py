@@ -1,8 +1,8 @@
-"""Row blocks for PyTorch's compiled calls: the plan shared with JAX (`models.row_blocks`), a blocked call
-(`models.torch.compiled.BlockedMethod`) equal to one call with the padding sliced off, a fixed-batch
-library compiled for the block size only, and the traced inference solve, whose pinv runs only where a
-sample is bad, compiled and run on batches with none, one and all samples bad. Four compiles (5-20 s
-each)."""
+"""Row blocks for PyTorch's compiled calls: the plan shared with JAX (`models.row_blocks`), the blocking
+mirror (`models.torch.blocking`), a blocked call (`models.torch.compiled.BlockedMethod`) equal to one
+call with the padding sliced off, a fixed-batch library compiled for the block size only, and the traced
+inference solve, whose pinv runs only where a sample is bad, compiled and run on batches with none, one
+and all samples bad. Four compiles (5-20 s each)."""
 import numpy as np
 import pytest
 import torch
@@ -30,6 +30,28 @@ def test_block_plan_equal_blocks_and_small_batches_in_one_call():
 def test_rows_per_sample_follow_the_jax_models(kind, form, dof, rows):
     spec = ModelSpec(kind=kind, dof=dof, hidden=(8,), formulation=form if kind in ("lnn", "lgn") else "fast")
     assert rows_per_sample(spec) == rows
+
+
+def test_in_row_blocks_mirrors_jax_with_padding_and_none_arguments():
+    """`models.torch.blocking.in_row_blocks`, the mirror of `models.jax.blocking.in_row_blocks`: blocks
+    equal one call, padding sliced off, None arguments passed through, small batches in one call."""
+    from models.torch.blocking import in_row_blocks
+
+    n = 3 * block_size(5) + 7                               # forces blocks and a padded last block
+    a, b = torch.tensor(RNG.normal(size=(n, 3))), torch.tensor(RNG.normal(size=(n, 2, 2)))
+    calls = []
+
+    def fn(x, none, y):
+        calls.append(x.shape[0])
+        return torch.sin(x) * y[:, 0, :1], x.sum(-1) if none is None else None
+    blocked, one = in_row_blocks(fn, (a, None, b), 5), fn(a, None, b)
+    assert len(calls) == 1 + block_plan(n, 5)[0]
+    for u, v in zip(blocked, one, strict=True):
+        assert u.shape == v.shape
+        np.testing.assert_array_equal(u.numpy(), v.numpy())
+    calls.clear()
+    in_row_blocks(fn, (a[:8], None, b[:8]), 5)
+    assert calls == [8]
 
 
 def _counting(f):
