@@ -24,6 +24,14 @@ from reports.load import Unit
 SIZE_METRIC = re.compile(r"^(?P<base>.+)_n(?P<n>\d+)$")
 
 
+def _numeric_rows(df: pd.DataFrame | None, *columns: str) -> pd.DataFrame | None:
+    """The rows whose `columns` all parse as numbers, those columns as floats; None if there are none."""
+    if df is None:
+        return None
+    df = df.assign(**{c: pd.to_numeric(df[c], errors="coerce") for c in columns}).dropna(subset=list(columns))
+    return None if df.empty else df
+
+
 def _x(u: Unit) -> tuple[str, float] | None:
     for key, label in (("train_samples_per_s", "training throughput (samples/s)"),
                        ("train_time_s", "training time (s)")):
@@ -58,12 +66,8 @@ def speed_error(units: list[Unit], metric: str, path: Path) -> bool:
 
 
 def bench_speed_error(df: pd.DataFrame | None, path: Path) -> bool:
+    df = _numeric_rows(df, "error", "samples_per_s")
     if df is None:
-        return False
-    df = df.assign(error=pd.to_numeric(df["error"], errors="coerce"),
-                   samples_per_s=pd.to_numeric(df["samples_per_s"], errors="coerce")).dropna(
-        subset=["error", "samples_per_s"])
-    if df.empty:
         return False
     if "mode" in df.columns:  # PyTorch compiled ahead of time gets its own marker: "torch/aoti", "torch/traced"
         aot = df["mode"].astype(str).isin(["aoti", "traced"])
@@ -88,12 +92,8 @@ def bench_speed_error(df: pd.DataFrame | None, path: Path) -> bool:
 
 
 def bench_scaling(df: pd.DataFrame | None, path: Path) -> bool:
+    df = _numeric_rows(df, "n", "seconds_per_eval")
     if df is None:
-        return False
-    df = df.assign(n=pd.to_numeric(df["n"], errors="coerce"),
-                   seconds_per_eval=pd.to_numeric(df["seconds_per_eval"], errors="coerce")).dropna(
-        subset=["n", "seconds_per_eval"])
-    if df.empty:
         return False
     studies = sorted(df["study"].astype(str).unique())[:4]
     fig, axes = new_figure(ncols=len(studies), width=3.6 * len(studies), height=3.4)
