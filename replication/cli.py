@@ -81,44 +81,16 @@ def cmd_bench(args):
 
 
 def cmd_train_target(args):
-    import pandas as pd
-    from tqdm.auto import tqdm
-
-    from replication.results import write_csv
-    from speedstudy import train_target
+    from replication.fit.cli import widths
+    from speedstudy.train_target_run import check_names, run_study
 
     if args.heldout < 1 or args.seed < 0:
         raise ValueError(f"--heldout takes an integer >= 1 and --seed one >= 0; got {args.heldout} and {args.seed}")
     names = _csv(args.protocols)
-    from replication.fit.cli import widths
-
     hidden = list(widths(args.hidden))
-    table = train_target.protocols(1000, 1)
-    unknown = sorted(set(names or ()) - set(table))
-    if unknown:  # checked here too, so that --out is not made for nothing
-        raise ValueError(f"unknown train-target protocol(s) {', '.join(unknown)}; valid: {', '.join(table)}")
+    check_names(names)  # here too, so that --out is not made for nothing
     folder = write_folder(Path(args.out) / "train_target")
-    n = sum(train_target.n_evaluations(table[k]) for k in (names or table) if k in table)
-    bar = tqdm(total=n, desc="lagbench train-target", unit="eval", disable=args.quiet)
-
-    def on_eval(log):
-        write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
-        bar.n = min(sum(r["step"] > 0 for r in log), bar.total)
-        bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
-
-    def on_model(name, spec, model):  # the final model: params and spec, loadable by both frameworks
-        import models.jax
-        from replication.results import write_json, write_npz
-
-        write_npz(folder / f"{name}.npz", models.jax.to_params(model))
-        write_json(folder / f"{name}.spec.json", spec.to_dict())
-
-    rows, log = train_target.study(args.budget, hidden, args.heldout, names=names, on_eval=on_eval,
-                                   seed=args.seed, on_model=on_model)
-    bar.close()
-    df = pd.DataFrame(rows)
-    write_csv(folder / "train_target.csv", df)
-    write_csv(folder / "train_target_log.csv", pd.DataFrame(log))
+    df = run_study(folder, args.budget, hidden, args.heldout, names=names, seed=args.seed, progress=not args.quiet)
     per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "seed", "hessian_rel_err",
                                            "skipped_steps", "samples_per_s"]]
     print(per.to_string(index=False))
@@ -127,18 +99,12 @@ def cmd_train_target(args):
 
 
 def cmd_stiff(args):
-    from pathlib import Path
-
     import systems
-    from replication.results import write_csv, write_json
-    from replication.studies.stiff_solvers import stiff_study
+    from replication.studies.stiff_solvers import write_study
 
     systems.get(args.system)  # an unknown name fails here, listing the valid ones
     folder = write_folder(Path(args.out) / "stiff")
-    df = stiff_study(system=args.system)
-    write_csv(folder / "solvers.csv", df)
-    write_json(folder / "choice.json", {"system": args.system, **{k: (float(v) if isinstance(v, float) else v)
-                                                                    for k, v in df.attrs.items()}})
+    df = write_study(folder, args.system)
     print(df.to_string(index=False))
     print(f"picked: {df.attrs.get('reason')}; written to {folder}")
 

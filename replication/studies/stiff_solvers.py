@@ -1,12 +1,13 @@
 """The stiff-solver study: which ground-truth solver stays accurate on the stiff spring chain, at what cost.
 
-``stiff_study(out_csv=None, system="stiff_chain", n_ics=4, t_end=10.0, quick=True) -> DataFrame`` with one
+``stiff_study(system="stiff_chain", n_ics=4, t_end=10.0, cases=QUICK, verlet_dt=VERLET_DT) -> DataFrame`` with one
 row per (solver, rtol): solver, rtol, dt (fixed-step rows), wall_s (after compilation), n_steps (mean
 accepted steps per trajectory), state_err (max |z(T) - z_ref(T)| over trajectories, z = (q, qdot)),
 energy_err (max over trajectories and time of |E(t) - E(0)| / |E(0)|), and the solver `pick_solver`
 chooses (column `picked`). The reference is dopri8 at rtol = atol = 1e-13. Besides the diffrax solvers
 (`systems.trajectories.SOLVERS`) it times a fixed-step Stoermer-Verlet (symplectic; valid here because
-the chain's mass matrix is constant) in NumPy. Writes the CSV if ``out_csv`` is given.
+the chain's mass matrix is constant) in NumPy. ``write_study(folder, system)`` (`lagbench stiff`) runs it and
+writes FOLDER/solvers.csv and FOLDER/choice.json.
 """
 from __future__ import annotations
 
@@ -52,7 +53,7 @@ def _row(s, name, rtol, dt, wall, steps, q, qd, ref):
             "state_err": float(np.max(np.abs(z - zr))), "energy_err": float(np.max(drift))}
 
 
-def stiff_study(out_csv=None, system: str = "stiff_chain", n_ics: int = 4, t_end: float = 10.0,
+def stiff_study(system: str = "stiff_chain", n_ics: int = 4, t_end: float = 10.0,
                 cases=QUICK, verlet_dt=VERLET_DT) -> pd.DataFrame:
     s = systems.get(system)
     st = s.sample_states(n_ics, 0)
@@ -73,14 +74,14 @@ def stiff_study(out_csv=None, system: str = "stiff_chain", n_ics: int = 4, t_end
     df = pd.DataFrame(rows)
     df["picked"] = (df["solver"] == choice.solver) & np.isclose(df["rtol"], choice.rtol, rtol=1e-9, atol=0.0)
     df.attrs.update(stiffness_ratio=choice.stiffness_ratio, reason=choice.reason)
-    if out_csv is not None:
-        df.to_csv(out_csv, index=False)
     return df
 
 
-if __name__ == "__main__":
-    import sys
+def write_study(folder, system: str = "stiff_chain") -> pd.DataFrame:
+    from replication.results import write_csv, write_json
 
-    frame = stiff_study(sys.argv[1] if len(sys.argv) > 1 else None)
-    print(frame.to_string(index=False))
-    print(frame.attrs)
+    df = stiff_study(system=system)
+    write_csv(folder / "solvers.csv", df)
+    write_json(folder / "choice.json", {"system": system, **{k: (float(v) if isinstance(v, float) else v)
+                                                           for k, v in df.attrs.items()}})
+    return df
