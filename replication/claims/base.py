@@ -2,7 +2,7 @@
 
 A `Claim` names a paper result and everything needed to check it: the system, the models (each a
 `ModelEntry`: a label, ModelSpec fields, protocol overrides), the protocol per profile, the
-evaluation routine (a name in `replication.evaluation.routines.EVALUATIONS`), the metric the verdict reads,
+evaluation routine (a name in `replication.evaluation.registry.EVALUATIONS`), the metric the verdict reads,
 the published values (`published.Published`, each with what it is), the competence bars its models
 must pass (`bars.Bar`), and the verdict rule (built from `rules`: a function of
 {model label: {metric: Stat}} for one framework, returning (verdict, reason)). Where a verdict is

@@ -1,7 +1,7 @@
 """Training pace: whether, and after how many samples, a model left the q-double-dot ~ 0 plateau and
 reached the competence bar (claims 6 and 7).
 
-`eval_pace(ctx)` adds to the held-out metrics (`evaluate.eval_heldout`), per level (`LEVELS`: a fraction
+`eval_pace(ctx)` adds to the held-out metrics (`routines.eval_heldout`), per level (`LEVELS`: a fraction
 of the null predictor's held-out L1):
 - ``left_plateau`` / ``reached_bar``: 1 if the held-out L1 is at most that level after the budget, else 0.
   Over a claim's seeds their mean is a share (`rules.faster` reports it with a Wilson interval);

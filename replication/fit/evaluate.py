@@ -4,7 +4,7 @@
 ctx.cfg: {"heldout": bool (evaluate the protocol file's held-out rows), "test": a prepared file's
 `userdata.reference` or None, "system": a `systems` name or None, "energy": "module:function" (a user's
 E(q, qdot), in place of the system's) or None, "substeps": RK4 steps per sample
-interval, "model": a fit's unit folder (evaluate: the model is loaded from it by `fitted.load_fitted`)}.
+interval, "model": a fit's unit folder (evaluate: the model is loaded from it by `load.load_fitted`)}.
 Every evaluation set S ("heldout", "test") gives, all NumPy and framework-neutral:
 
 one step   S_l1, S_mse (as the training loss: per-sample sum over components, mean over samples) and the

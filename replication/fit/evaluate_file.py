@@ -3,10 +3,10 @@
 `evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
 energy=None)`
 -> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
-in it, side by side). Each model is loaded by `fitted.load_fitted` (checksums verified; in `framework`,
+in it, side by side). Each model is loaded by `load.load_fitted` (checksums verified; in `framework`,
 default the one it was trained in: parameters load in either), the data file is prepared as a test file
-(`fit_data.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
-polyorder unless given) and evaluated by the fit routine (`fit_evaluate.eval_fit`: one-step errors per
+(`rows.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
+polyorder unless given) and evaluated by the fit routine (`evaluate.eval_fit`: one-step errors per
 component, rollouts, energies with `system` or `energy` ("module:function"), DeLaN's decomposition). Written as units of a claim
 "evaluate": `OUT/units/evaluate/<framework>/<model>/seed<k>/` (result.json, one_step.csv, rollouts.csv,
 timeseries.csv, arrays.npz; `lagbench report` renders them) and OUT/data/ (the prepared rows). A verified

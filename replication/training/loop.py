@@ -23,7 +23,7 @@ step kept, its later steps not taken; the run ends when no member is left), a lo
 columns, timed apart), then `on_log(row)` (with "member": i when K > 1). After every step each hook is
 called as `hook(k, stepper, info)`, info = {loss (K,), lr, step_seconds, skipped_steps (K,), live (K,)};
 a hook returning True stops the run there (early stop). Held-out evaluations, checkpoints and scout
-selection are hooks and callers of this one loop (`replication.training.scouting`, `bench.target_loop`).
+selection are hooks and callers of this one loop (`replication.training.scouting`, `speedstudy.target_loop`).
 `step_seconds` is the time spent in propose + commit (of all members together), the first step left out
 (it compiles) unless `compiled` says the step already is.
 

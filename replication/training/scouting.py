@@ -18,7 +18,7 @@ has no restarts: the report says so where a claim uses them.
 `train_scouted(trainer, spec, protocol, seed, on_log=None) -> TrainOutcome` (trainer: `train_jax` or
 `train_torch`): the continuation's parameters and log (its steps shifted by the scouts' samples in
 continuation steps, `progress_steps`), steps_done and samples counting every scout, its `scouting` record {init_seeds, tail_loss, chosen, scout_steps}. `scout(...)` and `continuation(...)` are
-the two phases, for callers that watch them (`bench.target_loop`).
+the two phases, for callers that watch them (`speedstudy.target_loop`).
 """
 from __future__ import annotations
 
