@@ -12,11 +12,15 @@ form one *chain* (`replication.run.chains`, shared with the Ray executor, `repli
 longest first (estimated from the training budget in samples, the model's width and the framework), so
 that the long ones do not start last. Every unit writes its own files as in a serial run, so a run is
 resumable and gives the same numbers either way (training is deterministic given the seed; only wall
-times differ). Ctrl-C cancels the chains not yet started and stops the workers.
+times differ). Ctrl-C cancels the chains not yet started and stops the workers. A worker whose driver is
+gone (killed, SIGTERM from a scheduler or `timeout`) exits within a second: it would otherwise finish its
+chain, hours in the long profiles, writing into a folder that a resumed run may be writing too.
 """
 from __future__ import annotations
 
 import os
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 
@@ -53,10 +57,18 @@ def _serial(todo, out, profile, progress):
     return failures, errors
 
 
-def _worker_start():
+def _exit_with(parent: int, every: float = 1.0):
+    """Exit this process once its parent is no longer `parent` (the driver died; we were re-parented)."""
+    while os.getppid() == parent:
+        time.sleep(every)
+    os._exit(1)
+
+
+def _worker_start(driver: int):
     import torch
 
     torch.set_num_threads(1)
+    threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
 
 
 def _parallel(todo, out, profile, progress, jobs):
@@ -67,7 +79,8 @@ def _parallel(todo, out, profile, progress, jobs):
     # inherited by the spawned workers before they import JAX or PyTorch; kept while the pool lives, as
     # the pool starts its processes on demand as chains are submitted
     os.environ.update(one)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start,
+                               initargs=(os.getpid(),))
     bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
     try:
         futures = {pool.submit(_run_chain, [_ref(u) for u in c], out): c for c in work}

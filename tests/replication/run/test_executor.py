@@ -1,5 +1,12 @@
 """Units in parallel worker processes: the same numbers as one after another, and a model shared by two
 claims trained once (its units form one chain)."""
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
 import pandas as pd
 import pytest
 
@@ -74,3 +81,46 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
     assert failures == [] and errors == []
     assert seen == one_thread_env({})
     assert "OMP_NUM_THREADS" not in os.environ
+
+
+def _children(pid):
+    out = []
+    for d in Path("/proc").iterdir():
+        try:
+            if d.name.isdigit() and int((d / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid:
+                out.append(int(d.name))
+        except (OSError, ValueError, IndexError):
+            continue
+    return out
+
+
+def _running(pid) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc to find the driver's workers")
+def test_workers_exit_when_their_driver_is_killed(tmp_path):
+    """SIGKILL on the driver (a scheduler's time limit, `kill -9`) as soon as its two workers exist: they
+    exit, and write no unit (left alone, each would finish its chain first)."""
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "replication.cli", "run", "--profile", "smoke", "--claims", "dp_loss,appendix_b",
+           "--frameworks", "jax", "--jobs", "2", "--quiet", "--out", str(out)]
+    driver = subprocess.Popen(cmd, start_new_session=True)
+    deadline, workers = time.time() + 120, []
+    while time.time() < deadline and len(workers) < 2 and driver.poll() is None:
+        workers = [c for c in _children(driver.pid) if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+        time.sleep(0.05)
+    assert len(workers) == 2, "the driver's two workers never started"
+    driver.kill()
+    driver.wait()
+    deadline = time.time() + 60
+    while time.time() < deadline and any(_running(w) for w in workers):
+        time.sleep(0.1)
+    alive = [w for w in workers if _running(w)]
+    for w in alive:
+        os.kill(w, signal.SIGKILL)
+    assert not alive, "workers kept running after their driver was killed"
+    assert not list(out.glob("units/*/*/*/seed*/result.json")), "a worker went on to finish a unit"
