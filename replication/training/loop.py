@@ -24,14 +24,22 @@ columns, timed apart), then `on_log(row)` (with "member": i when K > 1). After e
 called as `hook(k, stepper, info)`, info = {loss (K,), lr, step_seconds, skipped_steps (K,), live (K,)};
 a hook returning True stops the run there (early stop). Held-out evaluations, checkpoints and scout
 selection are hooks and callers of this one loop (`replication.training.scouting`, `speedstudy.target_loop`).
-`step_seconds` is the time spent in propose + commit (of all members together), the first step left out
-(it compiles) unless `compiled` says the step already is.
+`step_seconds` is the time spent in propose + commit (of all members together), the first step of the
+process left out (it compiles) unless `compiled` says the step already is.
 
-`train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False) -> TrainOutcome`: one model;
-its hooks see that stepper and scalar info.
+With `snapshot` (a `replication.training.snapshots.Snapshots`), the loop first puts back that store's
+snapshot if it has one for this run (the stepper's `load_state_arrays`, the guards, logs, failures, hooks
+with a `restore_snapshot`) and goes on from its step; it saves one after a step when the store says it is
+due and once at the end (an ended phase resumed returns its outcomes without a step). A stepper for
+snapshots also gives `state_arrays() -> [np.ndarray]` (parameters and optimiser state, in a fixed order)
+and `load_state_arrays(arrays)`.
+
+`train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome`:
+one model; its hooks see that stepper and scalar info.
 """
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -40,14 +48,26 @@ from replication.training.outcome import TrainOutcome, nonfinite_failure
 from replication.training.schedules import learning_rate
 from replication.training.spike_guard import SpikeGuard
 
+log = logging.getLogger("lagbench")
 
-def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False) -> list[TrainOutcome]:
+
+def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False,
+                  snapshot=None) -> list[TrainOutcome]:
     n = len(streams)
     guards = [SpikeGuard(protocol) for _ in range(n)]
     logs, failures = [[] for _ in range(n)], [None] * n
     live, done = np.ones(n, bool), np.zeros(n, int)
-    t0, t_probe, t_steps = time.perf_counter(), 0.0, 0.0
-    for k in range(protocol.steps):
+    start, ended, wall, t_steps = 0, False, 0.0, 0.0
+    saved = snapshot.load(n, protocol.steps) if snapshot else None
+    if saved and not _fits(saved[1], stepper):
+        log.warning("training snapshot in %s not used, starting over: its arrays do not fit this model and "
+                    "optimiser", snapshot.folder)
+        saved = None
+    if saved:
+        start, ended, wall, t_steps = _restore(*saved, stepper, guards, logs, failures, live, done, hooks)
+    t0, t_probe = time.perf_counter() - wall, 0.0
+    k = start
+    for k in range(start, protocol.steps if not ended else start):
         lr = learning_rate(protocol, k)
         batches = [stream.batch(k) for stream in streams]
         # a stopped member gets the bound -inf: no step of it is ever taken again
@@ -61,7 +81,7 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
             break
         taken = np.array([on and g.record(gnorm[i], bounds[i]) for i, (g, on) in enumerate(zip(guards, live, strict=True))])
         stepper.commit(taken, np.array([g.clip_scale(gnorm[i]) for i, g in enumerate(guards)]))
-        if k or compiled:
+        if k > start or compiled:   # the first step of a process compiles
             t_steps += time.perf_counter() - ts
         done[live] = k + 1
         if k % protocol.log_every == 0 or k == protocol.steps - 1:
@@ -81,10 +101,56 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
                 "skipped_steps": np.array([g.skipped for g in guards])}
         if any([hook(k, stepper, info) for hook in hooks]):
             break
+        if snapshot and k + 1 < protocol.steps and snapshot.due():
+            snapshot.save(*_state(k + 1, False, time.perf_counter() - t0 - t_probe, t_steps, stepper, guards,
+                                  logs, failures, live, done, hooks, protocol.steps))
     total = time.perf_counter() - t0 - t_probe
+    if snapshot and not ended:   # the end, so that a later phase resumes without redoing this one
+        snapshot.save(*_state(k + 1, True, total, t_steps, stepper, guards, logs, failures, live, done, hooks,
+                              protocol.steps))
     return [TrainOutcome(params=p, log=logs[i], failure=failures[i], train_time_s=total, steps_done=int(done[i]),
                          batch=protocol.batch, step_seconds=t_steps, skipped_steps=guards[i].skipped)
             for i, p in enumerate(stepper.params())]
+
+
+def _fits(arrays, stepper) -> bool:
+    mine = [np.shape(a) for a in stepper.state_arrays()]
+    return [np.shape(arrays[k]) for k in sorted(arrays) if k.startswith("stepper_")] == mine
+
+
+def _state(step, ended, wall, t_steps, stepper, guards, logs, failures, live, done, hooks,
+           steps) -> tuple[dict, dict]:
+    """(meta, arrays) of a snapshot (`replication.training.snapshots`): all the next step reads."""
+    arrays = {f"stepper_{j:04d}": a for j, a in enumerate(stepper.state_arrays())}
+    hook_meta = []
+    for h, hook in enumerate(hooks):
+        state = getattr(hook, "snapshot_state", None)
+        meta, extra = state() if state else (None, {})
+        hook_meta.append(meta)
+        arrays.update({f"hook{h}_{name}": a for name, a in extra.items()})
+    meta = {"step": step, "steps": steps, "ended": ended, "wall_s": wall, "step_seconds": t_steps,
+            "members": len(guards),
+            "logs": logs, "failures": failures, "live": live, "done": done, "hooks": hook_meta,
+            "guards": [{"history": list(g.history), "skipped": g.skipped} for g in guards]}
+    return meta, arrays
+
+
+def _restore(meta, arrays, stepper, guards, logs, failures, live, done, hooks):
+    """Put a snapshot's state back in place -> (next step, ended, wall seconds, step seconds)."""
+    stepper.load_state_arrays([arrays[k] for k in sorted(arrays) if k.startswith("stepper_")])
+    for g, saved in zip(guards, meta["guards"], strict=True):
+        g.history.extend(saved["history"])
+        g.skipped = int(saved["skipped"])
+    for i in range(len(guards)):
+        logs[i].extend(meta["logs"][i])
+        failures[i] = meta["failures"][i]
+    live[:], done[:] = meta["live"], meta["done"]
+    for h, hook in enumerate(hooks):
+        restore = getattr(hook, "restore_snapshot", None)
+        if restore:
+            prefix = f"hook{h}_"
+            restore(meta["hooks"][h], {k[len(prefix):]: a for k, a in arrays.items() if k.startswith(prefix)})
+    return int(meta["step"]), bool(meta["ended"]), float(meta["wall_s"]), float(meta["step_seconds"])
 
 
 class _One:
@@ -106,15 +172,24 @@ class _One:
     def params(self):
         return [self.stepper.params()]
 
+    def state_arrays(self):
+        return self.stepper.state_arrays()
+
+    def load_state_arrays(self, arrays):
+        self.stepper.load_state_arrays(arrays)
+
 
 def _scalar_hook(hook, stepper):
     def call(k, _, info):
         return hook(k, stepper, {"loss": float(info["loss"][0]), "lr": info["lr"],
                                  "step_seconds": info["step_seconds"],
                                  "skipped_steps": int(info["skipped_steps"][0])})
+    for name in ("snapshot_state", "restore_snapshot"):   # a hook's state travels through the wrapper
+        if hasattr(hook, name):
+            setattr(call, name, getattr(hook, name))
     return call
 
 
-def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False) -> TrainOutcome:
+def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome:
     return train_members(_One(stepper), protocol, [stream], on_log,
-                         [_scalar_hook(h, stepper) for h in hooks], compiled)[0]
+                         [_scalar_hook(h, stepper) for h in hooks], compiled, snapshot)[0]

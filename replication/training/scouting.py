@@ -64,19 +64,34 @@ def continuation_protocol(protocol):
     return protocol.replace(**_OFF)
 
 
-def scout(trainer, spec, protocol, seeds, on_log=None, hooks=()):
+class _Losses:
+    """The loop hook that keeps each scout's training loss at every step (NaN once it stopped)."""
+
+    def __init__(self):
+        self.losses = []
+
+    def __call__(self, k, stepper, info):
+        self.losses.append(np.where(info["live"], info["loss"], np.nan))
+
+    def snapshot_state(self):
+        return None, {"losses": np.asarray(self.losses, np.float64)}
+
+    def restore_snapshot(self, meta, arrays):
+        self.losses = list(arrays["losses"])
+
+
+def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None):
     """Phase 1: (outcomes, tail losses), one per init seed in `seeds`, trained as one program for
     `scout_protocol(protocol).steps`; the tail loss is inf for a scout that stopped."""
     from models import init_params  # here, not at import: claims read scout_protocol without
     from replication.training.data import BatchStream  # the models or the data (reports import the claims)
 
     p = scout_protocol(protocol)
-    losses = []
-
-    def keep(k, stepper, info):
-        losses.append(np.where(info["live"], info["loss"], np.nan))
+    keep = _Losses()
     outcomes = trainer.train_members(spec, [init_params(spec, seed=s) for s in seeds], p,
-                                     [BatchStream(p, s) for s in seeds], on_log=on_log, hooks=(keep, *hooks))
+                                     [BatchStream(p, s) for s in seeds], on_log=on_log, hooks=(keep, *hooks),
+                                     snapshot=snapshot)
+    losses = keep.losses
     tail = np.asarray(losses[-max(len(losses) // round(1 / TAIL), 1):]) if losses else np.full((1, len(seeds)), np.inf)
     tails = [float(np.mean(tail[:, i])) if o.failure is None else math.inf for i, o in enumerate(outcomes)]
     return outcomes, [t if math.isfinite(t) else math.inf for t in tails]
@@ -88,10 +103,11 @@ def choose(tails) -> int | None:
     return min(finite, key=lambda i: tails[i]) if finite else None
 
 
-def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None):
+def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, snapshot=None):
     """Scouts, then the chosen one's continuation; `track(protocol, offset_steps, offset_samples,
     offset_seconds)` may give a held-out tracking hook for the continuation (`training.tracker_for`): the
-    scouts' samples and step time count."""
+    scouts' samples and step time count. `snapshot` (`snapshots.Snapshots`): each phase snapshots under
+    its own name ("scouts", "continuation"), so that a run killed in its continuation does not scout again."""
     from replication.training.data import BatchStream
 
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
@@ -100,7 +116,8 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None):
     def scout_log(row):   # progress in continuation steps: the scouts advance together
         if on_log and row.get("member", 0) == 0:
             on_log({**row, "step": row["step"] * done // per})
-    outcomes, tails = scout(trainer, spec, protocol, seeds, on_log=scout_log)
+    outcomes, tails = scout(trainer, spec, protocol, seeds, on_log=scout_log,
+                            snapshot=snapshot.phase("scouts") if snapshot else None)
     best = choose(tails)
     record = {"init_seeds": seeds, "tail_loss": tails, "scout_steps": per,
               "chosen": None if best is None else seeds[best]}
@@ -116,7 +133,8 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None):
             on_log({**row, "step": row["step"] + done})
     t = track(p, done, len(seeds) * per * outcomes[0].batch, outcomes[0].step_seconds) if track else None
     out = trainer.train(spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
-                        on_log=shifted, hooks=(t,) if t else ())
+                        on_log=shifted, hooks=(t,) if t else (),
+                        snapshot=snapshot.phase("continuation") if snapshot else None)
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
     if t:
         t.merge([out.log])

@@ -8,6 +8,7 @@ steps only, the first compiling step and these evaluations left out) and `heldou
 writes them into the training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of
 the same step (a tracking step is also a log step: `track_every` is a multiple of `log_every`).
 The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
+Its rows travel in a training's snapshots (`snapshot_state`, `restore_snapshot`; `replication.training.snapshots`).
 """
 from __future__ import annotations
 
@@ -53,6 +54,12 @@ class Tracker:
                                  "train_s": float(info["step_seconds"]) + self.offset_seconds,
                                  "samples": (k + 1) * p.batch + self.offset_samples})
         return False
+
+    def snapshot_state(self):
+        return self.rows, {}
+
+    def restore_snapshot(self, meta, arrays):
+        self.rows = [[dict(r) for r in member] for member in meta]
 
     def merge(self, logs: list[list[dict]]) -> None:
         """Add the tracked columns to each member's log rows of the same step (in place)."""

@@ -2,7 +2,9 @@
 
 `train_cached(out, framework, spec, protocol, seed)` -> TrainOutcome. The cache folder
 `OUT/trained/<framework>/<key>/` holds checkpoint.npz (last good parameters), train_log.csv and
-train.json (timings, failure, file checksums); a corrupt entry is retrained, never trusted.
+train.json (timings, failure, file checksums); a corrupt entry is retrained, never trusted. While it
+trains, `inflight/` there holds its snapshots (`replication.training.snapshots`): a run killed mid-training
+resumes each training from its last one, and they are removed once the training is stored.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ from replication import results as R
 from replication.training.data import BatchStream, targets_version
 from replication.training.outcome import TrainOutcome, log_frame
 from replication.training.scouting import train_scouted
+from replication.training.snapshots import Snapshots
 from replication.training.tracking import Tracker
 
 log = logging.getLogger("lagbench")
@@ -53,15 +56,16 @@ def tracker_for(framework, spec):
     return make
 
 
-def run_training(framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
+def run_training(framework, spec, protocol, seed, on_log=None, snapshot=None) -> TrainOutcome:
     """One run of a protocol from the init of `seed`; with `protocol.scouts` > 1, restarts over inits
-    (`replication.training.scouting`)."""
+    (`replication.training.scouting`). `snapshot`: where it keeps snapshots and resumes from them."""
     track = tracker_for(framework, spec)
     if protocol.scouts > 1:
-        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track)
+        return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track,
+                             snapshot=snapshot)
     t = track(protocol)
     out = trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
-                                   on_log=on_log, hooks=(t,) if t else ())
+                                   on_log=on_log, hooks=(t,) if t else (), snapshot=snapshot)
     if t:
         t.merge([out.log])
     return out
@@ -80,7 +84,7 @@ def group_key(framework, spec, protocol, seed) -> str:
     return train_key(framework, spec, protocol, cohort_seeds(protocol, seed)[0])
 
 
-def train_cohort(framework, spec, protocol, seeds, on_log=None) -> list[TrainOutcome]:
+def train_cohort(framework, spec, protocol, seeds, on_log=None, snapshot=None) -> list[TrainOutcome]:
     """The seeds' runs of `protocol` as one vectorised program (`train_members`): each its own init and
     batch stream, as when run alone. `on_log` sees the first seed's rows; every outcome's `train_time_s` is
     the program's (shared by the cohort)."""
@@ -90,7 +94,7 @@ def train_cohort(framework, spec, protocol, seeds, on_log=None) -> list[TrainOut
     t = tracker_for(framework, spec)(protocol)
     outcomes = trainer(framework).train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
                                                 [BatchStream(protocol, s) for s in seeds], on_log=first,
-                                                hooks=(t,) if t else ())
+                                                hooks=(t,) if t else (), snapshot=snapshot)
     if t:
         t.merge([o.log for o in outcomes])
     for o in outcomes:
@@ -133,10 +137,12 @@ def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutc
     if done is not None:
         return done
     seeds = cohort_seeds(protocol, seed)
+    snapshot = Snapshots(folder(seeds[0]) / "inflight", train_key(framework, spec, protocol, seeds[0]))
     if len(seeds) > 1:
-        outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log)
+        outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log, snapshot=snapshot)
     else:
-        outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log)]
+        outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log, snapshot=snapshot)]
     for s, o in zip(seeds, outcomes, strict=True):
         _store(folder(s), o, spec, protocol, s)
+    snapshot.clear()
     return outcomes[seeds.index(seed)]

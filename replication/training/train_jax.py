@@ -5,13 +5,14 @@
 rate the loop passes; clipped to `protocol.grad_clip` and skipped above the spike guard's bound inside the
 compiled step, `replication.training.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
 `make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
-stream, on_log=None, hooks=()) -> TrainOutcome`: `replication.training.loop.train` with this stepper.
+stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome`: `replication.training.loop.train` with this
+stepper. Both steppers give their model and Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol, step=None)`: K models of one spec trained as one program (the
 stepper of `replication.training.loop.train_members`): the parameters and Adam states stacked along a leading axis
 and the same compiled step `eqx.filter_vmap`-ed over them and over the K batches (`make_members_step`);
 each member's numbers are those of its own `Stepper` run (`tests/replication/training/test_members_parity.py`).
-`train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> [TrainOutcome]`.
+`train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
 """
 from __future__ import annotations
 
@@ -84,6 +85,21 @@ def make_probe(spec, protocol):
     return run
 
 
+def _state_arrays(stepper) -> list[np.ndarray]:
+    """The arrays of a stepper's model and Adam state, in pytree order (`loop`'s snapshots)."""
+    return [np.asarray(a) for a in jax.tree_util.tree_leaves((eqx.filter(stepper.model, eqx.is_array),
+                                                              stepper.opt_state))]
+
+
+def _load_state_arrays(stepper, arrays) -> None:
+    leaves, treedef = jax.tree_util.tree_flatten((eqx.filter(stepper.model, eqx.is_array), stepper.opt_state))
+    if [np.shape(a) for a in arrays] != [a.shape for a in leaves]:
+        raise ValueError("a training snapshot's arrays do not fit this model and optimiser")
+    model, stepper.opt_state = jax.tree_util.tree_unflatten(
+        treedef, [jnp.asarray(a, dtype=leaf.dtype) for a, leaf in zip(arrays, leaves, strict=True)])
+    stepper.model = eqx.combine(model, eqx.filter(stepper.model, eqx.is_array, inverse=True))
+
+
 class Stepper:
     def __init__(self, spec, params, protocol, step=None):
         self.dtype = jnp.dtype(protocol.dtype)
@@ -110,9 +126,15 @@ class Stepper:
     def params(self) -> dict:
         return models.jax.to_params(self.model)
 
+    def state_arrays(self) -> list[np.ndarray]:
+        return _state_arrays(self)
 
-def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
-    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)
+    def load_state_arrays(self, arrays) -> None:
+        _load_state_arrays(self, arrays)
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot)
 
 
 def _stack(trees):
@@ -160,6 +182,13 @@ class Members:
     def params(self) -> list[dict]:
         return [models.jax.to_params(self.member(i)) for i in range(self.n)]
 
+    def state_arrays(self) -> list[np.ndarray]:
+        return _state_arrays(self)
 
-def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
-    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks)
+    def load_state_arrays(self, arrays) -> None:
+        _load_state_arrays(self, arrays)
+
+
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None) -> list[TrainOutcome]:
+    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks,
+                              snapshot=snapshot)

@@ -3,8 +3,9 @@
 
 `Stepper(spec, params, protocol)`: the gradient and its global norm in `propose` (the learning rate set on
 the optimiser there); in `commit`, if the spike guard takes the step, the gradient scaled by the clip
-factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome`:
-`replication.training.loop.train` with this stepper.
+factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) ->
+TrainOutcome`: `replication.training.loop.train` with this stepper. Both steppers give their parameters and
+Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol)`: K models of one spec trained as one program (the stepper of
 `replication.training.loop.train_members`): the parameters stacked by `torch.func.stack_module_state`, the K losses
@@ -13,7 +14,7 @@ of their sum (the members share nothing, so each gets its own gradient), and Ada
 (`_adam`: torch.optim.Adam's single-tensor arithmetic, with a step count per member, so that a member the
 guard skips keeps its state exactly). Each member's numbers are those of its own `Stepper` run
 (`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
-on_log=None, hooks=()) -> [TrainOutcome]`.
+on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
 """
 from __future__ import annotations
 
@@ -26,6 +27,9 @@ import models.torch
 from replication.training import hessian_probe, loop
 from replication.training.objective import loss_value, predict
 from replication.training.outcome import TrainOutcome
+
+
+_ADAM_STATE = ("step", "exp_avg", "exp_avg_sq")   # torch.optim.Adam's state of one parameter (no amsgrad)
 
 
 def _to_torch(batch: dict, dtype) -> dict:
@@ -92,9 +96,32 @@ class Stepper:
     def params(self) -> dict:
         return models.torch.to_params(self.model)
 
+    def state_arrays(self) -> list[np.ndarray]:
+        """Per parameter: its values, whether Adam holds a state for it (none before its first gradient),
+        and that state's step count and two moments (zeros when absent)."""
+        out = []
+        for p in self.model.parameters():
+            state = self.opt.state.get(p) or {}
+            out += [p.detach().numpy().copy(), np.asarray(bool(state))]
+            out += [(state[k].detach().numpy().copy() if k in state else np.zeros(() if k == "step" else p.shape))
+                    for k in _ADAM_STATE]
+        return out
 
-def train(spec, params, protocol, stream, on_log=None, hooks=()) -> TrainOutcome:
-    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks)
+    def load_state_arrays(self, arrays) -> None:
+        params = list(self.model.parameters())
+        if len(arrays) != len(params) * (2 + len(_ADAM_STATE)):
+            raise ValueError("a training snapshot's arrays do not fit this model and optimiser")
+        with torch.no_grad():
+            for j, p in enumerate(params):
+                value, has, *state = arrays[j * (2 + len(_ADAM_STATE)):(j + 1) * (2 + len(_ADAM_STATE))]
+                p.copy_(torch.as_tensor(value))
+                self.opt.state.pop(p, None)
+                if bool(has):
+                    self.opt.state[p] = {k: torch.as_tensor(a).clone() for k, a in zip(_ADAM_STATE, state, strict=True)}
+
+
+def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot)
 
 
 class _Objective(nn.Module):
@@ -176,6 +203,24 @@ class Members:
     def params(self) -> list[dict]:
         return [self._params_of(i) for i in range(self.n)]
 
+    def state_arrays(self) -> list[np.ndarray]:
+        """The stacked parameters, their two Adam moments (in `stacked` order) and the step counts."""
+        out = []
+        for k, p in self.stacked.items():
+            out += [p.detach().numpy().copy(), *(m.numpy().copy() for m in self.moments[k])]
+        return [*out, self.count.numpy().copy()]
 
-def train_members(spec, params_list, protocol, streams, on_log=None, hooks=()) -> list[TrainOutcome]:
-    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks)
+    def load_state_arrays(self, arrays) -> None:
+        if len(arrays) != 3 * len(self.stacked) + 1:
+            raise ValueError("a training snapshot's arrays do not fit these models and optimiser")
+        with torch.no_grad():
+            for j, (k, p) in enumerate(self.stacked.items()):
+                value, m, v = (torch.as_tensor(a) for a in arrays[3 * j:3 * j + 3])
+                p.copy_(value)
+                self.moments[k] = (m.clone(), v.clone())
+        self.count = torch.as_tensor(arrays[-1]).clone()
+
+
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None) -> list[TrainOutcome]:
+    return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks,
+                              snapshot=snapshot)

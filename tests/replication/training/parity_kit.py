@@ -56,18 +56,19 @@ class Recorder:
         self.phases.append([{"log": o.log, "params": [p[i] for p in params], "failure": o.failure}
                             for i, o in enumerate(outcomes)])
 
-    def train(self, spec, params, protocol, stream, on_log=None, hooks=()):
+    def train(self, spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None):
         seen = []
         keep = (lambda k, stepper, info: seen.append([stepper.params()]))   # noqa: E731
-        out = loop.train(self._stepper(spec, params, protocol, False), protocol, stream, on_log, (keep, *hooks))
+        out = loop.train(self._stepper(spec, params, protocol, False), protocol, stream, on_log, (keep, *hooks),
+                         snapshot=snapshot)
         self._record([out], seen)
         return out
 
-    def train_members(self, spec, params_list, protocol, streams, on_log=None, hooks=()):
+    def train_members(self, spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None):
         seen = []
         keep = (lambda k, stepper, info: seen.append(stepper.params()))   # noqa: E731
         outs = loop.train_members(self._stepper(spec, params_list, protocol, True), protocol, streams, on_log,
-                                  (keep, *hooks))
+                                  (keep, *hooks), snapshot=snapshot)
         self._record(outs, seen)
         return outs
 
