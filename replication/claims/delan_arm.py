@@ -4,7 +4,10 @@ positive definite everywhere.
 
 Protocol after the original PyTorch example (reference delan §3): 2 x 64 softplus, batch 512,
 Adam lr 5e-4, weight decay 1e-5 (as an L2 term), torque MSE; trained on one family of smooth
-trajectories, tested on another ("test" family). Data efficiency: the same models on smaller pools.
+trajectories, tested on another ("test" family). Data efficiency: the same models on smaller pools, each
+a few points along several trajectories (`replication.training.data.arm_trajectories`), trained for as
+many steps as the full pool; the competence bar asks every model, the small-pool ones included, to have
+learned the training family (torque MSE on its held-out states at most a tenth of the null's).
 """
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
@@ -31,7 +34,10 @@ MODELS = _models()
 _base = Protocol(data="two_link_arm", task="inverse_dynamics", steps=20, batch=32, n_train=512, n_heldout=512,
                  loss="mse", lr=5e-4, schedule="constant", l2=1e-5, log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=2000, batch=256, n_train=4096, n_heldout=4000, log_every=50, lr=1e-3),
+             # 8000 steps for every pool: at 2000 the small pools were under-trained (JAX, 3 seeds, torque MSE
+             # on the training family's held-out states against the null's 34.7: DeLaN n256 3.9 -> 0.22 at
+             # 8000, FF n256 5.0 -> 3.2), and every pool gets the same steps, so that only the data differ
+             "quick": _base.replace(steps=8000, batch=256, n_train=4096, n_heldout=4000, log_every=200, lr=1e-3),
              "paper": _base.replace(steps=40_000, batch=512, n_train=2459, n_heldout=4000, log_every=500)}
 
 
@@ -59,6 +65,7 @@ CLAIM = Claim(
                  "and DeLaN's mass matrix positive definite",
     verdict=_verdict,
     # learned on the training family (the unseen family is what the claim measures)
-    bars=(Bar(("delan", "ff"), "torque_mse_train"), Bar(tuple(f"delan_n{n}" for n in POOLS), "torque_mse_train")),
+    bars=(Bar(("delan", "ff"), "torque_mse_train"),
+          Bar(tuple(f"{m}_n{n}" for n in POOLS for m in ("delan", "ff")), "torque_mse_train")),
     seeds={"smoke": 1, "quick": 3, "paper": 3},
 )

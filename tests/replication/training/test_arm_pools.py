@@ -1,0 +1,24 @@
+"""The two-link arm's training pools (`replication.training.data.recipe_arm`): a small pool spreads its
+samples over several trajectories, and the cache key sees the change."""
+import numpy as np
+
+from replication.training import data as datamod
+from replication.training.protocol import Protocol
+
+ARM = Protocol(data="two_link_arm", task="inverse_dynamics", steps=10, batch=32, n_train=256, n_heldout=512,
+               loss="mse", lr=1e-3, schedule="constant")
+
+
+def test_a_small_pool_is_several_trajectories():
+    assert [datamod.arm_trajectories(n) for n in (4, 16, 256, 1024, 1600, 2459, 4096)] == [2, 8, 8, 8, 8, 12, 20]
+    pool = datamod.recipe_arm(ARM, 256, np.random.default_rng(0))
+    assert pool["q"].shape == (256, 2)
+    # 8 trajectories of 32 points: the pool's joint angles span far more than one 4-second trajectory's
+    one = datamod.recipe_arm(ARM, 200, np.random.default_rng(0))
+    assert np.ptp(pool["q"], 0).min() > np.ptp(one["q"], 0).min()
+
+
+def test_the_training_cache_key_changes_with_the_pool_rule_and_only_for_small_pools():
+    assert datamod.targets_version(ARM) == "arm-min-8-trajectories"
+    assert datamod.targets_version(ARM.replace(n_train=4096)) == ""
+    assert datamod.targets_version(ARM.replace(n_train=1600)) == ""
