@@ -83,20 +83,26 @@ def output_folder(path, option: str = "--out") -> Path:
     return path
 
 
-def _clean(obj):
-    """JSON-safe: NumPy scalars to Python, NaN to None. +-inf stay (JSON `Infinity`, which Python and
-    pandas read back): a diverged rollout's error is +inf, and a verdict must see it as such."""
+def _clean(obj, keep_nan: bool = False):
+    """JSON-safe: NumPy scalars to Python, NaN to None (kept as JSON `NaN` with `keep_nan`, for state read
+    back by this suite only: training snapshots). +-inf stay (JSON `Infinity`, which Python and pandas read
+    back): a diverged rollout's error is +inf, and a verdict must see it as such."""
     if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
+        return {str(k): _clean(v, keep_nan) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
+        return [_clean(v, keep_nan) for v in obj]
     if isinstance(obj, np.ndarray):
-        return _clean(obj.tolist())
+        return _clean(obj.tolist(), keep_nan)
     if isinstance(obj, np.generic):
         obj = obj.item()
-    if isinstance(obj, float) and math.isnan(obj):
+    if isinstance(obj, float) and math.isnan(obj) and not keep_nan:
         return None
     return obj
+
+
+def json_lossless(obj):
+    """`obj` JSON-ready without loss: NumPy to Python, NaN and infinities kept (`NaN`, `Infinity`)."""
+    return _clean(obj, keep_nan=True)
 
 
 def canonical(d: dict) -> bytes:

@@ -41,20 +41,6 @@ log = logging.getLogger("lagbench")
 SNAPSHOT_EVERY_S = 300.0   # at most this much wall time of a training is lost to an interruption
 
 
-def plain(obj):
-    """JSON-ready without loss: NumPy scalars and arrays to Python, NaN and infinities kept (JSON `NaN`,
-    `Infinity`, which `json` reads back)."""
-    if isinstance(obj, dict):
-        return {str(k): plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return plain(obj.tolist())
-    if isinstance(obj, np.generic):
-        return obj.item()
-    return obj
-
-
 class Snapshots:
     def __init__(self, folder, key: str, every_s: float | None = None, phase: str = "run"):
         self.folder, self.key, self.name = Path(folder), str(key), phase
@@ -79,7 +65,7 @@ class Snapshots:
             if self.folder.is_symlink():
                 raise OSError(f"{self.folder} is a symlink; snapshots are never written through one")
             digest = R.write_npz(self.folder / npz, arrays)
-            record = plain({**meta, "key": self.key, "phase": self.name, "arrays": npz, "arrays_sha256": digest})
+            record = R.json_lossless({**meta, "key": self.key, "phase": self.name, "arrays": npz, "arrays_sha256": digest})
             record["checksum"] = R.result_checksum(record)
             R.atomic_write_bytes(self._json(), json.dumps(record, sort_keys=True).encode())
             for old in self.folder.glob(f"{self.name}-*.npz"):
