@@ -28,11 +28,8 @@ from __future__ import annotations
 
 import json
 import logging
-import math
 import time
 from pathlib import Path
-
-import numpy as np
 
 from replication import results as R
 
@@ -107,4 +104,3 @@ class Snapshots:
             self.folder.rmdir()
         except OSError:
             pass
-

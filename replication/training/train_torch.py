@@ -28,7 +28,6 @@ from replication.training import hessian_probe, loop
 from replication.training.objective import loss_value, predict
 from replication.training.outcome import TrainOutcome
 
-
 _ADAM_STATE = ("step", "exp_avg", "exp_avg_sq")   # torch.optim.Adam's state of one parameter (no amsgrad)
 
 
