@@ -57,14 +57,19 @@ def block_tridiagonal_solve(diag, lower, upper, rhs):
 
 
 class _ImplicitSolve(torch.autograd.Function):
-    """Implicit gradient of the solve (see models.jax.banded.solve_cyclic_banded)."""
+    """Implicit gradient of the solve (see models.jax.banded.solve_cyclic_banded). Forward and backward
+    are plain batched torch ops, so torch.func.vmap (stacked members) maps them as they are."""
+    generate_vmap_rule = True
 
     @staticmethod
-    def forward(ctx, band, rhs, layout):
-        x = _solve(band, rhs, layout)
-        ctx.save_for_backward(band, x)
+    def forward(band, rhs, layout):
+        return _solve(band, rhs, layout)
+
+    @staticmethod
+    def setup_context(ctx, inputs, output):
+        band, _, layout = inputs
+        ctx.save_for_backward(band, output)
         ctx.layout = layout
-        return x
 
     @staticmethod
     def backward(ctx, xbar):

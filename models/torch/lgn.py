@@ -33,7 +33,7 @@ from models.graph import (
 )
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
-from models.torch.export_paths import pick
+from models.torch.export_paths import pick, vmapped
 from models.torch.lnn import euler_lagrange_info, pinv_solve
 from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
@@ -68,8 +68,9 @@ def dense_from_band(band):
 
 def _pinv_where_bad(band, rhs, x, bad, r, layout):
     """Eager: if any sample's banded solve is not finite, those take pinv of the dense matrix, solved
-    again on an identity band first so that no NaN reaches the gradient."""
-    if not bool(torch.any(bad)):
+    again on an identity band first so that no NaN reaches the gradient. Vmapped: always, with no
+    Python branch on data."""
+    if not vmapped(band) and not bool(torch.any(bad)):
         return x
     eye = torch.as_tensor(_identity_band(rhs.shape[-1], r), dtype=band.dtype, device=band.device)
     safe = torch.where(bad[:, None, None], eye, band)
@@ -136,9 +137,11 @@ class LGN(Model):
         x = mlp_input(spec, [wrap_angles(spec, q)[..., nb], qdot[..., nb]]).reshape(bsz * n, 2 * k)
         scale = input_scale(spec, 2 * k, x.dtype, x.device)
         s_q, s_qd = scale[:k], scale[k:]
-        tangents = torch.zeros((bsz * n, k + 1, 2 * k), dtype=x.dtype, device=x.device)
-        tangents[:, :k, k:] = torch.diag(s_qd)
-        tangents[:, k, :k] = qdot[..., nb].reshape(bsz * n, k) * s_q
+        # built out of place: under torch.func.vmap (stacked members) qdot is batched, the zeros are not
+        rows = torch.cat([torch.zeros((k, k), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1)
+        mixed = torch.cat([qdot[..., nb].reshape(bsz * n, k) * s_q,
+                           torch.zeros((bsz * n, k), dtype=x.dtype, device=x.device)], -1)
+        tangents = torch.cat([rows.expand(bsz * n, k, 2 * k), mixed[:, None, :]], 1)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
         g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]], -1)
         src = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n, device=x.device)

@@ -17,9 +17,14 @@ _base = Protocol(data="wave_iid", system_params=(("n", 10), ("variant", "code"))
                  n_train=160, n_heldout=256, loss="l1", lr=1e-3, schedule="onecycle", lr_start=0.3, log_every=5)
 PROTOCOLS = {"smoke": _base,
              # measured at this scale: under the one-cycle schedule the LGN stays on its qdd ~ 0 plateau
-             # (L1 ~ 95 after 1000 steps); a constant 1e-3 leaves it (L1 ~ 12 after 400 steps), then decays
-             "quick": _base.replace(steps=1000, batch=32, n_train=32 * 500, n_heldout=5000, log_every=50,
-                                    schedule="step", lr_step_every=700, lr_step_gamma=0.1),
+             # (L1 ~ 95 after 1000 steps); a constant 1e-3 leaves it (L1 ~ 12 after 400 steps), then decays.
+             # Whether it leaves is the init's luck: 1000 steps at 1e-3 left seed 1 at the null's 103 and
+             # seed 0's pulse rollout above its bar; 2000 at 1e-2 left 2 of 5 seeds on the plateau (84, 100).
+             # Restarts fix it: 8 scouts x 200 steps at 1e-2, the best by training loss continued 1500 steps
+             # at 3e-3 (PyTorch, seeds 0-4: held-out L1 0.70-0.87 against the null's 97; JAX seeds 2, 4: 0.90, 0.81)
+             "quick": _base.replace(steps=1500, batch=32, n_train=32 * 500, n_heldout=5000, log_every=50,
+                                    schedule="step", lr=3e-3, lr_step_every=1000, lr_step_gamma=0.1,
+                                    scouts=8, scout_steps=200, scout_lr=1e-2),
              "paper": _base.replace(steps=500_000, batch=1, n_train=5000, n_heldout=20_000, log_every=5000)}
 EVAL = {"smoke": {"n_big": 100, "t_end": 1.0, "n_t": 11, "dt": 0.05},
         "quick": {"n_big": 100, "t_end": 6.0, "n_t": 61, "dt": 0.05},

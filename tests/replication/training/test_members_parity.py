@@ -45,6 +45,24 @@ def test_every_member_equals_its_own_run(fw):
 
 
 @pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
+def test_banded_lgn_members_equal_their_own_runs(fw):
+    """The banded LGN under vmap (its out-of-place tangents, its implicit banded solve, its fallback with
+    no branch on data): what `Protocol.scouts` runs for the wave claim, in both frameworks."""
+    row = BY_NAME["lgn_banded"]
+    spec, protocol, seeds = row.spec, row.protocol.replace(steps=6), (0, 1, 2)
+    rec = Recorder(fw)
+    together = rec.train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
+                                 [BatchStream(protocol, s) for s in seeds])
+    for seed, b in zip(seeds, together, strict=True):
+        a = Recorder(fw).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed))
+        assert a.failure is None and b.failure is None and len(a.log) == len(b.log) == protocol.steps
+        for ra, rb in zip(a.log, b.log, strict=True):
+            np.testing.assert_allclose(rb["loss"], ra["loss"], rtol=1e-10, err_msg=f"seed {seed} step {ra['step']}")
+        for k in a.params:
+            np.testing.assert_allclose(b.params[k], a.params[k], rtol=1e-9, atol=1e-12, err_msg=f"seed {seed} {k}")
+
+
+@pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
 def test_a_failed_member_stops_alone(fw):
     """A member whose weights are NaN fails at step 0 with its parameters kept; the others train on."""
     params = [init_params(SPEC, seed=s) for s in SEEDS]
