@@ -13,6 +13,8 @@ remaining n mod (2w+1) nodes each a colour of their own (at most 4w+1 = 8r+1 col
 form solved in O(n): m = n // w - 1 interior blocks of size w (nodes 0 .. m*w-1) and one border
 block of the remaining nb = n - m*w nodes (w <= nb < 2w). Each entry is (rows, cols) node indices;
 `band_gather(rows, cols, n, w)` turns them into (band row, band column, mask) arrays.
+`identity_band(n, r)`: the band of the identity (the fallback's safe system); `band_sum(r)`: where a node's
+(2r+1)^2 velocity-Hessian terms land in the band (the hand-differentiated LGNs of both frameworks).
 """
 from __future__ import annotations
 
@@ -83,3 +85,15 @@ def band_columns(n: int, width: int) -> np.ndarray:
     """(n, 2w+1) column index of each band entry: band[:, i, k] = H[i, cols[i, k]]."""
     w = (width - 1) // 2
     return (np.arange(n)[:, None] + np.arange(width)[None, :] - w) % n
+
+
+def identity_band(n: int, r: int) -> np.ndarray:
+    """(n, 4r+1) band of the n x n identity."""
+    return np.eye(1, 4 * r + 1, 2 * r)[0][None, :].repeat(n, 0)
+
+
+def band_sum(r: int) -> np.ndarray:
+    """(k*k, 4r+1) 0/1: node term (a, b) (velocity slots of neighbours i+a-r, i+b-r) -> band column 2r+b-a."""
+    k = 2 * r + 1
+    a, b = np.divmod(np.arange(k * k), k)
+    return np.eye(4 * r + 1)[2 * r + b - a]

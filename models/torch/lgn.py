@@ -27,8 +27,10 @@ from models.graph import (
     band_coloring,
     band_columns,
     band_from_colours,
+    band_sum,
     banded_supported,
     cyclic_band_layout,
+    identity_band,
     periodic_neighbours,
 )
 from models.torch.banded import solve_cyclic_banded
@@ -53,10 +55,6 @@ def banded_terms(L_fn, q, qdot, r):
                                                  torch.as_tensor(row, device=q.device)], g_q[0] - dg_qdot[n_col]
 
 
-def _identity_band(n, r):
-    return np.eye(1, 4 * r + 1, 2 * r)[0][None, :].repeat(n, 0)
-
-
 def dense_from_band(band):
     """The (B, n, n) matrix of a cyclic band (B, n, 2w+1) (n >= 2w+1: no two band entries share a place)."""
     bsz, n, width = band.shape
@@ -72,7 +70,7 @@ def _pinv_where_bad(band, rhs, x, bad, r, layout):
     Python branch on data."""
     if not vmapped(band) and not bool(torch.any(bad)):
         return x
-    eye = torch.as_tensor(_identity_band(rhs.shape[-1], r), dtype=band.dtype, device=band.device)
+    eye = torch.as_tensor(identity_band(rhs.shape[-1], r), dtype=band.dtype, device=band.device)
     safe = torch.where(bad[:, None, None], eye, band)
     x_safe = solve_cyclic_banded(safe, rhs, layout)
     return torch.where(bad[:, None], pinv_solve(dense_from_band(band), rhs), x_safe)
@@ -111,13 +109,6 @@ def _neighbours(x, r):
     return torch.stack([torch.roll(x, r - a, dims=-1) for a in range(2 * r + 1)], dim=-1)
 
 
-def _band_sum(r):
-    """(k*k, 4r+1) 0/1: node term (a, b) (velocity slots of neighbours i+a-r, i+b-r) -> band column 2r+b-a."""
-    k = 2 * r + 1
-    a, b = np.divmod(np.arange(k * k), k)
-    return np.eye(4 * r + 1)[2 * r + b - a]
-
-
 class LGN(Model):
     def _lagrangian(self, q, qdot):
         x = mlp_input(self.spec, [_neighbours(wrap_angles(self.spec, q), self.spec.lgn_radius),
@@ -147,8 +138,8 @@ class LGN(Model):
         src = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n, device=x.device)
         slot = torch.arange(k, device=x.device)
         moved = g[:, src, slot]                  # (B, n, k, k + 2): [j, a] = node j-a+r's slot-a terms
-        band_sum = torch.as_tensor(_band_sum(r), dtype=x.dtype, device=x.device)
-        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ band_sum
+        to_band = torch.as_tensor(band_sum(r), dtype=x.dtype, device=x.device)
+        band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ to_band
         return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)
 
     def lagrangian(self, q, qdot, extra=None):
