@@ -1,7 +1,8 @@
 """Lagrangian graph network on a periodic 1D grid (JAX): L = sum_i density(q_nb(i), qdot_nb(i)).
 
 q, qdot (..., n) with any n at call time (a model trained at n = 10 runs at n = 100). The density MLP
-sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs) gathered by `models.graph.periodic_neighbours`.
+sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs): the neighbours `models.graph.periodic_neighbours`
+names, taken by rolls.
 Accelerations by spec.formulation:
   "dense":  full n x n Hessian (forward-over-reverse) + solve with the counted pinv fallback (`lnn`).
   "paper":  the original code's full Hessian, full mixed Jacobian and pinv (`lnn`, "paper").

@@ -1,7 +1,8 @@
 """Lagrangian graph network on a periodic 1D grid (PyTorch): L = sum_i density(q_nb(i), qdot_nb(i)).
 
 q, qdot (..., n) with any n at call time (a model trained at n = 10 runs at n = 100). The density MLP
-sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs) gathered by `models.graph.periodic_neighbours`.
+sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs): the neighbours `models.graph.periodic_neighbours`
+names, taken by rolls.
 Accelerations by spec.formulation:
   "dense":  full n x n Hessian (forward-over-reverse) + solve with the counted pinv fallback (`lnn`).
   "paper":  the original code's full Hessian, full mixed Jacobian and pinv (`lnn`, "paper").
@@ -31,7 +32,6 @@ from models.graph import (
     banded_supported,
     cyclic_band_layout,
     identity_band,
-    periodic_neighbours,
 )
 from models.torch.banded import solve_cyclic_banded
 from models.torch.base import Model
@@ -120,24 +120,22 @@ class LGN(Model):
         Node i's density sees x_i = scale * [q_nb(i), qdot_nb(i)] (k = 2r+1 neighbours i+a-r); its MLP
         gradient g_i and its Gram G_i (tangents: s_qd[a] e_(k+a) for each a, and s_q * qdot_nb(i) in the
         q slots) give every term: node i adds G_i[a, b] to H[i+a-r, i+b-r] (band column 2r+b-a),
-        G_i[a, k] to (J qdot)[i+a-r] and s_q[b] g_i[b] to dL/dq[i+b-r]. Gathering node j-a+r for slot a
-        at row j moves them all into place."""
+        G_i[a, k] to (J qdot)[i+a-r] and s_q[b] g_i[b] to dL/dq[i+b-r]. Rolling slot a's terms by a-r moves
+        them all into place."""
         spec, (bsz, n), r = self.spec, q.shape, self.spec.lgn_radius
         k = 2 * r + 1
-        nb = torch.as_tensor(periodic_neighbours(n, r), device=q.device)
-        x = mlp_input(spec, [wrap_angles(spec, q)[..., nb], qdot[..., nb]]).reshape(bsz * n, 2 * k)
+        qdot_nb = _neighbours(qdot, r)
+        x = mlp_input(spec, [_neighbours(wrap_angles(spec, q), r), qdot_nb]).reshape(bsz * n, 2 * k)
         scale = input_scale(spec, 2 * k, x.dtype, x.device)
         s_q, s_qd = scale[:k], scale[k:]
         # built out of place: under torch.func.vmap (stacked members) qdot is batched, the zeros are not
         rows = torch.cat([torch.zeros((k, k), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1)
-        mixed = torch.cat([qdot[..., nb].reshape(bsz * n, k) * s_q,
-                           torch.zeros((bsz * n, k), dtype=x.dtype, device=x.device)], -1)
+        mixed = torch.cat([qdot_nb.reshape(bsz * n, k) * s_q, torch.zeros((bsz * n, k), dtype=x.dtype, device=x.device)],
+                          -1)
         tangents = torch.cat([rows.expand(bsz * n, k, 2 * k), mixed[:, None, :]], 1)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
         g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]], -1)
-        src = torch.as_tensor((np.arange(n)[:, None] - np.arange(k) + r) % n, device=x.device)
-        slot = torch.arange(k, device=x.device)
-        moved = g[:, src, slot]                  # (B, n, k, k + 2): [j, a] = node j-a+r's slot-a terms
+        moved = torch.stack([torch.roll(g[:, :, a], a - r, dims=1) for a in range(k)], 2)  # [j, a]: node j-a+r's slot a
         to_band = torch.as_tensor(band_sum(r), dtype=x.dtype, device=x.device)
         band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ to_band
         return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)

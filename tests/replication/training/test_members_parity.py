@@ -16,13 +16,13 @@ SPEC, PROTOCOL, SEEDS = ROW.spec, ROW.protocol, ROW.seeds
 FRAMEWORKS = ("jax", "torch")
 
 
-def _alone(fw, seed, protocol=PROTOCOL):
-    return Recorder(fw).train(SPEC, init_params(SPEC, seed=seed), protocol, BatchStream(protocol, seed))
+def _alone(fw, seed, protocol=PROTOCOL, spec=SPEC):
+    return Recorder(fw).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed))
 
 
-def _together(fw, protocol=PROTOCOL, params=None):
-    params = params or [init_params(SPEC, seed=s) for s in SEEDS]
-    return Recorder(fw).train_members(SPEC, params, protocol, [BatchStream(protocol, s) for s in SEEDS])
+def _together(fw, protocol=PROTOCOL, params=None, spec=SPEC, seeds=SEEDS):
+    params = params or [init_params(spec, seed=s) for s in seeds]
+    return Recorder(fw).train_members(spec, params, protocol, [BatchStream(protocol, s) for s in seeds])
 
 
 @pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
@@ -50,11 +50,8 @@ def test_banded_lgn_members_equal_their_own_runs(fw):
     no branch on data): what `Protocol.scouts` runs for the wave claim, in both frameworks."""
     row = BY_NAME["lgn_banded"]
     spec, protocol, seeds = row.spec, row.protocol.replace(steps=6), (0, 1, 2)
-    rec = Recorder(fw)
-    together = rec.train_members(spec, [init_params(spec, seed=s) for s in seeds], protocol,
-                                 [BatchStream(protocol, s) for s in seeds])
-    for seed, b in zip(seeds, together, strict=True):
-        a = Recorder(fw).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed))
+    for seed, b in zip(seeds, _together(fw, protocol, spec=spec, seeds=seeds), strict=True):
+        a = _alone(fw, seed, protocol, spec)
         assert a.failure is None and b.failure is None and len(a.log) == len(b.log) == protocol.steps
         for ra, rb in zip(a.log, b.log, strict=True):
             np.testing.assert_allclose(rb["loss"], ra["loss"], rtol=1e-10, err_msg=f"seed {seed} step {ra['step']}")
