@@ -120,6 +120,11 @@ class Protocol:
         if self.scout_batch > self.n_train:
             raise ValueError(f"scout_batch {self.scout_batch} exceeds the training pool n_train={self.n_train}")
 
+    def objective_key(self) -> tuple:
+        """What one optimiser step depends on besides the model: the loss and its target (task, loss, l2),
+        Adam's constants, the clip, the dtype (a compiled step serves every protocol sharing them)."""
+        return self.task, self.loss, self.l2, self.b1, self.b2, self.eps, self.grad_clip, self.dtype
+
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["system_params"] = [list(p) for p in self.system_params]

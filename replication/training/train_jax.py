@@ -43,6 +43,23 @@ def make_loss(spec, protocol):
     return loss_fn
 
 
+def _compiled_per_objective(make):
+    """`make(spec, protocol)` memoised on what the compiled function depends on: the spec and the
+    protocol's objective and optimiser fields (`Protocol.objective_key`). A process that trains or probes
+    several models of one spec (seeds, cohorts, claims sharing a model) compiles once, not once per model:
+    equinox keeps the compiled program per function object, so a new closure would compile again."""
+    memo: dict = {}
+
+    def cached(spec, protocol):
+        key = (spec, protocol.objective_key())
+        if key not in memo:
+            memo[key] = make(spec, protocol)
+        return memo[key]
+    cached.__doc__, cached.__name__ = make.__doc__, make.__name__
+    return cached
+
+
+@_compiled_per_objective
 def make_step(spec, protocol):
     """(optax transform, step). step(model, opt_state, batch, lr, skip_above=inf) -> (model, opt_state, loss,
     gnorm): one Adam step on the gradient clipped to protocol.grad_clip (if set); not taken (model and state
@@ -67,6 +84,7 @@ def make_step(spec, protocol):
     return opt, step
 
 
+@_compiled_per_objective
 def make_probe(spec, protocol):
     """batch -> the `hessian_probe` columns (None for models without a velocity Hessian)."""
     if not hessian_probe.wanted(spec, protocol):
@@ -141,6 +159,7 @@ def _stack(trees):
     return jax.tree_util.tree_map(lambda *a: jnp.stack(a), *trees)
 
 
+@_compiled_per_objective
 def make_members_step(spec, protocol):
     """(optax transform, the `make_step` step vmapped over stacked models, states, batches and bounds)."""
     opt, step = make_step(spec, protocol)

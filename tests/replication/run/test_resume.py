@@ -88,19 +88,50 @@ def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
     assert len(list(tmp_path.glob("units/dp_energy/jax/baseline/superseded-*-seed0/result.json"))) == 1
 
 
-def test_compiled_code_is_released_after_every_unit(tmp_path, monkeypatch):
-    """JAX's compiled executables are dropped after each unit: kept, their memory mappings pile up until
-    a long run dies at the kernel's per-process limit (a 220-unit quick run did, at unit 202)."""
+def _release_calls(monkeypatch, tmp_path, budget):
+    """(clear_caches calls, functions traced for compilation by each unit) of a JAX smoke run of a cohort of
+    two seeds (one training, two units) releasing above `budget` mappings."""
     import jax
+    import jax.monitoring
 
-    from replication.run import runner
-    calls = []
-    real = jax.clear_caches
-    monkeypatch.setattr(jax, "clear_caches", lambda: (calls.append(1), real()))
-    runner.run(profile="smoke", out=tmp_path, claims=["appendix_b", "hnn_energy"], frameworks=("jax",),
-               progress=False)
-    n_units = len(runner.plan("smoke", claims=["appendix_b", "hnn_energy"], frameworks=("jax",)))
-    assert len(calls) == n_units > 1
+    from replication.run import chains, runner, units
+    calls, traced, per_unit = [], [], []
+    real_clear, real_unit = jax.clear_caches, units.run_unit
+    monkeypatch.setattr(jax, "clear_caches", lambda: (calls.append(1), real_clear()))
+    monkeypatch.setattr(chains, "MAP_BUDGET", budget)
+
+    def counted(*a, **k):
+        before = len(traced)
+        try:
+            return real_unit(*a, **k)
+        finally:
+            per_unit.append(len(traced) - before)
+    monkeypatch.setattr(units, "run_unit", counted)
+    jax.monitoring.register_event_duration_secs_listener(
+        lambda name, *a, **k: traced.append(1) if name == "/jax/core/compile/jaxpr_trace_duration" else None)
+    runner.run(profile="smoke", out=tmp_path, claims=["init_study"], frameworks=("jax",),
+               models=["lnn_init-kaiming"], progress=False)
+    return len(calls), per_unit
+
+
+def test_compiled_code_is_released_once_the_memory_map_is_crowded(tmp_path, monkeypatch):
+    """JAX's compiled executables are dropped after a unit once the process holds more memory mappings than
+    `MAP_BUDGET`: kept forever, they pile up until a long run dies at the kernel's per-process limit (a
+    220-unit quick run did, at unit 202, when nothing was released). Below the budget they are kept, and
+    the cohort's second member, whose training is the first's, compiles nothing: it reuses the first's
+    evaluation programs; released, it compiles them again."""
+    import os
+
+    import pytest
+
+    if not os.path.exists("/proc/self/maps"):
+        pytest.skip("no /proc/self/maps on this system")
+    released, per_unit = _release_calls(monkeypatch, tmp_path / "a", 0)
+    assert released == len(per_unit) == 2
+    assert per_unit[1] > 0
+    kept, per_unit = _release_calls(monkeypatch, tmp_path / "b", 10**9)
+    assert kept == 0
+    assert per_unit[0] > 0 and per_unit[1] == 0, per_unit
 
 
 def _map_count() -> int:
