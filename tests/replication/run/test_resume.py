@@ -134,11 +134,6 @@ def test_compiled_code_is_released_once_the_memory_map_is_crowded(tmp_path, monk
     assert per_unit[0] > 0 and per_unit[1] == 0, per_unit
 
 
-def _map_count() -> int:
-    with open("/proc/self/maps") as fh:
-        return sum(1 for _ in fh)
-
-
 def test_released_compilations_keep_the_memory_map_count_flat():
     """The mechanism behind the release, measured: adapters compiled one after another, released after
     each, leave the process's memory-map count where it was."""
@@ -149,6 +144,7 @@ def test_released_compilations_keep_the_memory_map_count_flat():
 
     from models import ModelSpec, init_params
     from replication.evaluation.adapters import adapter
+    from replication.run.chains import map_count
     from replication.run.executor import release_compiled
 
     if not os.path.exists("/proc/self/maps"):
@@ -159,5 +155,5 @@ def test_released_compilations_keep_the_memory_map_count_flat():
     for seed in range(6):
         adapter("jax", spec, init_params(spec, seed=seed)).acceleration(q, q, None)
         release_compiled()
-        counts.append(_map_count())
+        counts.append(map_count())
     assert max(counts[2:]) - min(counts[2:]) < 50, counts
