@@ -1,13 +1,14 @@
 """The framework-neutral model spec: one frozen dataclass both frameworks build from.
 
 `ModelSpec(kind, dof, hidden, activation, init, dtype, extra_inputs, formulation, n_out,
-angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius)` is validated on creation
+angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius, lorentz_factor)` is validated on creation
 (unknown names and bad sizes raise ValueError listing what is valid) and round-trips through
 `to_dict()` / `from_dict()` (plain JSON types).
 
 Per kind, the MLP input width and output width (see `mlp_sizes`):
   baseline: [q, qdot, extra]            (2*dof + extra_inputs) -> n_out (default dof)
-  lnn, hnn: [q, qdot, extra] / [x, y, extra]  (2*dof + extra_inputs) -> 1
+  lnn, hnn: [q, qdot, extra] / [x, y, extra]  (2*dof + extra_inputs) -> 1; with lorentz_factor
+            [q, qdot, gamma(qdot), extra]   (3*dof + extra_inputs) -> 1
   delan:    q (dof) -> hidden[-1], trunk only (every layer activated); heads in `models.params`
   lgn:      [q_nb, qdot_nb] of one node's 2r+1 neighbours (2*(2r+1)) -> 1
 Formulations: lnn "fast" | "paper"; lgn "banded" (alias "fast") | "dense" | "paper";
@@ -62,6 +63,9 @@ FORMULATIONS = ("fast", "paper", "dense", "banded")
 DTYPES = ("float32", "float64")
 
 
+LORENTZ_KINDS = ("lnn", "hnn")   # kinds whose MLP may take the Lorentz factor of qdot (`ModelSpec.lorentz_factor`)
+
+
 def _choices(what: str, value, valid) -> None:
     if value not in valid:
         raise ValueError(f"unknown {what} {value!r}; valid: {', '.join(map(str, valid))}")
@@ -80,6 +84,9 @@ class ModelSpec:
     input_scale: per-feature multipliers of the MLP input vector (length = MLP input width).
     delan_eps: epsilon of M = L L^T + eps I. delan_diag_offset: diag(L) = softplus(raw + offset).
     lgn_radius: neighbours on each side of a node in the density MLP.
+    lorentz_factor: lnn, hnn: the MLP also sees gamma_k = (1 - qdot_k^2)^(-1/2) of every velocity component
+        (the speed of light c = 1), after qdot; a kinematic feature of a speed-limited system, differentiated
+        through like qdot. Left out of `to_dict` while False, so older specs keep their training keys.
     """
 
     kind: str
@@ -96,6 +103,7 @@ class ModelSpec:
     delan_eps: float = 0.01
     delan_diag_offset: float = 2.0
     lgn_radius: int = 1
+    lorentz_factor: bool = False
 
     def __post_init__(self):
         _choices("kind", self.kind, KINDS)
@@ -123,6 +131,10 @@ class ModelSpec:
                 raise ValueError(f"kind {self.kind!r} has a scalar output; n_out must be None or 1")
         if not isinstance(self.lgn_radius, int) or self.lgn_radius < 1:
             raise ValueError(f"lgn_radius must be an int >= 1, got {self.lgn_radius!r}")
+        if not isinstance(self.lorentz_factor, bool):
+            raise ValueError(f"lorentz_factor must be True or False, got {self.lorentz_factor!r}")
+        if self.lorentz_factor and self.kind not in LORENTZ_KINDS:
+            raise ValueError(f"lorentz_factor is for kinds {', '.join(LORENTZ_KINDS)}, not {self.kind!r}")
         if not self.delan_eps >= 0:
             raise ValueError(f"delan_eps must be >= 0, got {self.delan_eps!r}")
         if self.input_scale is not None:
@@ -138,7 +150,7 @@ class ModelSpec:
             return (self.dof, *self.hidden)
         if self.kind == "lgn":
             return (2 * (2 * self.lgn_radius + 1), *self.hidden, 1)
-        n_in = 2 * self.dof + self.extra_inputs
+        n_in = (3 if self.lorentz_factor else 2) * self.dof + self.extra_inputs
         n_out = 1 if CAPABILITIES[self.kind].scalar_output else (self.n_out or self.dof)
         return (n_in, *self.hidden, n_out)
 
@@ -146,6 +158,8 @@ class ModelSpec:
         d = dataclasses.asdict(self)
         d["hidden"] = list(self.hidden)
         d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
+        if not self.lorentz_factor:
+            del d["lorentz_factor"]
         return d
 
     @classmethod

@@ -11,11 +11,12 @@ import jax.numpy as jnp
 
 from models.jax.base import Model
 from models.jax.mlp import mlp, mlp_input, wrap_angles
+from models.lorentz import velocity_parts
 
 
 class HNN(Model):
     def _hamiltonian(self, x, y, extra=None):
-        z = mlp_input(self.spec, [wrap_angles(self.spec, x), y, *self._parts(extra)])
+        z = mlp_input(self.spec, [wrap_angles(self.spec, x), *velocity_parts(self.spec, y), *self._parts(extra)])
         return mlp(self.params, z, self.spec)[..., 0]
 
     @eqx.filter_jit

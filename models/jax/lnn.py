@@ -30,6 +30,7 @@ from models.jax.base import Model
 from models.jax.blocking import in_row_blocks
 from models.jax.mlp import input_scale, mlp, mlp_input, wrap_angles
 from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
+from models.lorentz import lorentz_slopes, velocity_parts
 from models.numerics import pinv_rtol, rcond_min
 
 
@@ -120,22 +121,31 @@ class LNN(Model):
     (XLA's forward-over-reverse also pushes the d + 1 tangents back through the network)."""
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        x = mlp_input(self.spec, [wrap_angles(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
         MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
-        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
+        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term. With the
+        Lorentz factor, x = scale * [wrap(q), qdot, gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k)
+        in slot 2d + k, and H gains the curvature of the feature itself, diag(df/dx_(2d+k) s_g[k] gamma'')."""
         spec, (n, d) = self.spec, q.shape
-        x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
+        x = mlp_input(spec, [wrap_angles(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype)
         s_q, s_qd = scale[:d], scale[d:2 * d]
         tangents = jnp.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
         tangents = tangents.at[:, :d, d:2 * d].set(jnp.diag(s_qd))
         tangents = tangents.at[:, d, :d].set(qdot * s_q)
+        if spec.lorentz_factor:
+            slope, curve = lorentz_slopes(qdot)
+            s_g, k = scale[2 * d:3 * d], jnp.arange(d)
+            tangents = tangents.at[:, k, 2 * d + k].set(slope * s_g)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
-        return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
+        hess = gram[:, :d, :d]
+        if spec.lorentz_factor:
+            hess = hess + jnp.eye(d, dtype=x.dtype) * (g[:, 2 * d:3 * d] * s_g * curve)[:, None, :]
+        return hess, g[:, :d] * s_q - gram[:, :d, d]
 
     def _blocked_terms(self, q, qdot, extra):
         """`_fast_terms` on the flattened batch, in cache-sized row blocks (`models.jax.blocking`)."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import torch
 
+from models.lorentz import lorentz_slopes, velocity_parts
 from models.torch.base import Model
 from models.torch.mlp import mlp, mlp_input, wrap_angles
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
@@ -17,7 +18,7 @@ from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 class HNN(Model):
     def _hamiltonian(self, x, y, extra=None):
-        z = mlp_input(self.spec, [wrap_angles(self.spec, x), y, *self._parts(extra)])
+        z = mlp_input(self.spec, [wrap_angles(self.spec, x), *velocity_parts(self.spec, y), *self._parts(extra)])
         return mlp(self.params, z, self.spec)[..., 0]
 
     def hamiltonian(self, x, y, extra=None):
@@ -29,9 +30,12 @@ class HNN(Model):
         """(xdot, ydot) = (dH/dy, -dH/dx), each (..., dof)."""
         self._check_state(x, y, extra)
         spec, d = self.spec, x.shape[-1]
-        z = mlp_input(spec, [wrap_angles(spec, x), y, *self._parts(extra)])  # wrap has derivative 1
+        z = mlp_input(spec, [wrap_angles(spec, x), *velocity_parts(spec, y), *self._parts(extra)])  # wrap: slope 1
         g, _ = input_grad_and_tangent_hessian(self.params, z.reshape(-1, z.shape[-1]), None, spec)
         if spec.input_scale is not None:
             g = g * torch.tensor(spec.input_scale, dtype=g.dtype, device=g.device)
         g = g.reshape(*z.shape[:-1], z.shape[-1])
-        return g[..., d:2 * d], -g[..., :d]
+        dh_dy = g[..., d:2 * d]
+        if spec.lorentz_factor:   # y also enters as gamma(y), slot 2d + k
+            dh_dy = dh_dy + g[..., 2 * d:3 * d] * lorentz_slopes(y)[0]
+        return dh_dy, -g[..., :d]

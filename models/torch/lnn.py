@@ -15,6 +15,7 @@ from __future__ import annotations
 import torch
 from torch.func import grad, hessian, jacfwd, jacrev, jvp, vmap
 
+from models.lorentz import lorentz_slopes, velocity_parts
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
 from models.torch.export_paths import pick, replace_bad_rows
@@ -171,24 +172,35 @@ class LNN(Model):
     (`models.torch.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, faster."""
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        x = mlp_input(self.spec, [wrap_angles(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
         MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
-        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term."""
+        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term. With the
+        Lorentz factor, x = scale * [wrap(q), qdot, gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k)
+        in slot 2d + k, and H gains the curvature of the feature itself, diag(df/dx_(2d+k) s_g[k] gamma'')."""
         spec, (n, d) = self.spec, q.shape
-        x = mlp_input(spec, [wrap_angles(spec, q), qdot, *self._parts(extra)])
+        x = mlp_input(spec, [wrap_angles(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         s_q, s_qd = scale[:d], scale[d:2 * d]
         width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
-        zeros = torch.zeros((d, width - 2 * d), dtype=x.dtype, device=x.device)
-        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd), zeros], -1)
+        used = 3 * d if spec.lorentz_factor else 2 * d
+        zeros = torch.zeros((d, width - used), dtype=x.dtype, device=x.device)
+        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1).expand(n, d, 2 * d)
+        if spec.lorentz_factor:
+            slope, curve = lorentz_slopes(qdot)
+            s_g = scale[2 * d:3 * d]
+            rows = torch.cat([rows, torch.diag_embed(slope * s_g)], -1)
+        rows = torch.cat([rows, zeros.expand(n, d, width - used)], -1)
         mixed = torch.cat([qdot * s_q, torch.zeros((n, width - d), dtype=x.dtype, device=x.device)], -1)
-        tangents = torch.cat([rows.expand(n, d, width), mixed[:, None, :]], 1)
+        tangents = torch.cat([rows, mixed[:, None, :]], 1)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
-        return gram[:, :d, :d], g[:, :d] * s_q - gram[:, :d, d]
+        hess = gram[:, :d, :d]
+        if spec.lorentz_factor:
+            hess = hess + torch.diag_embed(g[:, 2 * d:3 * d] * s_g * curve)
+        return hess, g[:, :d] * s_q - gram[:, :d, d]
 
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""

@@ -8,6 +8,9 @@ The HNNs are trained on [qdot, pdot] (non-canonical: pdot := qdot-double-dot; ca
 pdot = dL/dq from `systems`). The original code put the canonical HNN's loss on q-double-dot, not pdot
 (a finding). The verdict reads the weighted L1 of q-double-dot for all three (the canonical HNN's pdot
 mapped through dp/dqdot).
+Departures (see MODELS and PROTOCOLS): the models on (q, qdot) also see the Lorentz factor of qdot, the LNN
+sees q unscaled, and quick trains every model with restarts at peak 1e-2. The original's LNN on qdot alone
+runs beside (`lnn_qdot_only`, its own rate, no restarts), outside the verdict.
 """
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry
@@ -16,12 +19,27 @@ from replication.claims.rules import fails
 from replication.training.protocol import Protocol
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "paper": (500, 500, 500, 500)}
+# The models on (q, qdot) see the velocity also through its Lorentz factor gamma = (1 - qdot^2)^(-1/2)
+# (`ModelSpec.lorentz_factor`, scaled by 0.01: gamma reaches 224 here), a departure from the original, which
+# fed qdot alone. Without it our LNN stays on the q-double-dot ~ 0 plateau for at least 2.6e7 samples (the
+# original left it after 5.8e7; `docs/relativistic_lnn_trials.md`): the weighted L1 pins every near-c
+# prediction to 0 until the velocity Hessian grows like (1 - qdot^2)^(-5/2), which gamma's own curvature
+# gives at once. gamma is kinematics (c), not the answer: with it the LNN also learns the standard
+# Lagrangian -1/gamma + g q, which it cannot on qdot alone (measured, same budget: 0.080 against 0.70, null
+# 0.71). The HNN on (q, qdot) gets it too, so the coordinates are all that differs; its failure is
+# structural (its field (qdot, qdd) has divergence g r'(qdot) != 0: no H in these coordinates has it).
+# The LNN sees q unscaled: q / 10 shrinks the g q coupling it must build (trials: with q / 10 and gamma, 2 of
+# 3 seeds learned less). The original's LNN (qdot alone, q / 10) runs beside as `lnn_qdot_only`, context
+# outside the verdict.
+ORIGINAL = {"lr": 1e-3, "scouts": 0, "scout_steps": 0, "scout_lr": 0.0}   # lnn_qdot_only: the original's rate, no restarts
+LORENTZ = {"lorentz_factor": True, "extra_inputs": 1, "activation": "softplus"}
 MODELS = (
-    ModelEntry("lnn", {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1,
-                       "input_scale": (0.1, 1.0, 0.1)}, hidden=W),
-    ModelEntry("hnn_qqdot", {"kind": "hnn", "activation": "softplus", "init": "xavier", "extra_inputs": 1,
-                             "input_scale": (0.1, 1.0, 0.1)}, hidden=W,
-               overrides={"task": "hamiltonian", "coords": "qqdot"}),
+    ModelEntry("lnn", {"kind": "lnn", "init": "cranmer2020", "input_scale": (1.0, 1.0, 0.01, 0.1), **LORENTZ},
+               hidden=W),
+    ModelEntry("hnn_qqdot", {"kind": "hnn", "init": "xavier", "input_scale": (0.1, 1.0, 0.01, 0.1), **LORENTZ},
+               hidden=W, overrides={"task": "hamiltonian", "coords": "qqdot"}),
+    ModelEntry("lnn_qdot_only", {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1,
+                                 "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides=ORIGINAL),
     ModelEntry("hnn_qp", {"kind": "hnn", "activation": "softplus", "init": "xavier", "extra_inputs": 1,
                           "input_scale": (1.0, 1.0, 0.1)}, hidden=W,
                overrides={"task": "hamiltonian", "coords": "qp"}),
@@ -32,10 +50,15 @@ _base = Protocol(data="relativistic_iid", steps=20, batch=32, n_train=640, n_hel
 _SRC = "original code, SpecialRelativity notebooks, weighted-L1 training loss: "
 PROTOCOLS = {
     "smoke": _base,
-    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50, track_every=100),
+    # restarts over initialisations at a ten times higher rate, for every model alike: 8 scouts x 200 steps
+    # at 1e-2, the best by training loss continued 1500 steps at 1e-2 (one-cycle). Measured (JAX, the LNN
+    # with gamma, 1500 steps at 1e-2 without scouts): held-out 0.0024 / 0.39 / 0.0077 on seeds 0-2; at 1e-3
+    # every seed stayed on the plateau
+    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50, track_every=100,
+                           lr=1e-2, scouts=8, scout_steps=200, scout_lr=1e-2),
     "paper": _base.replace(steps=300_000, batch=512, n_train=512 * 3000, n_heldout=100_000, log_every=1000),
 }
-# full: 13x quick's samples (5.1e6), judged on 1e5 held-out states. The original LNN sat on the
+# full: 13x quick's continuation, judged on 1e5 held-out states. The original LNN sat on the
 # q-double-dot ~ 0 plateau (weighted L1 0.40-0.58) for 38 epochs, 5.8e7 samples, before it dropped; in our
 # trials (JAX, 3 x 128, seed 0) it stayed at the null's 0.410 after 5.1e6 samples, with the original input
 # scaling and with q unscaled, and after MSE warm-ups: the weighted L1 pulls every near-c prediction to 0
@@ -49,7 +72,9 @@ CLAIM = Claim(
     system="relativistic", models=MODELS, protocols=PROTOCOLS, evaluate="heldout",
     metric="heldout_l1_qddot", metric_label="held-out (1+gamma)-weighted L1 of q-double-dot",
     published={
-        "lnn": Published(7.86e-4, "training loss", _SRC + "LNN, epoch 99", metric="final_train_loss"),
+        "lnn": Published(7.86e-4, "training loss", _SRC + "LNN, epoch 99", metric="final_train_loss",
+                         note="ours also sees gamma(qdot)"),
+        "lnn_qdot_only": Published(7.86e-4, "training loss", _SRC + "LNN, epoch 99", metric="final_train_loss"),
         "hnn_qqdot": Published(0.4096, "training loss", _SRC + "HNN on (q, qdot), epoch 99; on [qdot, qdd] as ours",
                                metric="final_train_loss"),
         "hnn_qp": Published(2.40e-4, "training loss", _SRC + "HNN on (q, p), epoch 99; on [qdot, qdd], ours on "
