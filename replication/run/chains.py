@@ -45,13 +45,13 @@ def release_compiled() -> None:
     gc.collect()
 
 
-def release_if_crowded(budget: int | None = None) -> bool:
-    """After a unit: drop the compiled code only once the process holds more than `budget` mappings (every
+def release_if_crowded() -> bool:
+    """After a unit: drop the compiled code only once the process holds more than `MAP_BUDGET` mappings (every
     unit where the count cannot be read). Kept, it serves the next units of the same model: a cohort's
     members, the other seeds of a model, a second claim on one trained model, which compiled their training
     step and evaluation again after every release (measured: 4 compilations, 3.5 s, per cohort member)."""
     n = map_count()
-    if n is not None and n <= (MAP_BUDGET if budget is None else budget):
+    if n is not None and n <= MAP_BUDGET:
         return False
     release_compiled()
     return True
