@@ -160,7 +160,7 @@ TRAIN_TARGET_NOTE = (
     "the best-so-far curve, not a measurement ('-': reached, or a flat curve; inf: beyond 1000 x 3e8 samples). "
     "restarts: the variant scouting 8 inits and continuing the one with the lowest training loss (seed: the one "
     "chosen); its samples count every scout. restarts_fast: the same scouts, the chosen one continued at batch "
-    "256 and peak 2e-3 (the quick profile's double-pendulum protocol). baseline_reference: the plain MLP on the variant's protocol, for "
+    "256 and peak 2e-3 (the full profile's double-pendulum protocol). baseline_reference: the plain MLP on the variant's protocol, for "
     "scale. hessian_rel_err: median relative distance of the final LNN's velocity Hessian from the true mass "
     "matrix times one best scale (0: the true Lagrangian up to its symmetries). skipped_steps: steps the "
     "gradient-spike guard skipped (`replication.training.spike_guard`).")

@@ -24,7 +24,7 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       samples. Why: which init finds a near-physical Lagrangian is luck (after 5e5 samples, 3 of 8 seeds at
       3x64, 2 of 8 and 3 of 8 at 3x128), a run that found one trains on without gradient spikes, and its
       training loss tells which it is (`train_target_trials.md`, section 5).
-  "restarts_fast": restarts, the scouts alike, the continuation at batch 256 and peak 2e-3 (the quick
+  "restarts_fast": restarts, the scouts alike, the continuation at batch 256 and peak 2e-3 (the full
       profile's double-pendulum protocol): about three times the samples per second of batch 32.
 The four use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
 them, for reference (not a target row):
@@ -118,7 +118,7 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
                      f"{var.lr:g}, clip {var.grad_clip:g}, skip at {var.spike_skip:g} x median, velocity scale "
                      f"{VELOCITY_SCALE:g}. Samples count every scout")
     # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak (the
-    # quick profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["quick"]`), same budget
+    # full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`), same budget
     fast_rest = max((budget - RESTART_SEEDS * scout * var.batch) // FAST_BATCH, 1)
     fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR,
                             scout_batch=var.batch, scout_lr=var.lr)
