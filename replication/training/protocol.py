@@ -21,7 +21,7 @@ DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
-SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr")
+SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr", "scout_lr_start")
 OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("cohort", "track_every")   # omitted from to_dict while 0 (off), so older keys hold
 
 
@@ -44,12 +44,13 @@ class Protocol:
                rescales a gradient whose global norm exceeds it; spike_skip skips a step (no update, Adam
                state kept) whose gradient norm is at least spike_skip x the median of the recent ones.
                Left out of `to_dict` (and so of `key`) while 0, so older protocols keep their keys.
-    scouts/scout_steps/scout_batch/scout_lr: restarts over initialisations (`replication.training.scouting`);
-               scouts <= 1 = off. With scouts = K > 1 the run first trains K initialisations side by side
-               for scout_steps each (0: 5e5 samples) at batch scout_batch and peak rate scout_lr (0: the
-               protocol's batch and lr), then continues the one with the lowest training loss for `steps`
-               steps of `batch`: the budget is K * scout_steps * scout_batch + steps * batch samples.
-               Left out of `to_dict` while 0, as the guard.
+    scouts/scout_steps/scout_batch/scout_lr/scout_lr_start: restarts over initialisations
+               (`replication.training.scouting`); scouts <= 1 = off. With scouts = K > 1 the run first trains K
+               initialisations side by side for scout_steps each (0: 5e5 samples) at batch scout_batch, peak
+               rate scout_lr and one-cycle start scout_lr_start (0: the protocol's batch, lr and lr_start), then
+               continues the one with the lowest training loss for `steps` steps of `batch` from `lr_start`:
+               the budget is K * scout_steps * scout_batch + steps * batch samples. Left out of `to_dict`
+               while 0, as the guard.
     cohort:    train the seeds in groups of `cohort` as one vectorised program (`replication.training.train`:
                seeds g*cohort .. g*cohort + cohort - 1 side by side, each its own init, batches, guard and
                stop); each seed's numbers are those of its own run (up to floating-point reassociation).
@@ -85,6 +86,7 @@ class Protocol:
     scout_steps: int = 0
     scout_batch: int = 0
     scout_lr: float = 0.0
+    scout_lr_start: float = 0.0
     cohort: int = 0
     track_every: int = 0
     dtype: str = "float32"
@@ -114,6 +116,10 @@ class Protocol:
                 raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")
         if not (_real(self.scout_lr) and math.isfinite(self.scout_lr) and self.scout_lr >= 0):
             raise ValueError(f"protocol scout_lr must be a finite number >= 0 (0 = lr), got {self.scout_lr!r}")
+        for name in ("lr_start", "scout_lr_start"):
+            v = getattr(self, name)
+            if not (_real(v) and 0 <= v < 1):
+                raise ValueError(f"protocol {name} must be a number in [0, 1) (the one-cycle's starting phase), got {v!r}")
         if self.cohort > 1 and self.scouts > 1:
             raise ValueError(f"protocol cohort {self.cohort} with scouts {self.scouts}: a cohort trains seeds side "
                              f"by side, scouts train initialisations side by side; use one of them")

@@ -6,12 +6,14 @@ training loss tells which it is (`docs/train_target_trials.md`, section 5). So a
 with `scouts` = K > 1:
   1. trains the K initialisations `init_seeds(protocol, seed)` side by side for `scout_steps(protocol)`
      steps each, as one program (`loop.train_members`; each member's numbers are its own run's), at
-     `scout_batch` and peak rate `scout_lr` (0: the protocol's), a schedule over the scout (the
-     protocol's shape over scout_steps), batches from a stream per init seed;
+     `scout_batch`, peak rate `scout_lr` and one-cycle start `scout_lr_start` (0: the protocol's), a
+     schedule over the scout (the protocol's shape over scout_steps), batches from a stream per init seed;
   2. chooses the scout with the lowest training loss over its last `TAIL` of steps (a scout that stopped
      on a non-finite loss is never chosen); the held-out set plays no part;
   3. continues the chosen one for `protocol.steps` steps of `protocol.batch`: a new schedule over those
-     steps, fresh Adam state, batches from a stream of its own (seed + 1000).
+     steps (from `protocol.lr_start`: a fresh Adam's first steps at a high rate can throw a near-physical
+     Lagrangian away, so a continuation may start lower than its scouts did), fresh Adam state, batches
+     from a stream of its own (seed + 1000).
 Every scout's samples count in the budget (`budget_samples`; the outcome's `samples`). The original code
 has no restarts: the report says so where a claim uses them.
 
@@ -52,12 +54,13 @@ def init_seeds(protocol, seed: int) -> list[int]:
     return [seed * protocol.scouts + i for i in range(protocol.scouts)]
 
 
-_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0}
+_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0, "scout_lr_start": 0.0}
 
 
 def scout_protocol(protocol):
     return protocol.replace(steps=scout_steps(protocol), batch=protocol.scout_batch or protocol.batch,
-                            lr=protocol.scout_lr or protocol.lr, **_OFF)
+                            lr=protocol.scout_lr or protocol.lr, lr_start=protocol.scout_lr_start or protocol.lr_start,
+                            **_OFF)
 
 
 def continuation_protocol(protocol):

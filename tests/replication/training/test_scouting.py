@@ -61,3 +61,22 @@ def test_protocol_checks_and_keys():
     assert "scouts" not in plain.to_dict() and "scout_steps" not in plain.to_dict()
     assert PROTOCOL.key() != plain.key()
     assert Protocol.from_dict(PROTOCOL.to_dict()) == PROTOCOL
+
+
+def test_scouts_and_continuation_start_their_one_cycles_apart():
+    """scout_lr_start sets the scouts' starting phase (0: the protocol's lr_start); the continuation starts at
+    lr_start, so it can warm up from below the rate a fresh Adam would be thrown by."""
+    from replication.training.schedules import learning_rate
+
+    p = PROTOCOL.replace(schedule="onecycle", lr=1e-2, lr_start=0.1, scout_lr=1e-3, scout_lr_start=0.2)
+    scout, rest = scouting.scout_protocol(p), scouting.continuation_protocol(p)
+    assert (scout.lr_start, rest.lr_start, scout.scout_lr_start, rest.scout_lr_start) == (0.2, 0.1, 0.0, 0.0)
+    assert learning_rate(rest, 0) < learning_rate(p.replace(lr_start=0.2), 0) / 3
+    assert scouting.scout_protocol(p.replace(scout_lr_start=0.0)).lr_start == 0.1
+    # 0 is left out of the key, so protocols written before the field keep theirs
+    assert "scout_lr_start" not in PROTOCOL.to_dict() and "scout_lr_start" in p.to_dict()
+    for bad in (1.0, -0.1, float("nan")):
+        with pytest.raises(ValueError, match="scout_lr_start"):
+            PROTOCOL.replace(scout_lr_start=bad)
+        with pytest.raises(ValueError, match="lr_start"):
+            PROTOCOL.replace(lr_start=bad)
