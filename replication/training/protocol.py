@@ -22,7 +22,7 @@ TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
 SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr", "scout_lr_start")
-OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("cohort", "track_every")   # omitted from to_dict while 0 (off), so older keys hold
+OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("rollback", "cohort", "track_every")   # omitted from to_dict while 0 (off), so older keys hold
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,9 @@ class Protocol:
                continues the one with the lowest training loss for `steps` steps of `batch` from `lr_start`:
                the budget is K * scout_steps * scout_batch + steps * batch samples. Left out of `to_dict`
                while 0, as the guard.
+    rollback:  put back the parameters and Adam state of the best window so far when a window's mean training
+               loss exceeds rollback x that best (`replication.training.rollback`); 0 = off, else > 1. One model
+               at a time: the scouts run without it, a cohort may not use it. Left out of `to_dict` while 0.
     cohort:    train the seeds in groups of `cohort` as one vectorised program (`replication.training.train`:
                seeds g*cohort .. g*cohort + cohort - 1 side by side, each its own init, batches, guard and
                stop); each seed's numbers are those of its own run (up to floating-point reassociation).
@@ -87,6 +90,7 @@ class Protocol:
     scout_batch: int = 0
     scout_lr: float = 0.0
     scout_lr_start: float = 0.0
+    rollback: float = 0.0
     cohort: int = 0
     track_every: int = 0
     dtype: str = "float32"
@@ -120,6 +124,11 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and 0 <= v < 1):
                 raise ValueError(f"protocol {name} must be a number in [0, 1) (the one-cycle's starting phase), got {v!r}")
+        if not (_real(self.rollback) and math.isfinite(self.rollback) and (self.rollback == 0 or self.rollback > 1)):
+            raise ValueError(f"protocol rollback must be 0 (off) or a factor > 1, got {self.rollback!r}")
+        if self.rollback and self.cohort > 1:
+            raise ValueError(f"protocol rollback {self.rollback} with cohort {self.cohort}: rollback restores one "
+                             f"model's state; train the seeds one at a time")
         if self.cohort > 1 and self.scouts > 1:
             raise ValueError(f"protocol cohort {self.cohort} with scouts {self.scouts}: a cohort trains seeds side "
                              f"by side, scouts train initialisations side by side; use one of them")

@@ -60,7 +60,7 @@ _OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0, "scout
 def scout_protocol(protocol):
     return protocol.replace(steps=scout_steps(protocol), batch=protocol.scout_batch or protocol.batch,
                             lr=protocol.scout_lr or protocol.lr, lr_start=protocol.scout_lr_start or protocol.lr_start,
-                            **_OFF)
+                            rollback=0.0, **_OFF)   # rollback is one model's: the continuation's
 
 
 def continuation_protocol(protocol):
