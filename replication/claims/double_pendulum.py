@@ -56,6 +56,9 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 #   peak 1e-2, start 0.2:                       0.23-0.26 in 8 of 9 runs; seed 0 stream 0: 8.1 (as above)
 #   peak 1e-2, start 0.0:                       0.27-0.30 (7 runs)
 #   peak 1e-2, start 0.1 (now):                 0.247-0.280 (9 runs: seeds 0-2 x 3 streams), none thrown off
+# In the quick run at 53914d1: JAX 0.255 / 0.268 / 0.278, PyTorch 0.236 / 10.46 / 0.283. PyTorch seed 1's scouts found
+# no near-physical Lagrangian (tails 13.4-18.2), and from its chosen one no continuation rate tried recovers at this
+# budget (2e-3: 9.85, 5e-3: 2.49; `docs/train_target_trials.md` section 7): the open problem is in the scouting.
 # The baseline gets the same protocol: 0.97 (seed 0; 1.52 at 2e-3). Wider, it gets lower (3 x 128: 0.54), but the
 # paper compares the two at one width, and so do we.
 _guard = {"grad_clip": 100.0, "spike_skip": 10.0}
