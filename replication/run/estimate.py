@@ -44,7 +44,7 @@ def _members_step(framework, spec, protocol, k: int) -> float:
 # what does not change the cost of a step: the init, the step counts, the rates and the pool sizes (the
 # probes leave held-out tracking off: its evaluations, the first one compiling, would count as step time)
 _FREE = ("steps", "scout_steps", "lr", "scout_lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start",
-         "lr_step_every", "lr_step_gamma", "track_every")
+         "scout_lr_start", "lr_step_every", "lr_step_gamma", "track_every")
 
 
 def _shape(framework, spec, protocol) -> str:
