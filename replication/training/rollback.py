@@ -3,8 +3,9 @@
 Why: the spike guard (`spike_guard`) stops single steps, but a run of steps at a high learning rate can still
 throw a learned Lagrangian off within a few hundred steps: the velocity Hessian turns indefinite and the
 training loss jumps several-fold, from which the run rarely comes back in its budget (the double pendulum's
-quick continuation at peak 1e-2: 12.5 -> 33 -> 47 in PyTorch seed 1, 3.9 -> 43 in a JAX replay; the run ended
-at held-out L1 10.5 / 8.1 instead of about 0.25; `docs/train_target_trials.md` section 7).
+quick continuation at peak 1e-2 from phase 0.2, JAX seed 0: 3.9 -> 43 within 250 steps, held-out L1 8.1 at the
+end instead of about 0.25; with rollback 2.5, 0.31). It cannot help a run that never held a near-physical
+Lagrangian (PyTorch seed 1 there: 10.4 without, 7.4 with; `docs/train_target_trials.md` section 7).
 
 The rule, per window of `WINDOW` steps (mean training loss over the window, the loss each step reports):
   - a window whose mean is the lowest so far keeps a copy of the model's parameters and optimiser state
@@ -51,10 +52,10 @@ class Rollback:
         return False
 
     def snapshot_state(self):
-        meta = {"losses": self.losses, "best": self.best, "rollbacks": self.rollbacks,
-                "saved": self.saved is not None, "n": 0 if self.saved is None else len(self.saved)}
-        return meta, ({f"saved_{j:04d}": a for j, a in enumerate(self.saved)} if self.saved is not None else {})
+        saved = self.saved or []   # never empty once kept: a stepper has state
+        meta = {"losses": self.losses, "best": self.best, "rollbacks": self.rollbacks, "n": len(saved)}
+        return meta, {f"saved_{j:04d}": a for j, a in enumerate(saved)}
 
     def restore_snapshot(self, meta, arrays):
         self.losses, self.best, self.rollbacks = list(meta["losses"]), float(meta["best"]), int(meta["rollbacks"])
-        self.saved = [arrays[f"saved_{j:04d}"] for j in range(int(meta["n"]))] if meta["saved"] else None
+        self.saved = [arrays[f"saved_{j:04d}"] for j in range(int(meta["n"]))] or None
