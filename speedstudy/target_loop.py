@@ -98,9 +98,9 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
     loop.row(models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
     outcomes, tails = scouting.scout(train_jax, spec, protocol, seeds)
     loop.wall += outcomes[0].step_seconds
+    loop.steps += scouting.scouting_samples(protocol) // protocol.batch
+    loop.extra += scouting.scouting_samples(protocol) % protocol.batch
     for s, out, tail in zip(seeds, outcomes, tails, strict=True):
-        loop.steps += scout.steps
-        loop.extra += scout.steps * (scout.batch - protocol.batch)
         loop.skipped += out.skipped_steps
         model = models.jax.build(spec, out.params)
         if out.failure is None:

@@ -28,6 +28,9 @@ selection are hooks and callers of this one loop (`replication.training.scouting
 `step_seconds` is the time spent in propose + commit (of all members together), the first step of the
 process left out (it compiles) unless `compiled` says the step already is.
 
+`start_state` (meta, arrays), a snapshot's state held in memory (`narrow` of another run's end state: the
+scouts that go on after a cut, `scouting`), is where the loop begins when `snapshot` has none of its own.
+
 With `snapshot` (a `replication.training.snapshots.Snapshots`), the loop first puts back that store's
 snapshot if it has one for this run (the stepper's `load_state_arrays`, the guards, logs, failures, hooks
 with a `restore_snapshot`) and goes on from its step; it saves one after a step when the store says it is
@@ -54,7 +57,7 @@ log = logging.getLogger("lagbench")
 
 
 def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False,
-                  snapshot=None) -> list[TrainOutcome]:
+                  snapshot=None, start_state=None) -> list[TrainOutcome]:
     n = len(streams)
     if protocol.rollback and not (n == 1 and any(isinstance(h, Rollback) for h in hooks)):
         raise ValueError(f"protocol rollback {protocol.rollback} with {n} member(s) and no rollback hook: rollback "
@@ -62,12 +65,16 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
     guards = [SpikeGuard(protocol) for _ in range(n)]
     logs, failures = [[] for _ in range(n)], [None] * n
     live, done = np.ones(n, bool), np.zeros(n, int)
-    start, ended, wall, t_steps = 0, False, 0.0, 0.0
     saved = snapshot.load(n, protocol.steps) if snapshot else None
     if saved and not _fits(saved[1], stepper):
         log.warning("training snapshot in %s not used, starting over: its arrays do not fit this model and "
                     "optimiser", snapshot.folder)
         saved = None
+    if not saved and start_state is not None:
+        if not _fits(start_state[1], stepper):
+            raise ValueError("the state to start from does not fit this model and optimiser")
+        saved = ({**start_state[0], "ended": False}, start_state[1])
+    start, ended, wall, t_steps = 0, False, 0.0, 0.0
     if saved:
         start, ended, wall, t_steps = _restore(*saved, stepper, guards, logs, failures, live, done, hooks)
     t0, t_probe = time.perf_counter() - wall, 0.0
@@ -118,6 +125,18 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
             for i, p in enumerate(stepper.params())]
 
 
+def narrow(state, members) -> tuple[dict, dict]:
+    """A snapshot's (meta, arrays) cut down to the stacked `members` (indices), to start a run of those
+    alone from it (`start_state`): the stepper's arrays, logs, failures, guards, liveness and steps done of
+    those members; the hooks' state is left behind (their owner carries what it needs)."""
+    meta, arrays = state
+    idx = np.asarray(members, int)
+    each = {name: [meta[name][i] for i in idx] for name in ("logs", "failures", "guards")}
+    return ({**meta, **each, "members": len(idx), "ended": False, "hooks": [],
+             "live": np.asarray(meta["live"])[idx], "done": np.asarray(meta["done"])[idx]},
+            {k: np.asarray(a)[idx] for k, a in arrays.items() if k.startswith("stepper_")})
+
+
 def _fits(arrays, stepper) -> bool:
     mine = [np.shape(a) for a in stepper.state_arrays()]
     return [np.shape(arrays[k]) for k in sorted(arrays) if k.startswith("stepper_")] == mine
@@ -150,7 +169,7 @@ def _restore(meta, arrays, stepper, guards, logs, failures, live, done, hooks):
         logs[i].extend(meta["logs"][i])
         failures[i] = meta["failures"][i]
     live[:], done[:] = meta["live"], meta["done"]
-    for h, hook in enumerate(hooks):
+    for h, hook in enumerate(hooks[:len(meta["hooks"])]):   # none for a `narrow`ed state
         restore = getattr(hook, "restore_snapshot", None)
         if restore:
             prefix = f"hook{h}_"

@@ -21,7 +21,7 @@ DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 COORDS = ("qqdot", "qp")
 GUARD_FIELDS = ("grad_clip", "spike_skip")
-SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr", "scout_lr_start")
+SCOUT_FIELDS = ("scouts", "scout_steps", "scout_batch", "scout_lr", "scout_lr_start", "scout_keep")
 OPTIONAL_FIELDS = GUARD_FIELDS + SCOUT_FIELDS + ("rollback", "cohort", "track_every")   # omitted from to_dict while 0 (off), so older keys hold
 
 
@@ -51,6 +51,10 @@ class Protocol:
                continues the one with the lowest training loss for `steps` steps of `batch` from `lr_start`:
                the budget is K * scout_steps * scout_batch + steps * batch samples. Left out of `to_dict`
                while 0, as the guard.
+    scout_keep: successive halving of the scouts: 0 = off (every scout runs its scout_steps); k with
+               1 <= k < scouts: all K run the first half of their schedule, the k lowest by training loss go
+               on to its end, each as it would have without the cut (`scouting`); the budget's scout part is
+               (K * half + k * (scout_steps - half)) * scout_batch, half = scout_steps // 2.
     rollback:  put back the parameters and Adam state of the best window so far when a window's mean training
                loss exceeds rollback x that best (`replication.training.rollback`); 0 = off, else > 1. One model
                at a time: the scouts run without it, a cohort may not use it. Left out of `to_dict` while 0.
@@ -90,6 +94,7 @@ class Protocol:
     scout_batch: int = 0
     scout_lr: float = 0.0
     scout_lr_start: float = 0.0
+    scout_keep: int = 0
     rollback: float = 0.0
     cohort: int = 0
     track_every: int = 0
@@ -114,7 +119,7 @@ class Protocol:
             v = getattr(self, name)
             if not (_real(v) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"protocol {name} must be a finite number >= 0 (0 = off), got {v!r}")
-        for name in ("scouts", "scout_steps", "scout_batch", "cohort", "track_every"):
+        for name in ("scouts", "scout_steps", "scout_batch", "scout_keep", "cohort", "track_every"):
             v = getattr(self, name)
             if not (v == 0 or _positive_integer(v)):
                 raise ValueError(f"protocol {name} must be an integer >= 0 (0 = off), got {v!r}")
@@ -132,6 +137,9 @@ class Protocol:
         if self.cohort > 1 and self.scouts > 1:
             raise ValueError(f"protocol cohort {self.cohort} with scouts {self.scouts}: a cohort trains seeds side "
                              f"by side, scouts train initialisations side by side; use one of them")
+        if self.scout_keep and not self.scout_keep < self.scouts:
+            raise ValueError(f"protocol scout_keep {self.scout_keep} must be below scouts {self.scouts} (the scouts "
+                             f"that go on after the first half of scouting; 0 = every scout goes on)")
         if self.scout_batch > self.n_train:
             raise ValueError(f"scout_batch {self.scout_batch} exceeds the training pool n_train={self.n_train}")
 

@@ -28,6 +28,8 @@ import math
 
 import numpy as np
 
+from replication.training import loop
+
 SCOUT_SAMPLES = 500_000   # samples per scout when the protocol does not say (at most half the budget in all)
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
 CONTINUATION_STREAM = 1000  # the chosen init seed + this: the continuation's batch stream
@@ -38,10 +40,23 @@ def scout_steps(protocol) -> int:
     return int(protocol.scout_steps) or max(SCOUT_SAMPLES // (protocol.scout_batch or protocol.batch), 1)
 
 
+def cut_step(protocol) -> int | None:
+    """The step after which only `scout_keep` scouts go on (half their schedule); None: no cut."""
+    return scout_steps(protocol) // 2 if protocol.scouts > 1 and protocol.scout_keep else None
+
+
+def scouting_samples(protocol) -> int:
+    """Samples of every scout: K x scout_steps, or with a cut K x half + scout_keep x the rest, at the scout batch."""
+    if protocol.scouts <= 1:
+        return 0
+    per, half = scout_steps(protocol), cut_step(protocol)
+    steps = protocol.scouts * per if half is None else protocol.scouts * half + protocol.scout_keep * (per - half)
+    return steps * (protocol.scout_batch or protocol.batch)
+
+
 def budget_samples(protocol) -> int:
     """Training samples of a run: every scout's and the continuation's (steps x batch without scouts)."""
-    scouts = protocol.scouts * scout_steps(protocol) * (protocol.scout_batch or protocol.batch)
-    return protocol.steps * protocol.batch + (scouts if protocol.scouts > 1 else 0)
+    return protocol.steps * protocol.batch + scouting_samples(protocol)
 
 
 def progress_steps(protocol) -> int:
@@ -54,7 +69,7 @@ def init_seeds(protocol, seed: int) -> list[int]:
     return [seed * protocol.scouts + i for i in range(protocol.scouts)]
 
 
-_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0, "scout_lr_start": 0.0}
+_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0, "scout_lr_start": 0.0, "scout_keep": 0}
 
 
 def scout_protocol(protocol):
@@ -83,21 +98,85 @@ class _Losses:
         self.losses = list(arrays["losses"])
 
 
-def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None):
+class _StopAt:
+    """The loop hook that ends a run after `steps` steps (the scouts' cut)."""
+
+    def __init__(self, steps: int):
+        self.steps = steps
+
+    def __call__(self, k, stepper, info):
+        return k + 1 >= self.steps
+
+
+class _Held:
+    """A snapshot store (or none) that also keeps in memory the last state saved or loaded: the scouts'
+    state at the cut, from which the kept ones go on."""
+
+    def __init__(self, store):
+        self.store, self.state = store, None
+        self.folder = store.folder if store else None
+
+    def due(self) -> bool:
+        return self.store.due() if self.store else False
+
+    def save(self, meta, arrays):
+        self.state = (meta, arrays)
+        if self.store:
+            self.store.save(meta, arrays)
+
+    def load(self, members, steps):
+        got = self.store.load(members, steps) if self.store else None
+        if got:
+            self.state = got
+        return got
+
+
+def _tails(losses, outcomes) -> list[float]:
+    """Each member's mean training loss over the last TAIL of the steps so far (inf: it stopped)."""
+    rows = np.asarray(losses) if losses else np.full((1, len(outcomes)), np.inf)
+    tail = rows[-max(len(rows) // round(1 / TAIL), 1):]
+    tails = [float(np.mean(tail[:, i])) if o.failure is None else math.inf for i, o in enumerate(outcomes)]
+    return [t if math.isfinite(t) else math.inf for t in tails]
+
+
+def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, record=None):
     """Phase 1: (outcomes, tail losses), one per init seed in `seeds`, trained as one program for
-    `scout_protocol(protocol).steps`; the tail loss is inf for a scout that stopped."""
+    `scout_protocol(protocol).steps`; the tail loss is inf for a scout that stopped. With
+    `protocol.scout_keep` = k, every scout runs to `cut_step` (snapshot phase `snapshot`), then the k
+    lowest tails there go on from their exact state (optimiser, guard, log, batch stream) to the end
+    (phase "scouts-kept"): each kept scout's numbers are those of its uncut run. The scouts left behind
+    keep their outcome at the cut and the tail inf (they are never chosen); `record` (a dict) gets
+    {cut_step, cut_tail_loss, kept}. The callers' `hooks` see both parts; their state is not carried
+    across the cut."""
     from models import init_params  # here, not at import: claims read scout_protocol without
     from replication.training.data import BatchStream  # the models or the data (reports import the claims)
 
-    p = scout_protocol(protocol)
+    p, half = scout_protocol(protocol), cut_step(protocol)
     keep = _Losses()
-    outcomes = trainer.train_members(spec, [init_params(spec, seed=s) for s in seeds], p,
-                                     [BatchStream(p, s) for s in seeds], on_log=on_log, hooks=(keep, *hooks),
-                                     snapshot=snapshot)
-    losses = keep.losses
-    tail = np.asarray(losses[-max(len(losses) // round(1 / TAIL), 1):]) if losses else np.full((1, len(seeds)), np.inf)
-    tails = [float(np.mean(tail[:, i])) if o.failure is None else math.inf for i, o in enumerate(outcomes)]
-    return outcomes, [t if math.isfinite(t) else math.inf for t in tails]
+    streams = [BatchStream(p, s) for s in seeds]
+    held = _Held(snapshot) if half is not None else snapshot
+    outcomes = trainer.train_members(spec, [init_params(spec, seed=s) for s in seeds], p, streams, on_log=on_log,
+                                     hooks=(keep, *((_StopAt(half),) if half is not None else ()), *hooks),
+                                     snapshot=held)
+    tails = _tails(keep.losses, outcomes)
+    if half is None:
+        return outcomes, tails
+    go_on = sorted(sorted((i for i, t in enumerate(tails) if math.isfinite(t)), key=lambda i: tails[i])
+                   [:protocol.scout_keep])
+    if record is not None:
+        record.update({"cut_step": half, "cut_tail_loss": tails, "kept": [seeds[i] for i in go_on]})
+    if not go_on:
+        return outcomes, tails
+    keep2 = _Losses()   # the kept scouts' losses so far (replaced by its own if the part resumes from a snapshot)
+    keep2.losses = [row[go_on] for row in keep.losses]
+    kept = trainer.train_members(spec, [outcomes[i].params for i in go_on], p, [streams[i] for i in go_on],
+                                 on_log=on_log, hooks=(keep2, *hooks),
+                                 snapshot=snapshot.phase("scouts-kept") if snapshot else None,
+                                 start_state=loop.narrow(held.state, go_on))
+    final = _tails(keep2.losses, kept)
+    for j, i in enumerate(go_on):
+        outcomes[i] = kept[j]
+    return outcomes, [final[go_on.index(i)] if i in go_on else math.inf for i in range(len(seeds))]
 
 
 def choose(tails) -> int | None:
@@ -119,10 +198,11 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     def scout_log(row):   # progress in continuation steps: the scouts advance together
         if on_log and row.get("member", 0) == 0:
             on_log({**row, "step": row["step"] * done // per})
+    record = {}
     outcomes, tails = scout(trainer, spec, protocol, seeds, on_log=scout_log,
-                            snapshot=snapshot.phase("scouts") if snapshot else None)
+                            snapshot=snapshot.phase("scouts") if snapshot else None, record=record)
     best = choose(tails)
-    record = {"init_seeds": seeds, "tail_loss": tails, "scout_steps": per,
+    record = {"init_seeds": seeds, "tail_loss": tails, "scout_steps": per, **record,
               "chosen": None if best is None else seeds[best]}
     if best is None:   # every scout stopped: the first one's failure stands for the run
         o = outcomes[0]
@@ -134,15 +214,15 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     def shifted(row):
         if on_log:
             on_log({**row, "step": row["step"] + done})
-    t = track(p, done, len(seeds) * per * outcomes[0].batch, outcomes[0].step_seconds) if track else None
+    t = track(p, done, scouting_samples(protocol), outcomes[best].step_seconds) if track else None
     out = trainer.train(spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
                         on_log=shifted, hooks=(t,) if t else (),
                         snapshot=snapshot.phase("continuation") if snapshot else None)
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
     if t:
         t.merge([out.log])
-    out.samples = out.steps_done * out.batch + len(seeds) * per * outcomes[0].batch
-    out.steps_done += len(seeds) * per
+    out.samples = out.steps_done * out.batch + scouting_samples(protocol)
+    out.steps_done += scouting_samples(protocol) // outcomes[0].batch
     out.train_time_s += outcomes[best].train_time_s
     out.scouting = record
     return out

@@ -208,6 +208,7 @@ class Members:
         _load_state_arrays(self, arrays)
 
 
-def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None) -> list[TrainOutcome]:
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None,
+                  start_state=None) -> list[TrainOutcome]:
     return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks,
-                              snapshot=snapshot)
+                              snapshot=snapshot, start_state=start_state)

@@ -220,6 +220,7 @@ class Members:
         self.count = torch.as_tensor(arrays[-1]).clone()
 
 
-def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None) -> list[TrainOutcome]:
+def train_members(spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None,
+                  start_state=None) -> list[TrainOutcome]:
     return loop.train_members(Members(spec, params_list, protocol), protocol, streams, on_log, hooks,
-                              snapshot=snapshot)
+                              snapshot=snapshot, start_state=start_state)

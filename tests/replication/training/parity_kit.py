@@ -64,11 +64,12 @@ class Recorder:
         self._record([out], seen)
         return out
 
-    def train_members(self, spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None):
+    def train_members(self, spec, params_list, protocol, streams, on_log=None, hooks=(), snapshot=None,
+                      start_state=None):
         seen = []
         keep = (lambda k, stepper, info: seen.append(stepper.params()))   # noqa: E731
         outs = loop.train_members(self._stepper(spec, params_list, protocol, True), protocol, streams, on_log,
-                                  (keep, *hooks), snapshot=snapshot)
+                                  (keep, *hooks), snapshot=snapshot, start_state=start_state)
         self._record(outs, seen)
         return outs
 

@@ -80,3 +80,59 @@ def test_scouts_and_continuation_start_their_one_cycles_apart():
             PROTOCOL.replace(scout_lr_start=bad)
         with pytest.raises(ValueError, match="lr_start"):
             PROTOCOL.replace(lr_start=bad)
+
+
+# successive halving (`Protocol.scout_keep`): 4 scouts of 10 steps, the 2 lowest at the cut (step 5) go on
+CUT = PROTOCOL.replace(scout_keep=2)
+
+
+class _Steps:
+    """A hook that keeps every step's per-member training loss (NaN once a member stopped)."""
+
+    def __init__(self):
+        self.rows = []
+
+    def __call__(self, k, stepper, info):
+        self.rows.append(np.where(info["live"], info["loss"], np.nan))
+
+
+@pytest.fixture(scope="module", params=["jax", "torch"])
+def cut_and_uncut(request):
+    seeds = scouting.init_seeds(CUT, 1)
+    seen, rec = _Steps(), {}
+    cut = scouting.scout(Recorder(request.param), SPEC, CUT, seeds, record=rec)
+    uncut = scouting.scout(Recorder(request.param), SPEC, PROTOCOL, seeds, hooks=(seen,))
+    return seeds, cut, uncut, rec, np.asarray(seen.rows)
+
+
+def test_a_cut_keeps_the_lowest_scouts_and_each_goes_on_as_if_uncut(cut_and_uncut):
+    seeds, (cut, tails), (uncut, uncut_tails), rec, steps = cut_and_uncut
+    half = scouting.cut_step(CUT)
+    assert half == 5 and rec["cut_step"] == 5 and steps.shape == (10, 4)
+    # the tails at the cut are the uncut run's over its first 5 steps (5 // 20 -> the last one)
+    np.testing.assert_allclose(rec["cut_tail_loss"], steps[half - 1], rtol=1e-12)
+    lowest = sorted(np.argsort(steps[half - 1])[:2])
+    assert rec["kept"] == [seeds[i] for i in lowest]
+    for i in range(4):
+        if i in lowest:   # the kept ones: the uncut run's numbers (vmapped over 2 instead of 4, float64)
+            assert cut[i].steps_done == 10 and tails[i] == pytest.approx(uncut_tails[i], rel=1e-10)
+            for k in cut[i].params:
+                np.testing.assert_allclose(cut[i].params[k], uncut[i].params[k], rtol=1e-9, atol=1e-12)
+            assert [r["step"] for r in cut[i].log] == [r["step"] for r in uncut[i].log]
+            np.testing.assert_allclose([r["loss"] for r in cut[i].log], [r["loss"] for r in uncut[i].log], rtol=1e-10)
+        else:             # left behind at the cut: never chosen
+            assert cut[i].steps_done == half and tails[i] == float("inf")
+    assert scouting.choose(tails) in lowest
+
+
+def test_a_cut_counts_its_budget():
+    assert scouting.scouting_samples(CUT) == (4 * 5 + 2 * 5) * 8
+    assert scouting.budget_samples(CUT) == (4 * 5 + 2 * 5) * 8 + 60 * 16
+    assert scouting.scouting_samples(PROTOCOL) == 4 * 10 * 8 and scouting.cut_step(PROTOCOL) is None
+    out = scouting.train_scouted(Recorder("jax"), SPEC, CUT.replace(steps=6), seed=1)
+    assert out.samples == scouting.budget_samples(CUT.replace(steps=6))
+    assert out.scouting["chosen"] in out.scouting["kept"] and out.scouting["cut_step"] == 5
+    with pytest.raises(ValueError, match="scout_keep"):
+        PROTOCOL.replace(scout_keep=4)
+    assert "scout_keep" not in PROTOCOL.to_dict() and CUT.key() != PROTOCOL.key()
+    assert scouting.scout_protocol(CUT).scout_keep == 0 and scouting.continuation_protocol(CUT).scout_keep == 0

@@ -16,6 +16,7 @@ SPEC = LNN                                            # the chaotic double-pendu
 ONE = GUARDED.replace(steps=30, track_every=5)        # guard acting often, held-out tracking
 COHORT = GUARDED.replace(steps=24, batch=8, cohort=3)
 SCOUTED = GUARDED.replace(scouts=3, scout_steps=8, scout_batch=8, scout_lr=3e-3, steps=16)
+SCOUTED_CUT = SCOUTED.replace(scout_keep=2)           # 3 scouts to step 4, the 2 lowest on to 8
 TIMING = {"wall_s", "train_s"}                        # clocks: the only columns allowed to differ
 
 
@@ -92,6 +93,17 @@ def test_a_scouted_run_resumes_in_either_phase(tmp_path, fw, at):
     _same(ref, out)
     if at >= SCOUTED.scout_steps:
         assert len(steps) == SCOUTED.steps - (at - SCOUTED.scout_steps), "the scouts were trained again"
+
+
+@pytest.mark.parametrize(("fw", "at"), [("jax", 2), ("jax", 6), ("jax", 10), ("torch", 6)])
+def test_a_scouted_run_with_a_cut_resumes_in_any_part(tmp_path, fw, at):
+    """at 2: before the cut; at 6: among the kept scouts (which must not scout the first half again);
+    at 10: in the continuation."""
+    ref, out, steps = _resumed(tmp_path, fw, SPEC, SCOUTED_CUT, 1, at=at)
+    _same(ref, out)
+    assert ref.scouting["kept"] and ref.scouting["chosen"] in ref.scouting["kept"]
+    if at >= 4:
+        assert steps[0] >= 4, "the first half of the scouts was trained again"
 
 
 @pytest.mark.parametrize("fw", ["jax", "torch"])
