@@ -42,25 +42,25 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
                             schedule="step", lr_step_every=2500, lr_step_gamma=0.1)
 
 # Restarts (`replication.training.scouting`) with the gradient-spike guard, for the LNN and the baseline alike (the
-# same budget and selection): 8 inits scouted for 5e5 samples each at batch 32, peak 1e-3 (which init finds
-# a near-physical Lagrangian is luck; its training loss tells, trials section 5), the best continued at
-# batch 256 for 4e6 samples (one-cycle, fresh Adam) at peak 1e-2, its one-cycle started at phase 0.1 (lr 9.6e-4,
-# about the scouts' peak) rather than the scouts' 0.2. 8e6 samples in all, a thirty-seventh of the original
-# code's 3e8. Why the start: a fresh Adam's first steps at the usual start (0.35 x peak = 3.5e-3) threw seed 0's
-# chosen scout off its near-physical Lagrangian within 250 steps (training loss 3.9 -> 43, 32 steps skipped by
-# the guard; it ended at held-out 8.1, every learned Hessian indefinite), in the quick run at 2f021b7 and in the
-# one-thread trial that replays its batch stream. Trials (JAX, one thread, each seed's chosen scout continued
-# on its own stream and on two other streams, held-out L1 on 4096 states):
-#   peak 2e-3, start 0.2 (until this commit):  0.53 / 0.69 / 0.51 (seeds 0-2, stream 0)
-#   peak 5e-3, start 0.2:                       0.29-0.31 (seeds 0-1, 6 runs)
-#   peak 1e-2, start 0.2:                       0.23-0.26 in 8 of 9 runs; seed 0 stream 0: 8.1 (as above)
-#   peak 1e-2, start 0.0:                       0.27-0.30 (7 runs)
-#   peak 1e-2, start 0.1 (now):                 0.247-0.280 (9 runs: seeds 0-2 x 3 streams), none thrown off
-# In the quick run at 53914d1: JAX 0.255 / 0.268 / 0.278, PyTorch 0.236 / 10.46 / 0.283. PyTorch seed 1's scouts found
-# no near-physical Lagrangian (tails 13.4-18.2), and from its chosen one no continuation rate tried recovers at this
-# budget (2e-3: 9.85, 5e-3: 2.49; `docs/train_target_trials.md` section 7): the open problem is in the scouting.
-# The baseline gets the same protocol: 0.97 (seed 0; 1.52 at 2e-3). Wider, it gets lower (3 x 128: 0.54), but the
-# paper compares the two at one width, and so do we.
+# same budget and selection): 16 inits scouted at batch 32, peak 1e-3, a one-cycle of 15 625 steps from phase 0.2;
+# at its half the 4 lowest by training loss go on to its end (successive halving, `scout_keep`), and the lowest
+# of those is continued at batch 256 for 4e6 samples (one-cycle, fresh Adam) at peak 1e-2 from phase 0.1 (lr 9.6e-4,
+# about the scouts' peak). 9e6 samples in all, a thirty-third of the original code's 3e8.
+# Why 16 and a cut: which init finds a near-physical Lagrangian is luck (about 28 % of them, JAX inits 0-31), and
+# only such a scout continues to a low held-out L1 at this budget. With 8 whole scouts PyTorch seed 1 found none
+# (tails 13.4-18.2) and ended at 10.46 in the quick run at 53914d1; every continuation rate tried from its scout
+# failed (2e-3: 9.85, 5e-3: 2.49). At half the schedule the near-physical scouts already lead (the 7 lowest of 32
+# are near-physical), so keeping 4 of 16 there costs 5e6 scout samples (4e6 before) and misses in about 2 % of runs
+# (0.78^16) against 7 % (`docs/train_target_trials.md` section 8).
+# Why the continuation's start: a fresh Adam's first steps at the usual start (0.35 x peak = 3.5e-3) threw seed 0's
+# chosen scout off its near-physical Lagrangian within 250 steps (training loss 3.9 -> 43; held-out 8.1) in the
+# quick run at 2f021b7 and in the one-thread trial that replays its batch stream. Trials (JAX, one thread, each
+# seed's chosen scout continued on its own stream and two others, held-out L1 on 4096 states; section 7):
+#   peak 2e-3, start 0.2:   0.51-0.69       peak 5e-3, start 0.2:   0.29-0.31
+#   peak 1e-2, start 0.2:   0.23-0.26 in 8 of 9 runs, one thrown off (8.1)
+#   peak 1e-2, start 0.0:   0.27-0.30       peak 1e-2, start 0.1 (now): 0.247-0.280 in 9 runs
+# The baseline gets the same protocol: 0.97 (seed 0; 0.81 at peak 2e-2, 1.02 at 5e-2). Wider, it gets lower
+# (3 x 128: 0.54), but the paper compares the two at one width, and so do we.
 _guard = {"grad_clip": 100.0, "spike_skip": 10.0}
 PROTOCOLS = {
     "smoke": _base.replace(scouts=2, scout_steps=10, scout_batch=16, track_every=5, **_guard),
@@ -69,8 +69,8 @@ PROTOCOLS = {
                            scout_lr_start=0.2, track_every=1000, **_guard),
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
-# full: the same scouts, the continuation at peak 2e-3 (from phase 0.2, as the scouts) for 3e7 samples in all
-# (the train-to-target study's `restarts_fast` at 3 x 128 reached held-out L1 0.075 on 1e5 states with this
+# full: 8 whole scouts (no cut: its trainings were measured so), the continuation at peak 2e-3 (from phase 0.2,
+# as the scouts) for 3e7 samples in all (the train-to-target study's `restarts_fast` at 3 x 128 reached held-out L1 0.075 on 1e5 states with this
 # budget, one thread, 22 min; measured in full: 0.056-0.075 JAX, 0.058-0.064 PyTorch), judged on the paper's
 # 1e5 held-out states. Its protocol (and so its cached trainings) is the one measured there.
 PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=(30_000_000 - 8 * 15_625 * 32) // 256, n_heldout=100_000,

@@ -7,9 +7,13 @@ with `scouts` = K > 1:
   1. trains the K initialisations `init_seeds(protocol, seed)` side by side for `scout_steps(protocol)`
      steps each, as one program (`loop.train_members`; each member's numbers are its own run's), at
      `scout_batch`, peak rate `scout_lr` and one-cycle start `scout_lr_start` (0: the protocol's), a
-     schedule over the scout (the protocol's shape over scout_steps), batches from a stream per init seed;
+     schedule over the scout (the protocol's shape over scout_steps), batches from a stream per init seed.
+     With `scout_keep` = k (successive halving), all K stop at `cut_step` (half the schedule) and only the k
+     lowest by training loss over the last `TAIL` of those steps go on to its end, from their exact state:
+     a near-physical scout leads by then (`docs/train_target_trials.md` section 8), so more inits are
+     tried for the samples of fewer whole scouts (`scouting_samples`);
   2. chooses the scout with the lowest training loss over its last `TAIL` of steps (a scout that stopped
-     on a non-finite loss is never chosen); the held-out set plays no part;
+     on a non-finite loss, or was left at the cut, is never chosen); the held-out set plays no part;
   3. continues the chosen one for `protocol.steps` steps of `protocol.batch`: a new schedule over those
      steps (from `protocol.lr_start`: a fresh Adam's first steps at a high rate can throw a near-physical
      Lagrangian away, so a continuation may start lower than its scouts did), fresh Adam state, batches
@@ -19,8 +23,9 @@ has no restarts: the report says so where a claim uses them.
 
 `train_scouted(trainer, spec, protocol, seed, on_log=None) -> TrainOutcome` (trainer: `train_jax` or
 `train_torch`): the continuation's parameters and log (its steps shifted by the scouts' samples in
-continuation steps, `progress_steps`), steps_done and samples counting every scout, its `scouting` record {init_seeds, tail_loss, chosen, scout_steps}. `scout(...)` and `continuation(...)` are
-the two phases, for callers that watch them (`speedstudy.target_loop`).
+continuation steps, `progress_steps`), steps_done and samples counting every scout, its `scouting` record
+{init_seeds, tail_loss, chosen, scout_steps; with a cut also cut_step, cut_tail_loss, kept}. `scout(...)`,
+`choose` and `continuation_protocol` are its parts, for callers that watch them (`speedstudy.target_loop`).
 """
 from __future__ import annotations
 
