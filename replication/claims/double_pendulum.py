@@ -51,7 +51,8 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 # (tails 13.4-18.2) and ended at 10.46 in the quick run at 53914d1; every continuation rate tried from its scout
 # failed (2e-3: 9.85, 5e-3: 2.49). At half the schedule the near-physical scouts already lead (the 7 lowest of 32
 # are near-physical), so keeping 4 of 16 there costs 5e6 scout samples (4e6 before) and misses in about 2 % of runs
-# (0.78^16) against 7 % (`docs/train_target_trials.md` section 8).
+# (0.78^16) against 7 % (`docs/train_target_trials.md` section 8). In the quick run at 41b6f6d: JAX 0.234 / 0.248 /
+# 0.260, PyTorch 0.236 / 0.243 / 0.271 (PyTorch seed 1 kept 4 near-physical scouts of 16).
 # Why the continuation's start: a fresh Adam's first steps at the usual start (0.35 x peak = 3.5e-3) threw seed 0's
 # chosen scout off its near-physical Lagrangian within 250 steps (training loss 3.9 -> 43; held-out 8.1) in the
 # quick run at 2f021b7 and in the one-thread trial that replays its batch stream. Trials (JAX, one thread, each
