@@ -140,6 +140,8 @@ class Protocol:
         if self.scout_keep and not self.scout_keep < self.scouts:
             raise ValueError(f"protocol scout_keep {self.scout_keep} must be below scouts {self.scouts} (the scouts "
                              f"that go on after the first half of scouting; 0 = every scout goes on)")
+        if self.scout_keep and self.scout_steps == 1:
+            raise ValueError("protocol scout_keep needs scout_steps >= 2: the cut is at half the scouts' steps")
         if self.scout_batch > self.n_train:
             raise ValueError(f"scout_batch {self.scout_batch} exceeds the training pool n_train={self.n_train}")
 

@@ -132,7 +132,8 @@ def test_a_cut_counts_its_budget():
     out = scouting.train_scouted(Recorder("jax"), SPEC, CUT.replace(steps=6), seed=1)
     assert out.samples == scouting.budget_samples(CUT.replace(steps=6))
     assert out.scouting["chosen"] in out.scouting["kept"] and out.scouting["cut_step"] == 5
-    with pytest.raises(ValueError, match="scout_keep"):
-        PROTOCOL.replace(scout_keep=4)
+    for bad in ({"scout_keep": 4}, {"scout_keep": -1}, {"scout_keep": 2, "scout_steps": 1}):
+        with pytest.raises(ValueError, match="scout_keep"):
+            PROTOCOL.replace(**bad)
     assert "scout_keep" not in PROTOCOL.to_dict() and CUT.key() != PROTOCOL.key()
     assert scouting.scout_protocol(CUT).scout_keep == 0 and scouting.continuation_protocol(CUT).scout_keep == 0
