@@ -97,9 +97,9 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
     seeds, scout = list(range(seed, seed + protocol.scouts)), scouting.scout_protocol(protocol)
     loop.row(models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
     outcomes, tails = scouting.scout(train_jax, spec, protocol, seeds)
-    loop.wall += outcomes[0].step_seconds
-    loop.steps += scouting.scouting_samples(protocol) // protocol.batch
-    loop.extra += scouting.scouting_samples(protocol) % protocol.batch
+    loop.wall += max(o.step_seconds for o in outcomes)   # the kept scouts' time runs on past a cut
+    steps, extra = divmod(scouting.scouting_samples(protocol), protocol.batch)
+    loop.steps, loop.extra = loop.steps + steps, loop.extra + extra
     for s, out, tail in zip(seeds, outcomes, tails, strict=True):
         loop.skipped += out.skipped_steps
         model = models.jax.build(spec, out.params)

@@ -15,7 +15,7 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
-from replication.training.scouting import continuation_protocol, cut_step, scout_protocol
+from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
 PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
@@ -70,16 +70,12 @@ def estimate(units, out, jobs: int = 1) -> dict:
         shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
         if shape not in per_step:
             if p.cohort > 1:
-                per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), 0.0, 0.0)
-            else:
-                sp = scout_protocol(p)
+                per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), {})
+            else:   # a step of each scouting part's member count (`scout_parts`)
                 per_step[shape] = (_plain_step(u.framework, spec, p),
-                                   _members_step(u.framework, spec, sp, p.scouts) if p.scouts > 1 else 0.0,
-                                   _members_step(u.framework, spec, sp, p.scout_keep) if cut_step(p) else 0.0)
-        plain, scouts, kept = per_step[shape]
-        per, half = scout_protocol(p).steps, cut_step(p)
-        todo[group] = plain * p.steps + (0.0 if p.scouts <= 1 else scouts * per if half is None
-                                         else scouts * half + kept * (per - half))
+                                   {m: _members_step(u.framework, spec, scout_protocol(p), m) for m, _ in scout_parts(p)})
+        plain, members = per_step[shape]
+        todo[group] = plain * p.steps + sum(members[m] * n for m, n in scout_parts(p))
     total = sum(todo.values())
     longest = max(todo.values(), default=0.0)
     return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),

@@ -50,13 +50,18 @@ def cut_step(protocol) -> int | None:
     return scout_steps(protocol) // 2 if protocol.scouts > 1 and protocol.scout_keep else None
 
 
-def scouting_samples(protocol) -> int:
-    """Samples of every scout: K x scout_steps, or with a cut K x half + scout_keep x the rest, at the scout batch."""
+def scout_parts(protocol) -> list[tuple[int, int]]:
+    """The scouting as (members side by side, steps) parts: [(K, scout_steps)], with a cut
+    [(K, half), (scout_keep, the rest)]; [] without scouts. The budget and the duration estimate read it."""
     if protocol.scouts <= 1:
-        return 0
+        return []
     per, half = scout_steps(protocol), cut_step(protocol)
-    steps = protocol.scouts * per if half is None else protocol.scouts * half + protocol.scout_keep * (per - half)
-    return steps * (protocol.scout_batch or protocol.batch)
+    return [(protocol.scouts, per)] if half is None else [(protocol.scouts, half), (protocol.scout_keep, per - half)]
+
+
+def scouting_samples(protocol) -> int:
+    """Samples of every scout, at the scout batch (`scout_parts`)."""
+    return sum(m * n for m, n in scout_parts(protocol)) * (protocol.scout_batch or protocol.batch)
 
 
 def budget_samples(protocol) -> int:
@@ -178,10 +183,10 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
                                  on_log=on_log, hooks=(keep2, *hooks),
                                  snapshot=snapshot.phase("scouts-kept") if snapshot else None,
                                  start_state=loop.narrow(held.state, go_on))
-    final = _tails(keep2.losses, kept)
-    for j, i in enumerate(go_on):
-        outcomes[i] = kept[j]
-    return outcomes, [final[go_on.index(i)] if i in go_on else math.inf for i in range(len(seeds))]
+    tails = [math.inf] * len(seeds)
+    for i, o, t in zip(go_on, kept, _tails(keep2.losses, kept), strict=True):
+        outcomes[i], tails[i] = o, t
+    return outcomes, tails
 
 
 def choose(tails) -> int | None:
