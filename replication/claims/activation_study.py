@@ -2,13 +2,18 @@
 work (its second derivative is zero, so the velocity Hessian vanishes).
 
 Judged as claim 6 is (`init_study`): each activation over many seeds trained side by side, the samples
-each run took to leave the q-double-dot ~ 0 plateau compared by a one-sided Mann-Whitney test; plain ReLU
-must stay more than 3x softplus's held-out L1 (it cannot leave: its velocity Hessian is zero).
+each run took to leave the q-double-dot ~ 0 plateau compared by a one-sided Mann-Whitney test, plain ReLU
+among the rivals; and plain ReLU must leave it in no seed (`rules.never`): its velocity Hessian is zero, so
+it cannot learn at all.
+Why not held-out L1 for ReLU (the rule until 7b3d8b6: "more than 3x softplus's"): the study's budget is sized
+for the pace, not the end loss, and softplus ends it half trained (held-out 20-27 against the null's 46.6,
+one PyTorch seed thrown back to 51 by a late spike in the quick run at 41b6f6d), so the end loss measured the
+budget, not the claim. ReLU's held-out L1 there is the null's, 46.6 in every seed.
 """
 from replication.claims import double_pendulum as dp
 from replication.claims import init_study
 from replication.claims.base import Claim, ModelEntry
-from replication.claims.rules import all_parts, fails, faster
+from replication.claims.rules import all_parts, faster, never
 
 ACTS = ("softplus", "relu2", "relu3", "tanh", "sigmoid", "relu")
 SMOKE_ACTS = ("softplus", "tanh", "relu")   # smoke: the reference, one smooth rival and plain ReLU
@@ -19,7 +24,7 @@ MODELS = tuple(ModelEntry(f"lnn_act-{a}", {"kind": "lnn", "activation": a, "init
                for a in ACTS)
 
 
-SMOOTH = tuple(f"lnn_act-{a}" for a in ACTS if a not in ("softplus", "relu"))
+RIVALS = tuple(f"lnn_act-{a}" for a in ACTS if a != "softplus")   # the smooth ones and plain ReLU
 
 CLAIM = Claim(
     id="activation_study", number=7, paper="LNN", section="§4, activation functions",
@@ -27,10 +32,9 @@ CLAIM = Claim(
     system="double_pendulum", models=MODELS, protocols=init_study.PROTOCOLS, evaluate="pace",
     metric="left_plateau", metric_label="share of seeds off the q-double-dot ~ 0 plateau after a fixed budget",
     published={},
-    verdict_rule="softplus leaves the plateau in fewer samples than every other smooth activation (one-sided "
-                 "Mann-Whitney over seeds, p < 0.05 / 4) and relu's held-out L1 > 3x softplus's, seed ranges "
-                 "apart (partly: some of it)",
-    verdict=all_parts(faster("lnn_act-softplus", SMOOTH),
-                      fails("lnn_act-relu", ("lnn_act-softplus",), 3.0, "heldout_l1")),
+    verdict_rule="softplus leaves the plateau in fewer samples than every other activation, relu included "
+                 "(one-sided Mann-Whitney over seeds, p < 0.05 / 5), and relu leaves it in no seed "
+                 "(partly: some of it)",
+    verdict=all_parts(faster("lnn_act-softplus", RIVALS), never("lnn_act-relu")),
     seeds=init_study.SEEDS, pooled=True,
 )

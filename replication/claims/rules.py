@@ -18,6 +18,8 @@ value itself, so the per-seed verdicts that ``replication.claims.verdicts`` take
 - ``faster(ours, others, pace)``: samples to reach a level per seed (+inf if never), ours faster than every
   other by a one-sided Mann-Whitney test with Bonferroni (partly: than some), with the share that got there
   and its Wilson interval beside; the seeds are a sample, not separate replications (``pooled``).
+- ``never(bad, pace)``: no seed of bad got there (every pace +inf): a model that cannot learn the task, such
+  as a plain-ReLU LNN whose velocity Hessian vanishes; paired with ``faster`` (the others must get there).
 - ``all_parts(*rules)``: a conjunction (every part reproduced).
 """
 from __future__ import annotations
@@ -182,6 +184,12 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return max(0.0, mid - half), min(1.0, mid + half)
 
 
+def _share(k: int, n: int) -> str:
+    """k/n with its 95 % Wilson interval."""
+    lo, hi = wilson(k, n)
+    return f"{k}/{n} [{lo:.2f}, {hi:.2f}]"
+
+
 def _one_sided_p(x, y) -> float:
     """Mann-Whitney U p-value that x tends to be smaller than y (inf = never, ties allowed); 1 when every
     value is the same."""
@@ -211,9 +219,8 @@ def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: floa
         for k in (ours, *rest):
             vals = _get(v, k, pace).values
             hits = sorted(x for x in vals if math.isfinite(x))
-            lo, hi = wilson(len(hits), len(vals))
             med = f"median {hits[len(hits) // 2]:.3g}" if hits else "never"
-            parts.append(f"{k} {len(hits)}/{len(vals)} [{lo:.2f}, {hi:.2f}], {med}")
+            parts.append(f"{k} {_share(len(hits), len(vals))}, {med}")
         text = f"{pace} (seeds that got there, 95 % Wilson interval, median): " + "; ".join(parts)
         if not any(math.isfinite(x) for k in (ours, *rest) for x in _get(v, k, pace).values):
             return "inconclusive", text + ": no seed of any model got there"
@@ -231,6 +238,23 @@ def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: floa
         if quicker:
             return "partly", f"{text}: faster than {', '.join(quicker)} only"
         return "inconclusive", f"{text}: no difference significant at {level:.2g}"
+    return rule
+
+
+def never(bad: str, pace: str = "samples_to_leave"):
+    """``bad`` cannot learn: no seed of it got there within the budget (pace +inf in every seed). Reproduced
+    if none did, not reproduced if any did (one seed that learned shows it can). Alone it would pass a null
+    model, which never gets there either: pair it with ``faster`` (ours, (..., bad)), which is inconclusive
+    unless some seed of some model got there and not reproduced unless ours got there first."""
+    def rule(v):
+        if (m := _missing(v, (bad,), pace)) is not None:
+            return m
+        vals = _get(v, bad, pace).values
+        k = sum(math.isfinite(x) for x in vals)
+        text = f"{bad} got there in {_share(k, len(vals))} seeds"
+        if k:
+            return "not reproduced", f"{text}: it can learn"
+        return "reproduced", f"{text}: never, within the budget"
     return rule
 
 

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from replication.claims.bars import Bar, competence
-from replication.claims.rules import Stat, all_parts, better_by, bound, fails, lowest, separated, similar
+from replication.claims.rules import Stat, all_parts, better_by, bound, fails, lowest, never, separated, similar
 
 M = "m"
 
@@ -70,6 +70,14 @@ def test_lowest(values, expected):
 ])
 def test_fails(values, expected):
     assert fails("bad", ("g1", "g2"), 10.0, M)(v(**values))[0] == expected
+
+
+def test_never():
+    inf = math.inf
+    assert never("bad", M)(v(bad=(inf, inf, inf)))[0] == "reproduced"
+    verdict, reason = never("bad", M)(v(bad=(inf, 5e4, inf)))
+    assert verdict == "not reproduced" and "1/3" in reason
+    assert never("bad", M)(v(good=(1.0,)))[0] == "not run"
 
 
 def test_bound_and_all_parts():

@@ -26,8 +26,8 @@ def _metrics(cid, label, good: bool) -> dict:
     if cid == "init_study":   # samples to leave the plateau, per seed: the winner's all fewer
         return {"samples_to_leave": 1e3 * (win if label == "lnn_init-cranmer2020" else lose)}
     if cid == "activation_study":
-        if label == "lnn_act-relu":
-            return {"heldout_l1": 100.0 if good else 1.0, "samples_to_leave": float("inf")}
+        if label == "lnn_act-relu":   # plain ReLU never leaves the plateau, or (bad case) leaves it first
+            return {"heldout_l1": 1.0, "samples_to_leave": float("inf") if good else 1e2}
         return {"heldout_l1": win, "samples_to_leave": 1e3 * (win if label == "lnn_act-softplus" else lose)}
     if cid == "delan_table1":
         return {"heldout_l1": win if label.startswith("lnn") else lose}
@@ -123,6 +123,24 @@ def test_training_pace_over_seeds_is_a_rank_test_not_each_seed():
     # another init clearly faster, every run of ours left later (or never)
     v = judge(CLAIMS[cid], _paces(cid, {ours: slow[:4] + [inf] * 4, "lnn_init-kaiming": fast}), "quick")
     assert v["verdict"] == "not reproduced" and "lnn_init-kaiming faster" in v["reason"], v["reason"]
+
+
+def test_plain_relu_must_never_leave_while_softplus_leaves_first():
+    cid, inf = "activation_study", float("inf")
+    fast, slow = [1e4 + i for i in range(8)], [5e4 + i for i in range(8)]
+    smooth = {m: slow for m in CLAIMS[cid].labels("quick") if m not in ("lnn_act-softplus", "lnn_act-relu")}
+    v = judge(CLAIMS[cid], _paces(cid, {"lnn_act-softplus": fast, **smooth}), "quick")
+    assert v["verdict"] == "reproduced" and "lnn_act-relu got there in 0/8 [0.00, 0.32]" in v["reason"], v["reason"]
+    # one ReLU seed left the plateau (late): it can learn, so half the claim fails
+    v = judge(CLAIMS[cid], _paces(cid, {"lnn_act-softplus": fast, **smooth, "lnn_act-relu": [9e4] + [inf] * 7}),
+              "quick")
+    assert v["verdict"] == "partly" and "it can learn" in v["reason"], v["reason"]
+    # nobody left, ReLU included: the ReLU part alone would pass, the pace part keeps it inconclusive
+    v = judge(CLAIMS[cid], _paces(cid, {}), "quick")
+    assert v["verdict"] == "inconclusive" and "no seed of any model got there" in v["reason"], v["reason"]
+    # softplus never leaves while the smooth ones do: the pace part fails, the ReLU part holds
+    v = judge(CLAIMS[cid], _paces(cid, {"lnn_act-softplus": [inf] * 8, **{m: fast for m in smooth}}), "quick")
+    assert v["verdict"] == "partly" and "faster (p <" in v["reason"], v["reason"]
 
 
 def test_wilson_interval_matches_reference_values():
