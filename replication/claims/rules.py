@@ -244,8 +244,8 @@ def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: floa
 def never(bad: str, pace: str = "samples_to_leave"):
     """``bad`` cannot learn: no seed of it got there within the budget (pace +inf in every seed). Reproduced
     if none did, not reproduced if any did (one seed that learned shows it can). Alone it would pass a null
-    model, which never gets there either: pair it with ``faster`` (ours, (..., bad)), which is inconclusive
-    unless some seed of some model got there and not reproduced unless ours got there first."""
+    model, which never gets there either: pair it with ``faster(ours, (..., bad))`` in ``all_parts``, which
+    reproduces only if ours got there significantly sooner than bad (so some seed of ours got there)."""
     def rule(v):
         if (m := _missing(v, (bad,), pace)) is not None:
             return m
