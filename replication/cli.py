@@ -172,8 +172,9 @@ def build_parser():
     s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
     s.add_argument("--heldout", type=int, default=4096, help="held-out states, >= 1 (default 4096)")
     s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, restarts_fast, "
-                                       "baseline_reference (default all)")
-    s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7; default 0)")
+                                       "restarts_halved, baseline_reference (default all)")
+    s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7, 15 for "
+                                                            "restarts_halved; default 0)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_train_target)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "

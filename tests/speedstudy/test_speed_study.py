@@ -94,7 +94,8 @@ def test_latency_compiled_matches_method_and_is_in_targets(bench_dir):
 def test_train_target_rows(bench_dir):
     out, targets = bench_dir
     df = pd.read_csv(out / "bench" / "train_target.csv")
-    assert set(df["protocol"]) == {"original_scaled", "variant", "restarts", "restarts_fast", "baseline_reference"}
+    assert set(df["protocol"]) == {"original_scaled", "variant", "restarts", "restarts_fast", "restarts_halved",
+                                 "baseline_reference"}
     assert set(df.loc[df["protocol"] == "baseline_reference", "model"]) == {"baseline"}
     lnn = df[df["model"] == "lnn"]
     assert np.all(np.isfinite(lnn["hessian_rel_err"].to_numpy(float)))
@@ -103,12 +104,15 @@ def test_train_target_rows(bench_dir):
     assert (df["skipped_steps"] >= 0).all()
     assert (df.loc[df["protocol"] == "original_scaled", "skipped_steps"] == 0).all()  # its guard is off
     assert df.loc[df["protocol"] == "variant", "description"].str.contains("gradient clip 100").all()
-    assert set(df["threshold"]) == {10.0, 3.0, 1.0, 0.3, 0.073}
+    assert set(df["threshold"]) == {10.0, 3.0, 1.0, 0.3, 0.073, 0.069}
     missed = df[~np.isfinite(df["samples_to_reach"].to_numpy(float))]
     assert missed["reached"].str.startswith("not reached within budget").all()
+    assert np.isnan(missed["wall_s_to_reach"].to_numpy(float)).all()
+    hit = df[np.isfinite(df["samples_to_reach"].to_numpy(float))]
+    assert (hit["wall_s_to_reach"] <= hit["wall_s"]).all()
     assert df["extrapolation"].str.contains("EXTRAPOLATED").all()
     assert targets["train_target_variant"]["met"] in (True, False)
-    assert set(targets["train_target_original_scaled"]["samples_to_reach"]) == {"10", "3", "1", "0.3", "0.073"}
+    assert set(targets["train_target_original_scaled"]["samples_to_reach"]) == {"10", "3", "1", "0.3", "0.073", "0.069"}
 
 
 def test_ratio_notes_explain_every_ratio_beyond_2x(bench_dir):

@@ -77,3 +77,24 @@ def test_a_scout_that_fails_is_logged_and_never_chosen(monkeypatch):
     assert [r["seed"] for r in ends] == [0, 1] and np.isfinite(ends[0]["scout_loss"])
     assert ends[1]["scout_loss"] == np.inf and "stopped" in ends[1]["phase"]
     assert {r["seed"] for r in log if r["phase"] == "continue"} == {0}
+
+
+def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
+    """restarts_halved: 16 scouts, the 4 lowest at the cut go on; its budget counts both parts, and it spends
+    at most the budget it is given (the continuation takes what the scouts leave)."""
+    for budget in (4096, 3e7):
+        p = TT.protocols(int(budget), 64)["restarts_halved"].protocol
+        assert (p.scouts, p.scout_keep) == (TT.HALVED_SEEDS, TT.HALVED_KEEP)
+        parts = scouting.scout_parts(p)
+        assert parts[0][0] == TT.HALVED_SEEDS and parts[-1][0] == TT.HALVED_KEEP
+        if budget == 3e7:
+            assert scouting.budget_samples(p) <= budget
+    entry = TT.protocols(4096, 64)["restarts_halved"]
+    lnn = next(m for m in MODELS if m.label == "lnn")
+    spec = ModelSpec(dof=2, hidden=(8,), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
+    log, _ = TL.run_protocol("restarts_halved", spec, entry.protocol)
+    scouts = [r for r in log if r["phase"].startswith("scout") and r["step"] > 0]
+    assert len(scouts) == TT.HALVED_SEEDS
+    assert log[-1]["phase"] == "continue" and log[-1]["samples"] == scouting.budget_samples(entry.protocol)
+    assert sum(np.isinf(r["scout_loss"]) for r in scouts) == TT.HALVED_SEEDS - TT.HALVED_KEEP   # left at the cut
+    assert log[-1]["seed"] == min(scouts, key=lambda r: r["scout_loss"])["seed"]
