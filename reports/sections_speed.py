@@ -146,7 +146,8 @@ def _train_target(b: Section, tables: dict, folder: str, out_dir: Path, title: s
     if tt is None:
         return
     cols = [c for c in ["protocol", "model", "seed", "hidden", "budget", "threshold", "samples_to_reach",
-                        "wall_s_to_reach", "best_l1", "final_l1", "hessian_rel_err", "skipped_steps", "samples_per_s", "extrapolated_samples"]
+                        "wall_s_to_reach", "best_l1", "final_l1", "hessian_rel_err", "skipped_steps", "samples_per_s",
+                        "extrapolated_samples"]
             if c in tt.columns]
     b.add(Table(title, _bench_table(tt[cols], missing="-"), [f"{folder}/train_target.csv"], note=TRAIN_TARGET_NOTE))
     fig = f"figures/{folder}_train_target.png"
@@ -162,8 +163,8 @@ TRAIN_TARGET_NOTE = (
     "chosen); its samples count every scout. restarts_fast: the same scouts, the chosen one continued at batch "
     "256 and peak 2e-3 (the full profile's double-pendulum protocol). restarts_halved: restarts_fast over 16 "
     "inits, the 4 lowest at half the scout going on to its end (successive halving). wall_s_to_reach: seconds "
-    "of training steps to the threshold (compiling and evaluations excluded). baseline_reference: the plain MLP on the variant's protocol, for "
-    "scale. hessian_rel_err: median relative distance of the final LNN's velocity Hessian from the true mass "
+    "of training steps to the threshold (compiling and evaluations excluded). baseline_reference: the plain MLP "
+    "on the variant's protocol, for scale. hessian_rel_err: median relative distance of the final LNN's velocity Hessian from the true mass "
     "matrix times one best scale (0: the true Lagrangian up to its symmetries). skipped_steps: steps the "
     "gradient-spike guard skipped (`replication.training.spike_guard`).")
 

@@ -31,7 +31,7 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       end, the lowest of those continues as in restarts_fast. More inits for a sixth more scout samples:
       with 8 whole scouts a run finds no near-physical Lagrangian often enough to matter (all 8 missed,
       tails 10-18, in a 2-thread run at seed 0; `train_target_trials.md` section 9).
-The four use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
+The five use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside
 them, for reference (not a target row):
   "baseline_reference": the claim's plain MLP baseline (ReLU, Glorot init, q'' straight out) on the
       variant's protocol and inputs: what the same samples buy when no Euler-Lagrange solve is learned.

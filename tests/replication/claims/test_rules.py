@@ -5,7 +5,17 @@ import math
 import pytest
 
 from replication.claims.bars import Bar, competence
-from replication.claims.rules import Stat, all_parts, better_by, bound, fails, lowest, never, separated, similar
+from replication.claims.rules import (
+    Stat,
+    all_parts,
+    better_by,
+    bound,
+    fails,
+    lowest,
+    never,
+    separated,
+    similar,
+)
 
 M = "m"
 
