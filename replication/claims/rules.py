@@ -237,7 +237,9 @@ def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: floa
             return "reproduced", f"{text}: {ours} faster than every other (p < {level:.2g})"
         if quicker:
             return "partly", f"{text}: faster than {', '.join(quicker)} only"
-        return "inconclusive", f"{text}: no difference significant at {level:.2g}"
+        n = min(len(_get(v, k, pace).values) for k in (ours, *rest))
+        return "inconclusive", (f"{text}: no difference significant at {level:.2g} with {n} or more seeds a model "
+                                "(a sample too small to tell, or no difference)")
     return rule
 
 
