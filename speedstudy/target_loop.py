@@ -104,7 +104,7 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
         loop.skipped += out.skipped_steps
         model = models.jax.build(spec, out.params)
         if out.failure is None:
-            loop.row(model, "scout", s, learning_rate(scout, scout.steps - 1), out.log[-1]["loss"])
+            loop.row(model, "scout", s, learning_rate(scout, out.steps_done - 1), out.log[-1]["loss"])   # a cut scout: at the cut
         else:
             loop.row(model, "scout (stopped: non-finite loss)", s, learning_rate(scout, out.failure["step"]), np.nan)
         loop.log[-1]["scout_loss"] = tail

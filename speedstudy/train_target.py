@@ -28,7 +28,7 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       profile's double-pendulum protocol): about three times the samples per second of batch 32.
   "restarts_halved": restarts_fast with successive halving (`Protocol.scout_keep`, as the quick claims
       scout): HALVED_SEEDS inits run half their scout, the HALVED_KEEP lowest by training loss go on to its
-      end, the lowest of those continues as in restarts_fast. More inits for a sixth more scout samples:
+      end, the lowest of those continues as in restarts_fast. More inits for a quarter more scout samples:
       with 8 whole scouts a run finds no near-physical Lagrangian often enough to matter (all 8 missed,
       tails 10-18, in a 2-thread run at seed 0; `train_target_trials.md` section 9).
 The five use the claim's LNN spec (softplus, empirical init, angle wrapping) at `sizes.target_hidden`. Beside

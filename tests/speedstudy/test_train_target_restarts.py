@@ -6,6 +6,7 @@ import pytest
 from models import ModelSpec
 from replication.claims.double_pendulum import MODELS
 from replication.training import scouting
+from replication.training.schedules import learning_rate
 from replication.training.spike_guard import SpikeGuard
 from speedstudy import target_loop as TL
 from speedstudy import train_target as TT
@@ -97,4 +98,6 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
     assert len(scouts) == TT.HALVED_SEEDS
     assert log[-1]["phase"] == "continue" and log[-1]["samples"] == scouting.budget_samples(entry.protocol)
     assert sum(np.isinf(r["scout_loss"]) for r in scouts) == TT.HALVED_SEEDS - TT.HALVED_KEEP   # left at the cut
+    cut_lr = learning_rate(scouting.scout_protocol(entry.protocol), scouting.cut_step(entry.protocol) - 1)
+    assert all(r["lr"] == cut_lr for r in scouts if np.isinf(r["scout_loss"]))   # their row: where they stopped
     assert log[-1]["seed"] == min(scouts, key=lambda r: r["scout_loss"])["seed"]
