@@ -127,15 +127,15 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
                      f"(a new one-cycle, fresh Adam state); otherwise the variant: batch {var.batch}, peak "
                      f"{var.lr:g}, clip {var.grad_clip:g}, skip at {var.spike_skip:g} x median, velocity scale "
                      f"{VELOCITY_SCALE:g}. Samples count every scout")
-    # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak (the
-    # full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`), same budget
+    # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak, same budget
     fast_rest = max((budget - RESTART_SEEDS * scout * var.batch) // FAST_BATCH, 1)
     fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR,
                             scout_batch=var.batch, scout_lr=var.lr)
     fast_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each at batch {var.batch}, peak {var.lr:g}, as "
                  f"restarts; the chosen one continued for {fast_rest} steps at batch {FAST_BATCH}, peak {FAST_LR:g} "
                  f"(a new one-cycle, fresh Adam state). Samples count every scout")
-    # restarts_halved: restarts_fast's scouts and continuation, HALVED_SEEDS scouts halved to HALVED_KEEP
+    # restarts_halved: restarts_fast's scouts and continuation, HALVED_SEEDS scouts halved to HALVED_KEEP (at
+    # 3.5e7 samples the full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`)
     halved = fast.replace(scouts=HALVED_SEEDS, scout_keep=HALVED_KEEP)
     halved = halved.replace(steps=max((budget - scouting.scouting_samples(halved)) // FAST_BATCH, 1))
     halved_text = (f"{HALVED_SEEDS} seeds scouted at batch {var.batch}, peak {var.lr:g}, for {scout} steps; at step "

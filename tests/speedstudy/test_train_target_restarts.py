@@ -101,3 +101,15 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
     cut_lr = learning_rate(scouting.scout_protocol(entry.protocol), scouting.cut_step(entry.protocol) - 1)
     assert all(r["lr"] == cut_lr for r in scouts if np.isinf(r["scout_loss"]))   # their row: where they stopped
     assert log[-1]["seed"] == min(scouts, key=lambda r: r["scout_loss"])["seed"]
+
+
+def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured():
+    """full's claims 1-2 cite the time-to-target run of restarts_halved at 3.5e7 samples: the same training."""
+    from replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
+    full = PROTOCOLS["full"]
+    entry = TT.protocols(FULL_SAMPLES, full.n_heldout)["restarts_halved"]
+    logging_only = {"log_every": 1, "track_every": 1, "lr_step_every": 1}   # lr_step_every: step schedules only
+    assert full.schedule == "onecycle"
+    assert full.replace(**logging_only) == entry.protocol.replace(**logging_only)
+    assert scouting.scouting_samples(full) + full.steps * full.batch <= FULL_SAMPLES
+    assert entry.overrides.get("input_scale") == VELOCITY_SCALE["quick"]["input_scale"]
