@@ -157,7 +157,9 @@ def _train_target(b: Section, tables: dict, folder: str, out_dir: Path, title: s
 
 
 TRAIN_TARGET_NOTE = (
-    "samples_to_reach '-': not reached within the budget. extrapolated_samples is a power-law extrapolation of "
+    "samples_to_reach '-': not reached within the budget; with restarts each scout's end-of-scout held-out "
+    "evaluation counts, at the samples of the whole scouting (so loose thresholds read as reached when it ends). "
+    "extrapolated_samples is a power-law extrapolation of "
     "the best-so-far curve, not a measurement ('-': reached, or a flat curve; inf: beyond 1000 x 3e8 samples). "
     "restarts: the variant scouting 8 inits and continuing the one with the lowest training loss (seed: the one "
     "chosen); its samples count every scout. restarts_fast: the same scouts, the chosen one continued at batch "
