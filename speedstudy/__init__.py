@@ -23,7 +23,8 @@ ignore):
   matmul.csv      dof, framework, rows, seconds, gflops, threads           (`speedstudy.roofline`)
   structure.csv   per system: declared structure and what using it buys   (`speedstudy.structure`)
   members.csv     framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s, cost_vs_one:
-                  K models trained as one program against one alone (`speedstudy.members`)
+                  K models trained as one program against one alone, and one at K x the batch
+                  (`speedstudy.members`)
   ratios.csv      operation, jax, torch, ratio, note                       (`speedstudy.tables`)
   targets.json    the issue's numeric targets (`speedstudy.targets.TARGETS`), each with the measured
                   values and met: true/false

@@ -10,8 +10,9 @@ its fastest round. The compiled step is built once per case and warmed up before
 `members_rows(sizes) -> rows` {framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s,
 cost_vs_one, step_cost_vs_one}: wall_s is the whole loop (batches drawn in NumPy, the guard, the step),
 step_s the optimiser steps alone (`TrainOutcome.step_seconds`); cost_vs_one = the K members' wall over one
-model's (K scouts run one after another would cost K). The issue's bound, K = 8 at most 2.5x one model's
-wall time per framework, is checked in `speedstudy.targets`.
+model's (K scouts run one after another would cost K). A third row per framework: one model at K x the
+batch, the same samples per step as the K members, for scale (what batching alone costs). The issue's
+bound, K = 8 at most 2.5x one model's wall time per framework, is checked in `speedstudy.targets`.
 """
 from __future__ import annotations
 
@@ -50,25 +51,31 @@ def _round(framework, spec, protocol, k, step):
     return out.train_time_s, out.step_seconds
 
 
+def _cases(protocol):
+    """(members, protocol): one model, MEMBERS members, and one model at MEMBERS x the batch (the same samples
+    per step as the members: what batching alone costs, the floor of what vectorising can reach)."""
+    wide = protocol.batch * MEMBERS
+    return [(1, protocol), (MEMBERS, protocol), (1, protocol.replace(batch=wide, n_train=wide * 1000))]
+
+
 def members_rows(sizes, bar=None) -> list[dict]:
     spec, protocol = _case(sizes)
     rows = []
     for fw in ("jax", "torch"):
-        steps = {k: _make_step(fw, spec, protocol, k) for k in (1, MEMBERS)}
-        best = {}
-        for k in (1, MEMBERS):   # warm-up: compile, first batches
-            _round(fw, spec, protocol.replace(steps=2), k, steps[k])
+        cases = _cases(protocol)
+        steps = [_make_step(fw, spec, p, k) for k, p in cases]
+        best = [(float("inf"), float("inf"))] * len(cases)
+        for (k, p), step in zip(cases, steps, strict=True):   # warm-up: compile, first batches
+            _round(fw, spec, p.replace(steps=2), k, step)
         for _ in range(sizes.members_rounds):
-            for k in (1, MEMBERS):
-                wall, step_s = _round(fw, spec, protocol, k, steps[k])
-                old = best.get(k, (float("inf"), float("inf")))
-                best[k] = (min(old[0], wall), min(old[1], step_s))
-        for k in (1, MEMBERS):
-            wall, step_s = best[k]
+            for i, ((k, p), step) in enumerate(zip(cases, steps, strict=True)):
+                wall, step_s = _round(fw, spec, p, k, step)
+                best[i] = (min(best[i][0], wall), min(best[i][1], step_s))
+        for (k, p), (wall, step_s) in zip(cases, best, strict=True):
             rows.append({"framework": fw, "members": k, "hidden": "x".join(map(str, spec.hidden)),
-                         "batch": protocol.batch, "steps": protocol.steps, "wall_s": wall, "step_s": step_s,
-                         "samples_per_s": k * protocol.steps * protocol.batch / wall,
-                         "cost_vs_one": wall / best[1][0], "step_cost_vs_one": step_s / best[1][1]})
+                         "batch": p.batch, "steps": p.steps, "wall_s": wall, "step_s": step_s,
+                         "samples_per_s": k * p.steps * p.batch / wall,
+                         "cost_vs_one": wall / best[0][0], "step_cost_vs_one": step_s / best[0][1]})
         if bar is not None:
             bar.update(1)
     return rows

@@ -161,12 +161,13 @@ def load_results_of(out):
     return load_results(out)
 
 
-def test_members_rows_pair_one_model_with_eight(bench_dir):
+def test_members_rows_pair_one_model_with_eight_and_with_one_at_eight_times_the_batch(bench_dir):
     out, _ = bench_dir
     df = pd.read_csv(out / "bench" / "members.csv")
     assert sorted(df["framework"].unique()) == ["jax", "torch"]
     for _, g in df.groupby("framework"):
-        assert sorted(g["members"]) == [1, 8]
-        assert float(g.loc[g["members"] == 1, "cost_vs_one"].iloc[0]) == 1.0
+        assert list(zip(g["members"], g["batch"], strict=True)) == [(1, 32), (8, 32), (1, 256)]
+        assert float(g["cost_vs_one"].iloc[0]) == 1.0
+        assert (g["samples_per_s"] > 0).all() and (g["cost_vs_one"].iloc[1:] > 0).all()
     targets = json.loads((out / "bench" / "targets.json").read_text())["targets"]
     assert targets["members_cost_vs_one"]["target"] == 2.5
