@@ -184,7 +184,7 @@ def _targets_table(path: Path) -> pd.DataFrame | None:
     for name, t in targets.items():
         if not isinstance(t, dict):
             continue
-        values = "; ".join(f"{k} {cell(v)}" for k, v in t.items()
-                           if k != "met" and isinstance(v, int | float | str) and not isinstance(v, bool))
+        values = "; ".join(f"{k} {('yes' if v else 'no') if isinstance(v, bool) else cell(v)}"
+                           for k, v in t.items() if k != "met" and isinstance(v, int | float | str))
         rows.append({"target": name, "met": "yes" if t.get("met") else "no", "measured": values})
     return pd.DataFrame(rows) if rows else None

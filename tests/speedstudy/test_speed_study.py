@@ -171,3 +171,22 @@ def test_members_rows_pair_one_model_with_eight_and_with_one_at_eight_times_the_
         assert (g["samples_per_s"] > 0).all() and (g["cost_vs_one"].iloc[1:] > 0).all()
     targets = json.loads((out / "bench" / "targets.json").read_text())["targets"]
     assert targets["members_cost_vs_one"]["target"] == 2.5
+
+
+def _members_row(fw, members, batch, cost):
+    return {"framework": fw, "members": members, "batch": batch, "cost_vs_one": cost}
+
+
+def test_the_members_target_sets_the_members_beside_one_model_at_eight_times_the_batch():
+    from speedstudy.targets import members_target
+
+    rows = [_members_row("jax", 1, 32, 1.0), _members_row("jax", 8, 32, 3.0), _members_row("jax", 1, 256, 2.4),
+            _members_row("torch", 1, 32, 1.0), _members_row("torch", 8, 32, 2.4), _members_row("torch", 1, 256, 2.0)]
+    t = members_target(rows)
+    assert (t["jax"], t["torch"], t["jax_one_at_k_batch"], t["torch_one_at_k_batch"]) == (3.0, 2.4, 2.4, 2.0)
+    assert t["met"] is False and t["floor_above_target"] is False   # both floors under 2.5: reachable
+    rows[2] = _members_row("jax", 1, 256, 2.6)
+    assert members_target(rows)["floor_above_target"] is True      # JAX's batching alone costs more than 2.5
+    rows[1], rows[4] = _members_row("jax", 8, 32, 2.5), _members_row("torch", 8, 32, 1.9)
+    assert members_target(rows)["met"] is True
+    assert "floor_above_target" not in members_target([r for r in rows if r["batch"] != 256])
