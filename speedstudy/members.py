@@ -1,5 +1,6 @@
 """Many seeds for the price of one: K models trained side by side as one program (`loop.train_members`:
-JAX `eqx.filter_vmap`, PyTorch `torch.func.vmap` over stacked parameters) against one model alone.
+JAX `eqx.filter_vmap` over stacked parameters; PyTorch one model whose parameters are stacked, its
+products batched over the members, `models.torch.build_stacked`) against one model alone.
 
 The case is the restarts protocol's scouting phase: the double-pendulum LNN (softplus, the code's init,
 angles wrapped, velocity inputs x 0.3) at `sizes.members_hidden` (quick: 3 x 128), batch 32, the spike

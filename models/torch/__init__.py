@@ -2,7 +2,8 @@
 
     build(spec, params) -> Model   (nn.Module; its nn.Parameters are exactly the params, spec.dtype)
     to_params(model) -> dict[str, np.ndarray] in the `models.params` layout
+    build_stacked(spec, params_list) -> one Model of K stacked members, for the specs where stacks(spec)
 """
-from models.torch.build import build, to_params
+from models.torch.build import build, build_stacked, stacks, to_params
 
-__all__ = ["build", "to_params"]
+__all__ = ["build", "build_stacked", "stacks", "to_params"]

@@ -3,6 +3,9 @@
 `Model(spec, params)`: params {key: array} in the `models.params` layout; each key "a.b.c" becomes the
 nn.Parameter "c" of nested submodule "a.b", so `dict(model.named_parameters())` has the same keys.
 `model.params` is that dict (what the pure functions take). Input checks: `models.checks` (shared with the JAX base).
+Stacked members (`members=K`, built by `models.torch.build.build_stacked`): every parameter has a leading
+axis of K models and every input a leading K, (K, ..., width); the kinds whose maths is written for that
+say so in `stacks(spec)` (the members then train without torch.func.vmap, `replication.training.train_torch`).
 """
 from __future__ import annotations
 
@@ -15,9 +18,9 @@ from models.spec import ModelSpec
 
 
 class Model(nn.Module):
-    def __init__(self, spec: ModelSpec, params: dict):
+    def __init__(self, spec: ModelSpec, params: dict, members: int | None = None):
         super().__init__()
-        self.spec = spec
+        self.spec, self.members = spec, members
         for key, value in params.items():
             *path, leaf = key.split(".")
             mod = self
@@ -27,6 +30,19 @@ class Model(nn.Module):
                 mod = mod._modules[name]
             data = torch.tensor(np.asarray(value, dtype=spec.dtype))
             mod.register_parameter(leaf, nn.Parameter(data))
+
+    @classmethod
+    def stacks(cls, spec: ModelSpec) -> bool:
+        """Whether this kind's maths takes stacked members (a leading K on parameters and inputs) for spec."""
+        return False
+
+    def _rows(self, x, width: int | None = None):
+        """x (..., width) as the flat batch the maths runs on: (B, width), or (K, B, width) for stacked
+        members; None stays None."""
+        if x is None:
+            return None
+        width = x.shape[-1] if width is None else width
+        return x.reshape(-1, width) if self.members is None else x.reshape(self.members, -1, width)
 
     @property
     def params(self) -> dict:

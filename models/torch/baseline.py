@@ -12,6 +12,10 @@ from models.torch.mlp import mlp, mlp_input, wrap_angles
 
 
 class Baseline(Model):
+    @classmethod
+    def stacks(cls, spec) -> bool:
+        return True
+
     def acceleration(self, q, qdot, extra=None):
         """MLP output (..., n_out)."""
         self._check_state(q, qdot, extra)

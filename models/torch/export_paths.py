@@ -11,7 +11,7 @@ call here pick. The captures:
 
 `pick(eager, traced=None, exporting=None)` -> the variant to call: `traced` while make_fx traces (if
   given), else `exporting` under torch.export (if given), else `eager`.
-`replace_bad_rows(x (B, d), bad (B,), fix, hess, rhs) -> (B, d)`: x with the rows where bad is True
+`replace_bad_rows(x (..., d), bad (...,), fix, hess, rhs) -> (..., d)`: x with the rows where bad is True
   replaced by those of fix(hess, rhs) (B, d), with no Python branch on data in a captured graph.
 No JAX twin: a JAX model is always traced by jit, so it has one path, already graph-safe (`lax.cond`).
 """
@@ -55,11 +55,11 @@ def replace_bad_rows(x, bad, fix, hess, rhs):
         view (the dense LGN's Hessian) failed in placeholder naming (torch 2.13)."""
     traced = tracing()
     if traced and torch.is_grad_enabled():
-        return torch.where(bad[:, None], fix(hess, rhs), x)
+        return torch.where(bad[..., None], fix(hess, rhs), x)
     if traced or torch.compiler.is_exporting():
         operands = (hess.contiguous(), rhs.contiguous(), bad, x.contiguous())
-        return torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[:, None], fix(h, r), y),
+        return torch.cond(torch.any(bad), lambda h, r, b, y: torch.where(b[..., None], fix(h, r), y),
                           lambda h, r, b, y: y.clone(), operands)
     if vmapped(hess) or bool(torch.any(bad)):
-        return torch.where(bad[:, None], fix(hess, rhs), x)
+        return torch.where(bad[..., None], fix(hess, rhs), x)
     return x

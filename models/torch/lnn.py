@@ -128,7 +128,7 @@ def solve_with_fallback(hess, rhs):
     rcond = 1.0 / (_norm1(h) * _norm1(inv))
     bad = ~(torch.isfinite(rcond) & (rcond >= rcond_min(_dtype_name(hess), d)) & (info == 0))
     if torch.is_grad_enabled():
-        safe = torch.where(bad[:, None, None], torch.eye(d, dtype=hess.dtype, device=hess.device), hess)
+        safe = torch.where(bad[..., None, None], torch.eye(d, dtype=hess.dtype, device=hess.device), hess)
         x = torch.linalg.solve(safe, rhs[..., None])[..., 0]
     else:
         x = (inv @ rhs[..., None])[..., 0]
@@ -171,6 +171,11 @@ class LNN(Model):
     The fast formulation and velocity_hessian differentiate the model's own MLP by hand
     (`models.torch.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, faster."""
 
+    @classmethod
+    def stacks(cls, spec) -> bool:
+        """The fast formulation's hand-written terms take stacked members; the paper's torch.func ones do not."""
+        return spec.formulation == "fast"
+
     def _lagrangian(self, q, qdot, extra=None):
         x = mlp_input(self.spec, [wrap_angles(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
@@ -181,26 +186,26 @@ class LNN(Model):
         tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term. With the
         Lorentz factor, x = scale * [wrap(q), qdot, gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k)
         in slot 2d + k, and H gains the curvature of the feature itself, diag(df/dx_(2d+k) s_g[k] gamma'')."""
-        spec, (n, d) = self.spec, q.shape
+        spec, lead, d = self.spec, q.shape[:-1], q.shape[-1]   # lead: (B,), or (K, B) for stacked members
         x = mlp_input(spec, [wrap_angles(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         s_q, s_qd = scale[:d], scale[d:2 * d]
         width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
         used = 3 * d if spec.lorentz_factor else 2 * d
         zeros = torch.zeros((d, width - used), dtype=x.dtype, device=x.device)
-        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1).expand(n, d, 2 * d)
+        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1).expand(*lead, d, 2 * d)
         if spec.lorentz_factor:
             slope, curve = lorentz_slopes(qdot)
             s_g = scale[2 * d:3 * d]
             rows = torch.cat([rows, torch.diag_embed(slope * s_g)], -1)
-        rows = torch.cat([rows, zeros.expand(n, d, width - used)], -1)
-        mixed = torch.cat([qdot * s_q, torch.zeros((n, width - d), dtype=x.dtype, device=x.device)], -1)
-        tangents = torch.cat([rows, mixed[:, None, :]], 1)
+        rows = torch.cat([rows, zeros.expand(*lead, d, width - used)], -1)
+        mixed = torch.cat([qdot * s_q, torch.zeros((*lead, width - d), dtype=x.dtype, device=x.device)], -1)
+        tangents = torch.cat([rows, mixed.unsqueeze(-2)], -2)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
-        hess = gram[:, :d, :d]
+        hess = gram[..., :d, :d]
         if spec.lorentz_factor:
-            hess = hess + torch.diag_embed(g[:, 2 * d:3 * d] * s_g * curve)
-        return hess, g[:, :d] * s_q - gram[:, :d, d]
+            hess = hess + torch.diag_embed(g[..., 2 * d:3 * d] * s_g * curve)
+        return hess, g[..., :d] * s_q - gram[..., :d, d]
 
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""
@@ -211,7 +216,7 @@ class LNN(Model):
         """(..., dof, dof)."""
         self._check_state(q, qdot, extra)
         d, extra = q.shape[-1], extra if self.spec.extra_inputs else None
-        hess, _ = self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None))
+        hess, _ = self._fast_terms(self._rows(q, d), self._rows(qdot, d), self._rows(extra))
         return hess.reshape(*q.shape, d)
 
     def acceleration_info(self, q, qdot, extra=None):
@@ -221,7 +226,7 @@ class LNN(Model):
         if self.spec.formulation != "fast":
             return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
         d = q.shape[-1]
-        return _solved(*self._fast_terms(_flat(q, d), _flat(qdot, d), _flat(extra, None)), q.shape[:-1])
+        return _solved(*self._fast_terms(self._rows(q, d), self._rows(qdot, d), self._rows(extra)), q.shape[:-1])
 
     def acceleration(self, q, qdot, extra=None):
         """qddot (..., dof)."""

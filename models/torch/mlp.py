@@ -62,8 +62,11 @@ ACT = {
 
 
 def linear(params: dict, prefix: str, x):
-    """x (..., in) -> (..., out)."""
-    return torch.nn.functional.linear(x, params[f"{prefix}.weight"], params[f"{prefix}.bias"])
+    """x (..., in) -> (..., out); stacked members (weight (K, out, in)): x (K, ..., in) -> (K, ..., out)."""
+    w, b = params[f"{prefix}.weight"], params[f"{prefix}.bias"]
+    if w.dim() == 2:
+        return torch.nn.functional.linear(x, w, b)
+    return torch.baddbmm(b.unsqueeze(-2), x.flatten(1, -2), w.mT).view(*x.shape[:-1], w.shape[-2])
 
 
 def mlp(params: dict, x, spec, prefix: str = "mlp", final_linear: bool = True):

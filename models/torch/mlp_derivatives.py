@@ -7,6 +7,9 @@ and the HNN.
   with v_s = tangents[b, s]: the Hessian of f in the tangents' span, e.g. the forward-mode derivative of
   g along v_t, read in direction v_s (what forward-over-reverse gives, projected).
   tangents=None gives (g, None): the reverse pass alone (the HNN's dH/dx).
+  Stacked members (`models.torch.build.build_stacked`): weights (K, out, in), biases (K, out), x (K, B, n_in),
+  tangents (K, B, T, n_in) give g (K, B, n_in), G (K, B, T, T); every product becomes one batched product
+  over the K members (`torch.baddbmm` / `torch.bmm`), no torch.func.vmap.
 How: with a_i = W_i h_(i-1) + b_i, h_i = act(a_i) and g_i = df/dh_i, the Hessian of an MLP is exactly
   d^2 f/dx^2 = sum_i J_i^T diag(g_i * act''(a_i)) J_i,   J_i = da_i/dx,
 so one forward-mode pass (J_i v_t for the T tangents, a leading batch dimension after B: every layer is
@@ -60,27 +63,42 @@ ACT_DERIVS = {"softplus": _softplus, "relu": _relu, "relu2": _relu2, "relu3": _r
               "tanh": _tanh, "sigmoid": _sigmoid}
 
 
+def _affine(h, w, b):
+    """h @ w^T + b: one model h (B, in), w (out, in); stacked members h (K, B, in), w (K, out, in), b (K, out)."""
+    if w.dim() == 2:
+        return torch.addmm(b, h, w.T)
+    return torch.baddbmm(b.unsqueeze(-2), h, w.mT)
+
+
+def _tangent_product(dh, w):
+    """dh @ w^T for tangents dh (B, T, in) (one (B*T, in) product), or (K, B, T, in) with w (K, out, in)."""
+    if w.dim() == 2:
+        return dh @ w.T
+    return torch.bmm(dh.flatten(1, 2), w.mT).view(*dh.shape[:-1], w.shape[-2])
+
+
 def input_grad_and_tangent_hessian(params: dict, x, tangents, spec, prefix: str = "mlp"):
     """(g = df/dx (B, n_in), G (B, T, T) with G[b, s, t] = tangents[b, s] . Hessian(f)(x[b]) tangents[b, t]),
-    G None when tangents is None; see the module docstring."""
+    G None when tangents is None; with stacked members a leading K on every shape; see the module docstring."""
     derivs, n = ACT_DERIVS[spec.activation], n_layers(spec)
     weights = [params[f"{prefix}.{i}.weight"] for i in range(n)]
     h, dh, saved = x, tangents, []
     for i in range(n - 1):                       # forward: primal (B, w) and tangents (B, T, w)
-        a = torch.addmm(params[f"{prefix}.{i}.bias"], h, weights[i].T)
+        a = _affine(h, weights[i], params[f"{prefix}.{i}.bias"])
         h, s1, s2 = derivs(a)
         if dh is None:
             saved.append((s1, None, None))
             continue
-        da = dh @ weights[i].T                   # J_i tangents: one (B*T, in) @ (in, w) product
+        da = _tangent_product(dh, weights[i])    # J_i tangents
         if i < n - 2:
-            dh = s1[:, None, :] * da
+            dh = s1.unsqueeze(-2) * da
         saved.append((s1, s2, da))
-    g, gram = weights[n - 1][0], None            # g = df/dh of the last hidden layer
+    g, gram = weights[n - 1][..., :1, :], None   # g = df/dh of the last hidden layer, (1, w) or (K, 1, w)
     for i in reversed(range(n - 1)):             # reverse pass; each layer adds da^T diag(g act'') da
         s1, s2, da = saved[i]
         if da is not None:
-            term = torch.bmm(da * (g * s2)[:, None, :], da.transpose(1, 2))
+            left = (da * (g * s2).unsqueeze(-2)).flatten(0, -3)
+            term = torch.bmm(left, da.flatten(0, -3).transpose(1, 2)).view(*da.shape[:-1], da.shape[-2])
             gram = term if gram is None else gram + term
         g = (g * s1) @ weights[i]
     return g, gram

@@ -28,8 +28,9 @@ def predict(model, kind: str, task: str, batch: dict, cat):
     raise ValueError(f"unknown task {task!r}")
 
 
-def loss_value(pred, target, weight, loss: str):
-    """Per-sample error summed over components, then averaged over the batch.
+def loss_value(pred, target, weight, loss: str, axis=None):
+    """Per-sample error summed over components, then averaged over the batch (axis None: over every sample;
+    axis=-1 with stacked members' (K, B, ...) arrays: per member, (K,)).
 
     "l1"/"l1_gamma": sum |err|; "mse": sum err^2. With a weight: sum(w * e) / sum(w).
     |err| is written max(err, 0) - min(err, 0) (`clip`, a method of both array types): the same values as
@@ -39,5 +40,5 @@ def loss_value(pred, target, weight, loss: str):
     err = pred - target
     per = (err * err).sum(-1) if loss == "mse" else (err.clip(min=0) - err.clip(max=0)).sum(-1)
     if weight is None:
-        return per.mean()
-    return (per * weight).sum() / weight.sum()
+        return per.mean(axis)
+    return (per * weight).sum(axis) / weight.sum(axis)

@@ -8,11 +8,15 @@ TrainOutcome`: `replication.training.loop.train` with this stepper. Both stepper
 Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol)`: K models of one spec trained as one program (the stepper of
-`replication.training.loop.train_members`): the parameters stacked by `torch.func.stack_module_state`, the K losses
-from `torch.func.functional_call` under `torch.func.vmap` over parameters and batches, one backward pass
-of their sum (the members share nothing, so each gets its own gradient), and Adam written out per member
-(`_adam`: torch.optim.Adam's single-tensor arithmetic, with a step count per member, so that a member the
-guard skips keeps its state exactly). Each member's numbers are those of its own `Stepper` run
+`replication.training.loop.train_members`). Where the model's maths takes stacked members
+(`models.torch.stacks(spec)`: the fast LNN, the feed-forward baseline) they are one model whose parameters
+have a leading K axis (`models.torch.build_stacked`): every product is one batched product over the members
+and the K losses come out per member (`loss_value(..., axis=-1)`). Other kinds stack with
+`torch.func.stack_module_state` and map `torch.func.functional_call` under `torch.func.vmap` over parameters
+and batches. Either way one backward pass of the losses' sum (the members share nothing, so each gets its
+own gradient), and Adam written out for all members at once (`_adam_in_place`: torch.optim.Adam's
+single-tensor arithmetic, with a step count per member; a member the guard skips gets its parameters and
+moments back, so it keeps its state exactly). Each member's numbers are those of its own `Stepper` run
 (`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
 on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
 """
@@ -35,12 +39,14 @@ def _to_torch(batch: dict, dtype) -> dict:
     return {k: torch.as_tensor(v, dtype=dtype) for k, v in batch.items()}
 
 
-def make_loss(spec, protocol):
+def make_loss(spec, protocol, per_member=False):
+    """(model, batch) -> the protocol's loss; per_member: of stacked members, (K,)."""
     def loss_fn(model, batch):
         pred = predict(model, spec.kind, protocol.task, batch, torch.cat)
-        loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss)
+        loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss, -1 if per_member else None)
         if protocol.l2:
-            loss = loss + protocol.l2 * sum((p * p).sum() for p in model.parameters())
+            loss = loss + protocol.l2 * sum((p * p).flatten(1).sum(1) if per_member else (p * p).sum()
+                                            for p in model.parameters())
         return loss
     return loss_fn
 
@@ -134,38 +140,48 @@ class _Objective(nn.Module):
         return self.loss_fn(self.model, batch)
 
 
-def _adam(p, g, m, v, t, lr, protocol):
-    """torch.optim.Adam's single-tensor update of stacked (K, ...) tensors, t (K,) the step counts after
-    this step: (new p, new m, new v)."""
-    m = torch.lerp(m, g, 1 - protocol.b1)
-    v = v * protocol.b2 + (1 - protocol.b2) * g * g
+def _adam_in_place(p, g, m, v, t, lr, protocol):
+    """torch.optim.Adam's single-tensor update of stacked (K, ...) tensors p, m, v in place, t (K,) the step
+    counts after this step (the bias corrections per member, in float64 as Adam's Python floats)."""
     shape = (-1,) + (1,) * (p.dim() - 1)
     t = t.to(torch.float64)
     step_size = (lr / (1 - protocol.b1 ** t)).to(p.dtype).reshape(shape)
     bc2_sqrt = ((1 - protocol.b2 ** t) ** 0.5).to(p.dtype).reshape(shape)
-    return p - step_size * (m / (v.sqrt() / bc2_sqrt + protocol.eps)), m, v
+    m.lerp_(g, 1 - protocol.b1)
+    v.mul_(protocol.b2).addcmul_(g, g, value=1 - protocol.b2)
+    p.sub_(step_size * (m / (v.sqrt() / bc2_sqrt).add_(protocol.eps)))
 
 
 class Members:
     def __init__(self, spec, params_list, protocol):
         self.dtype, self.protocol = getattr(torch, protocol.dtype), protocol
-        loss_fn = make_loss(spec, protocol)
-        objectives = [_Objective(models.torch.build(spec, p), loss_fn) for p in params_list]
-        self.base, self.spec = objectives[0], spec
-        self.stacked, self.buffers = stack_module_state(objectives)
+        self.spec, self.n = spec, len(params_list)
+        if models.torch.stacks(spec):
+            self.model, self.loss_fn = models.torch.build_stacked(spec, params_list), make_loss(spec, protocol, True)
+            self.stacked = dict(self.model.named_parameters())
+        else:
+            objectives = [_Objective(models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]
+            self.base = objectives[0]
+            self.stacked, self.buffers = stack_module_state(objectives)
         self.moments = {k: (torch.zeros_like(p), torch.zeros_like(p)) for k, p in self.stacked.items()}
-        self.count = torch.zeros(len(objectives), dtype=torch.int64)
+        self.count = torch.zeros(self.n, dtype=torch.int64)
         self.look = make_probe(spec, protocol)
-        self.clip_to, self.n = float(protocol.grad_clip), len(objectives)
+        self.clip_to = float(protocol.grad_clip)
 
     def _loss(self, params, buffers, batch):
         return functional_call(self.base, (params, buffers), (batch,))
+
+    def _losses(self, batch):
+        """The K losses, (K,)."""
+        if hasattr(self, "model"):
+            return self.loss_fn(self.model, batch)
+        return vmap(self._loss)(self.stacked, self.buffers, batch)
 
     def propose(self, batches, lr, bounds):
         batch = self._batch = _to_torch({k: np.stack([b[k] for b in batches]) for k in batches[0]}, self.dtype)
         for p in self.stacked.values():
             p.grad = None
-        losses = vmap(self._loss)(self.stacked, self.buffers, batch)
+        losses = self._losses(batch)
         losses.sum().backward()
         self._lr = lr
         # a parameter the loss does not reach (the LNN's last bias) has no gradient; Adam leaves it, as in Stepper
@@ -177,17 +193,20 @@ class Members:
         take = torch.as_tensor(taken)
         if not take.any():
             return
+        # unclipped members get the factor 1.0, which leaves their gradient exactly as it is
         clip = torch.as_tensor(scale != 1.0)
-        factor = torch.where(clip, self.clip_to / self._gnorm, torch.ones_like(self._gnorm))
+        factor = torch.where(clip, self.clip_to / self._gnorm, torch.ones_like(self._gnorm)) if clip.any() else None
         count = self.count + take.to(torch.int64)
+        skipped = torch.nonzero(~take).flatten() if not take.all() else None
         with torch.no_grad():
             for k, p in self._with_grad.items():
-                shape = (-1,) + (1,) * (p.dim() - 1)
-                g = torch.where(clip.reshape(shape), p.grad * factor.reshape(shape), p.grad)
-                new_p, m, v = _adam(p, g, *self.moments[k], count.clamp(min=1), self._lr, self.protocol)
-                keep = take.reshape(shape)
-                p.copy_(torch.where(keep, new_p, p))
-                self.moments[k] = (torch.where(keep, m, self.moments[k][0]), torch.where(keep, v, self.moments[k][1]))
+                m, v = self.moments[k]
+                kept = None if skipped is None else [x[skipped].clone() for x in (p, m, v)]
+                g = p.grad if factor is None else p.grad * factor.reshape((-1,) + (1,) * (p.dim() - 1))
+                _adam_in_place(p, g, m, v, count.clamp(min=1), self._lr, self.protocol)
+                if kept is not None:   # a member the guard skipped (or a stopped one) keeps its state
+                    for x, old in zip((p, m, v), kept, strict=True):
+                        x[skipped] = old
         self.count = count
 
     def _params_of(self, i: int) -> dict:
