@@ -60,6 +60,23 @@ def test_banded_lgn_members_equal_their_own_runs(fw):
 
 
 @pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
+@pytest.mark.parametrize("name", ["baseline_dp", "baseline_invdyn", "lnn_l1_gamma"])
+def test_baseline_and_relativistic_members_equal_their_own_runs(fw, name):
+    """The other kinds and losses that PyTorch stacks without vmap (`models.torch.stacks`): the baseline
+    (relu, and the inverse-dynamics map with extra inputs under MSE) and the LNN with extra inputs under the
+    relativistic weighted L1."""
+    row = BY_NAME[name]
+    spec, protocol, seeds = row.spec, row.protocol.replace(steps=6), (0, 1, 2)
+    for seed, b in zip(seeds, _together(fw, protocol, spec=spec, seeds=seeds), strict=True):
+        a = _alone(fw, seed, protocol, spec)
+        assert a.failure is None and b.failure is None and len(a.log) == len(b.log) == protocol.steps
+        for ra, rb in zip(a.log, b.log, strict=True):
+            np.testing.assert_allclose(rb["loss"], ra["loss"], rtol=1e-10, err_msg=f"seed {seed} step {ra['step']}")
+        for k in a.params:
+            np.testing.assert_allclose(b.params[k], a.params[k], rtol=1e-9, atol=1e-12, err_msg=f"seed {seed} {k}")
+
+
+@pytest.mark.parametrize("fw", sorted(FRAMEWORKS))
 def test_a_failed_member_stops_alone(fw):
     """A member whose weights are NaN fails at step 0 with its parameters kept; the others train on."""
     params = [init_params(SPEC, seed=s) for s in SEEDS]
