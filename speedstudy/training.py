@@ -53,7 +53,7 @@ def _torch_step_time(spec, params, protocol, batch, reps, compile_=False):
     loss_fn = train_torch.make_loss(spec, protocol)
     if compile_:
         loss_fn = torch.compile(loss_fn)
-    opt = torch.optim.Adam(model.parameters(), lr=1e-5, foreach=False)
+    opt = torch.optim.Adam(model.parameters(), lr=1e-5, **train_torch.ADAM_KERNEL)
     b = {k: torch.as_tensor(v, dtype=getattr(torch, protocol.dtype)) for k, v in batch.items()}
 
     def one():

@@ -163,8 +163,7 @@ def _restore(meta, arrays, stepper, guards, logs, failures, live, done, hooks):
     """Put a snapshot's state back in place -> (next step, ended, wall seconds, step seconds)."""
     stepper.load_state_arrays([arrays[k] for k in sorted(arrays) if k.startswith("stepper_")])
     for g, saved in zip(guards, meta["guards"], strict=True):
-        g.history.extend(saved["history"])
-        g.skipped = int(saved["skipped"])
+        g.restore(saved["history"], saved["skipped"])
     for i in range(len(guards)):
         logs[i].extend(meta["logs"][i])
         failures[i] = meta["failures"][i]

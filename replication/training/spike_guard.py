@@ -16,11 +16,14 @@ Two protocol knobs, both off at 0 (`Protocol.grad_clip`, `Protocol.spike_skip`):
 `SpikeGuard(protocol)`: `threshold(dtype)` -> the skip bound for the next step (inf when off or warming up);
 `record(gnorm, threshold)` -> True if that step is taken (gnorm < threshold), counting skips in
 `skipped`; `fails(loss, gnorm)` -> whether the loop stops there; `clip_scale(gnorm)` -> the factor the
-gradient is multiplied by.
+gradient is multiplied by; `restore(history, skipped)` puts a snapshot's window back. The window is also
+kept sorted, so that its median (numpy's: the middle value, or the mean of the two middle ones) costs a
+lookup a step instead of a sort, K times a step when K members train side by side.
 """
 from __future__ import annotations
 
 import math
+from bisect import bisect_left, insort
 from collections import deque
 
 import numpy as np
@@ -33,6 +36,7 @@ class SpikeGuard:
         self.clip = float(protocol.grad_clip)
         self.factor = float(protocol.spike_skip)
         self.history: deque = deque(maxlen=WINDOW)
+        self._sorted: list[float] = []   # the history's values in increasing order
         self.skipped = 0
 
     @property
@@ -44,12 +48,29 @@ class SpikeGuard:
         and PyTorch (comparing Python floats) take the same decision."""
         if not self.active or len(self.history) < MIN_HISTORY:
             return math.inf
-        return float(np.asarray(self.factor * float(np.median(self.history)), dtype=dtype))
+        return float(np.asarray(self.factor * self._median(), dtype=dtype))
+
+    def _median(self) -> float:
+        """np.median(self.history), read off the sorted window."""
+        s, n = self._sorted, len(self._sorted)
+        return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2
+
+    def _push(self, gnorm: float) -> None:
+        if len(self.history) == WINDOW:   # the oldest leaves the window
+            del self._sorted[bisect_left(self._sorted, self.history[0])]
+        self.history.append(gnorm)
+        insort(self._sorted, gnorm)
+
+    def restore(self, history, skipped: int) -> None:
+        """A snapshot's window (oldest first) and skip count, on a fresh guard."""
+        for gnorm in history:
+            self._push(float(gnorm))
+        self.skipped = int(skipped)
 
     def record(self, gnorm: float, threshold: float) -> bool:
         """Whether the step is taken; a non-finite norm is never taken and stays out of the history."""
         if math.isfinite(gnorm):
-            self.history.append(float(gnorm))
+            self._push(float(gnorm))
         taken = bool(gnorm < threshold)
         self.skipped += not taken
         return taken

@@ -39,6 +39,28 @@ def test_skip_bound_is_factor_times_recent_median():
     assert guard.threshold() == pytest.approx(1e4)
 
 
+def test_the_sorted_window_gives_numpy_median_at_every_step_and_after_a_restore():
+    """Past the window's length (old norms leaving), with repeated values and non-finite norms left out;
+    a guard restored from a window mid-way continues with the same bounds."""
+    rng = np.random.default_rng(3)
+    norms = np.exp(rng.normal(size=3 * WINDOW + 7)).round(2)   # rounding: ties in the window
+    norms[[5, 50, 400]] = [np.inf, np.nan, np.inf]
+    guard = SpikeGuard(BASE.replace(spike_skip=3.0))
+    seen = []
+    for k, g in enumerate(norms):
+        if k == WINDOW + 11:
+            restored = SpikeGuard(BASE.replace(spike_skip=3.0))
+            restored.restore(list(guard.history), guard.skipped)
+            guard = restored
+        bound = guard.threshold()
+        window = seen[-WINDOW:]
+        expected = math.inf if len(window) < MIN_HISTORY else 3.0 * float(np.median(window))
+        assert bound == expected, k
+        guard.record(float(g), bound)
+        if np.isfinite(g):
+            seen.append(float(g))
+
+
 def test_non_finite_norm_is_a_skipped_spike_only_when_skipping():
     off, on = SpikeGuard(BASE.replace(grad_clip=5.0)), SpikeGuard(BASE.replace(spike_skip=10.0))
     assert off.fails(1.0, float("inf")) and off.fails(float("nan"), 1.0)
