@@ -12,7 +12,7 @@ call here pick. The captures:
 `pick(eager, traced=None, exporting=None)` -> the variant to call: `traced` while make_fx traces (if
   given), else `exporting` under torch.export (if given), else `eager`.
 `replace_bad_rows(x (..., d), bad (...,), fix, hess, rhs) -> (..., d)`: x with the rows where bad is True
-  replaced by those of fix(hess, rhs) (B, d), with no Python branch on data in a captured graph.
+  replaced by those of fix(hess, rhs) (..., d), with no Python branch on data in a captured graph.
 No JAX twin: a JAX model is always traced by jit, so it has one path, already graph-safe (`lax.cond`).
 """
 from __future__ import annotations
@@ -47,7 +47,7 @@ def pick(eager, traced=None, exporting=None):
 
 
 def replace_bad_rows(x, bad, fix, hess, rhs):
-    """x (B, d) with the rows where bad (B,) is True taken from fix(hess, rhs) (B, d), computed:
+    """x (..., d) with the rows where bad (...,) is True taken from fix(hess, rhs) (..., d), computed:
       eager: only when some row is bad (a Python branch on data);
       traced with gradients, or vmapped: always, on every row (no branch on data);
       traced without gradients, or exporting: inside a torch.cond on any(bad), so it runs only where a

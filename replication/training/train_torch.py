@@ -14,9 +14,10 @@ have a leading K axis (`models.torch.build_stacked`): every product is one batch
 and the K losses come out per member (`loss_value(..., axis=-1)`). Other kinds stack with
 `torch.func.stack_module_state` and map `torch.func.functional_call` under `torch.func.vmap` over parameters
 and batches. Either way one backward pass of the losses' sum (the members share nothing, so each gets its
-own gradient), and Adam written out for all members at once (`_adam_in_place`: torch.optim.Adam's
-single-tensor arithmetic, with a step count per member; a member the guard skips gets its parameters and
-moments back, so it keeps its state exactly). Each member's numbers are those of its own `Stepper` run
+own gradient), and Adam as one call of torch's fused Adam kernel over every taken member's slice of every
+parameter (`_fused_adam`, what `Stepper`'s torch.optim.Adam(fused=True) runs), with a step count per
+member; a member the guard skips is left out of the call, so it keeps its state exactly. Each member's
+numbers are those of its own `Stepper` run
 (`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
 on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
 """
@@ -34,8 +35,8 @@ from replication.training.outcome import TrainOutcome
 
 _ADAM_STATE = ("step", "exp_avg", "exp_avg_sq")   # torch.optim.Adam's state of one parameter (no amsgrad)
 # which torch.optim.Adam implementation trains (and the speed study times): the fused kernel, one pass over
-# each tensor (on the 3 x 128 LNN's step at batch 32, 0.1 ms against the single-tensor loop's 0.7 ms); the
-# members' `_fused_adam` calls the same kernel
+# each tensor (the 3 x 128 LNN at batch 32, 2 threads: 0.45 ms a step against the single-tensor loop's
+# 0.67-0.86 ms); the members' `_fused_adam` calls the same kernel
 ADAM_KERNEL = {"fused": True}
 
 
