@@ -23,7 +23,7 @@ from __future__ import annotations
 import torch
 
 from models.params import n_layers
-from models.torch.mlp import softplus_given_sigmoid
+from models.torch.mlp import linear, softplus_given_sigmoid
 
 
 def _softplus(a):
@@ -63,13 +63,6 @@ ACT_DERIVS = {"softplus": _softplus, "relu": _relu, "relu2": _relu2, "relu3": _r
               "tanh": _tanh, "sigmoid": _sigmoid}
 
 
-def _affine(h, w, b):
-    """h @ w^T + b: one model h (B, in), w (out, in); stacked members h (K, B, in), w (K, out, in), b (K, out)."""
-    if w.dim() == 2:
-        return torch.addmm(b, h, w.T)
-    return torch.baddbmm(b.unsqueeze(-2), h, w.mT)
-
-
 def _tangent_product(dh, w):
     """dh @ w^T for tangents dh (B, T, in) (one (B*T, in) product), or (K, B, T, in) with w (K, out, in)."""
     if w.dim() == 2:
@@ -84,7 +77,7 @@ def input_grad_and_tangent_hessian(params: dict, x, tangents, spec, prefix: str 
     weights = [params[f"{prefix}.{i}.weight"] for i in range(n)]
     h, dh, saved = x, tangents, []
     for i in range(n - 1):                       # forward: primal (B, w) and tangents (B, T, w)
-        a = _affine(h, weights[i], params[f"{prefix}.{i}.bias"])
+        a = linear(params, f"{prefix}.{i}", h)   # one model or stacked members, as the MLP itself
         h, s1, s2 = derivs(a)
         if dh is None:
             saved.append((s1, None, None))
