@@ -159,9 +159,9 @@ class Members:
         if models.torch.stacks(spec):
             self.model, self.loss_fn = models.torch.build_stacked(spec, params_list), make_loss(spec, protocol, True)
             self.stacked = dict(self.model.named_parameters())
-        else:
+        else:   # no stacked model: the K losses come from vmap over the stacked parameters
             objectives = [_Objective(models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]
-            self.base = objectives[0]
+            self.model, self.base = None, objectives[0]
             self.stacked, self.buffers = stack_module_state(objectives)
         self.moments = {k: (torch.zeros_like(p), torch.zeros_like(p)) for k, p in self.stacked.items()}
         self.count = torch.zeros(self.n, dtype=torch.int64)
@@ -180,7 +180,7 @@ class Members:
 
     def _losses(self, batch):
         """The K losses, (K,)."""
-        if hasattr(self, "model"):
+        if self.model is not None:
             return self.loss_fn(self.model, batch)
         return vmap(self._loss)(self.stacked, self.buffers, batch)
 
