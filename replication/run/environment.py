@@ -31,16 +31,36 @@ def versions() -> dict:
     return out
 
 
+# the vector instruction sets that decide which CPU kernels XLA and PyTorch compile or pick, and so their
+# float rounding: the same code on hosts that differ here can train to other numbers (a run's seeds may
+# then choose other scouts; `docs/train_target_trials.md` section 12)
+CPU_FEATURES = ("sse4_2", "avx", "avx2", "fma", "avx512f", "avx512bw", "avx512vl", "avx512_bf16", "avx512_fp16",
+                "avx_vnni", "amx_tile")
+
+
+def cpu_description(cpuinfo: str) -> dict:
+    """From /proc/cpuinfo's text: {"cpu": model name ("" if absent), "cpu_model": "family F model M" ("" if
+    absent), "cpu_features": the CPU_FEATURES its first processor lists, space-separated}."""
+    fields = {}
+    for line in cpuinfo.splitlines():
+        if not line.strip():
+            break   # the first processor's block only
+        key, _, value = line.partition(":")
+        fields.setdefault(key.strip(), value.strip())
+    flags = set(fields.get("flags", "").split())
+    family, model = fields.get("cpu family", ""), fields.get("model", "")
+    return {"cpu": fields.get("model name", ""),
+            "cpu_model": f"family {family} model {model}" if family and model else "",
+            "cpu_features": " ".join(f for f in CPU_FEATURES if f in flags)}
+
+
 @lru_cache(maxsize=1)
 def hardware() -> dict:
-    cpu = platform.processor() or platform.machine()
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
+        cpu = cpu_description(Path("/proc/cpuinfo").read_text())
     except OSError:
-        pass
+        cpu = {"cpu": "", "cpu_model": "", "cpu_features": ""}
+    cpu["cpu"] = cpu["cpu"] or platform.processor() or platform.machine()
     gpu = None
     try:
         import jax  # noqa: PLC0415 - only if present
@@ -49,7 +69,8 @@ def hardware() -> dict:
         gpu = devs[0].device_kind if devs else None
     except Exception:
         gpu = None
-    return {"cpu": cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
+    return {"cpu": cpu["cpu"], "cpu_model": cpu["cpu_model"], "cpu_features": cpu["cpu_features"],
+            "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
 
 
 @lru_cache(maxsize=1)
