@@ -57,9 +57,10 @@ def cpu_description(cpuinfo: str) -> dict:
 @lru_cache(maxsize=1)
 def hardware() -> dict:
     try:
-        cpu = cpu_description(Path("/proc/cpuinfo").read_text())
+        cpuinfo = Path("/proc/cpuinfo").read_text()
     except OSError:
-        cpu = {"cpu": "", "cpu_model": "", "cpu_features": ""}
+        cpuinfo = ""   # no /proc: every field empty, the model name from `platform` below
+    cpu = cpu_description(cpuinfo)
     cpu["cpu"] = cpu["cpu"] or platform.processor() or platform.machine()
     gpu = None
     try:
@@ -69,8 +70,7 @@ def hardware() -> dict:
         gpu = devs[0].device_kind if devs else None
     except Exception:
         gpu = None
-    return {"cpu": cpu["cpu"], "cpu_model": cpu["cpu_model"], "cpu_features": cpu["cpu_features"],
-            "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
+    return {**cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
 
 
 @lru_cache(maxsize=1)
