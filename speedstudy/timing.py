@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import os
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import jax
+
+from replication.run.environment import torch_threads  # noqa: F401 - read as timing.torch_threads
 
 LONG_CALL_S = 5.0  # a call this long is timed once: other processes' noise is small against it
 
@@ -85,18 +86,6 @@ def torch_ready(fn, *args):
 TORCH_THREADS = 1  # PyTorch intra-op threads during the study (see run_bench)
 
 
-@contextmanager
-def torch_threads(n: int | None):
-    """Temporarily set PyTorch's intra-op threads (None: leave as is)."""
-    import torch
-
-    old = torch.get_num_threads()
-    if n is not None:
-        torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(old)
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ import importlib.metadata
 import os
 import platform
 import subprocess
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
@@ -18,6 +19,29 @@ def one_thread_env(env) -> dict:
     XLA_FLAGS already in `env`), PyTorch/OpenMP and MKL to one thread."""
     return {"XLA_FLAGS": f"{env.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(), "OMP_NUM_THREADS": "1",
             "MKL_NUM_THREADS": "1"}
+
+
+def worker_torch_threads(executor: str, jobs: int) -> int | None:
+    """PyTorch's intra-op threads in the processes that will train a run's units: one in each worker
+    process (`--jobs` > 1; `one_thread_env` and the worker's start) and in each Ray task; None with one
+    local job, where the units train in this process at its own setting."""
+    return 1 if executor == "ray" or jobs > 1 else None
+
+
+@contextmanager
+def torch_threads(n: int | None):
+    """Temporarily set PyTorch's intra-op threads (None: leave as is, without importing PyTorch)."""
+    if n is None:
+        yield
+        return
+    import torch
+
+    old = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(old)
 
 
 @lru_cache(maxsize=1)

@@ -1,6 +1,6 @@
 """How long a run will take, told before it starts: each distinct training is probed for a few steps.
 
-`estimate(units, out, jobs)` counts every training the run still has to do once (units that share a
+`estimate(units, out, jobs, torch_threads=None)` counts every training the run still has to do once (units that share a
 trained model, such as claims 1 and 2, train it once; a training already in `OUT/trained/` costs
 nothing), times three steps of each distinct configuration on this machine after one step to compile
 (the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K members side by
@@ -15,6 +15,7 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
+from replication.run.environment import torch_threads as threads_of_torch
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
@@ -52,9 +53,14 @@ def _shape(framework, spec, protocol) -> str:
     return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
 
 
-def estimate(units, out, jobs: int = 1) -> dict:
+def estimate(units, out, jobs: int = 1, torch_threads: int | None = None) -> dict:
     """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
     "probes": configurations timed}."""
+    with threads_of_torch(torch_threads if any(u.framework == "torch" for u in units) else None):
+        return _estimate(units, out, jobs)
+
+
+def _estimate(units, out, jobs: int) -> dict:
     per_step, todo, cached = {}, {}, 0
     for u in units:
         if not u.entry.train:

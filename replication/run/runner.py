@@ -114,11 +114,12 @@ def set_aside(folder: Path) -> Path:
     raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
-def announce(profile, units, todo, out, jobs) -> dict:
-    """Print the units a long profile will run and its estimated duration (`replication.run.estimate`)."""
+def announce(profile, units, todo, out, jobs, executor="local") -> dict:
+    """Print the units a long profile will run and its estimated duration (`replication.run.estimate`),
+    its probes timed at the thread setting the units will train with."""
     print(f"lagbench: profile {profile}: {len(units)} units, {len(todo)} to run:\n{describe(units, todo)}", flush=True)
     print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
-    est = estimate(todo, out, jobs)
+    est = estimate(todo, out, jobs, env.worker_torch_threads(executor, jobs))
     hw = env.hardware()
     print(f"lagbench: {est['trainings']} trainings to do ({est['cached']} reused from OUT/trained), estimated "
           f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
@@ -171,7 +172,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
         return {"dry_run": True, "units": len(units), "todo": len(todo),
-                "estimate": announce(profile, units, todo, out, jobs) if todo else None}
+                "estimate": announce(profile, units, todo, out, jobs, executor) if todo else None}
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
@@ -185,7 +186,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     todo = [u for u in units if not is_current(u, out, repairs)]
     manifest["repaired"] = repairs
     if profile in LONG_PROFILES and todo:
-        manifest["estimate"] = announce(profile, units, todo, out, jobs)
+        manifest["estimate"] = announce(profile, units, todo, out, jobs, executor)
         R.write_json(out / "run.json", manifest)
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()

@@ -39,6 +39,30 @@ def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
     assert again["trainings"] == 0 and again["cached"] == 1 and again["train_s"] == 0
 
 
+def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, monkeypatch):
+    # workers train on one PyTorch thread; probes at this process's default ran up to 30x slow (estimate.py)
+    import torch
+
+    from replication.run import estimate as E
+    from replication.run.environment import worker_torch_threads
+
+    seen = []
+    monkeypatch.setattr(E, "_plain_step", lambda *a: seen.append(torch.get_num_threads()) or 1e-3)
+    monkeypatch.setattr(E, "_members_step", lambda *a: seen.append(torch.get_num_threads()) or 1e-3)
+    before = torch.get_num_threads()
+    units = plan("smoke", claims=["dp_loss"], frameworks=("torch",), models=["lnn"])
+    try:
+        torch.set_num_threads(2)
+        estimate(units, tmp_path, jobs=2, torch_threads=worker_torch_threads("local", 2))
+        assert seen and set(seen) == {1} and torch.get_num_threads() == 2   # put back afterwards
+        seen.clear()
+        estimate(units, tmp_path, jobs=1, torch_threads=worker_torch_threads("local", 1))
+        assert set(seen) == {2}   # one job: the units train in this process, at its setting
+    finally:
+        torch.set_num_threads(before)
+    assert worker_torch_threads("ray", 1) == 1 and worker_torch_threads("local", 3) == 1
+
+
 def test_full_profile_inherits_quick_where_a_claim_is_silent():
     full = {u.name: u for u in plan("full", frameworks=("jax",))}
     quick = {u.name: u for u in plan("quick", frameworks=("jax",))}
