@@ -2,8 +2,8 @@
 
 `estimate(units, out, jobs, torch_threads=None)` counts every training the run still has to do once
 (units that share a trained model, such as claims 1 and 2, train it once; a training already in
-`OUT/trained/` costs nothing), times three steps of each distinct configuration on this machine after one
-step to compile (the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K
+`OUT/trained/` costs nothing), times seven steps of each distinct configuration on this machine after one
+step to compile (their median) (the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K
 members side by side), and scales up by the protocol's steps. Evaluation time is not included. The wall
 time assumes the trainings spread evenly over `jobs` workers, and is never below the longest single
 training.
@@ -23,16 +23,20 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 
+import numpy as np
+
 from replication.run.environment import torch_threads as threads_of_torch
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
-PROBE_STEPS = 4   # the first is discarded (compilation), the other three timed
+PROBE_STEPS = 8   # the first is discarded (compilation); the median of the other seven steps' times
 
 
 def _per_step(rows) -> float:
+    """The median time of a step after the first: on a shared machine one step can take several times
+    the others, and the mean of three let it move an estimate."""
     walls = [r["wall_s"] for r in rows if r.get("member", 0) == 0]
-    return (walls[-1] - walls[0]) / max(len(walls) - 1, 1)
+    return float(np.median(np.diff(walls))) if len(walls) > 1 else 0.0
 
 
 def _plain_step(framework, spec, protocol) -> float:
