@@ -3,17 +3,18 @@
 `estimate(units, out, jobs, torch_threads=None)` counts every training the run still has to do once
 (units that share a trained model, such as claims 1 and 2, train it once; a training already in
 `OUT/trained/` costs nothing), times seven steps of each distinct configuration on this machine after one
-step to compile (their median) (the scouts of a protocol with restarts, and a cohort of seeds, are timed as they run: K
-members side by side), and scales up by the protocol's steps. Evaluation time is not included. The wall
+step to compile and takes their median (the scouts of a protocol with restarts, and a cohort of seeds, are
+timed as they run: K members side by side), and scales up by the protocol's steps. Evaluation time is not included. The wall
 time assumes the trainings spread evenly over `jobs` workers, and is never below the longest single
 training.
 
 The probes run PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
-one local job trains them here). Probed at this process's default (2 threads on the 2-core development
-machine) instead, the `full` double-pendulum PyTorch trainings were estimated at 2.1x their measured time
-(14 514 s against 6 995 s, 2026-11-25); with both cores busy, a step of that LNN took 34x as long at 2
-threads as at 1 (0.76 s against 0.023 s, 2026-11-26).
+one local job trains them here). Measured on the 2-core development machine (2026-11-26), `full`'s PyTorch
+double pendulum (6 trainings; they took 10 097 s when run): probed at this process's default 2 threads,
+3.9 h; at the workers' one thread, 1.9-2.1 h in three dry runs. With both cores busy, a step of that LNN took
+34x as long at 2 threads as at 1 (0.76 s against 0.023 s). What the estimate leaves out: two workers slow
+each other down (that run's units took about 1.4x their probed steps), and evaluation.
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
 """
