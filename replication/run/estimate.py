@@ -13,7 +13,8 @@ the units (`environment.worker_torch_threads`: one per worker or Ray task; None:
 one local job trains them here). Measured on the 2-core development machine (2026-11-26), `full`'s PyTorch
 double pendulum (6 trainings; they took 10 097 s when run): probed at this process's default 2 threads,
 3.9 h; at the workers' one thread, 1.9-2.1 h in three dry runs. With both cores busy, a step of that LNN took
-34x as long at 2 threads as at 1 (0.76 s against 0.023 s). What the estimate leaves out: two workers slow
+34x as long at 2 threads as at 1 (0.76 s against 0.023 s); idle, under the passive OpenMP wait this package
+sets on import, 1.4x (0.028 s against 0.020 s). What the estimate leaves out: two workers slow
 each other down (that run's units took about 1.4x their probed steps), and evaluation.
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
