@@ -86,8 +86,6 @@ def torch_ready(fn, *args):
 TORCH_THREADS = 1  # PyTorch intra-op threads during the study (see run_bench)
 
 
-
-
 @dataclass(frozen=True)
 class Sizes:
     """The study's sizes. The fast/paper ratios and the roofline always use 3 x 600 (but tiny)."""

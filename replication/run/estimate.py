@@ -4,9 +4,9 @@
 (units that share a trained model, such as claims 1 and 2, train it once; a training already in
 `OUT/trained/` costs nothing), times seven steps of each distinct configuration on this machine after one
 step to compile and takes their median (the scouts of a protocol with restarts, and a cohort of seeds, are
-timed as they run: K members side by side), and scales up by the protocol's steps. Evaluation time is not included. The wall
-time assumes the trainings spread evenly over `jobs` workers, and is never below the longest single
-training.
+timed as they run: K members side by side), and scales up by the protocol's steps. Evaluation time is not
+included. The wall time assumes the trainings spread evenly over `jobs` workers, and is never below the
+longest single training.
 
 The probes run PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where

@@ -40,7 +40,7 @@ def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
 
 
 def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, monkeypatch):
-    # workers train on one PyTorch thread; probes at this process's default ran up to 30x slow (estimate.py)
+    # workers train on one PyTorch thread; probes at this process's default ran up to 34x slow (estimate.py)
     import torch
 
     from replication.run import estimate as E
