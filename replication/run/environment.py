@@ -12,20 +12,21 @@ from pathlib import Path
 
 PACKAGES = ("numpy", "sympy", "jax", "jaxlib", "equinox", "optax", "diffrax", "torch", "pandas")
 ONE_CORE_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+WORKER_THREADS = 1   # PyTorch / OpenMP / MKL threads of a worker process or Ray task (and XLA's, above)
 
 
 def one_thread_env(env) -> dict:
     """The environment variables that hold a new process's JAX (XLA's Eigen pool off, appended to any
     XLA_FLAGS already in `env`), PyTorch/OpenMP and MKL to one thread."""
-    return {"XLA_FLAGS": f"{env.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(), "OMP_NUM_THREADS": "1",
-            "MKL_NUM_THREADS": "1"}
+    return {"XLA_FLAGS": f"{env.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(), "OMP_NUM_THREADS": str(WORKER_THREADS),
+            "MKL_NUM_THREADS": str(WORKER_THREADS)}
 
 
 def worker_torch_threads(executor: str, jobs: int) -> int | None:
     """PyTorch's intra-op threads in the processes that will train a run's units: one in each worker
     process (`--jobs` > 1; `one_thread_env` and the worker's start) and in each Ray task; None with one
     local job, where the units train in this process at its own setting."""
-    return 1 if executor == "ray" or jobs > 1 else None
+    return WORKER_THREADS if executor == "ray" or jobs > 1 else None
 
 
 @contextmanager

@@ -31,7 +31,7 @@ from replication.run.chains import cost as _cost  # noqa: F401 - re-exported for
 from replication.run.chains import ref as _ref
 from replication.run.chains import run_chain as _run_chain
 from replication.run.chains import run_one as _one
-from replication.run.environment import one_thread_env
+from replication.run.environment import WORKER_THREADS, one_thread_env
 from replication.training.scouting import progress_steps
 
 
@@ -67,7 +67,7 @@ def _exit_with(parent: int, every: float = 1.0):
 def _worker_start(driver: int):
     import torch
 
-    torch.set_num_threads(1)
+    torch.set_num_threads(WORKER_THREADS)
     threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
 
 
