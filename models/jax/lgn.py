@@ -114,9 +114,8 @@ class LGN(Model):
         rows = jnp.concatenate([jnp.zeros((k, k), x.dtype), jnp.diag(s_qd)], -1)
         mixed = jnp.concatenate([qdot_nb.reshape(bsz * n, k) * s_q, jnp.zeros((bsz * n, k), x.dtype)], -1)
         tangents = jnp.concatenate([jnp.broadcast_to(rows, (bsz * n, k, 2 * k)), mixed[:, None, :]], 1)
-        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
-        g = jnp.concatenate([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]],
-                            -1)
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=k)
+        g = jnp.concatenate([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k, k + 1)], -1)
         moved = jnp.stack([jnp.roll(g[:, :, a], a - r, axis=1) for a in range(k)], 2)  # [j, a]: node j-a+r's slot a
         band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ jnp.asarray(band_sum(r), x.dtype)
         return band, moved[..., 0].sum(-1) - moved[..., k + 1].sum(-1)

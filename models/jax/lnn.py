@@ -141,7 +141,7 @@ class LNN(Model):
             slope, curve = lorentz_slopes(qdot)
             s_g, k = scale[2 * d:3 * d], jnp.arange(d)
             tangents = tangents.at[:, k, 2 * d + k].set(slope * s_g)
-        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=d)
         hess = gram[:, :d, :d]
         if spec.lorentz_factor:
             hess = hess + jnp.eye(d, dtype=x.dtype) * (g[:, 2 * d:3 * d] * s_g * curve)[:, None, :]

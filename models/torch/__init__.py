@@ -3,7 +3,8 @@
     build(spec, params) -> Model   (nn.Module; its nn.Parameters are exactly the params, spec.dtype)
     to_params(model) -> dict[str, np.ndarray] in the `models.params` layout
     build_stacked(spec, params_list) -> one Model of K stacked members, for the specs where stacks(spec)
+    compiles(spec) -> whether a training loss of spec's model may run under torch.compile
 """
-from models.torch.build import build, build_stacked, stacks, to_params
+from models.torch.build import build, build_stacked, compiles, stacks, to_params
 
-__all__ = ["build", "build_stacked", "stacks", "to_params"]
+__all__ = ["build", "build_stacked", "compiles", "stacks", "to_params"]

@@ -36,6 +36,13 @@ class Model(nn.Module):
         """Whether this kind's maths takes stacked members (a leading K on parameters and inputs) for spec."""
         return False
 
+    @classmethod
+    def compiles(cls, spec: ModelSpec) -> bool:
+        """Whether a training loss of this kind may be captured whole by torch.compile
+        (`replication.training.compile_torch`): its maths is plain tensor ops with no torch.func transform,
+        as for the kinds that stack."""
+        return cls.stacks(spec)
+
     def _rows(self, x, width: int | None = None):
         """x (..., width) as the flat batch the maths runs on: (B, width), or (K, B, width) for stacked
         members; None stays None."""

@@ -1,6 +1,7 @@
 """build(spec, params) -> the PyTorch model of spec.kind; to_params(model) -> the NumPy layout.
 build_stacked(spec, params_list) -> one model of K stacked members (`models.torch.base.Model`), for the
-kinds whose class `stacks(spec)`; to_params gives its (K, ...) arrays.
+kinds whose class `stacks(spec)`; to_params gives its (K, ...) arrays. compiles(spec): whether its training
+loss may run under torch.compile.
 
 CLASSES (kind -> class) is read off `models.spec.CAPABILITIES`: kind k's class is the one named
 `CAPABILITIES[k].model_class` in `models/torch/<k>.py`, imported by name (the mirror of `models.jax.build`).
@@ -32,6 +33,11 @@ def to_params(model) -> dict:
 def stacks(spec: ModelSpec) -> bool:
     """Whether spec's model takes stacked members (`build_stacked`)."""
     return CLASSES[spec.kind].stacks(spec)
+
+
+def compiles(spec: ModelSpec) -> bool:
+    """Whether a training loss of spec's model may run under torch.compile (`Model.compiles`)."""
+    return CLASSES[spec.kind].compiles(spec)
 
 
 def build_stacked(spec: ModelSpec, params_list: list[dict]):

@@ -8,6 +8,8 @@ call here pick. The captures:
              `get_proxy_mode()` is set.
   exporting: torch.export: `models.torch.compiled.compile_batched` / `compile_single` (AOTInductor).
   vmapped:   the tensor is batched by torch.func.vmap (stacked members trained side by side).
+  compiling: torch.compile (dynamo) is capturing a training loss (`replication.training.compile_torch`);
+             not torch.export, which is `exporting`.
 
 `pick(eager, traced=None, exporting=None)` -> the variant to call: `traced` while make_fx traces (if
   given), else `exporting` under torch.export (if given), else `eager`.
@@ -21,9 +23,15 @@ import torch
 from torch.fx.experimental.proxy_tensor import get_proxy_mode
 
 
+def compiling() -> bool:
+    """Whether torch.compile is capturing this call (not torch.export, which also counts as compiling)."""
+    return torch.compiler.is_compiling() and not torch.compiler.is_exporting()
+
+
 def tracing() -> bool:
-    """Whether make_fx is tracing this call (`models.torch.compiled.trace_flat`)."""
-    return get_proxy_mode() is not None
+    """Whether make_fx is tracing this call (`models.torch.compiled.trace_flat`); never under torch.compile,
+    which cannot capture the proxy-mode lookup."""
+    return not compiling() and get_proxy_mode() is not None
 
 
 def exporting() -> bool:
@@ -49,12 +57,12 @@ def pick(eager, traced=None, exporting=None):
 def replace_bad_rows(x, bad, fix, hess, rhs):
     """x (..., d) with the rows where bad (...,) is True taken from fix(hess, rhs) (..., d), computed:
       eager: only when some row is bad (a Python branch on data);
-      traced with gradients, or vmapped: always, on every row (no branch on data);
+      traced with gradients, vmapped, or under torch.compile: always, on every row (no branch on data);
       traced without gradients, or exporting: inside a torch.cond on any(bad), so it runs only where a
         row is bad. Its operands are made contiguous: export of a make_fx graph whose cond takes a strided
         view (the dense LGN's Hessian) failed in placeholder naming (torch 2.13)."""
     traced = tracing()
-    if traced and torch.is_grad_enabled():
+    if (traced and torch.is_grad_enabled()) or compiling():
         return torch.where(bad[..., None], fix(hess, rhs), x)
     if traced or torch.compiler.is_exporting():
         operands = (hess.contiguous(), rhs.contiguous(), bad, x.contiguous())

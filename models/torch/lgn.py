@@ -133,8 +133,8 @@ class LGN(Model):
         mixed = torch.cat([qdot_nb.reshape(bsz * n, k) * s_q, torch.zeros((bsz * n, k), dtype=x.dtype, device=x.device)],
                           -1)
         tangents = torch.cat([rows.expand(bsz * n, k, 2 * k), mixed[:, None, :]], 1)
-        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
-        g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k + 1, k + 1)[:, :, :k]], -1)
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=k)
+        g = torch.cat([(g[:, :k] * s_q).reshape(bsz, n, k, 1), gram.reshape(bsz, n, k, k + 1)], -1)
         moved = torch.stack([torch.roll(g[:, :, a], a - r, dims=1) for a in range(k)], 2)  # [j, a]: node j-a+r's slot a
         to_band = torch.as_tensor(band_sum(r), dtype=x.dtype, device=x.device)
         band = moved[..., 1:k + 1].reshape(bsz, n, k * k) @ to_band

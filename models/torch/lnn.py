@@ -201,7 +201,7 @@ class LNN(Model):
         rows = torch.cat([rows, zeros.expand(*lead, d, width - used)], -1)
         mixed = torch.cat([qdot * s_q, torch.zeros((*lead, width - d), dtype=x.dtype, device=x.device)], -1)
         tangents = torch.cat([rows, mixed.unsqueeze(-2)], -2)
-        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec)
+        g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=d)
         hess = gram[..., :d, :d]
         if spec.lorentz_factor:
             hess = hess + torch.diag_embed(g[..., 2 * d:3 * d] * s_g * curve)

@@ -11,6 +11,7 @@ import math
 import torch
 
 from models.params import n_layers
+from models.torch.export_paths import compiling
 
 
 class _Softplus(torch.autograd.Function):
@@ -41,13 +42,17 @@ class _Softplus(torch.autograd.Function):
 
 
 def softplus_given_sigmoid(x, s):
-    """softplus(x), with s = sigmoid(x) already computed (see `_Softplus`)."""
+    """softplus(x), with s = sigmoid(x) already computed (see `_Softplus`). Under torch.compile the plain
+    logaddexp (torch 2.13's dynamo cannot capture a Function with a jvp rule; the compiled training losses
+    take first derivatives only, and inductor fuses the recomputed sigmoid)."""
+    if compiling():
+        return torch.logaddexp(x, torch.zeros((), dtype=x.dtype, device=x.device))
     return _Softplus.apply(x, s)
 
 
 def softplus(x):
     """log(1 + e^x) with derivatives of every order finite (see `_Softplus`)."""
-    return _Softplus.apply(x, torch.sigmoid(x))
+    return softplus_given_sigmoid(x, torch.sigmoid(x))
 
 
 ACT = {

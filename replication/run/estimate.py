@@ -15,7 +15,9 @@ double pendulum (6 trainings; they took 10 097 s when run): probed at this proce
 3.9 h; at the workers' one thread, 1.9-2.1 h in three dry runs. With both cores busy, a step of that LNN took
 34x as long at 2 threads as at 1 (0.76 s against 0.023 s); idle, under the passive OpenMP wait this package
 sets on import, 1.4x (0.028 s against 0.020 s). What the estimate leaves out: two workers slow
-each other down (that run's units took about 1.4x their probed steps), and evaluation.
+each other down (that run's units took about 1.4x their probed steps), and evaluation. A PyTorch probe runs
+its loss under torch.compile where the phase it stands for will (`compile_torch.like`); its first step then
+compiles, and that time (about 26 s a phase on a cold cache) is not counted either.
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
 """
@@ -28,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from replication.run.environment import torch_threads as threads_of_torch
+from replication.training import compile_torch
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
@@ -42,9 +45,11 @@ def _per_step(rows) -> float:
 
 
 def _plain_step(framework, spec, protocol) -> float:
-    p = continuation_protocol(protocol).replace(steps=PROBE_STEPS, log_every=1, schedule="constant",
-                                                n_train=protocol.batch * PROBE_STEPS, track_every=0)
-    return _per_step(run_training(framework, spec, p, 0).log)
+    phase = continuation_protocol(protocol)
+    p = phase.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
+                      track_every=0)
+    with compile_torch.like(spec, phase):   # PyTorch's probe steps compiled where the phase's are
+        return _per_step(run_training(framework, spec, p, 0).log)
 
 
 def _members_step(framework, spec, protocol, k: int) -> float:
@@ -52,7 +57,8 @@ def _members_step(framework, spec, protocol, k: int) -> float:
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
                          cohort=0, track_every=0)
     rows = []
-    train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
+    with compile_torch.like(spec, protocol):
+        train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
     return _per_step(rows)
 
 

@@ -76,6 +76,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "final_train_loss": outcome.log[-1]["loss"] if outcome and outcome.log else None,
         "scouting": outcome.scouting if outcome else None,
         "cohort": outcome.cohort if outcome else None,
+        "train_step_mode": outcome.step_mode if outcome else None,
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

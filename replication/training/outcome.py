@@ -21,11 +21,18 @@ class TrainOutcome:
     scouting: dict | None = None  # restarts (`replication.training.scouting`): init seeds, tail losses, the chosen one
     samples: int | None = None    # training samples, where not steps_done x batch (scouts at their own batch)
     cohort: dict | None = None    # trained side by side with other seeds (`Protocol.cohort`): {"seeds": [...]}
+    step_mode: str | None = None  # "jit" (JAX); "compiled" or "eager" (PyTorch, `compile_torch`); phases joined by " + "
 
     @property
     def samples_per_s(self) -> float:
         n = self.samples if self.samples is not None else self.steps_done * self.batch
         return n / self.train_time_s if self.train_time_s > 0 else float("nan")
+
+
+def joined_modes(*modes) -> str | None:
+    """The step modes of a run's phases, each once, in order ("compiled", or "eager + compiled")."""
+    seen = [m for m in dict.fromkeys(x for mode in modes if mode for x in mode.split(" + "))]
+    return " + ".join(seen) or None
 
 
 def nonfinite_failure(step: int, loss: float, gnorm: float) -> dict:

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from replication.training import loop
+from replication.training.outcome import joined_modes
 
 SCOUT_SAMPLES = 500_000   # samples per scout when the protocol does not say (at most half the budget in all)
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
@@ -185,6 +186,7 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
                                  start_state=loop.narrow(held.state, go_on))
     tails = [math.inf] * len(seeds)
     for i, o, t in zip(go_on, kept, _tails(keep2.losses, kept), strict=True):
+        o.step_mode = joined_modes(outcomes[i].step_mode, o.step_mode)
         outcomes[i], tails[i] = o, t
     return outcomes, tails
 
@@ -234,5 +236,6 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     out.samples = out.steps_done * out.batch + scouting_samples(protocol)
     out.steps_done += scouting_samples(protocol) // outcomes[0].batch
     out.train_time_s += outcomes[best].train_time_s
+    out.step_mode = joined_modes(outcomes[best].step_mode, out.step_mode)
     out.scouting = record
     return out

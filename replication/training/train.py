@@ -114,7 +114,7 @@ def _cached(folder: Path) -> TrainOutcome | None:
                         log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
                         failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
                         batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
-                        cohort=meta.get("cohort"))
+                        cohort=meta.get("cohort"), step_mode=meta.get("step_mode"))
 
 
 def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
@@ -123,7 +123,8 @@ def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
                                           "scouting": outcome.scouting, "samples": outcome.samples,
-                                          "cohort": outcome.cohort, "spec": spec.to_dict(),
+                                          "cohort": outcome.cohort, "step_mode": outcome.step_mode,
+                                          "spec": spec.to_dict(),
                                           "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)
 

@@ -138,6 +138,8 @@ class Stepper:
         # the compiled step has clipped, and left model and state unchanged where the bound skipped it
         self.model, self.opt_state = self._next
 
+    mode = "jit"
+
     def probe(self):
         return None if self.look is None else self.look(self.model, self._batch)
 
@@ -191,6 +193,8 @@ class Members:
     def commit(self, taken, scale):
         # as Stepper: the compiled step has clipped each member and skipped those above their bound
         self.model, self.opt_state = self._next
+
+    mode = "jit"
 
     def probe(self):
         if self.look is None:

@@ -16,7 +16,8 @@ and the K losses come out per member (`loss_value(..., axis=-1)`). Other kinds s
 and batches. Either way one backward pass of the losses' sum (the members share nothing, so each gets its
 own gradient), and Adam as one call of torch's fused Adam kernel over every taken member's slice of every
 parameter (`_fused_adam`, what `Stepper`'s torch.optim.Adam(fused=True) runs), with a step count per
-member; a member the guard skips is left out of the call, so it keeps its state exactly. Each member's
+member; a member the guard skips is left out of the call, so it keeps its state exactly. Both run their loss
+under torch.compile where `replication.training.compile_torch` says so (`mode`). Each member's
 numbers are those of its own `Stepper` run
 (`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
 on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
@@ -30,6 +31,7 @@ from torch.func import functional_call, stack_module_state, vmap
 
 import models.torch
 from replication.training import hessian_probe, loop
+from replication.training.compile_torch import compiled_loss, step_mode
 from replication.training.objective import loss_value, predict
 from replication.training.outcome import TrainOutcome
 
@@ -75,7 +77,7 @@ class Stepper:
     def __init__(self, spec, params, protocol):
         self.dtype = getattr(torch, protocol.dtype)
         self.model = models.torch.build(spec, params)
-        self.loss_fn = make_loss(spec, protocol)
+        self.loss_fn = compiled_loss(make_loss(spec, protocol), spec, protocol)
         self.look = make_probe(spec, protocol)
         self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
                                     eps=protocol.eps, weight_decay=0.0, **ADAM_KERNEL)
@@ -99,6 +101,10 @@ class Stepper:
             for g in self._grads:
                 g.mul_(self.clip_to / self._gnorm)
         self.opt.step()
+
+    @property
+    def mode(self) -> str:
+        return step_mode(self.loss_fn)
 
     def probe(self):
         return None if self.look is None else self.look(self.model, self._batch)
@@ -157,7 +163,8 @@ class Members:
         self.dtype, self.protocol = getattr(torch, protocol.dtype), protocol
         self.spec, self.n = spec, len(params_list)
         if models.torch.stacks(spec):
-            self.model, self.loss_fn = models.torch.build_stacked(spec, params_list), make_loss(spec, protocol, True)
+            self.model = models.torch.build_stacked(spec, params_list)
+            self.loss_fn = compiled_loss(make_loss(spec, protocol, True), spec, protocol)
             self.stacked = dict(self.model.named_parameters())
         else:   # no stacked model: the K losses come from vmap over the stacked parameters
             objectives = [_Objective(models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]
@@ -221,6 +228,10 @@ class Members:
 
     def _params_of(self, i: int) -> dict:
         return {k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
+
+    @property
+    def mode(self) -> str:
+        return step_mode(self.loss_fn) if self.model is not None else "eager"
 
     def probe(self):
         if self.look is None:

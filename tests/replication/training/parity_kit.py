@@ -39,10 +39,11 @@ def _jax_step(spec, protocol, members: bool):
 
 
 class Recorder:
-    """A trainer for one framework that records every run (`phases`: per run, per member, {log, params})."""
+    """A trainer for one framework that records every run (`phases`: per run, per member, {log, params};
+    `modes`: per run, its step mode)."""
 
     def __init__(self, framework: str):
-        self.fw, self.phases = framework, []
+        self.fw, self.phases, self.modes = framework, [], []
 
     def _stepper(self, spec, params, protocol, members: bool):
         module = train_jax if self.fw == "jax" else train_torch
@@ -53,6 +54,7 @@ class Recorder:
         return stepper
 
     def _record(self, outcomes, params):
+        self.modes.append(outcomes[0].step_mode)
         self.phases.append([{"log": o.log, "params": [p[i] for p in params], "failure": o.failure}
                             for i, o in enumerate(outcomes)])
 

@@ -1,0 +1,125 @@
+"""torch.compile of a PyTorch training loss: when it is used, where its generated code lives, and the eager
+fallback. JAX needs none of this: its step is always jit-compiled.
+
+`compiled_loss(loss_fn, spec, protocol) -> CompiledLoss | loss_fn`: the loss as `train_torch.Stepper` and
+`Members` call it, `loss_fn(model, batch)`. `step_mode(loss) -> "compiled" | "eager" | "eager (...)"`: what
+a training phase ran, recorded in its outcome (`TrainOutcome.step_mode`). `like(spec, protocol)`: a context in
+which every phase compiles as a phase of `protocol` would.
+
+When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
+  auto (default): where the model's loss is plain tensor ops (`models.torch.compiles`: the fast LNN, the
+        feed-forward baseline) and the phase trains at least COMPILE_MIN_STEPS steps, so that the capture
+        (about 26 s for the double pendulum's 3 x 128 LNN on a cold cache, 12 s warm) is paid back;
+  on:   wherever the kind allows, however short (the tests);
+  off:  never.
+The whole loss is captured (fullgraph): in the models, `models.torch.export_paths.compiling` picks the
+branch-free fallback solve and the plain softplus. Gradients are autograd's of the same maths, so a compiled
+phase's numbers equal the eager ones up to rounding (`tests/replication/training/test_compile_torch.py`).
+A capture or build that fails (no C++ compiler, an op dynamo cannot take) is logged, and the phase goes on
+eager from the same state; its mode says so.
+
+Measured, `full`'s double-pendulum LNN (3 x 128, softplus), one thread, interleaved rounds on an idle
+2-core machine: the continuation's step at batch 256 7.8 ms compiled against 12.4 ms eager (JAX's jit
+8.6 ms); 16 stacked scouts at batch 32 17-20 ms against 28 ms.
+
+Where: inductor's cache of generated C++ and its shared objects is `$LAGBENCH_CACHE/torchinductor` (set as
+TORCHINDUCTOR_CACHE_DIR unless the environment already names one), so that workers and later runs reuse
+a capture. Inductor loads what it finds there, so the folder must be this user's own: created mode 0700,
+and used only if it is a real directory (not a symlink) owned by this user that no one else may write;
+otherwise nothing is compiled.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import stat
+
+import torch
+
+import models.torch
+from systems.cache import cache_dir
+
+log = logging.getLogger("lagbench")
+
+ENV = "LAGBENCH_TORCH_COMPILE"
+SETTINGS = ("auto", "on", "off")
+COMPILE_MIN_STEPS = 5000
+
+
+@contextlib.contextmanager
+def like(spec, protocol):
+    """Within it, every phase compiles exactly when a phase of `protocol` would (the duration estimate's short
+    probes of a long phase: `replication.run.estimate`)."""
+    before = os.environ.get(ENV)
+    os.environ[ENV] = "on" if wanted(spec, protocol) else "off"
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(ENV, None)
+        else:
+            os.environ[ENV] = before
+
+
+def setting() -> str:
+    value = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    if value not in SETTINGS:
+        raise ValueError(f"{ENV}={value!r}; valid: {', '.join(SETTINGS)}")
+    return value
+
+
+def wanted(spec, protocol) -> bool:
+    """Whether this phase's loss should run under torch.compile (see the module docstring)."""
+    how = setting()
+    if how == "off" or not models.torch.compiles(spec):
+        return False
+    return how == "on" or protocol.steps >= COMPILE_MIN_STEPS
+
+
+def private_cache() -> bool:
+    """Point inductor's cache at this user's own folder; False where no such folder can be had."""
+    if os.environ.get("TORCHINDUCTOR_CACHE_DIR"):
+        return True
+    folder = cache_dir("torchinductor")
+    try:
+        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+        st = os.lstat(folder)
+    except OSError as exc:
+        log.warning("torch.compile off: cannot make inductor's cache folder %s (%s)", folder, exc)
+        return False
+    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o022:
+        log.warning("torch.compile off: %s is not a folder of this user's that no one else may write", folder)
+        return False
+    os.environ["TORCHINDUCTOR_CACHE_DIR"] = str(folder.resolve())
+    return True
+
+
+class CompiledLoss:
+    """`loss_fn` under torch.compile (fullgraph); the first failure turns it to `loss_fn` for good."""
+
+    def __init__(self, loss_fn):
+        torch._dynamo.reset()   # one training phase at a time: earlier phases' captures are not called again
+        self.eager, self.mode = loss_fn, "compiled"
+        self.fn = torch.compile(loss_fn, fullgraph=True, dynamic=False)
+
+    def __call__(self, model, batch):
+        if self.fn is not self.eager:
+            try:
+                return self.fn(model, batch)
+            except Exception as exc:   # a capture or build failure: nothing was updated, go on eager
+                reason = f"{type(exc).__name__}: {str(exc).splitlines()[0][:160] if str(exc) else ''}"
+                log.warning("torch.compile failed, training eager: %s", reason)
+                self.fn, self.mode = self.eager, f"eager (torch.compile failed: {type(exc).__name__})"
+        return self.eager(model, batch)
+
+
+def compiled_loss(loss_fn, spec, protocol):
+    """loss_fn, compiled where `wanted` and inductor has a private cache folder."""
+    if wanted(spec, protocol) and private_cache():
+        return CompiledLoss(loss_fn)
+    return loss_fn
+
+
+def step_mode(loss) -> str:
+    return getattr(loss, "mode", "eager")

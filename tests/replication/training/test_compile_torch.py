@@ -1,0 +1,118 @@
+"""PyTorch training under torch.compile (`replication.training.compile_torch`): the compiled phases give the
+eager numbers up to rounding (float64, every step of a scouted run: stacked scouts, then the continuation;
+and the baseline), a failed capture goes on eager with the same numbers, and when it compiles."""
+import os
+
+import numpy as np
+import pytest
+import torch
+from parity_kit import compare, trace
+from parity_rows import BY_NAME
+
+from models import ModelSpec, init_params
+from replication.training import compile_torch, train_torch
+from replication.training.data import BatchStream
+from replication.training.outcome import joined_modes
+
+
+def _traced(monkeypatch, setting, row):
+    monkeypatch.setenv(compile_torch.ENV, setting)
+    return trace("torch", row)
+
+
+@pytest.mark.parametrize("name", ["lnn_scouted", "baseline_dp"])
+def test_compiled_training_equals_eager_up_to_rounding(monkeypatch, name):
+    row = BY_NAME[name]
+    eager = _traced(monkeypatch, "off", row)
+    compiled = _traced(monkeypatch, "on", row)
+    diffs, mismatches = compare(eager, compiled)
+    assert not mismatches, mismatches
+    assert diffs["steps"] >= row.protocol.steps
+    for k in ("loss", "grad_norm", "params"):
+        assert diffs[k] < 1e-9, (k, diffs)
+    assert set(compiled.modes) == {"compiled"} and set(eager.modes) == {"eager"}
+    if name == "lnn_scouted":
+        assert len(compiled.modes) == 2 and compiled.outcome.step_mode == "compiled"
+
+
+def test_a_failed_capture_trains_eager_from_the_same_state(monkeypatch, caplog):
+    row = BY_NAME["lnn_fast"]
+    spec, p = row.spec, row.protocol.replace(steps=3)
+
+    def broken(fn, **_):
+        def call(*args):
+            raise RuntimeError("no C++ compiler")
+        return call
+    monkeypatch.setattr(compile_torch.torch, "compile", broken)
+    runs = {}
+    for setting in ("off", "on"):
+        monkeypatch.setenv(compile_torch.ENV, setting)
+        runs[setting] = train_torch.train(spec, init_params(spec, seed=0), p, BatchStream(p, 0))
+    assert runs["on"].step_mode == "eager (torch.compile failed: RuntimeError)"
+    assert runs["off"].step_mode == "eager"
+    assert [r["loss"] for r in runs["on"].log] == [r["loss"] for r in runs["off"].log]
+    for k, v in runs["off"].params.items():
+        np.testing.assert_array_equal(runs["on"].params[k], v)
+    assert "torch.compile failed, training eager: RuntimeError: no C++ compiler" in caplog.text
+
+
+def test_when_a_phase_compiles(monkeypatch):
+    lnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8))
+    paper, hnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), formulation="paper"), ModelSpec(kind="hnn", dof=1)
+    long, short = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_STEPS), BY_NAME["lnn_fast"].protocol
+    monkeypatch.delenv(compile_torch.ENV, raising=False)
+    assert compile_torch.wanted(lnn, long) and not compile_torch.wanted(lnn, short)
+    assert not compile_torch.wanted(paper, long) and not compile_torch.wanted(hnn, long)   # torch.func maths
+    monkeypatch.setenv(compile_torch.ENV, "on")
+    assert compile_torch.wanted(lnn, short) and not compile_torch.wanted(paper, short)
+    monkeypatch.setenv(compile_torch.ENV, "off")
+    assert not compile_torch.wanted(lnn, long)
+    monkeypatch.setenv(compile_torch.ENV, "sometimes")
+    with pytest.raises(ValueError, match="LAGBENCH_TORCH_COMPILE='sometimes'; valid: auto, on, off"):
+        compile_torch.wanted(lnn, long)
+
+
+@pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX owners and modes")
+def test_inductor_cache_only_in_a_folder_of_this_users_own(monkeypatch, tmp_path, caplog):
+    monkeypatch.setenv("TORCHINDUCTOR_CACHE_DIR", "unused")
+    monkeypatch.delenv("TORCHINDUCTOR_CACHE_DIR")
+    monkeypatch.setenv("LAGBENCH_CACHE", str(tmp_path / "cache"))
+    assert compile_torch.private_cache()
+    folder = tmp_path / "cache" / "torchinductor"
+    assert os.environ["TORCHINDUCTOR_CACHE_DIR"] == str(folder.resolve()) and not folder.stat().st_mode & 0o077
+    for how in ("group-writable", "symlink"):
+        monkeypatch.delenv("TORCHINDUCTOR_CACHE_DIR", raising=False)
+        root = tmp_path / how
+        if how == "symlink":
+            root.mkdir()
+            (root / "torchinductor").symlink_to(folder)
+        else:
+            (root / "torchinductor").mkdir(parents=True)
+            (root / "torchinductor").chmod(0o775)
+        monkeypatch.setenv("LAGBENCH_CACHE", str(root))
+        assert not compile_torch.private_cache(), how
+        assert "TORCHINDUCTOR_CACHE_DIR" not in os.environ
+    assert "is not a folder of this user's that no one else may write" in caplog.text
+    # a stepper then trains eager
+    row = BY_NAME["lnn_fast"]
+    monkeypatch.setenv(compile_torch.ENV, "on")
+    assert train_torch.Stepper(row.spec, init_params(row.spec, seed=0), row.protocol).mode == "eager"
+
+
+def test_joined_modes_name_each_phase_mode_once_in_order():
+    assert joined_modes("compiled", "compiled") == "compiled"
+    assert joined_modes("eager", "compiled", "eager + compiled") == "eager + compiled"
+    assert joined_modes(None, "jit") == "jit" and joined_modes(None, None) is None
+
+
+def test_compiling_is_not_tracing_or_exporting():
+    from models.torch import export_paths
+
+    assert not export_paths.compiling() and not export_paths.tracing()
+    seen = {}
+
+    def f(x):
+        seen["compiling"], seen["tracing"] = export_paths.compiling(), export_paths.tracing()
+        return x + 1
+    torch.compile(f, fullgraph=True, backend="eager")(torch.ones(2))
+    assert seen == {"compiling": True, "tracing": False}
