@@ -38,9 +38,9 @@ class Model(nn.Module):
 
     @classmethod
     def compiles(cls, spec: ModelSpec) -> bool:
-        """Whether a training loss of this kind may be captured whole by torch.compile
-        (`replication.training.compile_torch`): its maths is plain tensor ops with no torch.func transform,
-        as for the kinds that stack."""
+        """Whether a training loss of this kind is run under torch.compile (`replication.training.compile_torch`):
+        its maths is plain tensor ops with no torch.func transform, as for the kinds that stack, and compiling
+        it pays."""
         return cls.stacks(spec)
 
     def _rows(self, x, width: int | None = None):

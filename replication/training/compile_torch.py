@@ -7,9 +7,10 @@ a training phase ran, recorded in its outcome (`TrainOutcome.step_mode`). `like(
 which every phase compiles as a phase of `protocol` would.
 
 When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
-  auto (default): where the model's loss is plain tensor ops (`models.torch.compiles`: the fast LNN, the
-        feed-forward baseline) and the phase trains at least COMPILE_MIN_STEPS steps, so that the capture
-        (about 26 s for the double pendulum's 3 x 128 LNN on a cold cache, 12 s warm) is paid back;
+  auto (default): where the model's loss is plain tensor ops and compiling pays (`models.torch.compiles`:
+        the fast LNN; not the feed-forward baseline, whose step is its matrix products) and the phase trains
+        at least COMPILE_MIN_STEPS steps, so that the capture (about 26 s for the double pendulum's 3 x 128
+        LNN on a cold cache, 12 s warm) is paid back;
   on:   wherever the kind allows, however short (the tests);
   off:  never.
 The whole loss is captured (fullgraph): in the models, `models.torch.export_paths.compiling` picks the

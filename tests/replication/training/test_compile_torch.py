@@ -1,6 +1,6 @@
 """PyTorch training under torch.compile (`replication.training.compile_torch`): the compiled phases give the
 eager numbers up to rounding (float64, every step of a scouted run: stacked scouts, then the continuation;
-and the baseline), a failed capture goes on eager with the same numbers, and when it compiles."""
+and the relativistic LNN with its extra input under the weighted L1), a failed capture goes on eager with the same numbers, and when it compiles."""
 import os
 
 import numpy as np
@@ -20,7 +20,7 @@ def _traced(monkeypatch, setting, row):
     return trace("torch", row)
 
 
-@pytest.mark.parametrize("name", ["lnn_scouted", "baseline_dp"])
+@pytest.mark.parametrize("name", ["lnn_scouted", "lnn_l1_gamma"])
 def test_compiled_training_equals_eager_up_to_rounding(monkeypatch, name):
     row = BY_NAME[name]
     eager = _traced(monkeypatch, "off", row)
@@ -59,10 +59,12 @@ def test_a_failed_capture_trains_eager_from_the_same_state(monkeypatch, caplog):
 def test_when_a_phase_compiles(monkeypatch):
     lnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8))
     paper, hnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), formulation="paper"), ModelSpec(kind="hnn", dof=1)
+    baseline = ModelSpec(kind="baseline", dof=2, hidden=(8, 8))
     long, short = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_STEPS), BY_NAME["lnn_fast"].protocol
     monkeypatch.delenv(compile_torch.ENV, raising=False)
     assert compile_torch.wanted(lnn, long) and not compile_torch.wanted(lnn, short)
     assert not compile_torch.wanted(paper, long) and not compile_torch.wanted(hnn, long)   # torch.func maths
+    assert not compile_torch.wanted(baseline, long)   # its matrix products: no gain
     monkeypatch.setenv(compile_torch.ENV, "on")
     assert compile_torch.wanted(lnn, short) and not compile_torch.wanted(paper, short)
     monkeypatch.setenv(compile_torch.ENV, "off")
