@@ -118,3 +118,17 @@ def test_compiling_is_not_tracing_or_exporting():
         return x + 1
     torch.compile(f, fullgraph=True, backend="eager")(torch.ones(2))
     assert seen == {"compiling": True, "tracing": False}
+
+
+def test_estimate_probes_compile_where_the_phase_they_stand_for_will(monkeypatch):
+    lnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8))
+    long = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_STEPS)
+    probe = long.replace(steps=8)
+    monkeypatch.delenv(compile_torch.ENV, raising=False)
+    with compile_torch.like(lnn, long):
+        assert compile_torch.wanted(lnn, probe)
+    assert not compile_torch.wanted(lnn, probe) and compile_torch.ENV not in os.environ
+    monkeypatch.setenv(compile_torch.ENV, "off")
+    with compile_torch.like(lnn, long):
+        assert not compile_torch.wanted(lnn, probe)
+    assert os.environ[compile_torch.ENV] == "off"
