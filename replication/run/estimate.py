@@ -57,7 +57,7 @@ def _members_step(framework, spec, protocol, k: int) -> float:
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
                          cohort=0, track_every=0)
     rows = []
-    with compile_torch.like(spec, protocol):
+    with compile_torch.like(spec, protocol, k):
         train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
     return _per_step(rows)
 

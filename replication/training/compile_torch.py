@@ -1,16 +1,18 @@
 """torch.compile of a PyTorch training loss: when it is used, where its generated code lives, and the eager
 fallback. JAX needs none of this: its step is always jit-compiled.
 
-`compiled_loss(loss_fn, spec, protocol) -> CompiledLoss | loss_fn`: the loss as `train_torch.Stepper` and
-`Members` call it, `loss_fn(model, batch)`. `step_mode(loss) -> "compiled" | "eager" | "eager (...)"`: what
-a training phase ran, recorded in its outcome (`TrainOutcome.step_mode`). `like(spec, protocol)`: a context in
-which every phase compiles as a phase of `protocol` would.
+`compiled_loss(loss_fn, spec, protocol, members=1) -> CompiledLoss | loss_fn`: the loss as `train_torch.Stepper`
+and `Members` call it, `loss_fn(model, batch)`. `step_mode(loss) -> "compiled" | "eager" | "eager (...)"`: what
+a training phase ran, recorded in its outcome (`TrainOutcome.step_mode`). `like(spec, protocol, members=1)`: a
+context in which every phase compiles as a phase of `protocol` would.
 
 When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
   auto (default): where the model's loss is plain tensor ops and compiling pays (`models.torch.compiles`:
         the fast LNN; not the feed-forward baseline, whose step is its matrix products) and the phase trains
-        at least COMPILE_MIN_STEPS steps, so that the capture (about 26 s for the double pendulum's 3 x 128
-        LNN on a cold cache, 12 s warm) is paid back;
+        at least COMPILE_MIN_SAMPLES samples (steps x batch x members), so that the capture (about 26 s for
+        the double pendulum's 3 x 128 LNN on a cold cache, 12 s warm) is paid back: the double pendulum's
+        scouts, kept scouts and continuation, claims 6 and 7's cohorts, claim 3's continuations; not the
+        relativistic scouts (200 steps) or the tests;
   on:   wherever the kind allows, however short (the tests);
   off:  never.
 The whole loss is captured (fullgraph): in the models, `models.torch.export_paths.compiling` picks the
@@ -45,15 +47,15 @@ log = logging.getLogger("lagbench")
 
 ENV = "LAGBENCH_TORCH_COMPILE"
 SETTINGS = ("auto", "on", "off")
-COMPILE_MIN_STEPS = 5000
+COMPILE_MIN_SAMPLES = 2_000_000
 
 
 @contextlib.contextmanager
-def like(spec, protocol):
-    """Within it, every phase compiles exactly when a phase of `protocol` would (the duration estimate's short
-    probes of a long phase: `replication.run.estimate`)."""
+def like(spec, protocol, members: int = 1):
+    """Within it, every phase compiles exactly when a phase of `protocol` with `members` would (the duration
+    estimate's short probes of a long phase: `replication.run.estimate`)."""
     before = os.environ.get(ENV)
-    os.environ[ENV] = "on" if wanted(spec, protocol) else "off"
+    os.environ[ENV] = "on" if wanted(spec, protocol, members) else "off"
     try:
         yield
     finally:
@@ -70,12 +72,12 @@ def setting() -> str:
     return value
 
 
-def wanted(spec, protocol) -> bool:
-    """Whether this phase's loss should run under torch.compile (see the module docstring)."""
+def wanted(spec, protocol, members: int = 1) -> bool:
+    """Whether the loss of this phase (`members` models side by side) should run under torch.compile."""
     how = setting()
     if how == "off" or not models.torch.compiles(spec):
         return False
-    return how == "on" or protocol.steps >= COMPILE_MIN_STEPS
+    return how == "on" or protocol.steps * protocol.batch * members >= COMPILE_MIN_SAMPLES
 
 
 def private_cache() -> bool:
@@ -115,9 +117,9 @@ class CompiledLoss:
         return self.eager(model, batch)
 
 
-def compiled_loss(loss_fn, spec, protocol):
+def compiled_loss(loss_fn, spec, protocol, members: int = 1):
     """loss_fn, compiled where `wanted` and inductor has a private cache folder."""
-    if wanted(spec, protocol) and private_cache():
+    if wanted(spec, protocol, members) and private_cache():
         return CompiledLoss(loss_fn)
     return loss_fn
 

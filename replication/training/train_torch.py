@@ -164,7 +164,7 @@ class Members:
         self.spec, self.n = spec, len(params_list)
         if models.torch.stacks(spec):
             self.model = models.torch.build_stacked(spec, params_list)
-            self.loss_fn = compiled_loss(make_loss(spec, protocol, True), spec, protocol)
+            self.loss_fn = compiled_loss(make_loss(spec, protocol, True), spec, protocol, self.n)
             self.stacked = dict(self.model.named_parameters())
         else:   # no stacked model: the K losses come from vmap over the stacked parameters
             objectives = [_Objective(models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]

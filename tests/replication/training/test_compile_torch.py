@@ -60,9 +60,12 @@ def test_when_a_phase_compiles(monkeypatch):
     lnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8))
     paper, hnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), formulation="paper"), ModelSpec(kind="hnn", dof=1)
     baseline = ModelSpec(kind="baseline", dof=2, hidden=(8, 8))
-    long, short = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_STEPS), BY_NAME["lnn_fast"].protocol
+    short = BY_NAME["lnn_fast"].protocol
+    long = short.replace(steps=-(-compile_torch.COMPILE_MIN_SAMPLES // short.batch))
     monkeypatch.delenv(compile_torch.ENV, raising=False)
     assert compile_torch.wanted(lnn, long) and not compile_torch.wanted(lnn, short)
+    assert compile_torch.wanted(lnn, long.replace(steps=long.steps // 4), members=4)   # side by side: their samples
+    assert not compile_torch.wanted(lnn, long.replace(steps=long.steps // 4 - 1), members=4)
     assert not compile_torch.wanted(paper, long) and not compile_torch.wanted(hnn, long)   # torch.func maths
     assert not compile_torch.wanted(baseline, long)   # its matrix products: no gain
     monkeypatch.setenv(compile_torch.ENV, "on")
@@ -122,7 +125,7 @@ def test_compiling_is_not_tracing_or_exporting():
 
 def test_estimate_probes_compile_where_the_phase_they_stand_for_will(monkeypatch):
     lnn = ModelSpec(kind="lnn", dof=2, hidden=(8, 8))
-    long = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_STEPS)
+    long = BY_NAME["lnn_fast"].protocol.replace(steps=compile_torch.COMPILE_MIN_SAMPLES)
     probe = long.replace(steps=8)
     monkeypatch.delenv(compile_torch.ENV, raising=False)
     with compile_torch.like(lnn, long):
