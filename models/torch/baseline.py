@@ -19,7 +19,8 @@ class Baseline(Model):
     @classmethod
     def compiles(cls, spec) -> bool:
         """No: a plain MLP's step is its matrix products, which compiling leaves as they are. The quick double
-        pendulum's baseline trained in 126 s compiled (three captures), against 93-107 s eager."""
+        pendulum's baselines (three captures each) trained in 126 s (a cold cache), 95 s and 89 s compiled,
+        against 107, 93 and 105 s eager."""
         return False
 
     def acceleration(self, q, qdot, extra=None):
