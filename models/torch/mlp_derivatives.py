@@ -10,7 +10,7 @@ and the HNN.
   the mixed term, never the mixed tangent's own row.
   tangents=None gives (g, None): the reverse pass alone (the HNN's dH/dx).
   Stacked members (`models.torch.build.build_stacked`): weights (K, out, in), biases (K, out), x (K, B, n_in),
-  tangents (K, B, T, n_in) give g (K, B, n_in), G (K, B, T, T); every product becomes one batched product
+  tangents (K, B, T, n_in) give g (K, B, n_in), G (K, B, R, T); every product becomes one batched product
   over the K members (`torch.baddbmm` / `torch.bmm`), no torch.func.vmap.
 How: with a_i = W_i h_(i-1) + b_i, h_i = act(a_i) and g_i = df/dh_i, the Hessian of an MLP is exactly
   d^2 f/dx^2 = sum_i J_i^T diag(g_i * act''(a_i)) J_i,   J_i = da_i/dx,

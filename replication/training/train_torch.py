@@ -18,8 +18,8 @@ own gradient), and Adam as one call of torch's fused Adam kernel over every take
 parameter (`_fused_adam`, what `Stepper`'s torch.optim.Adam(fused=True) runs), with a step count per
 member; a member the guard skips is left out of the call, so it keeps its state exactly. Both run their loss
 under torch.compile where `replication.training.compile_torch` says so (`mode`). Each member's
-numbers are those of its own `Stepper` run
-(`tests/replication/training/test_members_parity.py`). `train_members(spec, params_list, protocol, streams,
+numbers are those of its own `Stepper` run (`tests/replication/training/test_members_parity.py`; compiled,
+up to rounding: the two are different programs). `train_members(spec, params_list, protocol, streams,
 on_log=None, hooks=(), snapshot=None) -> [TrainOutcome]`.
 """
 from __future__ import annotations
