@@ -11,7 +11,7 @@ A framework gives one optimiser step of K members (K >= 1 models trained side by
   probe() -> list[dict | None] | None   the velocity-Hessian health columns (`hessian_probe`) of each member
                                  on the batch last proposed
   params() -> list[dict]         the current parameters of each member, `models.params` layout (NumPy)
-  mode                           how its step runs: "jit" (JAX), "compiled" or "eager" (PyTorch,
+  mode (optional)                how its step runs: "jit" (JAX), "compiled" or "eager" (PyTorch,
                                  `compile_torch`), recorded as the outcome's `step_mode`
 A one-model stepper (`train_jax.Stepper`, `train_torch.Stepper`: scalars in, scalars out) runs through
 the same loop as a member set of one (`train`), with the protocol's rollback (`rollback.Rollback`) as its
@@ -124,7 +124,7 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
                               protocol.steps))
     return [TrainOutcome(params=p, log=logs[i], failure=failures[i], train_time_s=total, steps_done=int(done[i]),
                          batch=protocol.batch, step_seconds=t_steps, skipped_steps=guards[i].skipped,
-                         step_mode=stepper.mode)
+                         step_mode=getattr(stepper, "mode", None))
             for i, p in enumerate(stepper.params())]
 
 
@@ -200,7 +200,7 @@ class _One:
 
     @property
     def mode(self):
-        return self.stepper.mode
+        return getattr(self.stepper, "mode", None)
 
     def state_arrays(self):
         return self.stepper.state_arrays()
