@@ -11,8 +11,9 @@ call here pick. The captures:
   compiling: torch.compile (dynamo) is capturing a training loss (`replication.training.compile_torch`);
              not torch.export, which is `exporting`.
 
-`pick(eager, traced=None, exporting=None)` -> the variant to call: `traced` while make_fx traces (if
-  given), else `exporting` under torch.export (if given), else `eager`.
+`pick(eager, traced=None, exporting=None, compiled=None)` -> the variant to call: `traced` while make_fx
+  traces (if given), else `exporting` under torch.export (if given), else `compiled` under torch.compile
+  (if given), else `eager`.
 `replace_bad_rows(x (..., d), bad (...,), fix, hess, rhs) -> (..., d)`: x with the rows where bad is True
   replaced by those of fix(hess, rhs) (..., d), with no Python branch on data in a captured graph.
 No JAX twin: a JAX model is always traced by jit, so it has one path, already graph-safe (`lax.cond`).
@@ -44,13 +45,16 @@ def vmapped(x) -> bool:
     return torch._C._functorch.is_batchedtensor(x)
 
 
-def pick(eager, traced=None, exporting=None):
-    """The variant to run now: traced while make_fx traces, exporting under torch.export (each only if
-    given), else eager. All variants take the same arguments and give the same numbers."""
+def pick(eager, traced=None, exporting=None, compiled=None):
+    """The variant to run now: traced while make_fx traces, exporting under torch.export, compiled under
+    torch.compile (each only if given), else eager. All variants take the same arguments and give the same
+    numbers."""
     if traced is not None and tracing():
         return traced
     if exporting is not None and torch.compiler.is_exporting():
         return exporting
+    if compiled is not None and compiling():
+        return compiled
     return eager
 
 

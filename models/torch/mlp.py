@@ -11,7 +11,7 @@ import math
 import torch
 
 from models.params import n_layers
-from models.torch.export_paths import compiling
+from models.torch.export_paths import pick
 
 
 class _Softplus(torch.autograd.Function):
@@ -41,13 +41,15 @@ class _Softplus(torch.autograd.Function):
         return a_t * s
 
 
+def _plain_softplus(x, s):
+    return torch.logaddexp(x, torch.zeros((), dtype=x.dtype, device=x.device))
+
+
 def softplus_given_sigmoid(x, s):
     """softplus(x), with s = sigmoid(x) already computed (see `_Softplus`). Under torch.compile the plain
     logaddexp (torch 2.13's dynamo cannot capture a Function with a jvp rule; the compiled training losses
     take first derivatives only, and inductor fuses the recomputed sigmoid)."""
-    if compiling():
-        return torch.logaddexp(x, torch.zeros((), dtype=x.dtype, device=x.device))
-    return _Softplus.apply(x, s)
+    return pick(_Softplus.apply, compiled=_plain_softplus)(x, s)
 
 
 def softplus(x):
