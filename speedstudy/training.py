@@ -6,8 +6,8 @@ samples_per_s, hidden}` for the claim's LNN (fast formulation) and baseline, wit
 Adam, l2 penalty) at batch `sizes.train_batch` (and each of `sizes.train_extra_batches`). One optimiser
 step is timed (fastest of `sizes.train_steps` after one warm-up/compile step) with the training loops' own step functions:
 `train_jax.make_step` (eqx.filter_jit) and `train_torch.make_loss` + torch.optim.Adam.
-mode "compile" wraps the PyTorch loss in `torch.compile`; where that fails or is disabled, no row is
-written and the reason goes to `notes` (shown in ratios.csv).
+mode "compile" wraps the PyTorch loss in `torch.compile` (generated code in `models.torch.inductor_cache`);
+where that fails or is disabled, no row is written and the reason goes to `notes` (shown in ratios.csv).
 """
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ import torch
 import models.jax
 import models.torch
 from models import ModelSpec, init_params
+from models.torch import inductor_cache
 from replication.claims.double_pendulum import MODELS, PROTOCOLS
 from replication.training import train_jax, train_torch
 from replication.training.data import BatchStream
@@ -52,6 +53,8 @@ def _torch_step_time(spec, params, protocol, batch, reps, compile_=False):
     model = models.torch.build(spec, params)
     loss_fn = train_torch.make_loss(spec, protocol)
     if compile_:
+        if not inductor_cache.private():
+            raise inductor_cache.InductorCacheError("no private folder for inductor's generated code (see the log)")
         loss_fn = torch.compile(loss_fn)
     opt = torch.optim.Adam(model.parameters(), lr=1e-5, **train_torch.ADAM_KERNEL)
     b = {k: torch.as_tensor(v, dtype=getattr(torch, protocol.dtype)) for k, v in batch.items()}

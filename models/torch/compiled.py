@@ -15,7 +15,7 @@ with `aoti_load_package`. The numbers are those of `getattr(model, method)(*inpu
 rounding (fused kernels reassociate sums).
 
 Costs and requirements: compiling takes 15-40 s and needs a C++ compiler (gcc; what inductor uses on
-CPU). The compiled kernels use OpenMP: for a one-core control loop set OMP_NUM_THREADS=1 before the
+CPU) and a private folder for the generated code (`models.torch.inductor_cache`). The compiled kernels use OpenMP: for a one-core control loop set OMP_NUM_THREADS=1 before the
 process starts (measured: DeLaN 3 x 128 one-sample inverse dynamics 12.3k calls/s with it, 6.5k without,
 eager 1.0-1.3k). Inputs must already have the compiled shape and dtype (torch tensors); anything else
 raises a ValueError naming the input. `compile_batched` exports with a dynamic batch dimension (one
@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import inspect
 import os
-import tempfile
 import warnings
 
 import torch
@@ -38,6 +37,7 @@ from torch.utils._pytree import tree_flatten, tree_unflatten
 
 from models.checks import n_required_inputs
 from models.row_blocks import block_plan
+from models.torch import inductor_cache
 from models.torch.blocking import in_row_blocks
 
 __all__ = ["BlockedMethod", "CompiledMethod", "compile_batched", "compile_single"]
@@ -127,8 +127,9 @@ _FREEZE_WEIGHTS = {"freezing": True}
 
 
 def _package(module, example, dynamic_shapes=None, inductor_configs=None):
-    """(AOTI runner, output tree spec) of module(*example), exported and compiled in a scratch folder."""
-    with tempfile.TemporaryDirectory(prefix="lagbench_aoti_") as tmp, torch.no_grad(), warnings.catch_warnings():
+    """(AOTI runner, output tree spec) of module(*example), exported and compiled in a scratch folder inside
+    inductor's private cache (`models.torch.inductor_cache`; InductorCacheError without one)."""
+    with inductor_cache.scratch("lagbench_aoti_") as tmp, torch.no_grad(), warnings.catch_warnings():
         # torch's own deprecation notices from inside export (nothing a caller can act on)
         warnings.simplefilter("ignore", FutureWarning)
         program = torch.export.export(module.eval(), example, dynamic_shapes=dynamic_shapes)

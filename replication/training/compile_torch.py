@@ -25,23 +25,20 @@ Measured, `full`'s double-pendulum LNN (3 x 128, softplus), one thread, interlea
 2-core machine: the continuation's step at batch 256 7.8 ms compiled against 12.4 ms eager (JAX's jit
 8.6 ms); 16 stacked scouts at batch 32 17-20 ms against 28 ms.
 
-Where: inductor's cache of generated C++ and its shared objects is `$LAGBENCH_CACHE/torchinductor` (set as
-TORCHINDUCTOR_CACHE_DIR unless the environment already names one), so that workers and later runs reuse
-a capture. Inductor loads what it finds there, so the folder must be this user's own: created mode 0700,
-and used only if it is a real directory (not a symlink) owned by this user that no one else may write;
-otherwise nothing is compiled.
+Where: inductor's cache of generated C++ and its shared objects is `$LAGBENCH_CACHE/torchinductor`
+(`models.torch.inductor_cache`), so that workers and later runs reuse a capture; where that folder is not
+this user's own, nothing is compiled.
 """
 from __future__ import annotations
 
 import contextlib
 import logging
 import os
-import stat
 
 import torch
 
 import models.torch
-from systems.cache import cache_dir
+from models.torch import inductor_cache
 
 log = logging.getLogger("lagbench")
 
@@ -80,24 +77,6 @@ def wanted(spec, protocol, members: int = 1) -> bool:
     return how == "on" or protocol.steps * protocol.batch * members >= COMPILE_MIN_SAMPLES
 
 
-def private_cache() -> bool:
-    """Point inductor's cache at this user's own folder; False where no such folder can be had."""
-    if os.environ.get("TORCHINDUCTOR_CACHE_DIR"):
-        return True
-    folder = cache_dir("torchinductor")
-    try:
-        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-        st = os.lstat(folder)
-    except OSError as exc:
-        log.warning("torch.compile off: cannot make inductor's cache folder %s (%s)", folder, exc)
-        return False
-    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o022:
-        log.warning("torch.compile off: %s is not a folder of this user's that no one else may write", folder)
-        return False
-    os.environ["TORCHINDUCTOR_CACHE_DIR"] = str(folder.resolve())
-    return True
-
-
 class CompiledLoss:
     """`loss_fn` under torch.compile (fullgraph); the first failure turns it to `loss_fn` for good."""
 
@@ -119,7 +98,7 @@ class CompiledLoss:
 
 def compiled_loss(loss_fn, spec, protocol, members: int = 1):
     """loss_fn, compiled where `wanted` and inductor has a private cache folder."""
-    if wanted(spec, protocol, members) and private_cache():
+    if wanted(spec, protocol, members) and inductor_cache.private():
         return CompiledLoss(loss_fn)
     return loss_fn
 

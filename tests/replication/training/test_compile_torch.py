@@ -78,27 +78,13 @@ def test_when_a_phase_compiles(monkeypatch):
 
 
 @pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX owners and modes")
-def test_inductor_cache_only_in_a_folder_of_this_users_own(monkeypatch, tmp_path, caplog):
+def test_no_private_inductor_cache_trains_eager(monkeypatch, tmp_path):
+    """Where inductor's folder is not this user's own (`models.torch.inductor_cache`), a stepper trains eager."""
     monkeypatch.setenv("TORCHINDUCTOR_CACHE_DIR", "unused")
     monkeypatch.delenv("TORCHINDUCTOR_CACHE_DIR")
-    monkeypatch.setenv("LAGBENCH_CACHE", str(tmp_path / "cache"))
-    assert compile_torch.private_cache()
-    folder = tmp_path / "cache" / "torchinductor"
-    assert os.environ["TORCHINDUCTOR_CACHE_DIR"] == str(folder.resolve()) and not folder.stat().st_mode & 0o077
-    for how in ("group-writable", "symlink"):
-        monkeypatch.delenv("TORCHINDUCTOR_CACHE_DIR", raising=False)
-        root = tmp_path / how
-        if how == "symlink":
-            root.mkdir()
-            (root / "torchinductor").symlink_to(folder)
-        else:
-            (root / "torchinductor").mkdir(parents=True)
-            (root / "torchinductor").chmod(0o775)
-        monkeypatch.setenv("LAGBENCH_CACHE", str(root))
-        assert not compile_torch.private_cache(), how
-        assert "TORCHINDUCTOR_CACHE_DIR" not in os.environ
-    assert "is not a folder of this user's that no one else may write" in caplog.text
-    # a stepper then trains eager
+    (tmp_path / "torchinductor").mkdir()
+    (tmp_path / "torchinductor").chmod(0o777)
+    monkeypatch.setenv("LAGBENCH_CACHE", str(tmp_path))
     row = BY_NAME["lnn_fast"]
     monkeypatch.setenv(compile_torch.ENV, "on")
     assert train_torch.Stepper(row.spec, init_params(row.spec, seed=0), row.protocol).mode == "eager"
