@@ -5,8 +5,10 @@
 `OUT/trained/` costs nothing), times seven steps of each distinct configuration on this machine after one
 step to compile and takes their median (the scouts of a protocol with restarts, and a cohort of seeds, are
 timed as they run: K members side by side), and scales up by the protocol's steps. Evaluation time is not
-included. The wall time assumes the trainings spread evenly over `jobs` workers, and is never below the
-longest single training.
+included. The wall time replays the executor's schedule (`scheduled_wall`): the chains of
+`replication.run.chains.chains`, longest first by its cost, each to the first of `jobs` workers to come free.
+(Before, it assumed the trainings spread evenly: three trainings of 0.33 h on two workers came out 0.5 h
+where the run took two rounds, 55 min.)
 
 The probes run PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
@@ -29,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from replication.run.chains import chains
 from replication.run.environment import torch_threads as threads_of_torch
 from replication.training import compile_torch
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
@@ -86,7 +89,7 @@ def _estimate(units, out, jobs: int) -> dict:
         if not u.entry.train:
             continue
         p, spec = u.protocol(), u.spec()
-        group = group_key(u.framework, spec, p, u.seed)   # a cohort of seeds trains as one program
+        group = _group(u)   # a cohort of seeds trains as one program
         if group in todo:
             continue
         if (Path(out) / "trained" / u.framework / train_key(u.framework, spec, p, u.seed) / "result.json").exists():
@@ -103,9 +106,23 @@ def _estimate(units, out, jobs: int) -> dict:
         plain, members = per_step[shape]
         todo[group] = plain * p.steps + sum(members[m] * n for m, n in scout_parts(p))
     total = sum(todo.values())
-    longest = max(todo.values(), default=0.0)
-    return {"train_s": total, "wall_s": max(total / max(jobs, 1), longest),
+    in_order = [todo.get(_group(c[0]), 0.0) for c in chains(units)]
+    return {"train_s": total, "wall_s": scheduled_wall(in_order, jobs),
             "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step)}
+
+
+def _group(u):
+    return group_key(u.framework, u.spec(), u.protocol(), u.seed) if u.entry.train else None
+
+
+def scheduled_wall(seconds, jobs: int) -> float:
+    """When the last of these jobs ends, given in the order they are handed out, each to the first of `jobs`
+    workers to come free (as a process pool takes them)."""
+    free = [0.0] * max(jobs, 1)
+    for s in seconds:
+        i = free.index(min(free))
+        free[i] += s
+    return max(free)
 
 
 def describe(units, todo) -> str:

@@ -4,7 +4,7 @@ import json
 import pytest
 
 from replication.cli import build_parser, main
-from replication.run.estimate import describe, estimate
+from replication.run.estimate import describe, estimate, scheduled_wall
 from replication.run.runner import plan
 
 
@@ -37,6 +37,27 @@ def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
     train_cached(tmp_path, u.framework, u.spec(), u.protocol(), u.seed)
     again = estimate(units, tmp_path)
     assert again["trainings"] == 0 and again["cached"] == 1 and again["train_s"] == 0
+
+
+def test_wall_replays_the_pool_schedule():
+    # three equal trainings on two workers take two rounds, not one and a half
+    assert scheduled_wall([1.0, 1.0, 1.0], 2) == 2.0
+    # handed out longest first, each to the first worker free: 5 | 4, then 3 -> the 4, 2 -> the 5
+    assert scheduled_wall([5.0, 4.0, 3.0, 2.0], 2) == 7.0
+    assert scheduled_wall([5.0, 4.0], 1) == 9.0 and scheduled_wall([], 2) == 0.0
+    assert scheduled_wall([5.0], 0) == 5.0   # no workers named: one
+
+
+def test_estimate_wall_follows_the_executor_chains(tmp_path, monkeypatch):
+    from replication.run import estimate as E
+
+    monkeypatch.setattr(E, "_plain_step", lambda *a: 1.0)
+    monkeypatch.setattr(E, "_members_step", lambda *a: 1.0)
+    units = plan("smoke", claims=["dp_loss", "dp_energy"], frameworks=("jax", "torch"), models=["lnn", "baseline"])
+    est = estimate(units, tmp_path, jobs=2)
+    per_training = est["train_s"] / est["trainings"]   # each the same probed step: all alike
+    assert est["trainings"] == 4 and est["wall_s"] == pytest.approx(2 * per_training)
+    assert estimate(units, tmp_path, jobs=3)["wall_s"] == pytest.approx(2 * per_training)   # 4 on 3: two rounds
 
 
 def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, monkeypatch):
