@@ -22,9 +22,9 @@ ignore):
   fast_paper.csv  dof, framework, formulation, mode, batch, seconds, samples_per_s, flops_per_sample, gflops, threads
   matmul.csv      dof, framework, rows, seconds, gflops, threads           (`speedstudy.roofline`)
   structure.csv   per system: declared structure and what using it buys   (`speedstudy.structure`)
-  members.csv     framework, members, hidden, batch, steps, wall_s, step_s, samples_per_s, cost_vs_one:
-                  K models trained as one program against one alone, and one at K x the batch
-                  (`speedstudy.members`)
+  members.csv     framework, mode, members, hidden, batch, steps, wall_s, step_s, samples_per_s, cost_vs_one:
+                  K models trained as one program against one alone, and one at K x the batch, per step
+                  mode (PyTorch eager and torch.compile) (`speedstudy.members`)
   ratios.csv      operation, jax, torch, ratio, note                       (`speedstudy.tables`)
   targets.json    the issue's numeric targets (`speedstudy.targets.TARGETS`), each with the measured
                   values and met: true/false

@@ -17,26 +17,36 @@ from __future__ import annotations
 import numpy as np
 
 from speedstudy.bounds import TARGETS
-from speedstudy.members import MEMBERS
+from speedstudy.members import MEMBERS, MODES
 from speedstudy.tables import fastest_per_batch, row_value
 from speedstudy.train_target import ORIGINAL_SAMPLES, PAPER_L1, TARGET_SAMPLES
 
 
 def members_target(rows) -> dict:
-    """{framework: wall time of MEMBERS members over one model's}, the bound and whether both meet it; beside
-    them, `<framework>_one_at_k_batch`: one model at MEMBERS x the batch over one model (the same samples per
-    step as the members), the floor that vectorising the members can reach; `floor_above_target` says whether
-    a framework's floor alone already exceeds the bound (then the bound is out of reach on this machine at this
-    size, whatever the vectorising)."""
-    cost = {r["framework"]: r["cost_vs_one"] for r in rows if r["members"] == MEMBERS}
-    base = {r["framework"]: r["batch"] for r in rows if r["members"] == MEMBERS}
-    floor = {f"{r['framework']}_one_at_k_batch": r["cost_vs_one"] for r in rows
-             if r["members"] == 1 and r["batch"] == MEMBERS * base.get(r["framework"], 0)}
+    """{framework: wall time of MEMBERS members over one model's}, the bound and whether every framework meets
+    it in one of its step modes at least; a mode other than a framework's first (`speedstudy.members.MODES`:
+    PyTorch's torch.compile) is keyed `<framework>_<mode>`. Beside them, `<key>_one_at_k_batch`: one model at
+    MEMBERS x the batch over one model (the same samples per step as the members), the floor that vectorising
+    the members can reach; `floor_above_target` says whether a framework's lowest floor already exceeds the
+    bound (then the bound is out of reach on this machine at this size, whatever the vectorising). Rows
+    without a mode (speed studies before modes) count as the framework's first."""
+    def key(r):
+        mode = r.get("mode") or MODES.get(r["framework"], ("",))[0]
+        return r["framework"] if mode == MODES.get(r["framework"], (mode,))[0] else f"{r['framework']}_{mode}"
+
+    cost = {key(r): r["cost_vs_one"] for r in rows if r["members"] == MEMBERS}
+    base = {key(r): r["batch"] for r in rows if r["members"] == MEMBERS}
+    floor = {f"{key(r)}_one_at_k_batch": r["cost_vs_one"] for r in rows
+             if r["members"] == 1 and r["batch"] == MEMBERS * base.get(key(r), 0)}
     bound = TARGETS["members_cost_vs_one"]
+    frameworks = {r["framework"] for r in rows if r["members"] == MEMBERS}
+    best = {fw: min(v for k, v in cost.items() if k == fw or k.startswith(f"{fw}_")) for fw in frameworks}
     out = {**cost, **floor, "members": MEMBERS, "target": bound,
-           "met": bool(cost) and max(cost.values()) <= bound}
+           "met": bool(cost) and max(best.values()) <= bound}
     if floor:
-        out["floor_above_target"] = max(floor.values()) > bound
+        lowest = {fw: min(v for k, v in floor.items() if k.startswith(f"{fw}_")) for fw in frameworks
+                  if any(k.startswith(f"{fw}_") for k in floor)}
+        out["floor_above_target"] = max(lowest.values()) > bound
     return out
 
 

@@ -4,7 +4,8 @@ fallback. JAX needs none of this: its step is always jit-compiled.
 `compiled_loss(loss_fn, spec, protocol, members=1) -> CompiledLoss | loss_fn`: the loss as `train_torch.Stepper`
 and `Members` call it, `loss_fn(model, batch)`. `step_mode(loss) -> "compiled" | "eager" | "eager (...)"`: what
 a training phase ran, recorded in its outcome (`TrainOutcome.step_mode`). `like(spec, protocol, members=1)`: a
-context in which every phase compiles as a phase of `protocol` would.
+context in which every phase compiles as a phase of `protocol` would; `setting_as(value)`: one in which the
+setting is `value` (the speed study's members stage times PyTorch both ways).
 
 When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
   auto (default): where the model's loss is plain tensor ops and compiling pays (`models.torch.compiles`:
@@ -51,8 +52,15 @@ COMPILE_MIN_SAMPLES = 2_000_000
 def like(spec, protocol, members: int = 1):
     """Within it, every phase compiles exactly when a phase of `protocol` with `members` would (the duration
     estimate's short probes of a long phase: `replication.run.estimate`)."""
+    with setting_as("on" if wanted(spec, protocol, members) else "off"):
+        yield
+
+
+@contextlib.contextmanager
+def setting_as(value: str):
+    """Within it, `LAGBENCH_TORCH_COMPILE` is `value` (one of SETTINGS); put back after."""
     before = os.environ.get(ENV)
-    os.environ[ENV] = "on" if wanted(spec, protocol, members) else "off"
+    os.environ[ENV] = _valid(value)
     try:
         yield
     finally:
@@ -63,7 +71,10 @@ def like(spec, protocol, members: int = 1):
 
 
 def setting() -> str:
-    value = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    return _valid(os.environ.get(ENV, "auto").strip().lower() or "auto")
+
+
+def _valid(value: str) -> str:
     if value not in SETTINGS:
         raise ValueError(f"{ENV}={value!r}; valid: {', '.join(SETTINGS)}")
     return value
