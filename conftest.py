@@ -13,14 +13,31 @@ def _cache_dir(tmp_path_factory):
     yield
 
 
-# Under pytest-xdist (`tox` runs `pytest -n 2 --dist loadgroup`), each group runs whole on one worker: a
-# test file's tests together (its module fixtures are built once), and every user of an expensive
-# session fixture in one group, so that fixture is built once, not once per worker.
-SHARED_SESSION_FIXTURES = {"smoke_results": "smoke-run", "bench_dir": "tiny-bench"}
+# Under pytest-xdist (`tox` runs `pytest -n 2`), tests go to the workers in groups, each run whole on one
+# worker (`pytest_xdist_make_scheduler`): a test file's tests together, so that its module fixtures are built
+# once, and the files that use one expensive session fixture together, so that it is built once, not once
+# per worker. A test file that starts using one of these fixtures is listed here;
+# `tests/test_worker_groups.py` fails until it is.
+SHARED_SESSION_FIXTURES = {
+    "smoke_results": ("tests/replication/run/test_executor.py", "tests/replication/run/test_resume.py",
+                      "tests/replication/run/test_smoke.py", "tests/replication/training/test_hard_cases.py"),
+    "bench_dir": ("tests/speedstudy/test_bench_resume.py", "tests/speedstudy/test_speed_study.py"),
+}
+WORKER_GROUP = {path: fixture for fixture, paths in SHARED_SESSION_FIXTURES.items() for path in paths}
 
 
-def pytest_collection_modifyitems(config, items):
-    for item in items:
-        used = getattr(item, "fixturenames", ())
-        group = next((g for f, g in SHARED_SESSION_FIXTURES.items() if f in used), item.nodeid.split("::")[0])
-        item.add_marker(pytest.mark.xdist_group(group))
+def worker_group(nodeid: str) -> str:
+    """The group a test runs in: its session fixture's, or its file's."""
+    path = nodeid.split("::", 1)[0]
+    return WORKER_GROUP.get(path, path)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    from xdist.scheduler import LoadScopeScheduling
+
+    class ByWorkerGroup(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return worker_group(nodeid)
+
+    return ByWorkerGroup(config, log)
