@@ -71,6 +71,7 @@ def test_hnn_exports_and_matches_the_autograd_gradient():
         np.testing.assert_allclose(ydot.numpy(), -dh_dx.numpy(), rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.slow   # slow: the speed study's AOT path, 30-50 s of compiling; its lighter siblings stay in the default run
 def test_banded_lgn_exports_and_keeps_its_fallback():
     """The banded LGN (hand-written node derivatives, O(n) solve) exports; under export its fallback
     takes pinv on the gathered bad samples only. A batch with one non-finite state: the good samples

@@ -69,6 +69,7 @@ def _fn(a, b):
     return torch.sin(a) * b, torch.sum(a * b, dim=-1)
 
 
+@pytest.mark.slow   # slow: the speed study's AOT path, 30-50 s of compiling; its lighter siblings stay in the default run
 def test_fixed_batch_is_compiled_for_its_block_and_called_per_block():
     n = 3 * block_size(5) + 7
     n_blocks, block = block_plan(n, 5)
@@ -96,6 +97,7 @@ def test_any_batch_library_blocks_large_batches_only():
         assert len(calls) == (1 if block_plan(n, 5) is None else 3) and sum(calls) >= n
 
 
+@pytest.mark.slow   # slow: the speed study's AOT path, 30-50 s of compiling; its lighter siblings stay in the default run
 def test_traced_solve_compiled_takes_pinv_only_where_bad():
     """The make_fx-traced inference solve (its pinv in a torch.cond), exported and compiled for two batch
     sizes in turn (the second once failed to export: dynamo had made the size dynamic): pinv's answer on
