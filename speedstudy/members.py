@@ -7,8 +7,9 @@ angles wrapped, velocity inputs x 0.3) at `sizes.members_hidden` (quick: 3 x 128
 guard on, `sizes.members_steps` steps per round. Per framework and step mode (JAX "jit"; PyTorch "eager" and,
 where `sizes.torch_compile`, "compiled": the training loss under torch.compile as the runs' long phases train
 it, `compile_torch`), rounds alternate one model and K members (`members_rounds` of each, interleaved, so that
-load on the shared machine falls on both alike); each keeps its fastest round. The JAX step is built once per case and warmed up before
-the first round; a PyTorch round's first step (a capture, under torch.compile) is left out of its times.
+load on the shared machine falls on both alike); each keeps its fastest round. The JAX step is built once per
+case and warmed up before the first round; every round's first step (a capture, under torch.compile) is left
+out of its times.
 
 `members_rows(sizes) -> rows` {framework, mode, members, hidden, batch, steps, wall_s, step_s, samples_per_s,
 cost_vs_one, step_cost_vs_one}: wall_s is the whole loop after the first step (batches drawn in NumPy, the
