@@ -31,21 +31,22 @@ def members_target(rows) -> dict:
     bound (then the bound is out of reach on this machine at this size, whatever the vectorising). Rows
     without a mode (speed studies before modes) count as the framework's first."""
     def key(r):
-        mode = r.get("mode") or MODES.get(r["framework"], ("",))[0]
-        return r["framework"] if mode == MODES.get(r["framework"], (mode,))[0] else f"{r['framework']}_{mode}"
+        first = MODES.get(r["framework"], (None,))[0]
+        mode = r.get("mode") or first
+        return r["framework"] if mode == first else f"{r['framework']}_{mode}"
 
-    cost = {key(r): r["cost_vs_one"] for r in rows if r["members"] == MEMBERS}
+    cost, floor, best, lowest = {}, {}, {}, {}   # best / lowest: per framework, over its modes
     base = {key(r): r["batch"] for r in rows if r["members"] == MEMBERS}
-    floor = {f"{key(r)}_one_at_k_batch": r["cost_vs_one"] for r in rows
-             if r["members"] == 1 and r["batch"] == MEMBERS * base.get(key(r), 0)}
+    for r in rows:
+        fw, c = r["framework"], r["cost_vs_one"]
+        if r["members"] == MEMBERS:
+            cost[key(r)], best[fw] = c, min(c, best.get(fw, c))
+        elif r["members"] == 1 and r["batch"] == MEMBERS * base.get(key(r), 0):
+            floor[f"{key(r)}_one_at_k_batch"], lowest[fw] = c, min(c, lowest.get(fw, c))
     bound = TARGETS["members_cost_vs_one"]
-    frameworks = {r["framework"] for r in rows if r["members"] == MEMBERS}
-    best = {fw: min(v for k, v in cost.items() if k == fw or k.startswith(f"{fw}_")) for fw in frameworks}
     out = {**cost, **floor, "members": MEMBERS, "target": bound,
            "met": bool(cost) and max(best.values()) <= bound}
     if floor:
-        lowest = {fw: min(v for k, v in floor.items() if k.startswith(f"{fw}_")) for fw in frameworks
-                  if any(k.startswith(f"{fw}_") for k in floor)}
         out["floor_above_target"] = max(lowest.values()) > bound
     return out
 

@@ -17,9 +17,10 @@ rounding (fused kernels reassociate sums).
 Costs and requirements: compiling takes 15-40 s and needs a C++ compiler (gcc; what inductor uses on
 CPU) and a private folder for the generated code (`models.torch.inductor_cache`). The compiled kernels use
 OpenMP: for a one-core control loop set OMP_NUM_THREADS=1 before the process starts (measured: DeLaN
-3 x 128 one-sample inverse dynamics 12.3k calls/s with it, 6.5k without, eager 1.0-1.3k). Inputs must already have the compiled shape and dtype (torch tensors); anything else
-raises a ValueError naming the input. `compile_batched` exports with a dynamic batch dimension (one
-library for every batch size; the speed study's "aoti" mode); code that fixes the batch size while
+3 x 128 one-sample inverse dynamics 12.3k calls/s with it, 6.5k without, eager 1.0-1.3k). Inputs must
+already have the compiled shape and dtype (torch tensors); anything else raises a ValueError naming the
+input. `compile_batched` exports with a dynamic batch dimension (one library for every batch size; the
+speed study's "aoti" mode); code that fixes the batch size while
 tracing fails there with torch's constraint error, and `compile_batched(..., batch=B)` compiles it for
 that one batch size instead. `compile_batched(..., rows_per_sample=k)` calls large batches in cache-sized
 row blocks (`BlockedMethod`, the blocks of `models.row_blocks`), as the JAX models compute them; a
