@@ -67,7 +67,7 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 # above the 0.3 asked of quick (JAX 0.249 / 0.308 / 0.257, PyTorch 0.323 / 0.302 / 0.275). Each chosen scout
 # replayed and continued on its own stream (one thread each, two at a time; held-out L1 on the quick
 # run's 20 000 states; `docs/train_target_trials.md` section 16):
-#   4e6 (15 625 steps): JAX 0.249 / 0.308 / 0.257, PyTorch seed 0 0.323 (the run's numbers, bit for bit)
+#   4e6 (15 625 steps): JAX 0.249 / 0.308 / 0.257, PyTorch seed 0 0.323 (the run's numbers to 4 digits)
 #   5e6 (19 531 steps): JAX 0.212 / 0.250 / 0.221
 #   6e6 (23 437 steps): JAX 0.179 / 0.220 / 0.193, PyTorch 0.236 / 0.218 (seeds 0, 1)
 #   8e6 as 15 625 steps at batch 512: JAX 0.211 / 0.256, and slower than 6e6 at batch 256
