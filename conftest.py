@@ -5,6 +5,14 @@ import os
 
 import pytest
 
+from replication.run.environment import one_thread_env
+
+# Under pytest-xdist the workers share the machine's cores, so each computes on one thread (JAX's XLA,
+# PyTorch, OpenMP, MKL), as the replication's own worker processes do. Set here, before any test module
+# imports JAX or PyTorch; a test that needs other threads sets them itself.
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    os.environ.update(one_thread_env(os.environ))
+
 
 @pytest.fixture(scope="session", autouse=True)
 def _cache_dir(tmp_path_factory):
