@@ -135,7 +135,7 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
                  f"restarts; the chosen one continued for {fast_rest} steps at batch {FAST_BATCH}, peak {FAST_LR:g} "
                  f"(a new one-cycle, fresh Adam state). Samples count every scout")
     # restarts_halved: restarts_fast's scouts and continuation, HALVED_SEEDS scouts halved to HALVED_KEEP (at
-    # 3.5e7 samples the full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`)
+    # 4e7 samples the full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`)
     halved = fast.replace(scouts=HALVED_SEEDS, scout_keep=HALVED_KEEP)
     halved = halved.replace(steps=max((budget - scouting.scouting_samples(halved)) // FAST_BATCH, 1))
     halved_text = (f"{HALVED_SEEDS} seeds scouted at batch {var.batch}, peak {var.lr:g}, for {scout} steps; at step "

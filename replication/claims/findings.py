@@ -89,7 +89,7 @@ FINDINGS = [
             "halving; never the held-out set), the lowest of those continued for 6e6 samples at batch 256, peak "
             "1e-2, its one-cycle started at phase 0.1 (the scouts' 0.2 threw a near-physical Lagrangian away); the "
             "gradient-spike guard (clip 100, skip at 10x the median norm) and velocity inputs scaled by 0.3; 1.1e7 "
-            "samples in all against the code's 3e8 (full: the same halving, 3.5e7, continued at peak 2e-3). The paper "
+            "samples in all against the code's 3e8 (full: the same halving, 4e7, continued at peak 2e-3). The paper "
             "profile keeps the code's recipe",
             ("double_pendulum",), ("scouts", "scout_keep", "scout_steps", "scout_lr", "lr", "lr_start", "grad_clip",
                                    "spike_skip", "input_scale")),

@@ -104,7 +104,7 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
 
 
 def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured():
-    """full's claims 1-2 cite the time-to-target run of restarts_halved at 3.5e7 samples: the same training."""
+    """full's claims 1-2 train what restarts_halved trains at FULL_SAMPLES (4e7): the same protocol."""
     from replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
     full = PROTOCOLS["full"]
     entry = TT.protocols(FULL_SAMPLES, full.n_heldout)["restarts_halved"]
