@@ -40,7 +40,7 @@ CLAIM = Claim(
     id="init_study", number=6, paper="LNN", section="Appendix C",
     title="The empirical initialisation trains faster than standard initialisations",
     system="double_pendulum", models=MODELS, protocols=PROTOCOLS, evaluate="pace",
-    metric="left_plateau", metric_label="share of seeds off the q-double-dot ~ 0 plateau after a fixed budget",
+    metric="left_plateau", metric_label="share of seeds whose held-out L1 is off the q-double-dot ~ 0 plateau at the end of the budget",
     published={},
     verdict_rule="cranmer2020 leaves the plateau in fewer samples than every other init (one-sided "
                  "Mann-Whitney over seeds, p < 0.05 / 3; partly: than some)",
