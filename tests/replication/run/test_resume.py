@@ -74,6 +74,24 @@ def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatc
     assert R.load_result(new.parent)["train_steps"] - R.load_result(old.parent)["train_steps"] == 7 - 20
 
 
+def test_a_dry_run_of_a_finished_folder_says_so_and_writes_nothing(tmp_path, monkeypatch, capsys):
+    from replication.claims import get
+
+    kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
+              progress=False)
+    run(**kw)
+    before = sorted((str(p), p.stat().st_mtime_ns) for p in tmp_path.rglob("*"))
+    capsys.readouterr()
+    assert run(**kw, dry_run=True) == {"dry_run": True, "units": 1, "todo": 0, "estimate": None}
+    assert "1 units, every one finished" in capsys.readouterr().out
+    claim = get("dp_loss")   # a changed protocol: the dry run counts the unit as to run, and still writes nothing
+    monkeypatch.setitem(claim.protocols, "smoke", claim.protocols["smoke"].replace(steps=7))
+    monkeypatch.setattr("replication.run.runner.announce", lambda *a, **k: {"probed": True})
+    assert run(**kw, dry_run=True)["todo"] == 1
+    assert "nothing to run" not in capsys.readouterr().out
+    assert sorted((str(p), p.stat().st_mtime_ns) for p in tmp_path.rglob("*")) == before
+
+
 def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
     from replication.claims import get
 
