@@ -30,7 +30,7 @@ CLAIM = Claim(
     id="activation_study", number=7, paper="LNN", section="§4, activation functions",
     title="Softplus beats ReLU^2, ReLU^3, tanh, sigmoid; plain ReLU cannot work",
     system="double_pendulum", models=MODELS, protocols=init_study.PROTOCOLS, evaluate="pace",
-    metric="left_plateau", metric_label="share of seeds whose held-out L1 is off the q-double-dot ~ 0 plateau at the end of the budget",
+    metric="left_plateau", metric_label=init_study.METRIC_LABEL,
     published={},
     verdict_rule="softplus leaves the plateau in fewer samples than every other activation, relu included "
                  "(one-sided Mann-Whitney over seeds, p < 0.05 / 5), and relu leaves it in no seed "

@@ -221,7 +221,8 @@ def faster(ours: str, others: tuple, pace: str = "samples_to_leave", alpha: floa
             hits = sorted(x for x in vals if math.isfinite(x))
             med = f"median {hits[len(hits) // 2]:.3g}" if hits else "never"
             parts.append(f"{k} {_share(len(hits), len(vals))}, {med}")
-        text = f"{pace} (seeds whose logged training loss got there within the budget, 95 % Wilson interval, median): " + "; ".join(parts)
+        text = (f"{pace} (seeds whose logged training loss got there within the budget, 95 % Wilson "
+                "interval, median): " + "; ".join(parts))
         if not any(math.isfinite(x) for k in (ours, *rest) for x in _get(v, k, pace).values):
             return "inconclusive", text + ": no seed of any model got there"
         level = alpha / len(rest)

@@ -172,8 +172,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
         if not todo:   # said, not left to silence: a finished folder is an answer too
-            print(f"lagbench: profile {profile}: {len(units)} units, every one finished in {out}: nothing to run",
-                  flush=True)
+            print(f"lagbench: profile {profile}: {len(units)} units, every one finished in {out}: "
+                  "nothing to run", flush=True)
         return {"dry_run": True, "units": len(units), "todo": len(todo),
                 "estimate": announce(profile, units, todo, out, jobs, executor) if todo else None}
     out = R.output_folder(out, "--out")
