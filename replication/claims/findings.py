@@ -77,7 +77,7 @@ FINDINGS = [
             "q̈ ≈ 0 plateau), the LNN sees q unscaled; the canonical HNN sees q / 10 and p / 100; restarts over 8 "
             "inits, peak 1e-2 (the canonical HNN 3e-3). γ holds in every profile; the paper profile keeps the "
             "code's rate without restarts and the canonical HNN's inputs. The original's q̇-only LNN runs "
-            "beside, outside the verdict",
+            "beside in smoke and paper, outside the verdict",
             ("relativ",), ("lorentz_factor", "input_scale", "lr", "scouts")),
     Finding("Relativistic data quirk", "not stated",
             "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",
