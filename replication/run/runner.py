@@ -171,11 +171,13 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     units = plan(profile, claims, frameworks, seeds, models)
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
-        if not todo:   # said, not left to silence: a finished folder is an answer too
+        if todo:
+            estimate = announce(profile, units, todo, out, jobs, executor)
+        else:   # said, not left to silence: a finished folder is an answer too
+            estimate = None
             print(f"lagbench: profile {profile}: {len(units)} units, every one finished in {out}: "
                   "nothing to run", flush=True)
-        return {"dry_run": True, "units": len(units), "todo": len(todo),
-                "estimate": announce(profile, units, todo, out, jobs, executor) if todo else None}
+        return {"dry_run": True, "units": len(units), "todo": len(todo), "estimate": estimate}
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,

@@ -80,7 +80,8 @@ def test_a_dry_run_of_a_finished_folder_says_so_and_writes_nothing(tmp_path, mon
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
               progress=False)
     run(**kw)
-    before = sorted((str(p), p.stat().st_mtime_ns) for p in tmp_path.rglob("*"))
+    snapshot = lambda: sorted((str(p), p.stat().st_mtime_ns) for p in tmp_path.rglob("*"))  # noqa: E731
+    before = snapshot()
     capsys.readouterr()
     assert run(**kw, dry_run=True) == {"dry_run": True, "units": 1, "todo": 0, "estimate": None}
     assert "1 units, every one finished" in capsys.readouterr().out
@@ -89,7 +90,7 @@ def test_a_dry_run_of_a_finished_folder_says_so_and_writes_nothing(tmp_path, mon
     monkeypatch.setattr("replication.run.runner.announce", lambda *a, **k: {"probed": True})
     assert run(**kw, dry_run=True)["todo"] == 1
     assert "nothing to run" not in capsys.readouterr().out
-    assert sorted((str(p), p.stat().st_mtime_ns) for p in tmp_path.rglob("*")) == before
+    assert snapshot() == before
 
 
 def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
