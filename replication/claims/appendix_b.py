@@ -3,7 +3,7 @@
 No training: the exact Lagrangian of `systems.get("free_fall")` is written as a model and passed
 through each framework's Euler-Lagrange routine, in both formulations, in float64.
 """
-from replication.claims.base import Claim, ModelEntry
+from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.published import Published
 from replication.claims.rules import bound
 from replication.training.protocol import Protocol
@@ -20,6 +20,7 @@ CLAIM = Claim(
     evaluate="exact_lagrangian", metric="max_abs_err", metric_label="max |qdd - (-g, 0)| over random states",
     published={m.label: Published(0.0, "exact", "LNN Appendix B: qdd = (-g, 0) analytically",
                                   metric="max_abs_err") for m in MODELS},
-    verdict_rule="max error <= 1e-12 (float64)", verdict=bound("max_abs_err", upper=1e-12),
+    verdict_rule="max error <= 1e-12 (float64)", kind="check",
+    parts=(Part("exact free fall", bound("max_abs_err", upper=1e-12), reads=tuple(m.label for m in MODELS)),),
     seeds={"smoke": 1, "quick": 1, "paper": 1},
 )

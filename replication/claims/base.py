@@ -4,15 +4,17 @@ A `Claim` names a paper result and everything needed to check it: the system, th
 `ModelEntry`: a label, ModelSpec fields, protocol overrides), the protocol per profile, the
 evaluation routine (a name in `replication.evaluation.registry.EVALUATIONS`), the metric the verdict reads,
 the published values (`published.Published`, each with what it is), the competence bars its models
-must pass (`bars.Bar`), and the verdict rule (built from `rules`: a function of
-{model label: {metric: Stat}} for one framework, returning (verdict, reason)). Where a verdict is
-decided: `replication.claims.verdicts.judge` (bars, then the rule, on seed means and on every seed).
+must pass (`bars.Bar`), its parts (`parts.Part`: each a rule from `rules`, the models it reads and its
+positive controls; sanity checks among them marked as such) and its variants (`parts.Variant`: models
+with a departure from the paper, judged on their own line). ``kind`` is "claim" for a paper claim and
+"check" for an implementation or numerics check, reported apart and not counted among the claims.
+Where a verdict is decided: `replication.claims.verdicts.judge`.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from replication.claims.parts import Part, Variant
 from replication.claims.rules import VERDICTS
 from replication.training.protocol import Protocol
 
@@ -20,7 +22,8 @@ PROFILES = ("smoke", "quick", "full", "paper")
 # a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`
 # except where a claim says otherwise (longer budgets, more seeds, the paper's evaluation horizon)
 PROFILE_PARENT = {"full": "quick"}
-__all__ = ["PROFILES", "PROFILE_PARENT", "VERDICTS", "Claim", "ModelEntry", "per_profile"]
+KINDS = ("claim", "check")
+__all__ = ["PROFILES", "PROFILE_PARENT", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
 
 
 def per_profile(table: dict, profile: str, default=None):
@@ -85,12 +88,25 @@ class Claim:
     metric_label: str
     published: dict          # model label -> Published (only numbers a paper or its repository prints)
     verdict_rule: str
-    verdict: Callable        # {label: {metric: Stat}} -> (verdict, reason), built from `rules`
-    bars: tuple = ()         # competence bars (`bars.Bar`); a model below its bar -> "inconclusive"
+    parts: tuple             # `parts.Part`s: the claim's verdict is `parts.claim_verdict` of the counted ones
+    bars: tuple = ()         # competence bars (`bars.Bar`); a model below its bar -> its parts "inconclusive"
+    variants: tuple = ()     # `parts.Variant`s: departures from the paper, each judged on its own line
+    kind: str = "claim"      # "claim" (a paper claim) or "check" (implementation, numerics)
     key: str = ""            # the model whose number the scorecard shows (default: the first)
     seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": 3, "paper": 3})
     eval_config: dict = field(default_factory=dict)   # profile -> dict of evaluation settings
     pooled: bool = False     # the rule reads the seeds as one sample (a share), not each seed as a replication
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"claim {self.id}: kind must be one of {KINDS}, got {self.kind!r}")
+        labels = {m.label for m in self.models}
+        named = {x for p in self.parts for x in (*p.reads, *p.controls)}
+        named |= {x for v in self.variants for pair in v.replaces for x in pair}
+        if named - labels:
+            raise ValueError(f"claim {self.id}: parts or variants name unknown models {sorted(named - labels)}")
+        if not any(not p.check for p in self.parts):
+            raise ValueError(f"claim {self.id}: no part that counts (every part is a check)")
 
     def entry(self, label: str) -> ModelEntry:
         for m in self.models:
@@ -103,7 +119,8 @@ class Claim:
                 "title": self.title, "system": self.system, "models": [m.label for m in self.models],
                 "metric": self.metric, "metric_label": self.metric_label,
                 "published": {k: p.to_dict() for k, p in self.published.items()},
-                "verdict_rule": self.verdict_rule, "bars": [b.describe() for b in self.bars],
+                "kind": self.kind, "verdict_rule": self.verdict_rule, "bars": [b.describe() for b in self.bars],
+                "parts": [p.describe() for p in self.parts], "variants": [v.describe() for v in self.variants],
                 "key": self.key_model, "seeds": dict(self.seeds), "pooled": self.pooled,
                 "protocol": {p: pr.to_dict() for p, pr in self.protocols.items()}}
 

@@ -2,17 +2,18 @@
 
 ``units`` is the table of summary/units.csv (``frame(records)`` builds it from result.json records):
 one row per unit with claim, framework, model, seed, status, its metrics and ``final_train_loss``.
-Per framework, on the units whose status is "ok":
+Each part of the claim (``claims.parts``) is decided per framework, on the units whose status is "ok":
 
-1. a model the claim runs in ``profile`` whose every unit failed makes the verdict "inconclusive"
-   (failed units never count; the reason names them); a model with no unit at all, "not run";
-2. the competence bars (``claims.bars``): a model below its bar -> "inconclusive", with the numbers;
-3. the claim's rule (``claims.rules``) on the seed statistics; then on every seed alone: a mean that
-   reproduces while some seed does not is only "partly" (not for a ``pooled`` claim, whose rule reads
-   the seeds as one sample: a share with its interval).
+1. a model the part reads (or controls) whose every unit failed makes the part "inconclusive" (failed
+   units never count; the reason names them); a model with no unit at all, "not run";
+2. the competence bars (``claims.bars``): a model the part reads below its bar -> "inconclusive", with
+   the numbers; a positive control below its bar -> "inconclusive" (a failure says nothing then);
+3. the part's rule (``claims.rules``) on the seed statistics, which reads an interval over seeds.
 
-The frameworks' verdicts combine into one: equal -> that one; any "inconclusive" -> "inconclusive";
-otherwise "partly".
+A part's frameworks combine by ``parts.combine_frameworks`` (decided verdicts that differ:
+"inconclusive", flagged "frameworks disagree"); the claim's verdict is ``parts.claim_verdict`` of its
+counted parts (sanity checks apart). Each variant (``parts.Variant``) is judged the same way with its
+units in the paper model's place, on its own line.
 """
 from __future__ import annotations
 
@@ -24,7 +25,8 @@ import pandas as pd
 from replication import results as R
 from replication.claims import CLAIMS
 from replication.claims.bars import competence
-from replication.claims.rules import Stat
+from replication.claims.parts import claim_verdict, combine_frameworks
+from replication.claims.rules import Outcome, Stat
 
 KEYS = ("claim", "framework", "model", "seed", "status")
 
@@ -76,59 +78,114 @@ def model_stats(units: pd.DataFrame) -> dict:
     return out
 
 
-def _decide(claim, v: dict, failed: dict) -> tuple[str, str, dict]:
-    """(verdict, reason, {label: (passed, why)}) for one framework's (or one seed's) statistics."""
-    if failed:
-        why = "; ".join(f"{m}: every unit failed ({k})" for m, k in failed.items())
-        return "inconclusive", f"no usable model: {why}", {}
-    ok, why, per = competence(claim.bars, v)
-    if not ok:
-        return "inconclusive", "below the competence bar: " + "; ".join(why), per
-    verdict, reason = claim.verdict(v)
-    return verdict, reason, per
+def _decide_part(part, v: dict, per: dict, failed: dict) -> Outcome:
+    """One part's outcome in one framework: usable models, their bars, the positive controls, the rule."""
+    needed = (*part.reads, *part.controls)
+    gone = [m for m in needed if m in failed]
+    if gone:
+        return Outcome("inconclusive", "no usable model: " + "; ".join(f"{m}: every unit failed ({failed[m]})"
+                                                                      for m in gone))
+    missing = [m for m in needed if m not in v]
+    if missing:
+        return Outcome("not run", "missing " + ", ".join(missing))
+    below = [per[m][1] for m in part.reads if m in per and not per[m][0]]
+    if below:
+        return Outcome("inconclusive", ("inconclusive: budget; " if part.budget else "")
+                       + "below the competence bar: " + "; ".join(below) + (f" ({part.budget})" if part.budget else ""))
+    weak = [per[m][1] if m in per else f"{m}: no bar" for m in part.controls if not per.get(m, (False, ""))[0]]
+    if weak:
+        return Outcome("inconclusive", "the positive control did not learn, so a failure says nothing: "
+                       + "; ".join(weak))
+    return part.rule(v)
 
 
-def _combine(verdicts) -> str:
-    run = set(verdicts)
-    if len(run) == 1:
-        return run.pop()
-    return "inconclusive" if "inconclusive" in run else "partly"
+def _framework(claim, s: pd.DataFrame, labels) -> tuple[dict, dict, dict, int]:
+    """({part: Outcome}, competence {label: (passed, why)}, stats, failed units) of one framework's rows."""
+    ok = s[s["status"] == "ok"]
+    bad = s[s["status"] != "ok"]
+    failed = {m: ", ".join(sorted({k for k in g.get("failure", ()) if isinstance(k, str)})) or "failed"
+              for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
+    v = model_stats(ok)
+    _, _, per = competence(claim.bars, v)
+    return {p.name: _decide_part(p, v, per, failed) for p in _active(claim, labels)}, per, v, len(bad)
+
+
+def _active(claim, labels) -> list:
+    """The parts whose models run in the profile."""
+    return [p for p in claim.parts if p.runs_in(labels)]
+
+
+def _parts(claim, per_fw: dict, labels) -> list:
+    out = []
+    for part in _active(claim, labels):
+        res = {fw: o[part.name] for fw, o in per_fw.items()}
+        verdict, flag = combine_frameworks({fw: o.verdict for fw, o in res.items()})
+        out.append({**part.describe(), "verdict": verdict, "flag": flag,
+                    "by_framework": {fw: o.verdict for fw, o in res.items()},
+                    "reason": {fw: o.reason for fw, o in res.items()},
+                    "interval": {fw: o.interval.to_dict() for fw, o in res.items() if o.interval is not None},
+                    "sensitivity": {fw: dict(o.sensitivity) for fw, o in res.items() if o.sensitivity}})
+    return out
+
+
+def _counted(parts) -> dict:
+    return {p["name"]: p["verdict"] for p in parts if not p["check"]}
+
+
+def _judge_parts(claim, sub: pd.DataFrame, labels) -> tuple[dict, list, dict]:
+    """(per-framework detail, the parts combined over frameworks, per-framework claim verdicts)."""
+    detail, per_fw = {}, {}
+    for fw in sorted(set(sub["framework"])) if len(sub) else []:
+        outcomes, per, v, n_bad = _framework(claim, sub[sub["framework"] == fw], labels)
+        per_fw[fw] = outcomes
+        detail[fw] = (per, v, n_bad)
+    parts = _parts(claim, per_fw, labels)
+    by_fw = {fw: claim_verdict({p.name: o[p.name].verdict for p in _active(claim, labels) if not p.check})[0]
+             for fw, o in per_fw.items()}
+    return detail, parts, by_fw
+
+
+def _variant(claim, var, sub: pd.DataFrame, labels) -> dict:
+    """The claim judged with each variant model's units in its paper model's place."""
+    line = {**var.describe(), "verdict": "not run", "reason": "the variant's models did not run", "parts": [],
+            "by_framework": {}}
+    if not len(sub) or not all(v in set(sub["model"]) for _, v in var.replaces):
+        return line
+    swap = dict((v, p) for p, v in var.replaces)
+    rows = sub[~sub["model"].isin([p for p, _ in var.replaces])].copy()
+    rows["model"] = rows["model"].map(lambda m: swap.get(m, m))
+    _, parts, by_fw = _judge_parts(claim, rows, labels)
+    verdict, why = claim_verdict(_counted(parts))
+    return {**line, "verdict": verdict, "reason": why, "parts": parts, "by_framework": by_fw}
 
 
 def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
     """The claim's verdict from ``units`` (rows of any claims; see the module docstring)."""
     sub = units[units["claim"] == claim.id] if len(units) else units
-    entry = {"id": claim.id, "verdict": "not run", "reason": "no finished units", "by_framework": {},
-             "values": {}, "by_seed": {}, "competence": {}, "failed_units": {}}
-    labels = claim.labels(profile)
-    reasons = []
-    for fw in sorted(set(sub["framework"])) if len(sub) else []:
-        s = sub[sub["framework"] == fw]
-        ok = s[s["status"] == "ok"]
-        bad = s[s["status"] != "ok"]
-        failed = {m: ", ".join(sorted({k for k in g.get("failure", ()) if isinstance(k, str)})) or "failed"
-                  for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
-        v = model_stats(ok)
-        verdict, reason, per = _decide(claim, v, failed)
-        seeds = sorted(set(ok["seed"]))
-        per_seed = [_decide(claim, model_stats(ok[ok["seed"] == k]), failed)[0] for k in seeds]
-        entry["by_seed"][fw] = {f"seed{k}": x for k, x in zip(seeds, per_seed, strict=True)}
-        if len(seeds) > 1 and verdict not in ("inconclusive", "not run") and not claim.pooled:
-            agree = sum(x == verdict for x in per_seed)
-            reason += f" [seeds: {agree}/{len(seeds)} give '{verdict}' alone]"
-            if verdict == "reproduced" and agree < len(seeds):
-                verdict, reason = "partly", reason + "; only partly: not every seed reproduces"
-        if len(bad):
-            entry["failed_units"][fw] = len(bad)
-            reason += f" ({len(bad)} failed unit{'s' if len(bad) > 1 else ''} excluded)"
-        entry["by_framework"][fw] = verdict
+    entry = {"id": claim.id, "kind": claim.kind, "verdict": "not run", "reason": "no finished units",
+             "by_framework": {}, "parts": [], "variants": [], "flags": [], "values": {}, "competence": {},
+             "failed_units": {}}
+    if not len(sub):
+        return entry
+    # a profile's models; without one, the models that ran (a report of an unnamed profile)
+    labels = claim.labels(profile) if profile is not None else [m for m in claim.labels() if m in set(sub["model"])]
+    detail, parts, by_fw = _judge_parts(claim, sub, labels)
+    for fw, (per, v, n_bad) in detail.items():
+        if n_bad:
+            entry["failed_units"][fw] = n_bad
         entry["competence"][fw] = {m: {"passed": p, "why": w} for m, (p, w) in per.items()}
         entry["values"][fw] = {m: {"mean": st[claim.metric].mean, "std": st[claim.metric].std,
                                    "n": st[claim.metric].n} for m, st in v.items() if claim.metric in st}
-        reasons.append(f"{fw}: {reason}")
-    if entry["by_framework"]:
-        entry["verdict"] = _combine(entry["by_framework"].values())
-        entry["reason"] = " | ".join(reasons)
+    verdict, why = claim_verdict(_counted(parts))
+    lines = [f"{p['name']}{' (check)' if p['check'] else ''}: {p['verdict']}"
+             + (f" ({p['flag']})" if p["flag"] else "") + " [" + " | ".join(f"{fw}: {r}" for fw, r in p["reason"].items())
+             + "]" for p in parts]
+    n_bad = sum(entry["failed_units"].values())
+    entry.update(verdict=verdict, by_framework=by_fw, parts=parts,
+                 reason=f"{why}. " + "; ".join(lines)
+                 + (f" ({n_bad} failed unit{'s' if n_bad > 1 else ''} excluded)" if n_bad else ""),
+                 flags=[f"{p['name']}: {p['flag']}" for p in parts if p["flag"]],
+                 variants=[_variant(claim, var, sub, labels) for var in claim.variants])
     return entry
 
 
@@ -136,8 +193,21 @@ def judge_all(units: pd.DataFrame, profile: str | None) -> list:
     return [judge(c, units, profile) for c in CLAIMS.values()]
 
 
+def headline(judged: list) -> dict:
+    """The count of paper claims (checks apart) per verdict."""
+    out = {}
+    for kind in ("claim", "check"):
+        counts = {}
+        for v in judged:
+            if v.get("kind", "claim") == kind:
+                counts[v["verdict"]] = counts.get(v["verdict"], 0) + 1
+        out[kind + "s"] = counts
+    return out
+
+
 def write_summary(out, profile: str) -> dict:
     df = collect_units(out)
     R.write_csv(Path(out) / "summary" / "units.csv", df)
-    verdicts = {"schema": R.SCHEMA, "profile": profile, "claims": judge_all(df, profile)}
+    judged = judge_all(df, profile)
+    verdicts = {"schema": R.SCHEMA, "profile": profile, "headline": headline(judged), "claims": judged}
     return R.write_json(Path(out) / "summary" / "verdicts.json", verdicts)

@@ -1,10 +1,13 @@
-"""No claim is ever reproduced by a model that learned nothing.
+"""No claim, part or variant is ever reproduced by a model that learned nothing.
 
 For every claim, each model of its smoke profile is replaced by a null model, evaluated by the claim's
 own evaluation routine, for three seeds, and the verdict path (`replication.claims.verdicts.judge`) runs on the
 resulting unit records: predicting zero, the untrained initialisation (the real init numbers, through
-the PyTorch adapter), and a model whose rollouts diverge. None may come out "reproduced" or "partly".
+the PyTorch adapter), and a model whose rollouts diverge. No claim may come out "reproduced" or "partly",
+no part that counts "reproduced", no variant "reproduced" or "partly".
 Appendix B trains nothing: its null is an Euler-Lagrange routine that returns zero or inf.
+A positive control passes with a model that learned and fails with a null, through the same pipeline.
+(`test_verdicts.py` puts a null in every slot a claim needs to succeed, one at a time, for every claim.)
 """
 import numpy as np
 import pytest
@@ -61,6 +64,8 @@ def test_a_null_model_never_reproduces_a_claim(cid, kind, monkeypatch):
     v = judge(claim, frame(_records(claim, kind, monkeypatch)), "smoke")
     assert v["verdict"] not in ("reproduced", "partly"), v["reason"]
     assert v["verdict"] in ("inconclusive", "not reproduced"), v["reason"]
+    assert not [p["name"] for p in v["parts"] if not p["check"] and p["verdict"] == "reproduced"], v["reason"]
+    assert all(x["verdict"] not in ("reproduced", "partly") for x in v["variants"]), v["variants"]
     if claim.bars:   # a learned claim: the null is caught by its competence bar, before any rule
         assert v["verdict"] == "inconclusive" and "below the competence bar" in v["reason"], v["reason"]
 
@@ -68,8 +73,12 @@ def test_a_null_model_never_reproduces_a_claim(cid, kind, monkeypatch):
 @pytest.mark.parametrize("cid, kinds, expected", [
     # both learned, with the same small error: similar held-out loss
     ("dp_loss", {"lnn": "learned", "baseline": "learned"}, "reproduced"),
-    # the LNN learned, DeLaN predicts nothing: the LNN is far better on both systems
-    ("delan_table1", {"lnn_relativistic": "learned", "lnn_magnetic": "learned"}, "reproduced"),
+    # the LNN learned, DeLaN predicts nothing, and DeLaN's positive control (the pendulum) learned: the LNN
+    # is far better on both systems
+    ("delan_table1", {"lnn_relativistic": "learned", "lnn_magnetic": "learned", "delan_control": "learned"},
+     "reproduced"),
+    # the same, but DeLaN fails its control as well: a DeLaN that learns nothing says nothing
+    ("delan_table1", {"lnn_relativistic": "learned", "lnn_magnetic": "learned"}, "inconclusive"),
     # the LNN learned, the baseline did not: no comparison
     ("dp_loss", {"lnn": "learned", "baseline": "zero"}, "inconclusive"),
     ("dp_energy", {"lnn": "learned", "baseline": "diverging"}, "inconclusive"),
@@ -80,5 +89,7 @@ def test_models_that_learned_are_judged_and_a_null_beside_them_is_caught(cid, ki
     claim = CLAIMS[cid]
     v = judge(claim, frame(_records(claim, "zero", monkeypatch, kinds)), "smoke")
     assert v["verdict"] == expected, v["reason"]
+    if expected == "inconclusive" and cid == "delan_table1":
+        assert "positive control did not learn" in v["reason"], v["reason"]
     learned = [m for m, k in kinds.items() if k == "learned"]
     assert all(v["competence"]["torch"][m]["passed"] for m in learned), v["competence"]

@@ -1,17 +1,20 @@
 """The verdict vocabulary (`replication.claims.rules`) and the competence bars, on synthetic seed values:
-each rule reproduces, half-reproduces, fails, and stays inconclusive where the seed ranges overlap."""
+each rule reproduces, fails, and stays inconclusive where the interval over seeds crosses its threshold;
+a part's verdict is never "partly"; each threshold of ours is reported at half and twice its value."""
 import math
 
 import pytest
 
 from replication.claims.bars import Bar, competence
 from replication.claims.rules import (
+    PART_VERDICTS,
+    Outcome,
     Stat,
-    all_parts,
+    below_null,
     better_by,
     bound,
     fails,
-    lowest,
+    faster,
     never,
     separated,
     similar,
@@ -39,68 +42,89 @@ def test_separated_means_no_seed_overlap():
     assert separated(Stat.of([1, 2]), Stat.of([3, math.inf]))
 
 
-@pytest.mark.parametrize("values, expected", [
-    (dict(a=(1.0, 1.1, 0.9), b=(5.0, 5.5, 4.5)), "reproduced"),
-    (dict(a=(1.0, 1.1, 0.9), b=(2.0, 2.1, 1.9)), "partly"),
-    (dict(a=(5.0, 5.5, 4.5), b=(1.0, 1.1, 0.9)), "not reproduced"),
-    (dict(a=(1.0, 4.0, 0.5), b=(5.0, 3.0, 6.0)), "inconclusive"),     # mean gap, seeds overlap
-    (dict(a=(1.0, 1.1, 0.9), b=(math.inf, 8.0, 9.0)), "reproduced"),  # one diverged seed of b
-    (dict(a=(1.0,)), "not run"),
+def test_a_part_verdict_is_never_partly():
+    with pytest.raises(ValueError, match="part's verdict"):
+        Outcome("partly", "")
+    assert "partly" not in PART_VERDICTS
+
+
+@pytest.mark.parametrize("values, expected, half, twice", [
+    (dict(a=(1.0, 1.1, 0.9), b=(5.0, 5.5, 4.5)), "reproduced", "reproduced", "inconclusive"),  # 0.16-0.24
+    (dict(a=(1.0, 1.1, 0.9), b=(2.0, 2.1, 1.9)), "not reproduced", "reproduced", "not reproduced"),   # 2x, not 3x
+    (dict(a=(5.0, 5.5, 4.5), b=(1.0, 1.1, 0.9)), "not reproduced", "not reproduced", "not reproduced"),
+    (dict(a=(1.0, 4.0, 0.5), b=(5.0, 3.0, 6.0)), "inconclusive", "inconclusive", "inconclusive"),   # seeds disagree
+    (dict(a=(1.0, 1.1, 0.9), b=(math.inf, 8.0, 9.0)), "reproduced", "reproduced", "reproduced"),   # b diverged once
 ])
-def test_better_by(values, expected):
-    assert better_by("a", "b", 3.0, M)(v(**values))[0] == expected
+def test_better_by_reads_every_seed_pair_and_reports_its_sensitivity(values, expected, half, twice):
+    out = better_by("a", "b", 3.0, M)(v(**values))
+    assert out.verdict == expected, out.reason
+    assert out.sensitivity == {"factor 1.5": half, "factor 6": twice}
+    a, b = values["a"], values["b"]
+    assert out.interval.lo == min(x / y for x in a for y in b) and out.interval.hi == max(x / y for x in a for y in b)
+
+
+def test_better_by_not_run_when_a_model_is_missing():
+    assert better_by("a", "b", 3.0, M)(v(a=(1.0,))).verdict == "not run"
 
 
 @pytest.mark.parametrize("values, expected", [
     (dict(a=1.0, b=1.5), "reproduced"),
-    (dict(a=1.0, b=5.0), "partly"),
+    (dict(a=1.0, b=5.0), "not reproduced"),          # a 5x gap is not "similar", whatever a looser band says
     (dict(a=1.0, b=50.0), "not reproduced"),
+    (dict(a=(1.0, 1.0), b=(2.0, 4.0)), "inconclusive"),
     (dict(a=math.inf, b=1.0), "not reproduced"),
 ])
 def test_similar(values, expected):
-    assert similar("a", "b", 3.0, 10.0, M)(v(**values))[0] == expected
-
-
-@pytest.mark.parametrize("values, expected", [
-    (dict(o=(1.0, 1.2), x=(2.0, 2.2), y=(3.0, 3.1)), "reproduced"),
-    (dict(o=(1.0, 2.5), x=(2.0, 2.2), y=(3.0, 3.1)), "partly"),
-    (dict(o=(3.0, 3.2), x=(2.0, 2.2), y=(1.0, 1.1)), "not reproduced"),
-    (dict(o=(1.0, 2.5), x=(2.0, 2.2)), "inconclusive"),
-])
-def test_lowest(values, expected):
-    others = tuple(k for k in values if k != "o")
-    assert lowest("o", others, M)(v(**values))[0] == expected
+    assert similar("a", "b", 3.0, M)(v(**values)).verdict == expected
 
 
 @pytest.mark.parametrize("values, expected", [
     (dict(bad=(40.0, 45.0), g1=(1.0, 1.1), g2=(2.0, 2.1)), "reproduced"),
-    (dict(bad=(4.0, 4.5), g1=(1.0, 1.1), g2=(2.0, 2.1)), "partly"),
+    (dict(bad=(4.0, 4.5), g1=(1.0, 1.1), g2=(2.0, 2.1)), "not reproduced"),   # the worst, but not by 10x
     (dict(bad=(0.5, 0.6), g1=(1.0, 1.1), g2=(2.0, 2.1)), "not reproduced"),
-    (dict(bad=(0.5, 4.0), g1=(1.0, 1.1), g2=(2.0, 2.1)), "inconclusive"),
+    (dict(bad=(5.0, 40.0), g1=(1.0, 1.1), g2=(2.0, 2.1)), "inconclusive"),
 ])
 def test_fails(values, expected):
-    assert fails("bad", ("g1", "g2"), 10.0, M)(v(**values))[0] == expected
+    assert fails("bad", ("g1", "g2"), 10.0, M)(v(**values)).verdict == expected
+
+
+def test_below_null():
+    def vals(x, null):
+        return {"a": {M: Stat.of(x), f"null_{M}": Stat.of(null)}}
+    assert below_null(M, 0.5, "a")(vals((0.1, 0.2), (1.0, 1.0))).verdict == "reproduced"
+    assert below_null(M, 0.5, "a")(vals((1.0, 0.9), (1.0, 1.0))).verdict == "not reproduced"   # the null itself
+    assert below_null(M, 0.5, "a")(vals((0.2, 0.9), (1.0, 1.0))).verdict == "inconclusive"
+    assert below_null(M, 0.5, "a")({"a": {M: Stat.of((0.1,))}}).verdict == "not run"
 
 
 def test_never():
     inf = math.inf
-    assert never("bad", M)(v(bad=(inf, inf, inf)))[0] == "reproduced"
-    verdict, reason = never("bad", M)(v(bad=(inf, 5e4, inf)))
-    assert verdict == "not reproduced" and "1/3" in reason
-    assert never("bad", M)(v(good=(1.0,)))[0] == "not run"
+    assert never("bad", M)(v(bad=(inf, inf, inf))).verdict == "reproduced"
+    out = never("bad", M)(v(bad=(inf, 5e4, inf)))
+    assert out.verdict == "not reproduced" and "1/3" in out.reason
+    assert never("bad", M)(v(good=(1.0,))).verdict == "not run"
 
 
-def test_bound_and_all_parts():
+def test_faster_reports_the_direction_with_an_interval():
+    inf = math.inf
+    fast, slow = tuple(1e4 + i for i in range(8)), tuple(5e4 + i for i in range(8))
+    out = faster("a", "b", 3, M)(v(a=fast, b=slow))
+    assert out.verdict == "reproduced" and out.interval.hi < 1, out.reason
+    out = faster("a", "b", 3, M)(v(a=slow, b=fast))
+    assert out.verdict == "not reproduced" and out.interval.lo > 1 and "b faster" in out.reason
+    out = faster("a", "b", 3, M)(v(a=(1e4, 1e4) + (inf,) * 6, b=(inf,) * 8))
+    assert out.verdict == "inconclusive", out.reason            # two of eight: too few to tell
+    assert faster("a", "b", 3, M)(v(a=(inf,) * 8, b=(inf,) * 8)).verdict == "inconclusive"
+    assert faster("a", "b", 3, M)(v(a=fast[:3], b=slow[:3])).verdict == "inconclusive"   # 3 seeds never reach it
+
+
+def test_bound():
     ok, bad = v(a=(0.0, 1e-13)), v(a=(0.0, 1e-3))
-    assert bound(M, upper=1e-12)(ok)[0] == "reproduced" and bound(M, upper=1e-12)(bad)[0] == "not reproduced"
-    assert bound(M, lower=0.0)(v(a=(0.1, 0.2)))[0] == "reproduced"
-    assert bound(M, lower=0.0)(v(a=(0.0, 0.2)))[0] == "not reproduced"
-    assert bound(M, upper=1.0)(v(a=math.inf))[0] == "not reproduced"
-    yes, no, unsure = (lambda x: ("reproduced", "")), (lambda x: ("not reproduced", "")), (lambda x: ("inconclusive", ""))
-    assert all_parts(yes, yes)({})[0] == "reproduced"
-    assert all_parts(yes, no)({})[0] == "partly"
-    assert all_parts(no, no)({})[0] == "not reproduced"
-    assert all_parts(yes, unsure)({})[0] == "inconclusive"
+    assert bound(M, upper=1e-12)(ok).verdict == "reproduced" and bound(M, upper=1e-12)(bad).verdict == "not reproduced"
+    assert bound(M, lower=0.0)(v(a=(0.1, 0.2))).verdict == "reproduced"
+    assert bound(M, lower=0.0)(v(a=(0.0, 0.2))).verdict == "not reproduced"
+    assert bound(M, upper=1.0)(v(a=math.inf)).verdict == "not reproduced"
+    assert bound(M, upper=1.0, models=("b",))(v(a=0.5)).verdict == "not run"
 
 
 def _with_null(model_value, null=10.0, n_div=None):
