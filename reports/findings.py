@@ -1,8 +1,8 @@
 """The Findings section: where the papers and their original code disagree (the data:
 ``replication/claims/findings.py``).
 
-The suite runs the code's protocol by default and offers the paper's wording as a variant. For each
-finding this module reports which one was run, read from the usable units' ``protocol`` and
+The paper profile runs the code's protocol; quick and full run the suite's efficient protocols (each
+finding's 'what it changes' says how). For each finding this module reports which one was run, read from the usable units' ``protocol`` and
 ``model_spec`` (any of the finding's ``keys``, searched in nested dicts, plus a generic ``variant``),
 restricted to units of claims whose ``system`` contains one of ``systems`` (all systems if empty).
 """
@@ -40,7 +40,7 @@ def what_ran(res: Results, f: Finding) -> str:
             for k, v in _lookup(u.result.get(src), keys).items():
                 seen.setdefault(f"{src}.{k}", set()).add(v)
     if not seen:
-        return "suite default (code's protocol); not recorded in result files"
+        return "not recorded in result files"
     return "; ".join(f"{k} = {', '.join(sorted(v)[:4])}" for k, v in sorted(seen.items())[:4])
 
 
@@ -48,9 +48,11 @@ def findings_sections(res: Results) -> list[Section]:
     rows = [{"#": str(i), "finding": f.title, "paper": f.paper, "original code": f.code, "run here": what_ran(res, f),
              "what it changes": f.changes} for i, f in enumerate(FINDINGS, 1)]
     s = Section("Findings: paper against original code")
-    s.add(Para("Where the LNN paper and its original code (MilesCranmer/lagrangian_nns) disagree. The suite "
-               "runs the code's protocol by default and offers the paper's wording as a variant; 'run here' "
-               "is read from the protocol and model spec recorded in each unit's result.json."))
+    profile = (res.run or {}).get("profile") or res.verdict_profile or "unknown"
+    s.add(Para("Where the LNN paper and its original code (MilesCranmer/lagrangian_nns) disagree. The paper "
+               "profile runs the code's protocol at the code's scales; quick and full run the suite's efficient "
+               "protocols at smaller scales, as 'what it changes' says. 'run here' is read from the protocol and "
+               f"model spec recorded in each unit's result.json of this run (profile: {profile})."))
     s.add(Table("Paper against code", pd.DataFrame(rows),
                 ["shared/reference/lnn_original_code.md §9", "units/*/*/*/seed*/result.json (protocol, model_spec)"]))
     return [s]

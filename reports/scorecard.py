@@ -1,9 +1,13 @@
-"""The scorecard that opens the report, and the per-claim competence table.
+"""The scorecard that opens the report, and the per-claim competence and parts tables.
 
-``scorecard_section(res)``: one row per claim: the verdict (recomputed from the unit files), the key
-model's reproduced number per framework beside its published number, marked "like for like" only when
-the published value is of the same kind and measured under the same conditions (else "context"), and a
-one-sentence reason. ``competence_table(res, claim)``: each model's competence bar per framework.
+``scorecard_section(res)``: the headline count of paper claims (checks apart); one row per paper claim,
+then one per check: the verdict (recomputed from the unit files), the key model's reproduced number per
+framework beside its published number, marked "like for like" only when the published value is of the
+same kind and measured under the same conditions (else "context", with its note), the reason, and each
+part's verdict with the interval it read; then the variants (departures from the paper, each with its own
+verdict, never a claim's) and the parts whose frameworks disagree (a defect to investigate).
+``competence_table(res, claim)``: each model's competence bar per framework; ``parts_table(res, claim)``:
+each part per framework with its interval and its verdict at half and twice the suite's threshold.
 """
 
 from __future__ import annotations
@@ -11,7 +15,7 @@ from __future__ import annotations
 import pandas as pd
 
 from reports.document import NOT_RUN, Para, Section, Table
-from reports.fmt import cell, stat, summarise
+from reports.fmt import cell, num, stat, summarise
 from reports.load import Results
 from reports.tables import published_cell, published_entry
 
@@ -40,41 +44,115 @@ def _reproduced(res: Results, claim: dict, model: str, metric: str) -> str:
 
 
 def _reason(v: dict | None) -> str:
+    """The claim's own reason, then the first undecided or failed part's reason in its first framework."""
     if not v:
         return "no verdict"
-    text = str(v.get("reason") or "")
-    first = text.split(" | ")[0]
-    return first if len(first) <= REASON_CHARS else first[: REASON_CHARS - 1] + "…"
+    parts = v.get("parts") or []
+    first = next((p for p in parts if not p.get("check") and p.get("verdict") != "reproduced"), None)
+    text = str(v.get("reason") or "").split(". ", 1)[0]
+    if first and first.get("reason"):
+        fw, why = next(iter(first["reason"].items()))
+        text += f". {first['name']} ({fw}): {why}"
+    return text if len(text) <= REASON_CHARS else text[: REASON_CHARS - 1] + "…"
 
 
-def scorecard_table(res: Results) -> pd.DataFrame:
+def interval_text(p: dict) -> str:
+    """A part's interval per framework: 'jax 0.21 [0.18, 0.25]; torch ...' ("" when it read none)."""
+    ivs = p.get("interval") or {}
+    return "; ".join(f"{fw} {num(iv.get('point'))} [{num(iv.get('lo'))}, {num(iv.get('hi'))}]"
+                     for fw, iv in ivs.items())
+
+
+def part_text(p: dict) -> str:
+    text = f"{p.get('name')}: {p.get('verdict')}"
+    if p.get("flag"):
+        text += f" ({p['flag']})"
+    ivs = p.get("interval") or {}
+    if ivs:
+        what = next(iter(ivs.values())).get("what", "")
+        text += f" ({what}: {interval_text(p)})"
+    return text
+
+
+def _kind(res: Results, claim: dict) -> str:
+    return str((res.verdicts.get(claim["id"]) or {}).get("kind") or claim.get("kind") or "claim")
+
+
+def scorecard_table(res: Results, kind: str = "claim") -> pd.DataFrame:
     rows = []
     for claim in res.claims:
+        if _kind(res, claim) != kind:
+            continue
         cid = claim["id"]
         key = claim.get("key") or next(iter(claim.get("models") or []), "")
         p = published_entry(claim, key)
         metric = (p or {}).get("metric") or claim.get("metric") or ""
         published = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
         v = res.verdicts.get(cid)
+        parts = [x for x in (v or {}).get("parts") or []]
         rows.append({"#": cell(claim.get("number"), "–"), "claim": cid,
                      "verdict": cell((v or {}).get("verdict"), NOT_RUN),
                      "key number": f"{key} {metric}: {_reproduced(res, claim, key, metric)}" if key else NOT_RUN,
-                     "published": published, "why": _reason(v)})
+                     "published": published, "why": _reason(v),
+                     "parts": "; ".join(part_text(x) + (" [check]" if x.get("check") else "") for x in parts)
+                     or NOT_RUN})
     return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN], "verdict": [NOT_RUN]})
+
+
+def variants_table(res: Results) -> pd.DataFrame | None:
+    rows = []
+    for claim in res.claims:
+        for var in (res.verdicts.get(claim["id"]) or {}).get("variants") or []:
+            rows.append({"claim": claim["id"], "variant": cell(var.get("name")),
+                         "departure": cell(var.get("departure")), "verdict": cell(var.get("verdict")),
+                         "parts": "; ".join(part_text(x) for x in var.get("parts") or [] if not x.get("check"))
+                         or cell(var.get("reason"))})
+    return pd.DataFrame(rows) if rows else None
+
+
+def headline(res: Results) -> str:
+    out = []
+    for kind, name in (("claim", "Paper claims"), ("check", "Checks (implementation and numerics)")):
+        counts = {}
+        for claim in res.claims:
+            if _kind(res, claim) == kind:
+                x = str((res.verdicts.get(claim["id"]) or {}).get("verdict") or NOT_RUN)
+                counts[x] = counts.get(x, 0) + 1
+        if counts:
+            out.append(f"{name}: " + ", ".join(f"{n} {x}" for x, n in sorted(counts.items(), key=lambda t: -t[1])))
+    return ". ".join(out) + "." if out else "Nothing was judged."
 
 
 def scorecard_section(res: Results) -> Section:
     s = Section("Scorecard")
-    s.add(Para("One line per claim. The verdict is recomputed from the unit files by the runner's own rule "
-               "(replication/claims/verdicts.py): a model below its competence bar (held-out error at most a set "
-               "fraction of a null predictor's, rollouts that do not diverge) makes a claim 'inconclusive'; "
-               "an ordering needs the seed ranges apart. A published number is 'like for like' only when it "
-               "is the same kind of number (training loss, held-out error, energy error) measured under the "
-               "same conditions; otherwise it is context, not a target."))
+    s.add(Para(headline(res)))
+    s.add(Para("One line per paper claim, then one per check (checks test the implementation and the numerics "
+               "and are not counted among the claims). The verdict is recomputed from the unit files by the "
+               "runner's own rule (replication/claims/verdicts.py): each claim is decided on the models as the "
+               "paper specified them, part by part; a part whose models are below their competence bar (held-out "
+               "error at most a set fraction of a null predictor's, rollouts that do not diverge), or whose "
+               "positive control did not learn, is 'inconclusive'; an ordering holds only if it holds for every "
+               "pair of seeds (the interval shown). 'partly' means only: the named parts reproduced, the others "
+               "did not. Frameworks that disagree on a part make it 'inconclusive' and are listed below as a "
+               "defect. A published number is 'like for like' only when it is the same kind of number "
+               "(training loss, held-out error, energy error) measured under the same conditions; otherwise it "
+               "is context, not a target."))
     if res.unfinished or res.planned_missing:
         s.add(Para(f"This run is unfinished: {len(res.planned_missing)} planned unit(s) have no result "
                    "(see Run status); the verdicts below rest on the units present."))
-    s.add(Table("Scorecard", scorecard_table(res), ["claims.json", "units/*/*/*/seed*/result.json"]))
+    s.add(Table("Scorecard", scorecard_table(res, "claim"), ["claims.json", "units/*/*/*/seed*/result.json"]))
+    checks = scorecard_table(res, "check")
+    if "#" in checks.columns:
+        s.add(Table("Checks", checks, ["claims.json", "units/*/*/*/seed*/result.json"]))
+    variants = variants_table(res)
+    if variants is not None:
+        s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
+                    note="A variant is a model with a departure from the paper standing in for the paper's model; "
+                         "the claim is judged again with it, on this line only. A variant never decides a claim."))
+    flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
+    s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
+               "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else
+               "No part has frameworks that disagree."))
     return s
 
 
@@ -86,4 +164,23 @@ def competence_table(res: Results, claim: dict) -> pd.DataFrame | None:
         for model, r in (per or {}).items():
             rows.append({"model": model, "framework": fw, "passed": "yes" if r.get("passed") else "no",
                          "bar": cell(r.get("why"), "")})
+    return pd.DataFrame(rows) if rows else None
+
+
+def parts_table(res: Results, claim: dict) -> pd.DataFrame | None:
+    """Each part (and check) of the claim and of its variants, per framework: verdict, interval, and the
+    verdict at half and twice the suite's own threshold."""
+    v = res.verdicts.get(claim["id"]) or {}
+    lines = [("claim", p) for p in v.get("parts") or []]
+    lines += [(f"variant: {var.get('name')}", p) for var in v.get("variants") or [] for p in var.get("parts") or []]
+    rows = []
+    for line, p in lines:
+        for fw, verdict in (p.get("by_framework") or {}).items():
+            iv = (p.get("interval") or {}).get(fw) or {}
+            sens = (p.get("sensitivity") or {}).get(fw) or {}
+            rows.append({"line": line, "part": cell(p.get("name")) + (" (check)" if p.get("check") else ""),
+                         "framework": fw, "verdict": cell(verdict),
+                         "interval": (f"{iv.get('what')}: {num(iv.get('point'))} [{num(iv.get('lo'))}, "
+                                      f"{num(iv.get('hi'))}] ({iv.get('method')})") if iv else "none",
+                         "at half / twice the threshold": "; ".join(f"{k}: {x}" for k, x in sens.items()) or "none"})
     return pd.DataFrame(rows) if rows else None

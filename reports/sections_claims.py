@@ -17,7 +17,7 @@ from reports import figures_speed as FS
 from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results
-from reports.scorecard import competence_table
+from reports.scorecard import competence_table, parts_table
 from reports.tables import claim_table, metrics_table, problem_units_table, status_table, summary_table
 from reports.themes import THEMES, assign
 
@@ -86,7 +86,16 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
                f"Competence bars: {'; '.join(claim.get('bars') or []) or 'none (no learned model)'}."))
     v = res.verdicts.get(cid)
     if v is not None:
-        s.add(Para(f"Verdict: {cell(v.get('verdict'))}. {cell(v.get('reason'), '')}"))
+        kind = "check (not counted among the paper claims)" if v.get("kind") == "check" else "paper claim"
+        s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {cell(v.get('reason'), '')}"))
+        for var in v.get("variants") or []:
+            s.add(Para(f"Variant: {cell(var.get('name'))} ({cell(var.get('departure'))}): {cell(var.get('verdict'))}, "
+                       f"{cell(var.get('reason'), '')}. It does not decide the claim."))
+    pt = parts_table(res, claim)
+    if pt is not None:
+        s.add(Table(f"{cid}: parts per framework", pt, [src + "result.json"],
+                    note="Each part is decided on the interval shown; the last column gives the part's verdict "
+                         "with the suite's own threshold (a factor, a band, a fraction, a level) halved and doubled."))
     ct = competence_table(res, claim)
     if ct is not None:
         s.add(Table(f"{cid}: competence bars per model and framework", ct, [src + "result.json"]))

@@ -133,6 +133,8 @@ def verdicts_table(res: Results) -> pd.DataFrame | None:
         row = {"claim": claim["id"]}
         row.update({fw: cell(by_fw.get(fw)) for fw in fws})
         row["same"] = "yes" if len({str(v) for v in by_fw.values()}) == 1 else "no"
+        parts = (res.verdicts.get(claim["id"]) or {}).get("parts") or []
+        row["parts that disagree (a defect)"] = ", ".join(p["name"] for p in parts if p.get("flag")) or "none"
         rows.append(row)
     return pd.DataFrame(rows) if rows else None
 

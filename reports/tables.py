@@ -62,8 +62,9 @@ def published_cell(claim: dict, model: str, units) -> str:
     if p is None:
         return "none published"
     same, why = like_for_like(p, units)
-    return (f"{num(p.get('value'))} ({p.get('kind')}, like for like)" if same
-            else f"{num(p.get('value'))} ({p.get('kind')}; context only: {why})")
+    note = f"; {p['note']}" if p.get("note") else ""
+    return (f"{num(p.get('value'))} ({p.get('kind')}, like for like{note})" if same
+            else f"{num(p.get('value'))} ({p.get('kind')}; context only: {why}{note})")
 
 
 def verdict_text(res: Results, claim: dict) -> str:

@@ -40,7 +40,8 @@ FINDINGS = [
     Finding("Architectures", "one MLP for both models",
             "LNN 3×600 softplus, 1 output, custom init; baseline 3×600 ReLU, 2 outputs, default init; "
             "SR 4×500; wave 3×400",
-            "the code's architectures are used per model", (), ("activation", "hidden")),
+            "the paper profile runs the code's architectures; quick and full run narrower ones, the same per "
+            "model kind where the paper compares two (each unit records its widths)", (), ("activation", "hidden")),
     Finding("Energy metric", "energy error over 40 ICs",
             "final time t = 100 only, /29.4, ICs near rest (ω < 0.1); baseline over 44 ICs; float32 truth",
             "final-time and max-over-time both reported, truth in float64, a diverged rollout counted as +inf "
@@ -73,11 +74,10 @@ FINDINGS = [
     Finding("Relativistic models' inputs and rates (quick, full)", "not stated",
             "every model sees q̇ alone; q and g divided by 10 (the canonical HNN: q unscaled, p raw); Adam one-cycle "
             "at peak 1e-3, no restarts",
-            "the models on (q, q̇) also see the Lorentz factor γ(q̇) x 0.01 (on q̇ alone our LNN stays on the "
-            "q̈ ≈ 0 plateau), the LNN sees q unscaled; the canonical HNN sees q / 10 and p / 100; restarts over 8 "
-            "inits, peak 1e-2 (the canonical HNN 3e-3). γ holds in every profile; the paper profile keeps the "
-            "code's rate without restarts and the canonical HNN's inputs. The original's q̇-only LNN runs "
-            "beside in smoke and paper, outside the verdict",
+            "the paper's models (q̇ alone) decide claims 3 and 8; the LNN sees q unscaled, the canonical HNN q / 10 "
+            "and p / 100; restarts over 8 inits at peak 1e-2 (the canonical HNN 3e-3) for every model. A variant "
+            "beside each claim also feeds the models on (q, q̇) the Lorentz factor γ(q̇) x 0.01, with the same "
+            "protocol, on its own verdict line. The paper profile keeps the code's rate without restarts",
             ("relativ",), ("lorentz_factor", "input_scale", "lr", "scouts")),
     Finding("Relativistic data quirk", "not stated",
             "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",

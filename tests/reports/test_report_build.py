@@ -134,8 +134,12 @@ def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
     md = built["markdown"].read_text()
     assert md.index("## Scorecard") < md.index("## Summary")
     rows = scorecard_rows(md)
-    assert set(rows) == {c[0] for c in CLAIMS}
+    checks = table_rows(md, "Checks")
+    assert set(rows) | set(checks) == {c[0] for c in CLAIMS} and not set(rows) & set(checks)
+    assert "appendix_b" in checks and "dp_loss" in rows      # a check is kept apart from the paper claims
+    assert re.search(r"Paper claims: (\d+ [a-z ]+, )*\d+ reproduced", md) and "Checks (implementation and numerics): " in md
     assert rows["dp_loss"][2] == "reproduced" and rows["dp_energy"][2] == "inconclusive"
+    assert rows["dp_loss"][6].startswith("similar held-out loss: reproduced (lnn/baseline: jax ")
     assert re.fullmatch(r"lnn heldout_l1: jax 0\.0\d+ ± \S+ \(n=2\); torch 0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][3])
     assert "below the competence bar" in rows["dp_energy"][5]
 
