@@ -28,10 +28,18 @@ def cmd_list(args):
     print("activations:" + " " + ", ".join(ACTIVATIONS))
     print("inits:      " + ", ".join(INITS))
     print("profiles:   " + ", ".join(PROFILES))
-    print("claims:")
+    print("claims (a check tests the implementation or the numerics, not a paper claim):")
     for c in CLAIMS.values():
-        print(f"  {c.number:>2} {c.id:<17} [{c.paper} {c.section}] {c.title}")
-        print(f"     models: {', '.join(m.label for m in c.models)}")
+        print(f"  {c.number:>2} {c.id:<17} [{c.paper} {c.section}]{' (check)' if c.kind == 'check' else ''} {c.title}")
+        controls = {x for p in c.parts for x in p.controls} - {x for p in c.parts for x in p.reads}
+        variant = {v for var in c.variants for _, v in var.replaces}
+        paper = [m.label for m in c.models if m.label not in controls | variant]
+        print(f"     models: {', '.join(paper)}")
+        print(f"     parts: {'; '.join(p.name + (' (check)' if p.check else '') for p in c.parts)}")
+        if controls:
+            print(f"     positive controls: {', '.join(sorted(controls))}")
+        for var in c.variants:
+            print(f"     variant: {var.name} ({', '.join(v for _, v in var.replaces)}; never decides)")
 
 
 def cmd_run(args):
