@@ -6,6 +6,8 @@ import logging
 import sys
 from pathlib import Path
 
+from replication.training.device import HELP as DEVICE_HELP
+
 
 def _csv(s):
     return [x.strip() for x in s.split(",") if x.strip()] if s else None
@@ -44,7 +46,9 @@ def cmd_list(args):
 
 def cmd_run(args):
     from replication.run.runner import run
+    from replication.training import device
 
+    device.apply(args.device, _csv(args.frameworks) or ("jax", "torch"))
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
@@ -97,8 +101,13 @@ def cmd_train_target(args):
     names = _csv(args.protocols)
     hidden = list(widths(args.hidden))
     check_names(names)  # here too, so that --out is not made for nothing
+    from replication.training import device
+
+    where = device.apply(args.device, ("jax",))["jax"]   # the study trains in JAX
     folder = write_folder(Path(args.out) / "train_target")
-    df = run_study(folder, args.budget, hidden, args.heldout, names=names, seed=args.seed, progress=not args.quiet)
+    with device.placed("jax", where):
+        df = run_study(folder, args.budget, hidden, args.heldout, names=names, seed=args.seed,
+                       progress=not args.quiet)
     per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "seed", "hessian_rel_err",
                                            "skipped_steps", "samples_per_s"]]
     print(per.to_string(index=False))
@@ -143,6 +152,7 @@ def build_parser():
     s.add_argument("--dry-run", action="store_true", help="print the units and an estimated duration (a few "
                    "probed steps of each training), then stop; writes nothing")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
+    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_run)
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",
                        description="Write REPORT.md, REPORT.typ, REPORT.pdf and figures/*.png into --out from "
@@ -184,6 +194,7 @@ def build_parser():
     s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7, 15 for "
                                                             "restarts_halved; default 0)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_train_target)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
                                      "(writes OUT/stiff/solvers.csv for the report)")

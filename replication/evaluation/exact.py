@@ -35,7 +35,7 @@ def eval_exact_lagrangian(ctx) -> Evaluation:
         import torch
 
         from models.torch.lnn import euler_lagrange
-        qdd = euler_lagrange(L, torch.as_tensor(q), torch.as_tensor(qdot), form).detach().numpy()
+        qdd = euler_lagrange(L, torch.as_tensor(q), torch.as_tensor(qdot), form).detach().cpu().numpy()
     truth = s.acceleration(q, qdot, backend="numpy")
     expected = np.broadcast_to(np.array([-float(s.params["g"]), 0.0]), qdd.shape)
     return Evaluation(metrics={"max_abs_err": float(np.max(np.abs(qdd - expected))),

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from replication.fit.rows import HELDOUT, SPLITS
 from replication.fit.trajectories import POLYORDER, WINDOW
+from replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
@@ -60,7 +61,9 @@ def cmd_fit(args):
     from tqdm.auto import tqdm
 
     from replication.fit.task import LOSS_NAMES, fit
+    from replication.training import device
 
+    device.apply(args.device, (args.framework,))   # before anything is written
     bars = []  # made at the first log row, so that a refused option prints one line and nothing else
 
     def on_log(row):
@@ -160,6 +163,7 @@ def add_commands(sub) -> None:
                    "(N, d) arrays to (N,)), compared along the rollouts in place of --system's")
     s.add_argument("--substeps", type=int, default=2, help="RK4 steps per sample interval in the rollouts")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_fit)
     _show_defaults(s)
 

@@ -10,7 +10,8 @@ included. The wall time replays the executor's schedule (`scheduled_wall`): the 
 (Before, it assumed the trainings spread evenly: three trainings of 0.33 h on two workers came out 0.5 h
 where the run took two rounds, 55 min.)
 
-The probes run PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
+The probes run on the device the units will train on (`replication.training.device`, from LAGBENCH_DEVICE),
+and PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
 one local job trains them here). Measured on the 2-core development machine (2026-11-26), `full`'s PyTorch
 double pendulum (6 trainings; they took 10 097 s when run): probed at this process's default 2 threads,
@@ -34,6 +35,7 @@ import numpy as np
 from replication.run.chains import chains
 from replication.run.environment import torch_threads as threads_of_torch
 from replication.training import compile_torch
+from replication.training import device as dev
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
@@ -51,7 +53,8 @@ def _plain_step(framework, spec, protocol) -> float:
     phase = continuation_protocol(protocol)
     p = phase.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
                       track_every=0)
-    with compile_torch.like(spec, phase):   # PyTorch's probe steps compiled where the phase's are
+    # PyTorch's probe steps compiled where the phase's are, on the device the run trains on
+    with compile_torch.like(spec, phase), dev.placed(framework, dev.resolve(dev.request(), framework)):
         return _per_step(run_training(framework, spec, p, 0).log)
 
 
@@ -60,7 +63,7 @@ def _members_step(framework, spec, protocol, k: int) -> float:
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
                          cohort=0, track_every=0)
     rows = []
-    with compile_torch.like(spec, protocol, k):
+    with compile_torch.like(spec, protocol, k), dev.placed(framework, dev.resolve(dev.request(), framework)):
         train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
     return _per_step(rows)
 

@@ -5,8 +5,9 @@ as `executor.run_units`. Without `address` it starts a local Ray instance on thi
 uses this process's Ray connection, if it has one); with one it joins that cluster (`ray start`).
 
 Every unit is one Ray task (`ray_task.run_unit_task`) asking for one CPU, and, where the cluster has GPUs,
-a JAX unit for a share of one (`gpu_share`: a whole GPU for the paper-sized models, a quarter for the
-others; PyTorch units train on the CPU in this suite, so they ask for none). Tasks run with JAX, PyTorch
+a unit of either framework for a share of one (`gpu_share`: a whole GPU for the paper-sized models, a
+quarter for the others), unless the run asked for `--device cpu`; the device request reaches the task in
+LAGBENCH_DEVICE. Tasks run with JAX, PyTorch
 and OpenMP on one thread (`environment.one_thread_env`) and JAX told not to preallocate the GPU's memory.
 Units that train the same model (`chains.chains`, as in the local executor) run one after another: each
 task takes the previous one's result (which carries the trained model) as its argument, so Ray starts it
@@ -35,7 +36,7 @@ from replication.run.environment import commit, one_thread_env
 INSTALL = "pip install 'lagbench[ray]'"
 RETRIES = 2          # retries of a task whose worker died, before the unit is recorded as an error
 POLL_S = 0.5         # how often the progress bar is refreshed
-FORWARDED = ("LAGBENCH_WORKER_DIR", "PYTHONHASHSEED", "OMP_WAIT_POLICY")
+FORWARDED = ("LAGBENCH_WORKER_DIR", "PYTHONHASHSEED", "OMP_WAIT_POLICY", "LAGBENCH_DEVICE", "LAGBENCH_TF32")
 
 
 def require_ray():
@@ -61,8 +62,8 @@ def gpu_share(unit) -> float:
     return 1.0 if sum(unit.spec().hidden) >= 1000 else 0.25
 
 
-def resources(unit, cluster_gpus: float) -> dict:
-    gpus = gpu_share(unit) if cluster_gpus > 0 and unit.framework == "jax" else 0
+def resources(unit, cluster_gpus: float, device: str = "auto") -> dict:
+    gpus = gpu_share(unit) if cluster_gpus > 0 and device != "cpu" else 0
     return {"num_cpus": 1, "num_gpus": gpus}
 
 
@@ -144,7 +145,7 @@ def _submit(ray, todo, out, retries, board):
         # what the driver's cache already holds of the chain's trainings (a cohort's seeds each have one)
         prev, before = {"cache": {k: v for u in chain for k, v in trained_entry(out, u).items()}}, None
         for u in chain:
-            r = task.options(**resources(u, gpus), max_retries=retries, retry_exceptions=False,
+            r = task.options(**resources(u, gpus, os.environ.get("LAGBENCH_DEVICE", "auto")), max_retries=retries, retry_exceptions=False,
                              runtime_env=env, name=f"lagbench {u.name}").remote(ref(u), prev, board)
             refs[r], prev, before = (u, before), r, u
     return refs

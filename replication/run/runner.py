@@ -25,6 +25,7 @@ from replication.run import environment as env
 from replication.run.estimate import describe, estimate
 from replication.run.executor import run_units
 from replication.run.units import Unit
+from replication.training import device as dev
 
 log = logging.getLogger("lagbench")
 FRAMEWORKS = ("jax", "torch")
@@ -121,9 +122,10 @@ def announce(profile, units, todo, out, jobs, executor="local") -> dict:
     print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
     est = estimate(todo, out, jobs, env.worker_torch_threads(executor, jobs))
     hw = env.hardware()
+    where = ", ".join(f"{fw} on the {dev.resolve(dev.request(), fw).upper()}" for fw in sorted({u.framework for u in todo}))
     print(f"lagbench: {est['trainings']} trainings to do ({est['cached']} reused from OUT/trained), estimated "
           f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
-          f"worker{'s' if jobs != 1 else ''} (evaluation not included; {hw['cpu']}, GPU: {hw['gpu']}). "
+          f"worker{'s' if jobs != 1 else ''} (evaluation not included; {where}; {hw['cpu']}, GPU: {hw['gpu']}). "
           f"Interrupt at any time: the run resumes where it stopped.", flush=True)
     return est
 

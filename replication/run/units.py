@@ -77,6 +77,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "scouting": outcome.scouting if outcome else None,
         "cohort": outcome.cohort if outcome else None,
         "train_step_mode": outcome.step_mode if outcome else None,
+        "train_device": outcome.device if outcome else None,   # evaluation computes on the CPU
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

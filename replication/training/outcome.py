@@ -22,6 +22,7 @@ class TrainOutcome:
     samples: int | None = None    # training samples, where not steps_done x batch (scouts at their own batch)
     cohort: dict | None = None    # trained side by side with other seeds (`Protocol.cohort`): {"seeds": [...]}
     step_mode: str | None = None  # "jit" (JAX); "compiled" or "eager" (PyTorch, `compile_torch`); phases joined by " + "
+    device: dict | None = None    # where it computed (`replication.training.device.describe`)
 
     @property
     def samples_per_s(self) -> float:

@@ -17,6 +17,7 @@ import pandas as pd
 
 from models import init_params
 from replication import results as R
+from replication.training import device as dev
 from replication.training.data import BatchStream, targets_version
 from replication.training.outcome import TrainOutcome, log_frame
 from replication.training.scouting import train_scouted
@@ -114,7 +115,7 @@ def _cached(folder: Path) -> TrainOutcome | None:
                         log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
                         failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
                         batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
-                        cohort=meta.get("cohort"), step_mode=meta.get("step_mode"))
+                        cohort=meta.get("cohort"), step_mode=meta.get("step_mode"), device=meta.get("device"))
 
 
 def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
@@ -124,6 +125,7 @@ def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
                                           "scouting": outcome.scouting, "samples": outcome.samples,
                                           "cohort": outcome.cohort, "step_mode": outcome.step_mode,
+                                          "device": outcome.device,
                                           "spec": spec.to_dict(),
                                           "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)
@@ -131,7 +133,7 @@ def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
 
 def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutcome:
     """`seed`'s training, from `OUT/trained/` when it is there; a cohort protocol trains (and stores) its
-    whole group of seeds at once."""
+    whole group of seeds at once, on the device asked for (`device.request()`; the key does not hold it)."""
     def folder(s):
         return Path(out) / "trained" / framework / train_key(framework, spec, protocol, s)
     done = _cached(folder(seed))
@@ -139,11 +141,14 @@ def train_cached(out, framework, spec, protocol, seed, on_log=None) -> TrainOutc
         return done
     seeds = cohort_seeds(protocol, seed)
     snapshot = Snapshots(folder(seeds[0]) / "inflight", train_key(framework, spec, protocol, seeds[0]))
-    if len(seeds) > 1:
-        outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log, snapshot=snapshot)
-    else:
-        outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log, snapshot=snapshot)]
+    where = dev.resolve(dev.request(), framework)
+    with dev.placed(framework, where):
+        if len(seeds) > 1:
+            outcomes = train_cohort(framework, spec, protocol, seeds, on_log=on_log, snapshot=snapshot)
+        else:
+            outcomes = [run_training(framework, spec, protocol, seed, on_log=on_log, snapshot=snapshot)]
     for s, o in zip(seeds, outcomes, strict=True):
+        o.device = dev.describe(framework, where)
         _store(folder(s), o, spec, protocol, s)
     snapshot.clear()
     return outcomes[seeds.index(seed)]

@@ -68,7 +68,7 @@ def make_probe(spec, protocol):
         with torch.no_grad():
             hess = model.velocity_hessian(q, qdot, extra) if hasattr(model, "velocity_hessian") else None
             qdd, n_fb = model.acceleration_info(q, qdot, extra)
-        return hessian_probe.probe(qdd.numpy(), int(n_fb), None if hess is None else hess.numpy(),
+        return hessian_probe.probe(qdd.cpu().numpy(), int(n_fb), None if hess is None else hess.cpu().numpy(),
                                    protocol.dtype)
     return run
 
@@ -118,8 +118,8 @@ class Stepper:
         out = []
         for p in self.model.parameters():
             state = self.opt.state.get(p) or {}
-            out += [p.detach().numpy().copy(), np.asarray(bool(state))]
-            out += [(state[k].detach().numpy().copy() if k in state else np.zeros(() if k == "step" else p.shape))
+            out += [p.detach().cpu().numpy().copy(), np.asarray(bool(state))]
+            out += [(state[k].detach().cpu().numpy().copy() if k in state else np.zeros(() if k == "step" else p.shape))
                     for k in _ADAM_STATE]
         return out
 
@@ -201,7 +201,7 @@ class Members:
         # a parameter the loss does not reach (the LNN's last bias) has no gradient; Adam leaves it, as in Stepper
         self._with_grad = {k: p for k, p in self.stacked.items() if p.grad is not None}
         self._gnorm = torch.sqrt(sum((p.grad * p.grad).flatten(1).sum(1) for p in self._with_grad.values()))
-        return losses.detach().double().numpy(), self._gnorm.double().numpy()
+        return losses.detach().double().cpu().numpy(), self._gnorm.double().cpu().numpy()
 
     def commit(self, taken, scale):
         members = np.flatnonzero(taken)
@@ -227,7 +227,7 @@ class Members:
         self.count = count
 
     def _params_of(self, i: int) -> dict:
-        return {k.removeprefix("model."): p[i].detach().numpy().copy() for k, p in self.stacked.items()}
+        return {k.removeprefix("model."): p[i].detach().cpu().numpy().copy() for k, p in self.stacked.items()}
 
     @property
     def mode(self) -> str:
@@ -246,8 +246,8 @@ class Members:
         """The stacked parameters, their two Adam moments (in `stacked` order) and the step counts."""
         out = []
         for k, p in self.stacked.items():
-            out += [p.detach().numpy().copy(), *(m.numpy().copy() for m in self.moments[k])]
-        return [*out, self.count.numpy().copy()]
+            out += [p.detach().cpu().numpy().copy(), *(m.cpu().numpy().copy() for m in self.moments[k])]
+        return [*out, self.count.cpu().numpy().copy()]
 
     def load_state_arrays(self, arrays) -> None:
         if len(arrays) != 3 * len(self.stacked) + 1:
