@@ -4,7 +4,8 @@ suite's one training loop (`replication.training.train.run_training`), as a `pap
 `measure(claim, model, profile, frameworks, device, steps)` trains `steps` optimiser steps of the model's
 protocol (its schedule, guard and loss; restarts off: one run) from seed 0 and returns one row per
 framework: samples per second over the steps after the first (`TrainOutcome.step_seconds`: the first step
-compiles), the step mode (JAX jit, PyTorch compiled or eager), and where it computed. It says nothing of
+compiles), the step mode (JAX jit; PyTorch compiled where the protocol's training would be, or eager, with
+the reason if a compile failed), and where it computed. It says nothing of
 accuracy: the steps are a few of the protocol's.
 
 `python -m speedstudy.train_throughput --device gpu --out FILE.csv` (defaults: the double-pendulum LNN of
@@ -18,6 +19,7 @@ import sys
 import pandas as pd
 
 from replication.claims import get as get_claim
+from replication.training import compile_torch
 from replication.training import device as dev
 from replication.training.train import run_training
 
@@ -35,7 +37,8 @@ def measure(claim: str = "dp_loss", model: str = "lnn", profile: str = "paper", 
         spec, protocol = unit.spec(), unit.protocol()
         p = protocol.replace(steps=steps, log_every=max(steps // 10, 1), scouts=0, scout_steps=0, track_every=0,
                              n_train=protocol.batch * steps)
-        with dev.placed(fw, where[fw]):
+        # PyTorch compiles where the protocol's own training would (its full length decides, not these steps)
+        with compile_torch.like(spec, protocol), dev.placed(fw, where[fw]):
             out = run_training(fw, spec, p, 0)
         timed = max(out.steps_done - 1, 1)
         rows.append({"claim": claim, "model": model, "profile": profile, "framework": fw,

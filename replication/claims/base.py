@@ -89,6 +89,7 @@ class Claim:
     published: dict          # model label -> Published (only numbers a paper or its repository prints)
     verdict_rule: str
     parts: tuple             # `parts.Part`s: the claim's verdict is `parts.claim_verdict` of the counted ones
+                             # (none: a fit of a user's data, which has no verdict)
     bars: tuple = ()         # competence bars (`bars.Bar`); a model below its bar -> its parts "inconclusive"
     variants: tuple = ()     # `parts.Variant`s: departures from the paper, each judged on its own line
     kind: str = "claim"      # "claim" (a paper claim) or "check" (implementation, numerics)
@@ -105,7 +106,7 @@ class Claim:
         named |= {x for v in self.variants for pair in v.replaces for x in pair}
         if named - labels:
             raise ValueError(f"claim {self.id}: parts or variants name unknown models {sorted(named - labels)}")
-        if not any(not p.check for p in self.parts):
+        if self.parts and not any(not p.check for p in self.parts):   # no parts: a fit of user data, no verdict
             raise ValueError(f"claim {self.id}: no part that counts (every part is a check)")
 
     def entry(self, label: str) -> ModelEntry:

@@ -97,7 +97,8 @@ def cmd_evaluate(args):
     from replication.fit.evaluate_file import evaluate
 
     for d in evaluate(args.model, args.data, out=args.out, framework=args.framework, system=args.system,
-                      substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy):
+                      substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy,
+                      device=args.device):
         m = d["metrics"]
         parts = [f"{k} {m[k]:.4g}" for k in (f"test_{d['protocol']['loss']}", "test_rollout_gmean_err",
                                              "test_learned_energy_drift", "test_energy_err_final") if m.get(k) is not None]
@@ -179,6 +180,7 @@ def add_commands(sub) -> None:
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
+    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")
     s.set_defaults(func=cmd_evaluate)

@@ -35,7 +35,7 @@ def _check(framework, system, substeps, window, polyorder):
 
 
 def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
-             polyorder=None, energy=None) -> list[dict]:
+             polyorder=None, energy=None, device="auto") -> list[dict]:
     _check(framework, system, substeps, window, polyorder)
     path = str(Path(data).resolve())
     has_tau = "tau" in userdata.read(path)[1]
@@ -48,6 +48,9 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         if (f.task == "inverse_dynamics") != has_tau:
             raise ValueError(f"--data {data}: {'has' if has_tau else 'lacks'} tau columns, but the fit in {f.folder} "
                              f"was trained {'with' if f.task == 'inverse_dynamics' else 'without'} them")
+    from replication.training import device as dev
+
+    dev.apply(device, sorted({framework or f.result["framework"] for f in fits}))   # before anything is written
     out = R.output_folder(out, "--out")
     from replication.run.runner import is_current
 
@@ -72,7 +75,7 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         claim = Claim(id="evaluate", number=0, paper="user", section="-", title=f"{r['model']} on {Path(data).name}",
                       system=cfg["system"] or Path(data).name, models=(entry,), protocols={"quick": f.protocol},
                       evaluate="fit", metric=f"test_{loss}", metric_label=f"test {LOSS_NAMES[loss]}", published={},
-                      verdict_rule="none", verdict=lambda v: ("not run", "user data"), eval_config={"quick": cfg})
+                      verdict_rule="none (user data)", parts=(), eval_config={"quick": cfg})
         unit = Unit(claim, entry, framework or r["framework"], int(r["seed"]), "quick")
         if is_current(unit, out):
             done.append(dict(R.load_result(unit.folder(out)), reused=True, folder=str(unit.folder(out))))

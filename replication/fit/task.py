@@ -173,7 +173,7 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
     claim = Claim(id="fit", number=0, paper="user", section="-", title=f"{model} on {Path(data).name}",
                   system=system or Path(data).name, models=(entry,), protocols={"quick": protocol}, evaluate="fit",
                   metric=metric, metric_label=label, published={}, verdict_rule="none",
-                  verdict=lambda v: ("not run", "user data"), eval_config={"quick": cfg})
+                  parts=(), eval_config={"quick": cfg})
     unit = Unit(claim, entry, framework, seed, "quick")
     from replication.run.runner import is_current
 

@@ -11,6 +11,7 @@ from replication.evaluation.adapters import adapter
 from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
 from replication.evaluation.routines import Context, system_of
 from replication.run import environment as env
+from replication.training import device as dev
 from replication.training import hessian_probe
 from replication.training.outcome import log_frame
 from replication.training.train import train_cached
@@ -59,7 +60,9 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
         ctx.log = outcome.log
-    ev = EVALUATIONS[unit.claim.evaluate](ctx)
+    where = dev.resolve(dev.request(), unit.framework)
+    with dev.placed(unit.framework, where):   # the model's evaluation on the run's device
+        ev = EVALUATIONS[unit.claim.evaluate](ctx)
     for name, df in ev.tables.items():
         files[name] = R.write_csv(folder / name, df)
     if ev.arrays:
@@ -77,7 +80,7 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
         "scouting": outcome.scouting if outcome else None,
         "cohort": outcome.cohort if outcome else None,
         "train_step_mode": outcome.step_mode if outcome else None,
-        "train_device": outcome.device if outcome else None,   # evaluation computes on the CPU
+        "train_device": outcome.device if outcome else None, "eval_device": dev.describe(unit.framework, where),
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

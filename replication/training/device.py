@@ -1,5 +1,4 @@
-"""Where a training computes: `--device cpu | gpu | auto` (`run`, `fit`, `train-target`; `evaluate` takes it
-and evaluates on the CPU, as every evaluation does).
+"""Where models train and are evaluated: `--device cpu | gpu | auto` (`run`, `fit`, `evaluate`, `train-target`).
 
 `resolve(request, framework)` -> "cpu" | "gpu": auto takes the framework's GPU where it sees one (JAX's
 default, and now PyTorch's too), else the CPU; gpu where the framework sees none raises `DeviceError`, one
@@ -8,8 +7,8 @@ resolves every framework of a command up front (the CLI's early check). `placed(
 context in which the framework's training computes on that device: PyTorch's default device (so models,
 batches, optimiser state and the constants the models make land on it) or JAX's default device, with
 float32 matrix products at full precision on a GPU (JAX's default there is TF32-like; PyTorch's
-`allow_tf32` off) unless `LAGBENCH_TF32=1`. Everything else (data, ground truth, evaluation) stays on the
-CPU, in float64 where it is, so a GPU changes only the training's arithmetic. `describe(framework, device)`:
+`allow_tf32` off) unless `LAGBENCH_TF32=1`. Training data and targets are made in NumPy on the CPU; an
+evaluation runs its model on the device (its JAX ground-truth integrations, float64, where JAX computes). `describe(framework, device)`:
 what result files record (the device, its name and driver).
 
 The request travels to worker processes and Ray tasks in the environment variable `LAGBENCH_DEVICE`
@@ -22,8 +21,9 @@ import os
 from contextlib import contextmanager
 
 CHOICES = ("auto", "cpu", "gpu")
-HELP = ("where training computes: auto (a GPU where the framework sees one, else the CPU), cpu, or gpu (an "
-        "error if a framework sees none); evaluation computes on the CPU (default: auto)")
+HELP = ("where the models train and are evaluated: auto (a GPU where the framework sees one, else the CPU), "
+        "cpu, or gpu (an error if a framework sees none); data and ground truth are made on the CPU in float64 "
+        "(default: auto)")
 ENV = "LAGBENCH_DEVICE"
 TF32_ENV = "LAGBENCH_TF32"
 

@@ -40,15 +40,30 @@ def test_without_a_gpu_auto_takes_the_cpu_and_gpu_names_what_is_missing():
     (["run", "--profile", "smoke", "--frameworks", "jax", "--device", "gpu"], "JAX"),
     (["fit", "--data", "none.csv", "--model", "lnn", "--framework", "torch", "--device", "gpu"], "PyTorch"),
     (["train-target", "--device", "gpu"], "JAX"),
+    (["evaluate", "--model", "{fit}", "--data", "{data}", "--framework", "torch", "--device", "gpu"], "PyTorch"),
 ])
-def test_a_gpu_asked_for_where_none_is_seen_is_one_line_and_writes_nothing(tmp_path, argv, framework):
+def test_a_gpu_asked_for_where_none_is_seen_is_one_line_and_writes_nothing(tmp_path, argv, framework, fitted):
     out = tmp_path / "out"
+    argv = [a.format(fit=fitted["fit"], data=fitted["data"]) for a in argv]
     r = subprocess.run([sys.executable, "-m", "replication.cli", *argv, "--out", str(out)], capture_output=True,
                        text=True, cwd=tmp_path, timeout=300)
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("lagbench: error: --device gpu: ") and framework in lines[0]
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    """A tiny fit of simulated data (for `evaluate`), made on the CPU."""
+    from replication.fit.simulate import simulate
+    from replication.fit.task import fit
+
+    root = tmp_path_factory.mktemp("fitted")
+    data = root / "pendulum.csv"
+    simulate("pendulum", trajectories=3, duration=1.0, rate=20.0, seed=0).to_csv(data, index=False)
+    fit(str(data), model="baseline", out=str(root / "fit"), framework="torch", steps=3, hidden=(8,), batch=8)
+    return {"fit": str(root / "fit"), "data": str(data)}
 
 
 def test_placed_on_the_cpu_leaves_both_frameworks_where_they_were():
