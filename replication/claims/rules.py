@@ -62,22 +62,25 @@ def _below(iv: Interval, t: float) -> str:
     return "reproduced" if iv.hi < t else "not reproduced" if iv.lo >= t else "inconclusive"
 
 
-def better_by(a: str, b: str, factor: float, metric: str):
-    def at(iv, f):
-        return _below(iv, 1.0 / f)
-
+def _ratio_rule(a: str, b: str, metric: str, at, t: float, label: str, why: dict):
+    """A rule on the interval of a / b over seed pairs: ``at(interval, t)`` decides, and is also read at
+    t / 2 and 2 t (the sensitivity); ``why`` words each verdict."""
     def rule(v):
         if (m := _missing(v, (a, b), metric)) is not None:
             return m
         x, y = _get(v, a, metric), _get(v, b, metric)
         iv = ratio_interval(x, y, f"{a}/{b}")
-        verdict = at(iv, factor)
-        why = {"reproduced": f"below 1/{factor:g} for every seed pair",
-               "not reproduced": f"not below 1/{factor:g} for any seed pair",
-               "inconclusive": f"across 1/{factor:g}: the seeds disagree"}[verdict]
-        return Outcome(verdict, f"{a} {x} vs {b} {y}; {iv}: {why}", iv,
-                       {f"factor {factor / 2:g}": at(iv, factor / 2), f"factor {factor * 2:g}": at(iv, factor * 2)})
+        verdict = at(iv, t)
+        return Outcome(verdict, f"{a} {x} vs {b} {y}; {iv}: {why[verdict]}", iv,
+                       {f"{label} {t / 2:g}": at(iv, t / 2), f"{label} {t * 2:g}": at(iv, t * 2)})
     return rule
+
+
+def better_by(a: str, b: str, factor: float, metric: str):
+    return _ratio_rule(a, b, metric, lambda iv, f: _below(iv, 1.0 / f), factor, "factor",
+                       {"reproduced": f"below 1/{factor:g} for every seed pair",
+                        "not reproduced": f"not below 1/{factor:g} for any seed pair",
+                        "inconclusive": f"across 1/{factor:g}: the seeds disagree"})
 
 
 def similar(a: str, b: str, within: float, metric: str):
@@ -87,19 +90,10 @@ def similar(a: str, b: str, within: float, metric: str):
         if iv.hi < 1 / w or iv.lo > w:
             return "not reproduced"
         return "inconclusive"
-
-    def rule(v):
-        if (m := _missing(v, (a, b), metric)) is not None:
-            return m
-        x, y = _get(v, a, metric), _get(v, b, metric)
-        iv = ratio_interval(x, y, f"{a}/{b}")
-        verdict = at(iv, within)
-        why = {"reproduced": f"inside [1/{within:g}, {within:g}] for every seed pair",
-               "not reproduced": f"outside [1/{within:g}, {within:g}] for every seed pair",
-               "inconclusive": f"across the edge of [1/{within:g}, {within:g}]"}[verdict]
-        return Outcome(verdict, f"{a} {x} vs {b} {y}; {iv}: {why}", iv,
-                       {f"within {within / 2:g}": at(iv, within / 2), f"within {within * 2:g}": at(iv, within * 2)})
-    return rule
+    return _ratio_rule(a, b, metric, at, within, "within",
+                       {"reproduced": f"inside [1/{within:g}, {within:g}] for every seed pair",
+                        "not reproduced": f"outside [1/{within:g}, {within:g}] for every seed pair",
+                        "inconclusive": f"across the edge of [1/{within:g}, {within:g}]"})
 
 
 def fails(bad: str, goods: tuple, factor: float, metric: str):
@@ -148,20 +142,15 @@ def bound(metric: str, *, upper: float | None = None, lower: float | None = None
 def below_null(metric: str, fraction: float, model: str):
     """``model``'s metric at most ``fraction`` x the null predictor's (``null_<metric>``, recorded beside it),
     for every pair of seeds: a statement that the null predictor itself fails."""
-    def at(iv, f):
-        return _below(iv, f) if iv.hi < f or iv.lo >= f else "inconclusive"
+    rule = _ratio_rule(model, f"{model} null", metric, _below, fraction, "fraction",
+                       {"reproduced": f"below {fraction:g}", "not reproduced": f"not below {fraction:g}",
+                        "inconclusive": f"across {fraction:g}"})
 
-    def rule(v):
-        if (m := _missing(v, (model,), metric)) is not None or (m := _missing(v, (model,), f"null_{metric}")):
+    def with_null(v):
+        if (m := _missing(v, (model,), f"null_{metric}")) is not None:
             return m
-        x, null = _get(v, model, metric), _get(v, model, f"null_{metric}")
-        iv = ratio_interval(x, null, f"{model} {metric}/null")
-        verdict = at(iv, fraction)
-        return Outcome(verdict, f"{model} {metric} {x} vs the null's {null}; {iv}: "
-                       + {"reproduced": f"below {fraction:g}", "not reproduced": f"not below {fraction:g}",
-                          "inconclusive": f"across {fraction:g}"}[verdict], iv,
-                       {f"fraction {fraction / 2:g}": at(iv, fraction / 2), f"fraction {fraction * 2:g}": at(iv, fraction * 2)})
-    return rule
+        return rule({model: {metric: _get(v, model, metric)}, f"{model} null": {metric: _get(v, model, f"null_{metric}")}})
+    return with_null
 
 
 def _share(vals) -> str:
