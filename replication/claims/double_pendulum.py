@@ -15,7 +15,6 @@ from replication.training.protocol import Protocol
 from replication.training.scouting import scouting_samples
 
 PAPER_W, QUICK_W, SMOKE_W = (600, 600, 600), (64, 64, 64), (16, 16)
-PLAIN_QUICK_W = (128, 128, 128)   # the quick width of the side studies (precision, init, activation)
 FULL_W = (128, 128, 128)          # full: the train-to-target study's width that reached held-out 0.069
 WIDTHS = {"smoke": SMOKE_W, "quick": QUICK_W, "full": FULL_W, "paper": PAPER_W}
 
@@ -35,10 +34,9 @@ MODELS = (
 _base = Protocol(data="double_pendulum_iid", steps=20, batch=32, n_train=640, n_heldout=512, resample=True,
                  loss="l1", lr=1e-3, schedule="onecycle", l2=1e-6 / 512, log_every=5)
 
-# the side studies' quick protocol (claims 6, 7, 11): at 2 cores' scale the code's schedule leaves the LNN
-# on its q-double-dot ~ 0 plateau (L1 ~ 47 after 2000 steps at peak 1e-3, measured); a higher constant
-# rate then one decay gets it off for some seeds
-PLAIN_SMOKE = _base
+# the speed study's short LNN protocol (`speedstudy.learned`, the train-to-target `variant`): at 2 cores' scale
+# the code's schedule leaves the LNN on its q-double-dot ~ 0 plateau (L1 ~ 47 after 2000 steps at peak 1e-3,
+# measured); a higher constant rate then one decay gets it off for some seeds
 PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout=20_000, log_every=50, lr=3e-3,
                             schedule="step", lr_step_every=2500, lr_step_gamma=0.1)
 
@@ -46,32 +44,10 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 # same budget and selection): 16 inits scouted at batch 32, peak 1e-3, a one-cycle of 15 625 steps from phase 0.2;
 # at its half the 4 lowest by training loss go on to its end (successive halving, `scout_keep`), and the lowest
 # of those is continued at batch 256 for 6e6 samples (one-cycle, fresh Adam) at peak 1e-2 from phase 0.1 (lr 9.6e-4,
-# about the scouts' peak). 1.1e7 samples in all, a twenty-seventh of the original code's 3e8.
-# Why 16 and a cut: which init finds a near-physical Lagrangian is luck (about 28 % of them, JAX inits 0-31), and
-# only such a scout continues to a low held-out L1 at this budget. With 8 whole scouts PyTorch seed 1 found none
-# (tails 13.4-18.2) and ended at 10.46 in the quick run at 53914d1; every continuation rate tried from its scout
-# failed (2e-3: 9.85, 5e-3: 2.49). At half the schedule the near-physical scouts already lead (the 7 lowest of 32
-# are near-physical), so keeping 4 of 16 there costs 5e6 scout samples (4e6 before) and misses in about 2 % of runs
-# (0.78^16) against 7 % (`docs/train_target_trials.md` section 8). In the quick run at 41b6f6d: JAX 0.234 / 0.248 /
-# 0.260, PyTorch 0.236 / 0.243 / 0.271 (PyTorch seed 1 kept 4 near-physical scouts of 16).
-# Why the continuation's start: a fresh Adam's first steps at the usual start (0.35 x peak = 3.5e-3) threw seed 0's
-# chosen scout off its near-physical Lagrangian within 250 steps (training loss 3.9 -> 43; held-out 8.1) in the
-# quick run at 2f021b7 and in the one-thread trial that replays its batch stream. Trials (JAX, one thread, each
-# seed's chosen scout continued on its own stream and two others, held-out L1 on 4096 states; section 7):
-#   peak 2e-3, start 0.2:   0.51-0.69       peak 5e-3, start 0.2:   0.29-0.31
-#   peak 1e-2, start 0.2:   0.23-0.26 in 8 of 9 runs, one thrown off (8.1)
-#   peak 1e-2, start 0.0:   0.27-0.30       peak 1e-2, start 0.1 (now): 0.247-0.280 in 9 runs
-# The baseline gets the same protocol: 0.97 (seed 0; 0.81 at peak 2e-2, 1.02 at 5e-2). Wider, it gets lower
-# (3 x 128: 0.54), but the paper compares the two at one width, and so do we.
-# Why 6e6 continuation samples (4e6 until 2026-11-26): with 4e6, 3 of the 6 runs of the quick run at 8cf1d1a ended
-# above the 0.3 asked of quick (JAX 0.249 / 0.308 / 0.257, PyTorch 0.323 / 0.302 / 0.275). Each chosen scout
-# replayed and continued on its own stream (one thread each, two at a time; held-out L1 on the quick
-# run's 20 000 states; `docs/train_target_trials.md` section 16):
-#   4e6 (15 625 steps): JAX 0.249 / 0.308 / 0.257, PyTorch seed 0 0.323 (the run's numbers to 4 digits)
-#   5e6 (19 531 steps): JAX 0.212 / 0.250 / 0.221
-#   6e6 (23 437 steps): JAX 0.179 / 0.220 / 0.193, PyTorch 0.236 / 0.218 (seeds 0, 1)
-#   8e6 as 15 625 steps at batch 512: JAX 0.211 / 0.256, and slower than 6e6 at batch 256
-# The continuation is the cheaper part of a run (about 40 % of the JAX LNN's time at 4e6).
+# about the scouts' peak). 1.1e7 samples in all, a twenty-seventh of the original code's 3e8. Which init finds a
+# near-physical Lagrangian is luck, and only such a scout continues to a low held-out L1 at this budget; a fresh
+# Adam at a higher start throws a chosen scout off it. The measurements behind each number:
+# `docs/decisions/double_pendulum_protocol.md`.
 _guard = {"grad_clip": 100.0, "spike_skip": 10.0}
 PROTOCOLS = {
     "smoke": _base.replace(scouts=2, scout_steps=10, scout_batch=16, track_every=5, **_guard),
@@ -81,17 +57,12 @@ PROTOCOLS = {
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
 # full: quick's 16 scouts halved to 4, the continuation at peak 2e-3 (from phase 0.2, as the scouts) for 4e7
-# samples in all: the train-to-target study's `restarts_halved` at 3 x 128 (the same Protocol), which reached
-# held-out L1 0.069 on 1e5 states at 3.5e7 samples (0.063 at the end) on 2 threads (`docs/train_target_trials.md`
-# section 9). Before, with 8 whole scouts and 3e7 samples (`restarts_fast`), two of six seeds missed 0.069
-# (JAX 0.0748, 0.0700; the rest 0.056-0.064). Judged on the paper's 1e5 held-out states.
-# Why 4e7 (3.5e7 until 2026-11-26): at 3.5e7 the compiled PyTorch seed 1 ended at 0.0742 (the other five
-# 0.0537-0.0616); with 4e7 it chose the same scout and ended at 0.0662 (section 16).
+# samples in all: the train-to-target study's `restarts_halved` at 3 x 128 (the same Protocol), judged on the
+# paper's 1e5 held-out states (`docs/decisions/double_pendulum_protocol.md`).
 FULL_SAMPLES = 40_000_000
-PROTOCOLS["full"] = PROTOCOLS["quick"].replace(n_heldout=100_000, lr=2e-3, lr_start=0.2, scout_lr_start=0.0,
-                                               log_every=1000, track_every=5000)
-PROTOCOLS["full"] = PROTOCOLS["full"].replace(
-    steps=(FULL_SAMPLES - scouting_samples(PROTOCOLS["full"])) // PROTOCOLS["full"].batch)
+_full = PROTOCOLS["quick"].replace(n_heldout=100_000, lr=2e-3, lr_start=0.2, scout_lr_start=0.0, log_every=1000,
+                                   track_every=5000)
+PROTOCOLS["full"] = _full.replace(steps=(FULL_SAMPLES - scouting_samples(_full)) // _full.batch)
 
 SEEDS = {"smoke": 1, "quick": 3, "paper": 3}
 
