@@ -11,8 +11,6 @@ protocols, restarts and spike guard included), so that the float32 models are th
 training cache, and only the dtype differs. In `quick` (and `full`, which inherits it) the baseline
 alone: it has learned there (held-out L1 about 1.5 against the null's 47); a float64 LNN would cost
 about 3x its float32 training in JAX, 40 more minutes of the quick run. The LNN joins at `paper` scale.
-(Until 2026-11-24 the claim trained its own shortened protocol, 600 steps, on which both models were
-still on the q-double-dot ~ 0 plateau, so the verdict was "inconclusive".)
 The reference's 0.10 % float32 truth drift is measured on the original code, not published: it is
 context in the module docstring, not a published value.
 """

@@ -6,9 +6,9 @@
 step to compile and takes their median (the scouts of a protocol with restarts, and a cohort of seeds, are
 timed as they run: K members side by side), and scales up by the protocol's steps. Evaluation time is not
 included. The wall time replays the executor's schedule (`scheduled_wall`): the chains of
-`replication.run.chains.chains`, longest first by its cost, each to the first of `jobs` workers to come free.
-(Before, it assumed the trainings spread evenly: three trainings of 0.33 h on two workers came out 0.5 h
-where the run took two rounds, 55 min.)
+`replication.run.chains.chains`, longest first by its cost, each to the first of `jobs` workers to come free
+(spreading the trainings evenly would call three trainings of 0.33 h on two workers 0.5 h, where the run
+takes two rounds).
 
 The probes run on the device the units will train on (`replication.training.device`, from LAGBENCH_DEVICE),
 and PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
