@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from replication.training.device import HELP as DEVICE_HELP
@@ -213,10 +215,21 @@ RESUME = {"run": "finished units are kept; run the same command again to resume"
           "evaluate": "no result was written; run the same command again"}
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (a scheduler's or `kill`'s stop), handled as Ctrl-C is: recorded, with how to resume."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
 def main(argv=None):
     """Every error is one line on stderr and a non-zero exit: 2 for bad input or an OS error (a file
-    where a folder belongs, no permission, a full disk), 130 for Ctrl-C (with how to resume)."""
+    where a folder belongs, no permission, a full disk), 130 for Ctrl-C and 143 for SIGTERM (with how to
+    resume)."""
     args = build_parser().parse_args(argv)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminate)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     try:
         code = args.func(args)
@@ -228,11 +241,12 @@ def main(argv=None):
         where = f": {e.filename}" if e.filename else ""
         print(f"lagbench: error: {e.strerror or e}{where}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         hint = RESUME.get(args.command, "nothing half-written was left; run the same command again")
         hint = hint.format(out=getattr(args, "out", None) or "OUT")
-        print(f"\nlagbench: interrupted; {hint}", file=sys.stderr)
-        return 130
+        how = "terminated (SIGTERM)" if isinstance(e, Terminated) else "interrupted"
+        print(f"\nlagbench: {how}; {hint}", file=sys.stderr)
+        return 143 if isinstance(e, Terminated) else 130
     return code or 0
 
 

@@ -58,6 +58,28 @@ def test_ctrl_c_says_how_to_resume_and_is_recorded(monkeypatch, tmp_path, capsys
     assert manifest["interrupted"] and manifest["finished"] is None
 
 
+def test_sigterm_is_recorded_like_ctrl_c_and_says_how_to_resume(monkeypatch, tmp_path, capsys):
+    import os
+    import signal
+    import time
+
+    def killed(*a, **kw):   # a real SIGTERM to this process, in the middle of a unit
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+
+    before = signal.getsignal(signal.SIGTERM)
+    monkeypatch.setattr(units, "run_unit", killed)
+    try:
+        assert main(["run", *ONE, "--out", str(tmp_path)]) == 143
+    finally:
+        signal.signal(signal.SIGTERM, before)
+    err = capsys.readouterr().err
+    assert "terminated (SIGTERM); finished units are kept; run the same command again to resume" in err
+    assert "Traceback" not in err
+    manifest = json.loads((tmp_path / "run.json").read_text())
+    assert manifest["interrupted"] and manifest["finished"] is None
+
+
 def test_repairs_are_named_and_every_run_record_is_kept(tmp_path, caplog):
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
               progress=False)
