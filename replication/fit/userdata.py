@@ -64,6 +64,11 @@ def _from_csv(path, raw: bytes):
         df = pd.read_csv(io.BytesIO(raw))
     except Exception as e:
         raise ValueError(f"{path}: cannot read as CSV ({e})") from e
+    header = [str(c).strip() for c in pd.read_csv(io.BytesIO(raw), header=None, nrows=1).iloc[0]]
+    twice = sorted({c for c in header if header.count(c) > 1})
+    if twice:   # pandas would rename the second one ("q1.1") and read the first alone
+        raise ValueError(f"{path}: column{'s' if len(twice) > 1 else ''} {', '.join(twice)} named more than once; "
+                         f"give each column one name")
     df.columns = [str(c).strip() for c in df.columns]
     out = {name: df[name].to_numpy() for name in COLUMNS if name in df.columns}
     for name in ARRAYS:

@@ -55,6 +55,8 @@ def _csv(path, header, rows=40, big=False):
     (["q0", " qdot0", " qddot0"], False, None),  # spaces after the commas are ignored
     (["q0", "q2", "qdot0", "qdot1", "qddot0", "qddot1"], False, "without gaps"),
     (["q0", "qdot0", "qddot0"], True, "beyond the float32 range"),
+    (["q0", "qdot0", "qddot0", "qdot0"], False, "column qdot0 named more than once"),   # not silently the first
+    (["q0", " qdot0", "qddot0", "qdot0 "], False, "column qdot0 named more than once"),
 ])
 def test_csv_headers_gaps_and_float32_range(tmp_path, header, big, message):
     path = _csv(tmp_path / "d.csv", header, big=big)
