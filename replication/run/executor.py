@@ -12,16 +12,19 @@ form one *chain* (`replication.run.chains`, shared with the Ray executor, `repli
 longest first (estimated from the training budget in samples, the model's width and the framework), so
 that the long ones do not start last. Every unit writes its own files as in a serial run, so a run is
 resumable and gives the same numbers either way (training is deterministic given the seed; only wall
-times differ). Ctrl-C cancels the chains not yet started and stops the workers. A worker whose driver is
+times differ). Each worker holds one chain at a time; one that dies (the out-of-memory killer, a `kill`)
+loses that chain's units alone, each named as an error (no result; a rerun retries it), and a new worker
+takes the next chain. Ctrl-C cancels the chains not yet started and stops the workers. A worker whose driver is
 gone (killed, SIGTERM from a scheduler or `timeout`) exits within a second: it would otherwise finish its
 chain, hours in the long profiles, writing into a folder that a resumed run may be writing too.
 """
 from __future__ import annotations
 
 import os
+import queue
+import signal
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 
 from tqdm.auto import tqdm
@@ -71,37 +74,116 @@ def _worker_start(driver: int):
     threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
 
 
+def _worker_loop(driver: int, tasks, results):
+    """A worker process: chains from `tasks` (None: stop), each answered on `results` as (chain id, done,
+    error)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the driver's: it stops the workers
+    _worker_start(driver)
+    while (item := tasks.get()) is not None:
+        cid, refs, out = item
+        try:
+            results.put((cid, _run_chain(refs, out), None))
+        except Exception as e:  # noqa: BLE001 - reported for this chain; the worker goes on
+            results.put((cid, None, f"{type(e).__name__}: {e}"))
+
+
+class _Workers:
+    """`jobs` worker processes (spawned on demand), each with its own task queue and one chain at a time.
+    A worker that dies (the out-of-memory killer, a `kill`) loses only the chain it held: `dead()` names it
+    and the next `assign` starts a replacement."""
+
+    def __init__(self, jobs):
+        self.ctx, self.jobs = get_context("spawn"), jobs
+        self.results = self.ctx.Queue()
+        self.slots = []   # [process, task queue, chain id or None]
+
+    def idle(self):
+        self.slots = [s for s in self.slots if s[2] is not None or s[0].is_alive()]   # an idle one that died
+        free = [s for s in self.slots if s[2] is None]
+        if not free and len(self.slots) < self.jobs:
+            q = self.ctx.Queue()
+            proc = self.ctx.Process(target=_worker_loop, args=(os.getpid(), q, self.results), daemon=True)
+            proc.start()
+            self.slots.append([proc, q, None])
+            free = [self.slots[-1]]
+        return free[0] if free else None
+
+    def assign(self, slot, cid, refs, out):
+        slot[2] = cid
+        slot[1].put((cid, refs, out))
+
+    def busy(self) -> bool:
+        return any(s[2] is not None for s in self.slots)
+
+    def finished(self, cid):
+        for s in self.slots:
+            if s[2] == cid:
+                s[2] = None
+
+    def dead(self) -> list:
+        """[(chain id, exit code)] of busy workers that died; their slots are freed for a replacement."""
+        out = []
+        for s in list(self.slots):
+            if s[2] is not None and not s[0].is_alive():
+                out.append((s[2], s[0].exitcode))
+                self.slots.remove(s)
+        return out
+
+    def close(self, wait: bool):
+        for proc, q, _ in self.slots:
+            if wait and proc.is_alive():
+                q.put(None)
+            else:
+                proc.terminate()
+        for proc, _, _ in self.slots:
+            proc.join(timeout=10 if wait else 2)
+
+
 def _parallel(todo, out, profile, progress, jobs):
     work = chains(todo)
     failures, errors = [], []
     one = one_thread_env(os.environ)
     saved = {k: os.environ.get(k) for k in one}
-    # inherited by the spawned workers before they import JAX or PyTorch; kept while the pool lives, as
-    # the pool starts its processes on demand as chains are submitted
+    # inherited by the spawned workers before they import JAX or PyTorch; kept while they live, as they
+    # start on demand as chains are handed out
     os.environ.update(one)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"), initializer=_worker_start,
-                               initargs=(os.getpid(),))
+    workers = _Workers(jobs)
     bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
+    pending, held = list(enumerate(work)), {}
+
+    def record(done):
+        nonlocal failures, errors
+        for name, failure, error in done:
+            failures += [failure] if failure else []
+            errors += [error] if error else []
+            bar.update(1)
+            bar.set_postfix_str(name)
     try:
-        futures = {pool.submit(_run_chain, [_ref(u) for u in c], out): c for c in work}
-        for f in as_completed(futures):
+        while pending or held:
+            while pending and (slot := workers.idle()) is not None:
+                cid, chain = pending.pop(0)
+                held[cid] = chain
+                workers.assign(slot, cid, [_ref(u) for u in chain], out)
             try:
-                done = f.result()
-            except Exception as e:  # noqa: BLE001 - a worker that died loses its chain's units, not the run
-                done = [(u.name, None, f"{u.name}: worker stopped: {type(e).__name__}: {e}") for u in futures[f]]
-            for name, failure, error in done:
-                failures += [failure] if failure else []
-                errors += [error] if error else []
-                bar.update(1)
-                bar.set_postfix_str(name)
+                cid, done, error = workers.results.get(timeout=0.5)
+            except queue.Empty:
+                # a worker that died loses the chain it held, not the run
+                for cid, code in workers.dead():
+                    record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
+                            for u in held.pop(cid)])
+                continue
+            chain = held.pop(cid, None)
+            workers.finished(cid)
+            if chain is not None:
+                record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain])
     except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
+        workers.close(wait=False)
         raise
     finally:
         bar.close()
         for k, v in saved.items():
             os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
-    pool.shutdown()
+    workers.close(wait=True)
     return failures, errors
 
 

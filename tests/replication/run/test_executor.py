@@ -60,22 +60,29 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
     def fake_chain(refs, out):
         return [(f"u{i}", None, None) for i, _ in enumerate(refs)]
 
-    class Pool:
-        def __init__(self, **kw):
-            pass
+    class Workers:   # answers each chain at once, noting the environment a worker would start with
+        def __init__(self, jobs):
+            import queue
 
-        def submit(self, fn, refs, out):
-            from concurrent.futures import Future
+            self.results = queue.Queue()
 
+        def idle(self):
             seen.update({k: os.environ.get(k) for k in one_thread_env({})})
-            f = Future()
-            f.set_result(fake_chain(refs, out))
-            return f
+            return object()
 
-        def shutdown(self, **kw):
+        def assign(self, slot, cid, refs, out):
+            self.results.put((cid, fake_chain(refs, out), None))
+
+        def finished(self, cid):
             pass
 
-    monkeypatch.setattr(executor, "ProcessPoolExecutor", Pool)
+        def dead(self):
+            return []
+
+        def close(self, wait):
+            pass
+
+    monkeypatch.setattr(executor, "_Workers", Workers)
     todo = runner.plan("smoke", claims=["appendix_b", "dp_loss"], frameworks=("jax",))
     failures, errors = executor.run_units(todo, "unused", "smoke", progress=False, jobs=2)
     assert failures == [] and errors == []
@@ -124,3 +131,36 @@ def test_workers_exit_when_their_driver_is_killed(tmp_path):
         os.kill(w, signal.SIGKILL)
     assert not alive, "workers kept running after their driver was killed"
     assert not list(out.glob("units/*/*/*/seed*/result.json")), "a worker went on to finish a unit"
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc to find the workers")
+def test_a_dead_worker_loses_only_its_chain(tmp_path):
+    """SIGKILL on one worker (as the out-of-memory killer would) while it holds its first chain: that
+    chain's unit is an error naming the worker's end, a new worker takes the remaining chains, and every
+    other unit is written."""
+    import threading
+
+    todo = runner.plan("smoke", claims=["dp_loss", "appendix_b"], frameworks=("jax",))
+    killed = []
+
+    def kill_first_worker():
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            workers = [c for c in _children(os.getpid()) if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+            if workers:
+                time.sleep(1.0)   # it holds its first chain from the start; importing JAX alone takes longer
+                os.kill(workers[0], signal.SIGKILL)
+                killed.append(workers[0])
+                return
+            time.sleep(0.05)
+
+    t = threading.Thread(target=kill_first_worker, daemon=True)
+    t.start()
+    failures, errors = executor.run_units(todo, tmp_path, "smoke", progress=False, jobs=2)
+    t.join(timeout=5)
+    assert killed, "no worker started"
+    assert failures == [] and len(errors) == 1 and "worker stopped (exit code -9)" in errors[0], errors
+    lost = errors[0].split(":", 1)[0]
+    written = {f"{p.parts[-5]}/{p.parts[-4]}/{p.parts[-3]}/{p.parts[-2]}"
+               for p in tmp_path.glob("units/*/*/*/seed*/result.json")}
+    assert written == {u.name for u in todo} - {lost}
