@@ -8,6 +8,7 @@ import sys
 import threading
 from pathlib import Path
 
+from replication.results import writing
 from replication.training.device import HELP as DEVICE_HELP
 
 
@@ -232,7 +233,8 @@ def main(argv=None):
         signal.signal(signal.SIGTERM, _terminate)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     try:
-        code = args.func(args)
+        with writing():   # the folders the command locks are let go when it ends
+            code = args.func(args)
     except (KeyError, ValueError, FileNotFoundError) as e:
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
         print(f"lagbench: error: {msg}", file=sys.stderr)

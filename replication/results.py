@@ -10,12 +10,14 @@ both and raises `CorruptResult` on any mismatch; the runner then reruns the unit
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import io
 import json
 import math
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -68,9 +70,66 @@ def read_nofollow(path) -> bytes:
         return fh.read()
 
 
+LOCK_NAME = ".lagbench.lock"
+_LOCKS: dict = {}   # resolved folder -> the open lock file this process holds on it
+
+
+def _lock(path: Path, option: str) -> None:
+    """Hold the folder's exclusive lock (an flock on its LOCK_NAME, released when this process lets go or
+    ends); a ValueError naming the holder if another process holds it. Reentrant within a process."""
+    import fcntl
+
+    key = str(path.resolve())
+    if key in _LOCKS:
+        return
+    try:
+        fd = os.open(path / LOCK_NAME, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+    except OSError as e:
+        raise ValueError(f"{option} {path}: cannot make its lock file {LOCK_NAME} ({e.strerror or e})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
+        os.close(fd)
+        raise ValueError(f"{option} {path}: another lagbench command is writing into this folder ({holder}); "
+                         "wait for it to end, or give another folder") from None
+    os.ftruncate(fd, 0)
+    os.write(fd, f"pid {os.getpid()}, since {_now()}".encode())
+    _LOCKS[key] = fd
+
+
+def _now() -> str:
+    import datetime as dt
+
+    return dt.datetime.now(dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+@contextmanager
+def writing():
+    """The folders locked (by `output_folder`) inside the block are let go at its end; a block inside
+    another lets go only of its own. Every command, and every library call that writes a folder, runs in
+    one: two commands never write into one folder at once."""
+    before = set(_LOCKS)
+    try:
+        yield
+    finally:
+        for key in set(_LOCKS) - before:
+            os.close(_LOCKS.pop(key))
+
+
+def writes(fn):
+    """`fn` run inside `writing`: the folders it locks are let go when it returns."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        with writing():
+            return fn(*args, **kwargs)
+    return wrapper
+
+
 def output_folder(path, option: str = "--out") -> Path:
-    """`path` as a folder this process can write into, created if absent; else a ValueError naming
-    `option` (checked before any work starts, so no computation is lost to a bad output folder)."""
+    """`path` as a folder this process can write into, created if absent, and locked for this process
+    (`writing`); else a ValueError naming `option` (checked before any work starts, so no computation is
+    lost to a bad output folder or to another command writing into it)."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise ValueError(f"{option} {path}: exists and is not a folder; give a folder path")
@@ -80,6 +139,7 @@ def output_folder(path, option: str = "--out") -> Path:
         raise ValueError(f"{option} {path}: cannot create the folder ({e.strerror or e})") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise ValueError(f"{option} {path}: the folder is not writable; give a writable folder")
+    _lock(path, option)
     return path
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import datetime as dt
 from pathlib import Path
 
+from replication.results import writes
 from reports import output
 from reports.document import Figure, Section, tables_and_figures
 from reports.environment import environment_sections, sources_sections
@@ -47,6 +48,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     return sections + sources_sections(res, sections)
 
 
+@writes
 def build_report(results_dir: str | Path, out_dir: str | Path, *, pdf: bool = True) -> dict:
     """Build REPORT.md (and REPORT.pdf unless ``pdf=False``) from ``results_dir`` into ``out_dir``."""
     out_dir = output.prepare(out_dir)

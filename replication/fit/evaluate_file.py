@@ -34,6 +34,7 @@ def _check(framework, system, substeps, window, polyorder):
         trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
 
 
+@R.writes
 def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
              polyorder=None, energy=None, device="auto") -> list[dict]:
     _check(framework, system, substeps, window, polyorder)

@@ -112,6 +112,7 @@ def metric_of(counts: dict, has_test: bool, loss: str) -> tuple[str, str]:
     return f"{where}_{loss}", f"{SET_NAMES[where]} {LOSS_NAMES[loss]}"
 
 
+@R.writes
 def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidden=(128, 128), batch=256,
         lr=1e-3, seed=0, loss="l1", dtype="float32", activation="softplus", weight_decay=0.0, schedule="onecycle",
         lr_min_ratio=1e-4, delan_eps=0.01, delan_offset=2.0, angle_wrap=False, input_scale=None, split=None,

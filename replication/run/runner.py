@@ -165,6 +165,7 @@ def executor_of(executor, jobs, address):
     raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
 
 
+@R.writes
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
         progress=True, jobs=1, executor="local", address=None, dry_run=False) -> dict:
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:

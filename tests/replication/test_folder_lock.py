@@ -1,0 +1,62 @@
+"""Two commands never write into one folder at once (issue 58, item 1): every command that writes a folder
+holds its lock (`results.output_folder`, let go by `results.writing` when the command ends); a second one
+is refused with one line naming the holder, before it writes anything."""
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from replication import results as R
+from replication.fit.task import fit
+
+
+def _data(path):
+    rng = np.random.default_rng(0)
+    q, qdot = rng.normal(size=(40, 1)), rng.normal(size=(40, 1))
+    np.savez(path, q=q, qdot=qdot, qddot=-9.81 * np.sin(q))
+    return path
+
+
+def _fit_cli(data, out, steps=2):
+    return [sys.executable, "-m", "replication.cli", "fit", "--data", str(data), "--model", "baseline",
+            "--steps", str(steps), "--hidden", "8", "--batch", "16", "--framework", "torch", "--quiet",
+            "--device", "cpu", "--out", str(out)]
+
+
+def test_a_second_writer_is_refused_in_one_line_and_writes_nothing(tmp_path):
+    data, out = _data(tmp_path / "d.npz"), tmp_path / "out"
+    with R.writing():
+        R.output_folder(out)
+        R.output_folder(out)   # reentrant within a process
+        r = subprocess.run(_fit_cli(data, out), capture_output=True, text=True, timeout=300)
+        assert r.returncode == 2, r.stderr
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and "another lagbench command is writing into this folder" in lines[0]
+        assert f"pid {os.getpid()}" in lines[0]
+        assert sorted(p.name for p in out.iterdir()) == [R.LOCK_NAME]
+    r = subprocess.run(_fit_cli(data, out), capture_output=True, text=True, timeout=300)   # let go: it runs
+    assert r.returncode == 0 and r.stdout.startswith("ok:"), r.stderr
+
+
+def test_a_library_call_lets_go_of_its_folder_when_it_returns(tmp_path):
+    fit(_data(tmp_path / "d.npz"), model="baseline", out=tmp_path / "out", steps=2, hidden=(8,), batch=16)
+    assert not R._LOCKS
+
+
+def test_two_fits_into_one_folder_at_once_never_both_report_success(tmp_path):
+    """The second starts while the first holds the folder: it is refused, and the folder holds the first
+    fit alone, whole."""
+    data, out = _data(tmp_path / "d.npz"), tmp_path / "out"
+    first = subprocess.Popen(_fit_cli(data, out, steps=3000), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and f"pid {first.pid}" not in ((out / R.LOCK_NAME).read_text()
+                                                                  if (out / R.LOCK_NAME).exists() else ""):
+        time.sleep(0.05)
+    second = subprocess.run(_fit_cli(_data(tmp_path / "e.npz"), out), capture_output=True, text=True, timeout=300)
+    stdout, stderr = first.communicate(timeout=300)
+    assert first.returncode == 0, stderr
+    assert second.returncode == 2 and f"pid {first.pid}" in second.stderr, second.stderr
+    assert len(list(out.glob("units/fit/*/*/seed*/result.json"))) == 1
