@@ -8,7 +8,7 @@ import sys
 import threading
 from pathlib import Path
 
-from replication.results import writing
+from replication.results import DiskFull, writing
 from replication.training.device import HELP as DEVICE_HELP
 
 
@@ -238,6 +238,11 @@ def main(argv=None):
     except (KeyError, ValueError, FileNotFoundError) as e:
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
         print(f"lagbench: error: {msg}", file=sys.stderr)
+        return 2
+    except DiskFull as e:
+        hint = RESUME.get(args.command, "run the same command again").format(out=getattr(args, "out", None) or "OUT")
+        print(f"lagbench: error: no space left on the device of {e.filename}; free space there, then: {hint}",
+              file=sys.stderr)
         return 2
     except OSError as e:
         where = f": {e.filename}" if e.filename else ""

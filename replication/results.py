@@ -10,6 +10,7 @@ both and raises `CorruptResult` on any mismatch; the runner then reruns the unit
 """
 from __future__ import annotations
 
+import errno
 import functools
 import hashlib
 import io
@@ -42,14 +43,25 @@ def umask() -> int:
     return old
 
 
+FULL = (errno.ENOSPC, errno.EDQUOT)
+
+
+class DiskFull(OSError):
+    """No space (or no quota) left where a result was being written: `filename` names the file. A run
+    stops at the first one (`replication.run.runner`), since every later unit would train for nothing."""
+
+
 def atomic_write_bytes(path: Path, data: bytes, *, sync: bool = True) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder (fsync'd unless ``sync``
     is False) and a rename: never half-written, and a symlink at ``path`` is replaced, never written
     through. The file gets the mode a plain ``open`` would give (0666 less the umask; ``mkstemp``
     alone makes 0600)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as e:
+        raise (DiskFull(e.errno, e.strerror, str(path)) if e.errno in FULL else e) from e
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -58,8 +70,10 @@ def atomic_write_bytes(path: Path, data: bytes, *, sync: bool = True) -> None:
             if sync:
                 os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(e, OSError) and e.errno in FULL:
+            raise DiskFull(e.errno, e.strerror, str(path)) from e
         raise
 
 

@@ -19,6 +19,8 @@ import gc
 import logging
 import sys
 
+from replication import results as R
+
 log = logging.getLogger("lagbench")
 TORCH_COST = 3.0   # PyTorch's eager LNN step against JAX's compiled one, per sample (measured, 3 x 64 and 3 x 128)
 
@@ -63,6 +65,8 @@ def run_one(unit, out, on_log=None):
 
     try:
         d = run_unit(unit, out, on_log=on_log)
+    except R.DiskFull:
+        raise   # every later unit would fail the same way: the run stops (`runner.run`)
     except Exception as e:  # noqa: BLE001 - one unit's error must not lose the rest of the run
         log.exception("%s failed", unit.name)
         return None, f"{unit.name}: {type(e).__name__}: {e}"

@@ -1,4 +1,5 @@
 """Running the units of a plan: one after another in this process, or in parallel worker processes.
+A full disk (`results.DiskFull`) stops either at once: every later unit would fail to store its result.
 
 `run_units(todo, out, profile, progress=True, jobs=1) -> (failures, errors)`; failures: "<unit>: <reason>"
 of units whose training failed (a result is written), errors: "<unit>: <exception>" of units that raised
@@ -29,6 +30,7 @@ from multiprocessing import get_context
 
 from tqdm.auto import tqdm
 
+from replication.results import DiskFull
 from replication.run.chains import TORCH_COST, chains, release_compiled  # noqa: F401 - TORCH_COST, release_compiled: re-exported
 from replication.run.chains import cost as _cost  # noqa: F401 - re-exported for the tests
 from replication.run.chains import ref as _ref
@@ -82,9 +84,11 @@ def _worker_loop(driver: int, tasks, results):
     while (item := tasks.get()) is not None:
         cid, refs, out = item
         try:
-            results.put((cid, _run_chain(refs, out), None))
+            results.put((cid, _run_chain(refs, out), None, None))
+        except DiskFull as e:   # the driver stops the run
+            results.put((cid, None, None, (e.errno, e.strerror, e.filename)))
         except Exception as e:  # noqa: BLE001 - reported for this chain; the worker goes on
-            results.put((cid, None, f"{type(e).__name__}: {e}"))
+            results.put((cid, None, f"{type(e).__name__}: {e}", None))
 
 
 class _Workers:
@@ -165,13 +169,15 @@ def _parallel(todo, out, profile, progress, jobs):
                 held[cid] = chain
                 workers.assign(slot, cid, [_ref(u) for u in chain], out)
             try:
-                cid, done, error = workers.results.get(timeout=0.5)
+                cid, done, error, full = workers.results.get(timeout=0.5)
             except queue.Empty:
                 # a worker that died loses the chain it held, not the run
                 for cid, code in workers.dead():
                     record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
                             for u in held.pop(cid)])
                 continue
+            if full is not None:
+                raise DiskFull(*full)
             chain = held.pop(cid, None)
             workers.finished(cid)
             if chain is not None:

@@ -204,6 +204,14 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
         manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
         R.write_json(out / "run.json", manifest)
         raise
+    except R.DiskFull as e:
+        manifest.update(stopped={"reason": "no space left on device", "path": e.filename, "at": env.now()},
+                        wall_time_s=time.perf_counter() - t0)
+        try:   # it may not fit either; the message says what happened all the same
+            R.write_json(out / "run.json", manifest)
+        except OSError:
+            pass
+        raise
     summary = write_summary(out, profile)
     manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
                     units_run=len(todo), failures=failures, errors=errors)

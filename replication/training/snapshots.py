@@ -54,8 +54,9 @@ class Snapshots:
         return self.folder / f"{self.name}.json"
 
     def save(self, meta: dict, arrays: dict) -> None:
-        """Write the snapshot; a failed write (disk full, folder gone) is a warning, never the end of the
-        training it was to protect."""
+        """Write the snapshot; a failed write (the folder gone, a symlink) is a warning, never the end of the
+        training it was to protect; a full disk stops the run (`results.DiskFull`), before hours of training
+        end with nowhere to go."""
         self._last = time.monotonic()
         npz = f"{self.name}-{int(meta['step'])}.npz"
         try:
@@ -68,6 +69,8 @@ class Snapshots:
             for old in self.folder.glob(f"{self.name}-*.npz"):
                 if old.name != npz and not old.is_symlink():
                     old.unlink(missing_ok=True)
+        except R.DiskFull:
+            raise   # the run stops: the last snapshot written stays, and a resumed run starts from it
         except OSError as e:
             log.warning("training snapshot not written to %s (the training goes on): %s", self.folder, e)
 

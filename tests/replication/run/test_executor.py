@@ -71,7 +71,7 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
             return object()
 
         def assign(self, slot, cid, refs, out):
-            self.results.put((cid, fake_chain(refs, out), None))
+            self.results.put((cid, fake_chain(refs, out), None, None))
 
         def finished(self, cid):
             pass

@@ -80,6 +80,35 @@ def test_sigterm_is_recorded_like_ctrl_c_and_says_how_to_resume(monkeypatch, tmp
     assert manifest["interrupted"] and manifest["finished"] is None
 
 
+def test_a_full_disk_stops_the_run_at_once_names_the_path_and_is_recorded(monkeypatch, tmp_path, capsys):
+    """The first "no space left on device" stops the run: no later unit trains for nothing; one line names
+    where and how to resume; run.json says why it stopped (issue 58, item 3)."""
+    import errno
+    import tempfile
+
+    calls, real_unit, real_mkstemp = [], units.run_unit, tempfile.mkstemp
+
+    def counting(*a, **kw):
+        calls.append(a[0].name)
+        return real_unit(*a, **kw)
+
+    def full(*a, dir=None, **kw):
+        if "units" in str(dir):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_mkstemp(*a, dir=dir, **kw)
+
+    monkeypatch.setattr(units, "run_unit", counting)
+    monkeypatch.setattr(tempfile, "mkstemp", full)
+    two = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--quiet"]   # two units, two chains
+    assert main(["run", *two, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"no space left on the device of {tmp_path / 'units'}" in err, err
+    assert err.rstrip().endswith("run the same command again to resume")
+    assert len(calls) == 1
+    manifest = json.loads((tmp_path / "run.json").read_text())
+    assert manifest["stopped"]["reason"] == "no space left on device" and "units" in manifest["stopped"]["path"]
+
+
 def test_repairs_are_named_and_every_run_record_is_kept(tmp_path, caplog):
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
               progress=False)
