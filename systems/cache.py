@@ -9,7 +9,9 @@ able to plant the file can recompute it. A file that fails verification (planted
 unreadable, a symlink, made by an older version) is reported by ``load_*`` as missing (``None``) and
 logged at INFO level, so callers regenerate and overwrite it. Without a private key nothing is loaded
 or stored. Writes are atomic (temporary file + ``os.replace``, which replaces a symlink rather than
-following it), safe for concurrent processes, with the mode the umask allows.
+following it), safe for concurrent processes, with the mode the umask allows. A cache that cannot be
+written (read-only, full, a file where its folder belongs) is warned about once per folder and skipped:
+the caller goes on with what it computed in memory.
 
 - ``load_text(kind, name) -> str | None``, ``store_text(kind, name, text)``
 - ``load_arrays(name) -> dict[str, np.ndarray] | None``, ``store_arrays(name, arrays)``
@@ -47,13 +49,29 @@ def text_path(kind: str, name: str) -> Path:
     return cache_dir(kind) / f"{name}.py"
 
 
+_UNWRITABLE: set = set()   # cache folders already warned about
+
+
+def _store(path: Path, data: bytes) -> Path | None:
+    """Write an entry; where the cache cannot be written (read-only, full, not a folder) the caller goes on
+    with what it computed in memory, after one warning per folder naming it: the cache only saves time."""
+    try:
+        atomic_write_bytes(path, data, sync=False)
+        return path
+    except OSError as e:
+        if str(path.parent) not in _UNWRITABLE:
+            _UNWRITABLE.add(str(path.parent))
+            log.warning("the cache folder %s cannot be written (%s); going on without storing there (set "
+                        "LAGBENCH_CACHE to a writable folder to keep what is computed)", path.parent,
+                        e.strerror or e)
+        return None
+
+
 def store_text(kind: str, name: str, text: str) -> Path | None:
     tag = cache_key.tag(kind, name, text.encode())
     if tag is None:
         return None
-    path = text_path(kind, name)
-    atomic_write_bytes(path, f"{_HEADER}{tag}\n{text}".encode(), sync=False)
-    return path
+    return _store(text_path(kind, name), f"{_HEADER}{tag}\n{text}".encode())
 
 
 def load_text(kind: str, name: str) -> str | None:
@@ -95,9 +113,7 @@ def store_arrays(name: str, arrays: dict) -> Path | None:
         return None
     buf = io.BytesIO()
     np.savez(buf, **arrays, **{_CHECKSUM_KEY: np.array(tag)})
-    path = array_path(name)
-    atomic_write_bytes(path, buf.getvalue(), sync=False)
-    return path
+    return _store(array_path(name), buf.getvalue())
 
 
 def load_arrays(name: str) -> dict | None:

@@ -149,3 +149,24 @@ def test_cache_and_result_files_follow_the_umask(fresh_cache, mask, mode):
     finally:
         os.umask(old)
     assert [oct(p.stat().st_mode & 0o777) for p in written] == [oct(mode)] * 3
+
+
+def test_an_unwritable_cache_warns_once_naming_it_and_work_goes_on(fresh_cache, monkeypatch, caplog):
+    """A file where the cache's folder belongs (as a read-only or full cache, but failing for root too):
+    the system's generated code and a dataset still come out, with one warning per folder naming it
+    (issue 58, item 4)."""
+    blocked = fresh_cache / "blocked"
+    blocked.write_text("a file, not a folder")
+    monkeypatch.setenv("LAGBENCH_CACHE", str(blocked / "cache"))
+    monkeypatch.setattr(cache, "_UNWRITABLE", set())
+    with caplog.at_level("WARNING"):
+        s = systems.get("spring")
+        qdd = s.acceleration(np.array([[0.5]]), np.array([[0.0]]), backend="numpy")
+        data = datasets.iid_dataset("double_pendulum", 20, 3)
+        datasets.iid_dataset("double_pendulum", 20, 4)
+    np.testing.assert_allclose(qdd, [[-0.5]])
+    assert len(data["qddot"]) == 20
+    warned = [r.getMessage() for r in caplog.records if "cannot be written" in r.getMessage()]
+    assert {str(blocked / "cache" / "codegen"), str(blocked / "cache" / "datasets")} == {
+        w.split("the cache folder ", 1)[1].split(" cannot", 1)[0] for w in warned}
+    assert len(warned) == 2, warned
