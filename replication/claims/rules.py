@@ -62,16 +62,20 @@ def _below(iv: Interval, t: float) -> str:
     return "reproduced" if iv.hi < t else "not reproduced" if iv.lo >= t else "inconclusive"
 
 
-def _ratio_rule(a: str, b: str, metric: str, at, t: float, label: str, why: dict):
-    """A rule on the interval of a / b over seed pairs: ``at(interval, t)`` decides, and is also read at
-    t / 2 and 2 t (the sensitivity); ``why`` words each verdict."""
+def _ratio_rule(a: str, b: str, metric: str, at, t: float, label: str, why: dict, what: str = "",
+                names: tuple = ()):
+    """A rule on the interval of a / b over seed pairs (``what`` names it; ``names`` the two sides in the
+    reason): ``at(interval, t)`` decides, and is also read at t / 2 and 2 t (the sensitivity); ``why`` words
+    each verdict."""
+    shown = names or (a, b)
+
     def rule(v):
         if (m := _missing(v, (a, b), metric)) is not None:
             return m
         x, y = _get(v, a, metric), _get(v, b, metric)
-        iv = ratio_interval(x, y, f"{a}/{b}")
+        iv = ratio_interval(x, y, what or f"{a}/{b}")
         verdict = at(iv, t)
-        return Outcome(verdict, f"{a} {x} vs {b} {y}; {iv}: {why[verdict]}", iv,
+        return Outcome(verdict, f"{shown[0]} {x} vs {shown[1]} {y}; {iv}: {why[verdict]}", iv,
                        {f"{label} {t / 2:g}": at(iv, t / 2), f"{label} {t * 2:g}": at(iv, t * 2)})
     return rule
 
@@ -142,9 +146,11 @@ def bound(metric: str, *, upper: float | None = None, lower: float | None = None
 def below_null(metric: str, fraction: float, model: str):
     """``model``'s metric at most ``fraction`` x the null predictor's (``null_<metric>``, recorded beside it),
     for every pair of seeds: a statement that the null predictor itself fails."""
-    rule = _ratio_rule(model, f"{model} null", metric, _below, fraction, "fraction",
+    null = f"{model} null"
+    rule = _ratio_rule(model, null, metric, _below, fraction, "fraction",
                        {"reproduced": f"below {fraction:g}", "not reproduced": f"not below {fraction:g}",
-                        "inconclusive": f"across {fraction:g}"})
+                        "inconclusive": f"across {fraction:g}"}, what=f"{model} {metric}/null",
+                       names=(f"{model} {metric}", "the null's"))
 
     def with_null(v):
         if (m := _missing(v, (model,), f"null_{metric}")) is not None:
