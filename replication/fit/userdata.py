@@ -47,6 +47,21 @@ def parse_reference(ref: str) -> tuple[str, str | None]:
     return ref, None
 
 
+def content_only(obj):
+    """`obj` (a protocol or an evaluation config, as plain data) with every user-file reference reduced to
+    the sha256 of its bytes: what a fit's training key and its currency are compared on, so that moving a
+    results folder or fitting a byte-identical copy under another name reuses the fit."""
+    if isinstance(obj, dict):
+        return {k: content_only(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [content_only(v) for v in obj]
+    if isinstance(obj, str) and obj.startswith("file:"):
+        _, digest = parse_reference(obj)
+        if digest:
+            return f"file:{_MARK}{digest}"
+    return obj
+
+
 def _columns(path, df, name) -> list:
     cols = sorted((c for c in df.columns if c.startswith(name) and c[len(name):].isdigit()),
                   key=lambda c: int(c[len(name):]))

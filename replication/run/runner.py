@@ -21,6 +21,7 @@ from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
+from replication.fit.userdata import content_only
 from replication.run import environment as env
 from replication.run.estimate import describe, estimate
 from replication.run.executor import run_units
@@ -91,10 +92,12 @@ def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = T
             repairs.append(f"{unit.name}: {reason}")
         return False
     cfg = unit.claim.evaluation_config(unit.profile)
-    # a result that records no evaluation config or version predates them: stale, re-evaluated
-    same_eval = (d.get("eval_config") == json.loads(json.dumps(cfg))
+    # a result that records no evaluation config or version predates them: stale, re-evaluated; a user's
+    # file counts by its content, not its path (a moved folder, a renamed copy)
+    same_eval = (content_only(d.get("eval_config")) == content_only(json.loads(json.dumps(cfg)))
                  and d.get("evaluation_version") == EVALUATION_VERSION)
-    if d.get("protocol") == unit.protocol().to_dict() and d.get("model_spec") == unit.spec().to_dict() and same_eval:
+    if (content_only(d.get("protocol")) == content_only(unit.protocol().to_dict())
+            and d.get("model_spec") == unit.spec().to_dict() and same_eval):
         return True
     if not set_stale_aside:   # a look only (--dry-run): nothing renamed
         return False

@@ -28,7 +28,10 @@ log = logging.getLogger("lagbench")
 
 
 def train_key(framework, spec, protocol, seed) -> str:
-    key = {"fw": framework, "spec": spec.to_dict(), "protocol": protocol.to_dict(), "seed": seed}
+    """The training's cache key: framework, spec, protocol (a user file by its content, not its path) and seed."""
+    from replication.fit.userdata import content_only
+
+    key = {"fw": framework, "spec": spec.to_dict(), "protocol": content_only(protocol.to_dict()), "seed": seed}
     targets = targets_version(protocol)
     if targets:
         key["targets"] = targets

@@ -101,3 +101,23 @@ def test_a_failed_fit_exits_non_zero_with_its_reason(tmp_path, capsys):
                  "--hidden", "8", "--lr", "1e38"])
     err = capsys.readouterr().err
     assert code == 1 and "fit failed: non-finite" in err, err
+
+
+def test_a_moved_folder_or_a_renamed_copy_of_the_data_reuses_the_fit(tmp_path):
+    """A fit is keyed by the data's content and the options, never by a path (issue 58, item 5)."""
+    import shutil
+
+    data, out = _pendulum(tmp_path / "d.npz"), tmp_path / "out"
+    first = fit(data, out=out, **FAST)
+    moved = tmp_path / "moved"
+    shutil.move(out, moved)
+    again = fit(data, out=moved, **FAST)
+    assert again.get("reused") and again["checksum"] == first["checksum"]
+    assert not list(moved.glob("units/fit/*/*/superseded-*"))
+    copy = tmp_path / "renamed.npz"
+    shutil.copy(data, copy)
+    third = fit(copy, out=moved, **FAST)
+    assert third.get("reused") and third["final_train_loss"] == first["final_train_loss"]
+    # other bytes are another fit
+    _pendulum(copy, scale=2.0)
+    assert "reused" not in fit(copy, out=moved, **FAST)
