@@ -228,6 +228,9 @@ def main(argv=None):
     """Every error is one line on stderr and a non-zero exit: 2 for bad input or an OS error (a file
     where a folder belongs, no permission, a full disk), 130 for Ctrl-C and 143 for SIGTERM (with how to
     resume)."""
+    for stream in (sys.stdout, sys.stderr):   # a path with undecodable bytes is printed escaped, never an error
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     args = build_parser().parse_args(argv)
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)

@@ -16,11 +16,17 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 from pathlib import Path
 
 from replication.results import atomic_write_bytes, output_folder, read_nofollow
 
 MANIFEST = ".lagbench-report.json"
+
+
+# a temporary file of `atomic_write_bytes` that a killed build left: ".<name>.<8 random characters>.tmp"
+_TEMPORARY = re.compile(r"^\..+\.[A-Za-z0-9_]{8}\.tmp$")
+_BUILD: dict = {}   # the build in progress: its folder, the previous build's record and what it wrote so far
 
 
 def prepare(out_dir) -> Path:
@@ -30,11 +36,25 @@ def prepare(out_dir) -> Path:
         raise ValueError(f"--out {out_dir}: figures/ is a symlink or a file; the report writes only into "
                          f"real folders inside --out (remove or rename it)")
     output_folder(figures, "--out")
+    for folder in (out_dir, figures):   # what a killed build left half-written
+        for p in folder.iterdir():
+            if _TEMPORARY.match(p.name) and p.is_file() and not p.is_symlink():
+                p.unlink()
+    _BUILD.clear()
+    _BUILD.update(dir=out_dir.resolve(), recorded=_recorded(out_dir), written={})
     return out_dir
 
 
 def write(path: Path, data: bytes | str) -> Path:
-    atomic_write_bytes(Path(path), data.encode("utf-8") if isinstance(data, str) else data)
+    """Write one output; its record is kept at once (with the previous build's), so that a build killed
+    part-way leaves nothing the next build does not know to replace or remove."""
+    raw = data.encode("utf-8") if isinstance(data, str) else data
+    atomic_write_bytes(Path(path), raw)
+    root = _BUILD.get("dir")
+    if root is not None and Path(path).resolve().parent.is_relative_to(root):
+        _BUILD["written"][Path(path).resolve().relative_to(root).as_posix()] = hashlib.sha256(raw).hexdigest()
+        files = {**_BUILD["recorded"], **_BUILD["written"]}
+        atomic_write_bytes(root / MANIFEST, json.dumps({"files": files}, indent=1, sort_keys=True).encode())
     return Path(path)
 
 
@@ -59,8 +79,10 @@ def finish(out_dir: Path, paths: list) -> list:
     out_dir = Path(out_dir)
     root = out_dir.resolve()
     now = {Path(p).resolve().relative_to(root).as_posix(): _sha(Path(p)) for p in paths}
+    previous = _BUILD.get("recorded") if _BUILD.get("dir") == root else None
+    _BUILD.clear()
     removed = []
-    for rel, digest in _recorded(out_dir).items():
+    for rel, digest in (_recorded(out_dir) if previous is None else previous).items():
         p = out_dir / rel
         inside = ".." not in Path(rel).parts and not Path(rel).is_absolute()
         if rel in now or not inside or p.is_symlink() or p.parent.resolve() != (root / rel).parent:

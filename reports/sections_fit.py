@@ -49,11 +49,13 @@ def _models_table(units) -> pd.DataFrame:
     for u in units:
         p, s, r = u.result.get("protocol") or {}, u.result.get("model_spec") or {}, u.result
         cfg = r.get("eval_config") or {}
+        # a fit's --test rows are recorded apart from its own split's
+        counts = {**(cfg.get("rows") or {}), **({"test": cfg["test_rows"]} if cfg.get("test_rows") is not None else {})}
         rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
                      "steps": str(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
                      "weight decay (l2)": num(p.get("l2")), "schedule": f"{p.get('schedule')}, peak {num(p.get('lr'))}",
-                     "rows (train/held-out/test)": "/".join(str((cfg.get("rows") or {}).get(k, 0))
+                     "rows (train/held-out/test)": "/".join(str(counts.get(k, 0))
                                                             for k in ("train", "heldout", "test")),
                      "final training loss": num(r.get("final_train_loss")), "train time (s)": num(r.get("train_time_s"))})
     return pd.DataFrame(rows)

@@ -51,3 +51,33 @@ def test_report_refuses_a_results_folder_that_is_not_one(tmp_path, capsys, make,
     err = capsys.readouterr().err
     assert "--results" in err and words in err and err.count("\n") == 1
     assert not (tmp_path / "out").exists()
+
+
+def test_a_killed_builds_temporaries_and_figures_are_cleaned_by_the_next(results_dir, tmp_path):
+    """A build killed part-way (issue 58, item 7): its half-written temporaries go at the next build, and
+    the figures it wrote are on record, so the next build removes those it does not write again."""
+    from reports import output
+
+    out = tmp_path / "out"
+    output.prepare(out)
+    stray = output.write(out / "figures" / "gone_claim_energy.png", b"from the killed build")
+    (out / ".REPORT.md.ab12cd34.tmp").write_bytes(b"half")
+    (out / "figures" / ".x_energy.png.zz99yy88.tmp").write_bytes(b"half")
+    (out / "figures" / ".notes.tmp").write_text("a user's own file")      # not our pattern: kept
+    build_report(tmp_path / "empty", out, pdf=False)                      # the next build, no figures
+    assert not stray.exists()
+    assert not (out / ".REPORT.md.ab12cd34.tmp").exists() and not (out / "figures" / ".x_energy.png.zz99yy88.tmp").exists()
+    assert (out / "figures" / ".notes.tmp").read_text() == "a user's own file"
+
+
+def test_report_prints_a_path_with_undecodable_bytes_escaped(results_dir, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    out = os.fsencode(str(tmp_path)) + b"/rep\xffort"
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8"}
+    r = subprocess.run([sys.executable, "-m", "replication.cli", "report", "--results", str(results_dir),
+                        "--out", os.fsdecode(out)], capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "\\udcff" in r.stdout and os.path.isdir(out)
