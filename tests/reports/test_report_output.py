@@ -56,11 +56,13 @@ def test_report_refuses_a_results_folder_that_is_not_one(tmp_path, capsys, make,
 def test_a_killed_builds_temporaries_and_figures_are_cleaned_by_the_next(results_dir, tmp_path):
     """A build killed part-way (issue 58, item 7): its half-written temporaries go at the next build, and
     the figures it wrote are on record, so the next build removes those it does not write again."""
+    from replication.results import writing
     from reports import output
 
     out = tmp_path / "out"
-    output.prepare(out)
-    stray = output.write(out / "figures" / "gone_claim_energy.png", b"from the killed build")
+    with writing():   # the killed build's process: its lock goes with it
+        output.prepare(out)
+        stray = output.write(out / "figures" / "gone_claim_energy.png", b"from the killed build")
     (out / ".REPORT.md.ab12cd34.tmp").write_bytes(b"half")
     (out / "figures" / ".x_energy.png.zz99yy88.tmp").write_bytes(b"half")
     (out / "figures" / ".notes.tmp").write_text("a user's own file")      # not our pattern: kept
