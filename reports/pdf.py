@@ -40,9 +40,16 @@ PREAMBLE = """#set document(title: {title})
 """
 
 
+# scripts the fonts typst ships (Libertinus, New Computer Modern, DejaVu Sans Mono) have no glyphs for:
+# CJK, kana, Hangul, Yi, full-width forms, emoji and the supplementary planes; the PDF shows them as U+XXXX
+# (the Markdown report keeps them as they are) rather than as empty boxes
+_NO_GLYPH = re.compile("[\u2e80-\ua4cf\uac00-\ud7af\uf900-\ufaff\ufe30-\ufe4f\uff00-\uffef\U0001f000-\U0010ffff]")
+
+
 def lit(text) -> str:
-    """A typst string literal holding ``text`` verbatim."""
-    s = str(text).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\r", "")
+    """A typst string literal holding ``text`` verbatim (characters no shipped font can show as U+XXXX)."""
+    s = _NO_GLYPH.sub(lambda m: f"U+{ord(m.group()):04X}", str(text))
+    s = s.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\r", "")
     s = re.sub(r"[\x00-\x08\x0b-\x1f]", " ", s)
     return f'"{s}"'
 

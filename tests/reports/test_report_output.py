@@ -83,3 +83,14 @@ def test_report_prints_a_path_with_undecodable_bytes_escaped(results_dir, tmp_pa
                         "--out", os.fsdecode(out)], capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, r.stderr
     assert "\\udcff" in r.stdout and os.path.isdir(out)
+
+
+def test_the_pdf_shows_characters_its_fonts_lack_as_code_points():
+    """CJK in a user's path (issue 58, item 7): U+XXXX in the PDF's source instead of empty boxes; the
+    report's own symbols stay as they are."""
+    from reports.pdf import lit
+
+    s = lit('data/中文-한국-ファイル.csv: "q̇" γ × 3 − 1 ≈ 2 😀')
+    assert "U+4E2D" in s and "U+D55C" in s and "U+30D5" in s and "U+1F600" in s
+    assert not any(c in s for c in "中한フ😀")
+    assert "q̇" in s and "γ × 3 − 1 ≈ 2" in s and '\\"' in s
