@@ -22,7 +22,7 @@ from contextlib import contextmanager
 
 CHOICES = ("auto", "cpu", "gpu")
 HELP = ("where the models train and are evaluated: auto (a GPU where the framework sees one, else the CPU), "
-        "cpu, or gpu (an error if a framework sees none); data and ground truth are made on the CPU in float64 "
+        "cpu, or gpu (an error if a framework sees none); training data are made in NumPy on the CPU "
         "(default: auto)")
 ENV = "LAGBENCH_DEVICE"
 TF32_ENV = "LAGBENCH_TF32"
@@ -86,10 +86,11 @@ def check(req: str, frameworks) -> dict:
     that sees no GPU where one was asked for."""
     if req not in CHOICES:
         raise DeviceError(f"--device {req!r} is not a device; valid: {', '.join(CHOICES)}")
-    missing = [what for fw in frameworks for seen, what in [gpu_seen(fw)] if req == "gpu" and not seen]
-    if missing:
+    seen = {fw: gpu_seen(fw) for fw in frameworks} if req != "cpu" else {}   # each framework asked once
+    missing = [what for ok, what in seen.values() if not ok]
+    if req == "gpu" and missing:
         raise DeviceError(f"--device gpu: {'; '.join(missing)}; use --device cpu or auto")
-    return {fw: resolve(req, fw) for fw in frameworks}
+    return {fw: "gpu" if seen.get(fw, (False,))[0] else "cpu" for fw in frameworks}
 
 
 def apply(req: str, frameworks) -> dict:
