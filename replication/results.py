@@ -108,14 +108,10 @@ def _lock(path: Path, option: str) -> None:
         raise ValueError(f"{option} {path}: another lagbench command is writing into this folder ({holder}); "
                          "wait for it to end, or give another folder") from None
     os.ftruncate(fd, 0)
-    os.write(fd, f"pid {os.getpid()}, since {_now()}".encode())
+    from replication.run.environment import now  # imports the standard library only
+
+    os.write(fd, f"pid {os.getpid()}, since {now()}".encode())
     _LOCKS[key] = fd
-
-
-def _now() -> str:
-    import datetime as dt
-
-    return dt.datetime.now(dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 @contextmanager
