@@ -89,7 +89,7 @@ def scorecard_table(res: Results, kind: str = "claim") -> pd.DataFrame:
         metric = (p or {}).get("metric") or claim.get("metric") or ""
         published = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
         v = res.verdicts.get(cid)
-        parts = [x for x in (v or {}).get("parts") or []]
+        parts = (v or {}).get("parts") or []
         rows.append({"#": cell(claim.get("number"), "–"), "claim": cid,
                      "verdict": cell((v or {}).get("verdict"), NOT_RUN),
                      "key number": f"{key} {metric}: {_reproduced(res, claim, key, metric)}" if key else NOT_RUN,
