@@ -2,7 +2,7 @@
 
 Learned models of both frameworks are rolled out by this one integrator (float64 state, the model
 evaluated in its own dtype through a NumPy callable), so that a JAX and a PyTorch model are judged
-by the same numerics; the precision evaluation runs the exact equations of motion through it in float32
+by the same numerics; `rollout_native` runs the same steps inside the model's framework, for long rollouts; the precision evaluation runs the exact equations of motion through it in float32
 (`replication.evaluation.precision`), and the speed study's jitted RK4 is `rk4_scan` (JAX). Ground truth
 uses diffrax at tight tolerances (`systems.trajectories`).
 
@@ -46,7 +46,7 @@ def rk4_step(f, z, h):
     return z + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def _steps(interval, dt, step, dtype):
+def steps(interval, dt, step, dtype):
     """(number of steps, step size in `dtype`) covering one interval of the output grid."""
     if step == "dt":
         return max(1, int(round(interval / dt))), np.asarray(dt, dtype)
@@ -64,7 +64,7 @@ def rollout(f, z0, t_eval, dt, *, dtype=np.float64, step: str = "split"):
     out[:, 0] = z
     alive = np.ones(z.shape[0], bool)
     for j in range(1, t_eval.size):
-        n, h = _steps(t_eval[j] - t_eval[j - 1], dt, step, dtype)
+        n, h = steps(t_eval[j] - t_eval[j - 1], dt, step, dtype)
         for _ in range(n):
             with np.errstate(all="ignore"):
                 z = rk4_step(f, z, h)

@@ -39,6 +39,7 @@ class Context:
     cfg: dict
     model: object = None
     log: list | None = None   # the training log rows (`TrainOutcome.log`), for routines that read the pace
+    progress: object = None   # progress(label, done, total) or None: a routine's long work, for a progress bar
 
 
 @dataclass

@@ -14,6 +14,9 @@ DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optio
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
              "state file: columns (arrays) q, qdot, qddot and optional tau (format: README)")
 
+HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (longer trajectories are rolled "
+                "out and scored to there)")
+
 
 def _show_defaults(parser) -> None:
     """Every option's help ends with its default, unless it states one itself (flags and required ones aside)."""
@@ -57,6 +60,29 @@ def cmd_simulate(args):
     print(f"{args.trajectories} trajectories of {args.system}, {len(df)} rows, written to {path}")
 
 
+class RolloutBars:
+    """tqdm bars for an evaluation's rollouts, one per evaluation set: `bars(label, done, total)`."""
+
+    def __init__(self, quiet: bool, prefix: str):
+        self.quiet, self.prefix, self.bars = quiet, prefix, {}
+
+    def __call__(self, label, done, total):
+        from tqdm.auto import tqdm
+
+        if label not in self.bars:
+            self.bars[label] = tqdm(total=total, desc=f"{self.prefix} rollouts ({label})", unit="sample",
+                                    disable=self.quiet)
+        bar = self.bars[label]
+        bar.update(min(done, total) - bar.n)
+        if done >= total:
+            bar.close()
+
+    def close(self):
+        for bar in self.bars.values():
+            bar.close()
+        self.bars = {}
+
+
 def cmd_fit(args):
     from tqdm.auto import tqdm
 
@@ -65,6 +91,7 @@ def cmd_fit(args):
 
     device.apply(args.device, (args.framework,))   # before anything is written
     bars = []  # made at the first log row, so that a refused option prints one line and nothing else
+    rollouts = RolloutBars(args.quiet, f"lagbench fit {args.model}")
 
     def on_log(row):
         if not bars:
@@ -72,6 +99,8 @@ def cmd_fit(args):
         bar = bars[0]
         bar.set_postfix_str(f"training {LOSS_NAMES[args.loss]} {row['loss']:.4g}", refresh=False)
         bar.update(min(int(row["step"]) + 1, bar.total) - bar.n)
+        if bar.n >= bar.total:   # closed now, so that its time is the training's, not the evaluation's too
+            bar.close()
 
     try:
         d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
@@ -80,10 +109,12 @@ def cmd_fit(args):
                 lr_min_ratio=args.lr_final, delan_eps=args.delan_eps, delan_offset=args.delan_offset,
                 angle_wrap=args.angle_wrap, input_scale=_scale(args.input_scale), split=args.split,
                 heldout=args.heldout, test=args.test, window=args.window, polyorder=args.polyorder,
-                system=args.system, substeps=args.substeps, energy=args.energy, on_log=on_log)
+                system=args.system, substeps=args.substeps, energy=args.energy, horizon=args.horizon,
+                on_log=on_log, on_progress=rollouts)
     finally:
         for bar in bars:
             bar.close()
+        rollouts.close()
     folder = Path(args.out) / "units" / "fit" / args.framework / args.model / f"seed{args.seed}"
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
@@ -96,9 +127,14 @@ def cmd_fit(args):
 def cmd_evaluate(args):
     from replication.fit.evaluate_file import evaluate
 
-    for d in evaluate(args.model, args.data, out=args.out, framework=args.framework, system=args.system,
-                      substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy,
-                      device=args.device):
+    rollouts = RolloutBars(args.quiet, "lagbench evaluate")
+    try:
+        done = evaluate(args.model, args.data, out=args.out, framework=args.framework, system=args.system,
+                        substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy,
+                        device=args.device, horizon=args.horizon, on_progress=rollouts)
+    finally:
+        rollouts.close()
+    for d in done:
         m = d["metrics"]
         parts = [f"{k} {m[k]:.4g}" for k in (f"test_{d['protocol']['loss']}", "test_rollout_gmean_err",
                                              "test_learned_energy_drift", "test_energy_err_final") if m.get(k) is not None]
@@ -163,6 +199,7 @@ def add_commands(sub) -> None:
     s.add_argument("--energy", help="your energy function E(q, qdot) as module:function (importable from here; "
                    "(N, d) arrays to (N,)), compared along the rollouts in place of --system's")
     s.add_argument("--substeps", type=int, default=2, help="RK4 steps per sample interval in the rollouts")
+    s.add_argument("--horizon", type=float, help=HORIZON_HELP + " (default: whole trajectories)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_fit)
@@ -180,6 +217,8 @@ def add_commands(sub) -> None:
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
+    s.add_argument("--horizon", type=float, help=HORIZON_HELP + " (default: the fit's)")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")

@@ -4,17 +4,18 @@
 ctx.cfg: {"heldout": bool (evaluate the protocol file's held-out rows), "test": a prepared file's
 `userdata.reference` or None, "system": a `systems` name or None, "energy": "module:function" (a user's
 E(q, qdot), in place of the system's) or None, "substeps": RK4 steps per sample
-interval, "model": a fit's unit folder (evaluate: the model is loaded from it by `load.load_fitted`)}.
-Every evaluation set S ("heldout", "test") gives, all NumPy and framework-neutral:
+interval, "horizon": seconds of each trajectory rolled out (absent: all), "model": a fit's unit folder (evaluate: the model is loaded from it by `load.load_fitted`)}.
+Every evaluation set S ("heldout", "test") gives, as NumPy arrays and alike for both frameworks:
 
 one step   S_l1, S_mse (as the training loss: per-sample sum over components, mean over samples) and the
            null predictor's (`metrics.null_errors`); per component (`one_step.csv`: set, quantity,
            component, mae, rmse, null_mae, rel_mae = mae / null_mae) in the quantity trained: qddot,
            (qdot, qddot) for an HNN, tau for inverse dynamics.
-rollouts   (sets with whole trajectories) every trajectory from its first state over its own times by the
-           shared RK4 (`rollout.rollout`, step = sample spacing / substeps; an HNN by its own flow, with qdot
-           in the place of p as it was trained), under the recorded torques
-           when the model is a forward model given tau (DeLaN; linear interpolation in t). State error:
+rollouts   (sets with whole trajectories) every trajectory from its first state over its own times (to
+           cfg["horizon"] seconds when set) by the shared RK4 in the model's framework (`Fitted.rollout`,
+           `rollout_native`: step = sample spacing / substeps; an HNN by its own flow, with qdot in the place
+           of p as it was trained), under the recorded torques when the model is a forward model given tau
+           (DeLaN; linear interpolation in t); cfg["progress"](set, intervals done, intervals) as it goes. State error:
            `metrics.bounded_relative_error` of (q, qdot) against the data per time; S_rollout_gmean_err
            is its geometric mean over time (`geometric_mean_over_time`), averaged over trajectories;
            S_rollout_final_err the mean final-time error (a diverged rollout counts 1).
@@ -42,7 +43,6 @@ from replication.evaluation.metrics import (
     heldout_errors,
     null_errors,
 )
-from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
 from replication.evaluation.routines import Evaluation
 from replication.fit import userdata
 from replication.fit.load import Fitted, Padded, load_fitted
@@ -70,21 +70,6 @@ def _one_step(f: Fitted, r, name, out: Evaluation, rows: list):
                      "rmse": float(np.sqrt(np.mean(err[:, j] ** 2))), "null_mae": null_mae,
                      "rel_mae": mae / null_mae if null_mae > 0 else float("nan")})
     out.arrays[f"{name}_target"], out.arrays[f"{name}_pred"] = b["target"][:KEEP], pred[:KEEP]
-
-
-def _field(f: Fitted, dof, taus=None, t0=None):
-    """dz/dt of z = (q, qdot) (`rollout.lagrangian_field`; an HNN's own flow (dH/dy, -dH/dx) by
-    `rollout.hamiltonian_field`) or, under recorded torques, of z = (q, qdot, t) with tau interpolated per row."""
-    if taus is None:
-        if f.task == "hamiltonian":
-            return hamiltonian_field(lambda x, y: f.model.time_derivative(x, y, None), dof)
-        return lagrangian_field(f.acceleration, dof)
-
-    def g(z):
-        tau = np.stack([[np.interp(z[i, -1], t0[i], taus[i][:, j]) for j in range(dof)] for i in range(len(z))])
-        acc = f.acceleration(z[:, :dof], z[:, dof:2 * dof], tau)
-        return np.concatenate([z[:, dof:2 * dof], acc, np.ones((len(z), 1))], 1)
-    return g
 
 
 def _forward(f: Fitted, r) -> str | None:
@@ -124,24 +109,38 @@ def energy_function(cfg, dof):
     return energy
 
 
-def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list, true_energy):
-    d = f.spec.dof
-    forced = f.task == "inverse_dynamics"
+def _groups(r, horizon=None) -> dict:
+    """Trajectories by their time grid (from 0; to `horizon` seconds when given): {grid: [row indices]}."""
     groups: dict = {}
     for idx in starts(r["traj"]):
         t = r["t"][idx] - r["t"][idx[0]]
+        if horizon is not None:
+            keep = t <= horizon * (1 + 1e-12)
+            if keep.sum() < 2:
+                raise ValueError(f"--horizon {horizon}: shorter than the first sample interval ({t[1]:.6g} s) of "
+                                 f"trajectory {r['traj'][idx[0]]}")
+            idx, t = idx[keep], t[keep]
         groups.setdefault(tuple(np.round(t, 9)), []).append(idx)
+    return groups
+
+
+def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list, true_energy):
+    d = f.spec.dof
+    forced = f.task == "inverse_dynamics"
+    groups = _groups(r, cfg.get("horizon"))
+    total, done = sum(len(g) - 1 for g in groups), [0]
+    progress = cfg.get("progress")
+
+    def advanced(n):
+        if progress is not None:
+            progress(name, done[0] + n, total)
     errs, finals, drifts, e_sys = [], [], [], []
     for k, (tgrid, members) in enumerate(groups.items()):
         t = np.asarray(tgrid)
         z_data = np.stack([np.concatenate([r["q"][i], r["qdot"][i]], 1) for i in members])
-        z0 = z_data[:, 0]
-        if forced:
-            t0 = [r["t"][i] - r["t"][i[0]] for i in members]
-            z = rollout(_field(f, d, [r["tau"][i] for i in members], t0), np.concatenate([z0, np.zeros((len(z0), 1))], 1),
-                        t, (t[1] - t[0]) / cfg["substeps"])[..., :2 * d]
-        else:
-            z = rollout(_field(f, d), z0, t, (t[1] - t[0]) / cfg["substeps"])
+        tau = np.stack([r["tau"][i] for i in members]) if forced else None
+        z = f.rollout(z_data[:, 0], t, (t[1] - t[0]) / cfg["substeps"], tau, advanced)
+        done[0] += t.size - 1
         err = bounded_relative_error(z, z_data)
         errs.append(geometric_mean_over_time(err))
         finals.append(err[:, -1])
@@ -244,7 +243,7 @@ def eval_fit(ctx) -> Evaluation:
         sets["test"] = userdata.rows(cfg["test"], "test")
     sets = {k: v for k, v in sets.items() if len(v["q"])}
     out = Evaluation()
-    cfg = {**cfg, "primary": "test" if "test" in sets else "heldout"}
+    cfg = {**cfg, "primary": "test" if "test" in sets else "heldout", "progress": ctx.progress}
     out.counters["primary"] = cfg["primary"]
     one, roll, series = [], [], []
     for name, r in sets.items():

@@ -1,7 +1,7 @@
 """`lagbench evaluate --model DIR --data FILE`: fitted models judged on a new data file.
 
 `evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
-energy=None)`
+energy=None, device="auto", horizon=None, on_progress=None)`
 -> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
 in it, side by side). Each model is loaded by `load.load_fitted` (checksums verified; in `framework`,
 default the one it was trained in: parameters load in either), the data file is prepared as a test file
@@ -26,18 +26,18 @@ from replication.fit.task import FRAMEWORKS, LOSS_NAMES, check_options
 from replication.run.units import Unit, run_unit
 
 
-def _check(framework, system, substeps, window, polyorder):
+def _check(framework, system, substeps, window, polyorder, horizon):
     if framework is not None and framework not in FRAMEWORKS:
         raise ValueError(f"--framework: {framework!r} is not valid; expected one of {', '.join(FRAMEWORKS)}")
-    check_options("lnn", "jax", 1, (1,), 1, 1.0, 0, "l1", substeps=substeps or 1, system=system)
+    check_options("lnn", "jax", 1, (1,), 1, 1.0, 0, "l1", substeps=substeps or 1, system=system, horizon=horizon)
     if window is not None or polyorder is not None:
         trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
 
 
 @R.writes
 def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
-             polyorder=None, energy=None, device="auto") -> list[dict]:
-    _check(framework, system, substeps, window, polyorder)
+             polyorder=None, energy=None, device="auto", horizon=None, on_progress=None) -> list[dict]:
+    _check(framework, system, substeps, window, polyorder, horizon)
     path = str(Path(data).resolve())
     has_tau = "tau" in userdata.read(path)[1]
     fits = [load_fitted(f) for f in fitted_folders(model)]
@@ -72,6 +72,8 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
                "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
                "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
+        if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys
+            cfg["horizon"] = float(horizon or fcfg["horizon"])
         loss = f.protocol.loss if f.protocol.loss in LOSS_NAMES else "l1"
         claim = Claim(id="evaluate", number=0, paper="user", section="-", title=f"{r['model']} on {Path(data).name}",
                       system=cfg["system"] or Path(data).name, models=(entry,), protocols={"quick": f.protocol},
@@ -81,5 +83,5 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         if is_current(unit, out):
             done.append(dict(R.load_result(unit.folder(out)), reused=True, folder=str(unit.folder(out))))
         else:
-            done.append(dict(run_unit(unit, out), folder=str(unit.folder(out))))
+            done.append(dict(run_unit(unit, out, on_progress=on_progress), folder=str(unit.folder(out))))
     return done

@@ -18,6 +18,9 @@ a fit trained in JAX loads in PyTorch and back (`framework`, default the one it 
                                    Evaluated in float64 with the same parameters (exactly the trained
                                    float32 function, without float32 round-off: in float32 the round-off of an
                                    LNN's L, whose offset is arbitrary, swamped the drift it was to measure).
+  rollout(z0, t, dt, tau=None, progress=None)
+                                   the model's motion from z0 = (q, qdot) over the times t, in its own
+                                   framework (`replication.evaluation.rollout_native`).
   spec, protocol, task, framework, folder, result, and `model`: the adapter (`Padded`: any batch size, a few
   compiled shapes) with all the kind's methods (mass_matrix, coriolis, gravity, lagrangian, hamiltonian, ...).
 """
@@ -32,6 +35,7 @@ import numpy as np
 from models import ModelSpec
 from replication import results as R
 from replication.evaluation.adapters import adapter
+from replication.evaluation.rollout_native import native_rollout
 from replication.training.protocol import Protocol
 
 ENERGY_STEP = 1e-4   # in float64: truncation ~1e-8 relative, round-off ~1e-12 x |L|
@@ -46,6 +50,11 @@ class Padded:
 
     def __init__(self, model):
         self._model = model
+
+    @property
+    def native(self):
+        """The framework model itself (`models.jax.build` / `models.torch.build`)."""
+        return self._model.model
 
     def __getattr__(self, name):
         method = getattr(self._model, name)
@@ -94,6 +103,18 @@ class Fitted:
             raise ValueError(f"{self.folder}: an inverse-dynamics {self.spec.kind} predicts torques only; it has "
                              f"no forward model (fit delan for both)")
         return self.model.acceleration(q, qdot, tau if self.spec.kind == "delan" else None)
+
+    def rollout(self, z0, t, dt, tau=None, progress=None):
+        """z (B, T, 2 dof): the model's motion from z0 = (q, qdot) (B, 2 dof) over the times t (T,) by the
+        shared RK4 in steps of at most dt, in the model's framework (`rollout_native`); an HNN by its own
+        flow on (q, qdot), DeLaN under the torques tau (B, T, dof) at the times t (interpolated linearly)."""
+        if tau is not None and self.spec.kind != "delan":
+            raise ValueError(f"{self.folder}: only DeLaN has a forward model under torques")
+        if self.task == "inverse_dynamics" and self.spec.kind != "delan":
+            self.acceleration(z0[:, :1], z0[:, :1])   # the ValueError saying why it has no forward model
+        field = "time_derivative" if self.task == "hamiltonian" else "acceleration"
+        return native_rollout(self.framework, self.model.native, self.spec.dtype, field, z0, t, dt, forcing=tau,
+                              progress=progress)
 
     def inverse_dynamics(self, q, qdot, qddot):
         if self.task != "inverse_dynamics":

@@ -46,7 +46,7 @@ SET_NAMES = {"heldout": "held-out", "test": "test"}
 
 def check_options(model, framework, steps, hidden, batch, lr, seed, loss, activation="softplus", weight_decay=0.0,
                   schedule="onecycle", lr_min_ratio=1e-4, delan_eps=0.01, delan_offset=2.0, input_scale=None,
-                  substeps=2, system=None) -> None:
+                  substeps=2, system=None, horizon=None) -> None:
     """ValueError naming the first bad option and what it accepts."""
     checks = [
         ("--model", model in MODELS, f"one of {', '.join(MODELS)}", model),
@@ -68,6 +68,7 @@ def check_options(model, framework, steps, hidden, batch, lr, seed, loss, activa
             _real(v) and v > 0 for v in input_scale)), "none, auto or positive numbers such as 1,1,0.3,0.3",
          input_scale),
         ("--substeps", _count(substeps, 1), "an integer >= 1", substeps),
+        ("--horizon", horizon is None or (_real(horizon) and horizon > 0), "a number of seconds > 0", horizon),
     ]
     for option, ok, valid, value in checks:
         if not ok:
@@ -117,11 +118,11 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
         lr=1e-3, seed=0, loss="l1", dtype="float32", activation="softplus", weight_decay=0.0, schedule="onecycle",
         lr_min_ratio=1e-4, delan_eps=0.01, delan_offset=2.0, angle_wrap=False, input_scale=None, split=None,
         heldout=fit_data.HELDOUT, test=None, window=trajectories.WINDOW, polyorder=trajectories.POLYORDER,
-        system=None, substeps=2, energy=None, on_log=None) -> dict:
+        system=None, substeps=2, energy=None, horizon=None, on_log=None, on_progress=None) -> dict:
     hidden = tuple(hidden)
     input_scale = tuple(input_scale) if isinstance(input_scale, (list, tuple)) else input_scale
     check_options(model, framework, steps, hidden, batch, lr, seed, loss, activation, weight_decay, schedule,
-                  lr_min_ratio, delan_eps, delan_offset, input_scale, substeps, system)
+                  lr_min_ratio, delan_eps, delan_offset, input_scale, substeps, system, horizon)
     if split is not None:
         fit_data.check_options(split, heldout)
     trajectories.check_options(window, polyorder)
@@ -168,6 +169,8 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
            "system": system, "energy": energy, "substeps": substeps, "source": prep.source,
            "derivatives": {"window": window, "polyorder": polyorder}, "rows": prep.counts,
            "trajectories": prep.trajectories}
+    if horizon is not None:   # recorded only when given: fits without it keep their keys
+        cfg["horizon"] = float(horizon)
     if tprep is not None:  # the user's test file and its rows, for the report
         cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
     entry = ModelEntry(model, spec, hidden=hidden)
@@ -180,4 +183,4 @@ def fit(data, model="lnn", out="results/fit", framework="jax", steps=2000, hidde
 
     if is_current(unit, out):
         return dict(R.load_result(unit.folder(out)), reused=True, metric=metric, metric_label=label)
-    return dict(run_unit(unit, out, on_log=on_log), metric=metric, metric_label=label)
+    return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)

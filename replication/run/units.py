@@ -42,8 +42,9 @@ class Unit:
         return R.unit_dir(out, self.claim.id, self.framework, self.entry.label, self.seed)
 
 
-def run_unit(unit: Unit, out, on_log=None) -> dict:
-    """Train (or reuse the cached training), evaluate, and write the unit's files; result.json last."""
+def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
+    """Train (or reuse the cached training), evaluate, and write the unit's files; result.json last.
+    on_log(row): each training log row; on_progress(label, done, total): the evaluation's long work."""
     t0 = time.perf_counter()
     protocol, spec = unit.protocol(), unit.spec()
     folder = unit.folder(out)
@@ -56,7 +57,8 @@ def run_unit(unit: Unit, out, on_log=None) -> dict:
     else:
         params = None
     ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
-                  protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile))
+                  protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile),
+                  progress=on_progress)
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
         ctx.log = outcome.log

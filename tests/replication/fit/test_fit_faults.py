@@ -77,6 +77,8 @@ def test_csv_headers_gaps_and_float32_range(tmp_path, header, big, message):
     (["--batch", "-3"], ["--batch", ">= 1"]),
     (["--lr", "nan"], ["--lr", "> 0"]),
     (["--seed", "-1"], ["--seed", ">= 0"]),
+    (["--horizon", "0"], ["--horizon", "> 0"]),
+    (["--horizon", "nan"], ["--horizon", "> 0"]),
 ])
 def test_bad_fit_options_name_the_option_before_any_work(tmp_path, capsys, args, words):
     out = tmp_path / "out"
