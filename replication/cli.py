@@ -55,7 +55,7 @@ def cmd_run(args):
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
-                  dry_run=args.dry_run)
+                  dry_run=args.dry_run, split=args.split)
     if summary.get("dry_run"):
         return 0
     for c in summary["claims"]:
@@ -143,6 +143,9 @@ def build_parser():
                    "list`)")
     s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
     s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
+    s.add_argument("--split", default="test", choices=("test", "dev"), help="test: seeds 1000.. and held-out "
+                   "data and initial conditions no protocol choice has seen, where verdicts are decided; dev: "
+                   "seeds 0.. and the development draws that trials and tuning read (default: test)")
     s.add_argument("--out", help="results folder (default: results/<profile>)")
     s.add_argument("--jobs", type=int, default=1,
                    help="worker processes, one CPU thread each; units training the same model stay in one "

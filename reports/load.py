@@ -94,6 +94,8 @@ class Results:
     verdicts: dict[str, dict] = field(default_factory=dict)          # recomputed from the unit files
     stored_verdicts: dict[str, dict] = field(default_factory=dict)   # summary/verdicts.json as written
     verdict_profile: str | None = None
+    verdict_split: str | None = None
+    split: str = "dev"   # the split judged (`replication.run.splits`): run.json's, else verdicts.json's
     planned_missing: list[str] = field(default_factory=list)
     unfinished: bool = False
     units_csv: pd.DataFrame | None = None
@@ -217,6 +219,8 @@ def load_results(root: str | Path) -> Results:
     claims_json = _read_json(root / "claims.json", res.problems, root)
     verdicts = _read_json(root / "summary" / "verdicts.json", res.problems, root) or {}
     res.verdict_profile = verdicts.get("profile")
+    res.verdict_split = verdicts.get("split")
+    res.split = (res.run or {}).get("split") or res.verdict_split or "dev"
     for v in verdicts.get("claims") or []:
         if isinstance(v, dict) and isinstance(v.get("id"), str):
             res.stored_verdicts[v["id"]] = v
@@ -225,6 +229,11 @@ def load_results(root: str | Path) -> Results:
         # results superseded by a later protocol (folders "superseded-<time>-seed<k>") are history, not units
         found = [_load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))
                  if not p.parent.name.startswith("superseded-")]
+        mine = [u for u in found if not u.result or (u.result.get("split") or "dev") == res.split]
+        if len(mine) < len(found):   # one split a report: the other's seeds are neither shown nor judged
+            res.problems.append(f"{len(found) - len(mine)} unit(s) of another split than this run's ({res.split}) "
+                                f"are in this folder and left out of this report")
+        found = mine
         res.units = sorted(found, key=lambda u: (u.claim, u.framework, u.model, _seed_key(u.seed)))
     csv_path = root / "summary" / "units.csv"
     if csv_path.is_file():
@@ -248,10 +257,10 @@ def load_results(root: str | Path) -> Results:
 def _recompute_verdicts(res: Results) -> None:
     """Verdicts from the verified unit files, by the runner's own function; stored ones only compared."""
     from replication.claims import CLAIMS
-    from replication.claims.verdicts import frame, judge
+    from replication.claims.verdicts import frame, judge, of_split
 
     profile = (res.run or {}).get("profile") or res.verdict_profile
-    df = frame([u.result for u in res.units if u.status in ("ok", "failed")])
+    df = of_split(frame([u.result for u in res.units if u.status in ("ok", "failed")]), res.split)
     ids = {c["id"] for c in res.claims} | {u.claim for u in res.units}
     res.verdicts = {cid: judge(CLAIMS[cid], df, profile) for cid in sorted(ids) if cid in CLAIMS}
     for cid, v in res.stored_verdicts.items():

@@ -123,9 +123,22 @@ def headline(res: Results) -> str:
     return ". ".join(out) + "." if out else "Nothing was judged."
 
 
+SPLIT_TEXT = {
+    "test": "Decided on the test split: training seeds from 1000 on, and a held-out draw, rollout initial "
+            "conditions and sampled states from generator seeds that no trial, study or protocol choice has "
+            "read (replication/run/splits.py). The protocols were frozen before this run; they were tuned "
+            "by hand on the development split (seeds from 0, the development draws), with more trials for "
+            "some models than for others (docs/decisions/, docs/lab/).",
+    "dev": "Development split (seeds from 0, the development draws): the data the protocols were tuned on. "
+           "These numbers are for development; verdicts of record come from the test split (`lagbench run`, "
+           "its default).",
+}
+
+
 def scorecard_section(res: Results) -> Section:
     s = Section("Scorecard")
     s.add(Para(headline(res)))
+    s.add(Para(SPLIT_TEXT.get(res.split, f"Split: {res.split}.")))
     s.add(Para("One line per paper claim, then one per check (checks test the implementation and the numerics "
                "and are not counted among the claims). The verdict is recomputed from the unit files by the "
                "runner's own rule (replication/claims/verdicts.py): each claim is decided on the models as the "

@@ -35,13 +35,20 @@ def frame(records) -> pd.DataFrame:
     """summary/units.csv rows from result.json records (dicts)."""
     rows = []
     for d in records:
-        rows.append({**{k: d.get(k) for k in KEYS}, "profile": d.get("profile"),
+        rows.append({**{k: d.get(k) for k in KEYS}, "split": d.get("split") or "dev", "profile": d.get("profile"),
                      "train_time_s": d.get("train_time_s"), "train_samples_per_s": d.get("train_samples_per_s"),
                      "wall_time_s": d.get("wall_time_s"), "final_train_loss": d.get("final_train_loss"),
                      "failure": (d.get("failure") or {}).get("kind"),
                      **{k: v for k, v in (d.get("metrics") or {}).items()},
                      **{f"counter_{k}": v for k, v in (d.get("counters") or {}).items()}})
-    return pd.DataFrame(rows, columns=None if rows else [*KEYS, "profile"])
+    return pd.DataFrame(rows, columns=None if rows else [*KEYS, "split", "profile"])
+
+
+def of_split(units: pd.DataFrame, split: str) -> pd.DataFrame:
+    """The rows of one split (`replication.run.splits`): a summary never judges two splits' seeds together."""
+    if not len(units) or "split" not in units.columns:
+        return units
+    return units[units["split"].fillna("dev") == split]
 
 
 def collect_units(out) -> pd.DataFrame:
@@ -65,7 +72,7 @@ def _numeric(x):
 def model_stats(units: pd.DataFrame) -> dict:
     """{model: {metric: Stat}} over the rows of ``units`` (one framework), numeric columns only."""
     out = {}
-    skip = set(KEYS) | {"profile", "failure"}
+    skip = set(KEYS) | {"split", "profile", "failure"}
     for label, g in units.groupby("model", sort=False):
         stats = {}
         for col in g.columns:
@@ -167,6 +174,7 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
              "failed_units": {}}
     if not len(sub):
         return entry
+    entry["seeds"] = sorted({int(s) for s in sub["seed"]})
     # a profile's models; without one, the models that ran (a report of an unnamed profile)
     labels = claim.labels(profile) if profile is not None else [m for m in claim.labels() if m in set(sub["model"])]
     detail, parts, by_fw = _judge_parts(claim, sub, labels)
@@ -205,9 +213,11 @@ def headline(judged: list) -> dict:
     return out
 
 
-def write_summary(out, profile: str) -> dict:
-    df = collect_units(out)
+def write_summary(out, profile: str, split: str = "dev") -> dict:
+    """summary/units.csv and summary/verdicts.json of the units of `split` in `out`."""
+    df = of_split(collect_units(out), split)
     R.write_csv(Path(out) / "summary" / "units.csv", df)
     judged = judge_all(df, profile)
-    verdicts = {"schema": R.SCHEMA, "profile": profile, "headline": headline(judged), "claims": judged}
+    verdicts = {"schema": R.SCHEMA, "profile": profile, "split": split, "headline": headline(judged),
+                "claims": judged}
     return R.write_json(Path(out) / "summary" / "verdicts.json", verdicts)

@@ -9,8 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from replication.evaluation.metrics import null_errors
-from replication.evaluation.routines import Evaluation, system_of
-from replication.training import data as datamod
+from replication.evaluation.routines import Evaluation, heldout_of, system_of
 from replication.training.objective import predict
 
 
@@ -23,7 +22,7 @@ def eval_arm(ctx) -> Evaluation:
     out = Evaluation()
     s = system_of(p)
     for fam in ("train", "test"):
-        b = datamod.heldout(p, kind=fam)
+        b = heldout_of(ctx, kind=fam)
         tau = predict(m, kind, p.task, b, np.concatenate)
         out.metrics[f"torque_mse_{fam}"] = _mse(tau, b["target"])
         out.metrics[f"null_torque_mse_{fam}"] = null_errors(b["target"])["mse"]

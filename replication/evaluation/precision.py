@@ -19,7 +19,7 @@ from functools import lru_cache
 import numpy as np
 
 from replication.evaluation.rollout import lagrangian_field, rollout
-from replication.evaluation.routines import _truth, eval_energy_rollout
+from replication.evaluation.routines import _truth, eval_energy_rollout, truth_key
 
 
 @lru_cache(maxsize=8)
@@ -63,8 +63,7 @@ def _dopri5_in_dtype(s, y0, t, cfg, dtype):
 
 def eval_precision(ctx):
     out = eval_energy_rollout(ctx)
-    name = ctx.protocol.data.removesuffix("_iid")
-    key = (name, tuple(sorted(ctx.protocol.system_params)), tuple(sorted(ctx.cfg.items())))
+    key = truth_key(ctx)
     final, mx = truth_drift_in_dtype(*key, ctx.protocol.dtype)
     ok = np.isfinite(final)
     out.metrics["truth_energy_drift_final"] = float(np.mean(final[ok])) if ok.any() else float("nan")

@@ -1,8 +1,9 @@
 """Evaluation routines named by claims: each maps a trained model to metrics, tables and arrays.
 
 `EVALUATIONS[name](ctx) -> Evaluation`. `ctx` is a `Context` (claim, entry, framework, spec,
-params, protocol, profile, evaluation config, and `model`: a NumPy adapter of the trained model,
-see `replication.evaluation.adapters`). Everything here is NumPy and framework-neutral, so both frameworks
+params, protocol, profile, evaluation config, `split` (`replication.run.splits`: the held-out draw and
+the seeds of the routine's own draws, through `heldout_of` and `truth_key`), and `model`: a NumPy adapter
+of the trained model, see `replication.evaluation.adapters`). Everything here is NumPy and framework-neutral, so both frameworks
 are judged by the same code; ground truth comes from `systems` in float64.
 """
 from __future__ import annotations
@@ -23,6 +24,7 @@ from replication.evaluation.metrics import (
     null_errors,
 )
 from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
+from replication.run.splits import DEV
 from replication.training import data as datamod
 from replication.training.objective import predict
 
@@ -39,6 +41,7 @@ class Context:
     cfg: dict
     model: object = None
     log: list | None = None   # the training log rows (`TrainOutcome.log`), for routines that read the pace
+    split: object = DEV   # `replication.run.splits.Split`: the held-out draw and the draws' seeds evaluated on
     progress: object = None   # progress(label, done, total) or None: a routine's long work, for a progress bar
 
 
@@ -55,6 +58,19 @@ def system_of(protocol, **extra):
     return systems.get(name, **{**dict(protocol.system_params), **extra})
 
 
+def heldout_of(ctx, protocol=None, **kw) -> dict:
+    """The held-out set of `protocol` (default the unit's) in the unit's split."""
+    return datamod.heldout(protocol or ctx.protocol, seed=ctx.split.heldout_seed, **kw)
+
+
+def truth_key(ctx) -> tuple:
+    """The arguments of `_truth` for this unit: its system, and its evaluation config with the rollout
+    initial conditions' seed (`ic_seed`, default 0) moved by the split's offset."""
+    cfg = dict(ctx.cfg)
+    cfg["ic_seed"] = cfg.get("ic_seed", 0) + ctx.split.draw_offset
+    return ctx.protocol.data.removesuffix("_iid"), tuple(sorted(ctx.protocol.system_params)), tuple(sorted(cfg.items()))
+
+
 def pdot_to_qddot(protocol, q, qdot, pdot):
     """q-double-dot from a predicted pdot along the motion, pdot = dp/dq qdot + dp/dqdot qdd: with the
     truth's own rate r = dp/dq qdot + dp/dqdot qdd_true, qdd = qdd_true + (d2L/dqdot2)^-1 (pdot - r)."""
@@ -65,7 +81,7 @@ def pdot_to_qddot(protocol, q, qdot, pdot):
 
 def eval_heldout(ctx) -> Evaluation:
     p, m = ctx.protocol, ctx.model
-    batch = datamod.heldout(p)
+    batch = heldout_of(ctx)
     pred = predict(m, ctx.spec.kind, p.task, batch, np.concatenate)
     w = batch.get("weight")
     e = heldout_errors(pred, batch["target"], w)
@@ -139,8 +155,7 @@ def _model_rollout(ctx, s, q0, qd0, t):
 def eval_energy_rollout(ctx) -> Evaluation:
     out = eval_heldout(ctx)
     cfg = ctx.cfg
-    name = ctx.protocol.data.removesuffix("_iid")
-    s, t, q, qd, qc, qdc = _truth(name, tuple(sorted(ctx.protocol.system_params)), tuple(sorted(cfg.items())))
+    s, t, q, qd, qc, qdc = _truth(*truth_key(ctx))
     qp, qdp = _model_rollout(ctx, s, q[:, 0], qd[:, 0], t)
     E_true, E_pred = s.energy(q, qd, backend="numpy"), s.energy(qp, qdp, backend="numpy")
     out.metrics.update(energy_errors(E_pred, E_true, cfg["energy_scale"]))

@@ -7,8 +7,7 @@ import pandas as pd
 
 from replication.evaluation.metrics import bounded_relative_error, geometric_mean_over_time, heldout_errors
 from replication.evaluation.rollout import lagrangian_field, rollout
-from replication.evaluation.routines import Evaluation, eval_heldout, system_of
-from replication.training import data as datamod
+from replication.evaluation.routines import Evaluation, eval_heldout, heldout_of, system_of
 
 
 def eval_wave(ctx) -> Evaluation:
@@ -19,7 +18,7 @@ def eval_wave(ctx) -> Evaluation:
     out.metrics["heldout_l1_per_node"] = out.metrics["heldout_l1"] / n_small
     big = p.replace(system_params=tuple(sorted({**dict(p.system_params), "n": n_big}.items())),
                     n_heldout=min(p.n_heldout, 2000))
-    b = datamod.heldout(big)
+    b = heldout_of(ctx, big)
     tl1 = heldout_errors(m.acceleration(b["q"], b["qdot"], None), b["target"])["l1"] / n_big
     out.metrics["transfer_l1_per_node"] = tl1
     out.metrics["transfer_ratio"] = tl1 / out.metrics["heldout_l1_per_node"]

@@ -23,6 +23,7 @@ from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
 from replication.run import environment as env
+from replication.run import splits
 from replication.run.estimate import describe, estimate
 from replication.run.executor import run_units
 from replication.run.units import Unit
@@ -39,10 +40,12 @@ def _once(option: str, values) -> None:
         raise ValueError(f"{option}: {', '.join(twice)} given more than once; name each at most once")
 
 
-def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None) -> list:
+def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None,
+         split: str = "dev") -> list:
     """The units of a run; a ValueError naming the option if any is invalid or nothing would run."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
+    splits.get(split)
     for fw in frameworks:
         if fw not in FRAMEWORKS:
             raise ValueError(f"unknown framework {fw!r}; valid: {', '.join(FRAMEWORKS)}")
@@ -68,7 +71,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
             for fw in frameworks:
-                for seed in range(n):
+                for seed in splits.get(split).seeds(n):
                     units.append(Unit(claim, entry, fw, seed, profile))
     if not units:
         raise ValueError(f"nothing to run: no model of the chosen claims and --models runs under profile "
@@ -96,7 +99,7 @@ def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = T
     # file counts by its content, not its path (a moved folder, a renamed copy)
     same_eval = (content_only(d.get("eval_config")) == content_only(json.loads(json.dumps(cfg)))
                  and d.get("evaluation_version") == EVALUATION_VERSION)
-    if (content_only(d.get("protocol")) == content_only(unit.protocol().to_dict())
+    if (d.get("split", "dev") == unit.split and content_only(d.get("protocol")) == content_only(unit.protocol().to_dict())
             and d.get("model_spec") == unit.spec().to_dict() and same_eval):
         return True
     if not set_stale_aside:   # a look only (--dry-run): nothing renamed
@@ -170,11 +173,11 @@ def executor_of(executor, jobs, address):
 
 @R.writes
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
-        progress=True, jobs=1, executor="local", address=None, dry_run=False) -> dict:
+        progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT) -> dict:
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
-    units = plan(profile, claims, frameworks, seeds, models)
+    units = plan(profile, claims, frameworks, seeds, models, split)
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
         if todo:
@@ -186,7 +189,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
         return {"dry_run": True, "units": len(units), "todo": len(todo), "estimate": estimate}
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
-    manifest = {"schema": R.SCHEMA, "profile": profile, "frameworks": list(frameworks), "seeds": seeds,
+    manifest = {"schema": R.SCHEMA, "profile": profile, "split": split, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
                 # the units this run plans: the report names any that have no result (an unfinished run)
                 "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
@@ -215,7 +218,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
         except OSError:
             pass
         raise
-    summary = write_summary(out, profile)
+    summary = write_summary(out, profile, split)
     manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
                     units_run=len(todo), failures=failures, errors=errors)
     R.write_json(out / "run.json", manifest)

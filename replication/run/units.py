@@ -11,6 +11,7 @@ from replication.evaluation.adapters import adapter
 from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
 from replication.evaluation.routines import Context, system_of
 from replication.run import environment as env
+from replication.run import splits
 from replication.training import device as dev
 from replication.training import hessian_probe
 from replication.training.outcome import log_frame
@@ -24,6 +25,11 @@ class Unit:
     framework: str
     seed: int
     profile: str
+
+    @property
+    def split(self) -> str:
+        """"dev" or "test" (`replication.run.splits`): a claim unit's split follows from its seed."""
+        return splits.of_seed(self.seed).name
 
     @property
     def name(self) -> str:
@@ -58,7 +64,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         params = None
     ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
                   protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile),
-                  progress=on_progress)
+                  split=splits.of_seed(unit.seed), progress=on_progress)
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
         ctx.log = outcome.log
@@ -71,7 +77,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         files["arrays.npz"] = R.write_npz(folder / "arrays.npz", ev.arrays)
     record = {
         "schema": R.SCHEMA, "claim": unit.claim.id, "framework": unit.framework, "model": unit.entry.label,
-        "seed": unit.seed, "profile": unit.profile, "status": "ok" if failure is None else "failed",
+        "seed": unit.seed, "split": unit.split, "profile": unit.profile, "status": "ok" if failure is None else "failed",
         "failure": failure, "metrics": ev.metrics, "counters": {**ev.counters, **(hessian_probe.summarize(outcome.log) if outcome else {})},
         "model_spec": spec.to_dict(),
         "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "evaluation_version": EVALUATION_VERSION, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,

@@ -126,11 +126,13 @@ def recipe_for(protocol):
     raise ValueError(f"unknown data recipe {protocol.data!r}; valid: <system>_iid, two_link_arm")
 
 
-def heldout(protocol, **kw) -> dict:
-    """The fixed held-out set of a protocol (the same for every seed and model)."""
+def heldout(protocol, seed: int = HELDOUT_SEED, **kw) -> dict:
+    """The fixed held-out set of a protocol (the same for every seed and model): the draw of generator
+    `seed` (`replication.run.splits`: the development draw unless a test run's evaluation asks for its own);
+    a user's file: its held-out rows."""
     if protocol.data.startswith("file:"):
         kw = {"kind": "heldout", **kw}
-    return recipe_for(protocol)(protocol, protocol.n_heldout, np.random.default_rng(HELDOUT_SEED), **kw)
+    return recipe_for(protocol)(protocol, protocol.n_heldout, np.random.default_rng(seed), **kw)
 
 
 class BatchStream:

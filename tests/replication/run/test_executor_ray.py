@@ -147,8 +147,8 @@ def test_past_its_retries_a_unit_is_an_error_and_a_rerun_redoes_it(cluster, loca
     assert killed, "no worker was seen running the unit"
     errors = sorted(s["errors"])
     assert len(errors) == 2, errors
-    assert errors[0].startswith("dp_energy/torch/baseline/seed0: not run: dp_loss/torch/baseline/seed0")
-    assert errors[1].startswith("dp_loss/torch/baseline/seed0: worker stopped (1 attempts): ")
+    assert errors[0].startswith("dp_energy/torch/baseline/seed1000: not run: dp_loss/torch/baseline/seed1000")
+    assert errors[1].startswith("dp_loss/torch/baseline/seed1000: worker stopped (1 attempts): ")
     assert not (tmp_path / "units" / "dp_loss").exists()
     monkeypatch.undo()
     s = runner.run(out=tmp_path, executor="ray", **KW)
@@ -159,7 +159,7 @@ def test_past_its_retries_a_unit_is_an_error_and_a_rerun_redoes_it(cluster, loca
 def interrupt_when_written(worker, out, target, held, done):
     """Hold the chain's first unit stopped; once the untrained unit is written, Ctrl-C this process."""
     stop_one(worker, "dp_loss", held, done)
-    written = Path(out) / "units" / "appendix_b" / "torch" / "lnn_exact_fast" / "seed0" / "result.json"
+    written = Path(out) / "units" / "appendix_b" / "torch" / "lnn_exact_fast" / "seed1000" / "result.json"
     while not done.is_set() and not written.exists():
         time.sleep(0.02)
     if not done.is_set():
@@ -207,7 +207,7 @@ def test_ctrl_c_on_a_driver_joining_with_address(cluster, local, tmp_path):
     try:
         stop_one(cluster["worker"], "dp_loss", held, done, proc)
         assert held, f"no worker was seen running the unit; the driver said: {proc.communicate()[1]}"
-        written = tmp_path / "units" / "appendix_b" / "torch" / "lnn_exact_fast" / "seed0" / "result.json"
+        written = tmp_path / "units" / "appendix_b" / "torch" / "lnn_exact_fast" / "seed1000" / "result.json"
         while not written.exists() and proc.poll() is None:
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)

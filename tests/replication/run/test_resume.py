@@ -66,9 +66,9 @@ def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatc
     claim = get("dp_loss")
     monkeypatch.setitem(claim.protocols, "smoke", claim.protocols["smoke"].replace(steps=7))
     run(**kw)
-    (new,) = tmp_path.glob("units/dp_loss/jax/baseline/seed0/result.json")
+    (new,) = tmp_path.glob("units/dp_loss/jax/baseline/seed1000/result.json")
     assert R.load_result(new.parent)["protocol"]["steps"] == 7
-    (old,) = tmp_path.glob("units/dp_loss/jax/baseline/superseded-*-seed0/result.json")
+    (old,) = tmp_path.glob("units/dp_loss/jax/baseline/superseded-*-seed1000/result.json")
     assert R.load_result(old.parent)["protocol"]["steps"] == 20
     # train_steps counts every scout's steps as well (the smoke protocol scouts)
     assert R.load_result(new.parent)["train_steps"] - R.load_result(old.parent)["train_steps"] == 7 - 20
@@ -102,9 +102,9 @@ def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
     claim = get("dp_energy")
     monkeypatch.setitem(claim.eval_config, "smoke", {**claim.eval_config["smoke"], "n_ics": 2})
     run(**kw)
-    (new,) = tmp_path.glob("units/dp_energy/jax/baseline/seed0/result.json")
+    (new,) = tmp_path.glob("units/dp_energy/jax/baseline/seed1000/result.json")
     assert R.load_result(new.parent)["eval_config"]["n_ics"] == 2
-    assert len(list(tmp_path.glob("units/dp_energy/jax/baseline/superseded-*-seed0/result.json"))) == 1
+    assert len(list(tmp_path.glob("units/dp_energy/jax/baseline/superseded-*-seed1000/result.json"))) == 1
 
 
 def _release_calls(monkeypatch, tmp_path, budget):

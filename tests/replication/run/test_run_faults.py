@@ -118,8 +118,8 @@ def test_repairs_are_named_and_every_run_record_is_kept(tmp_path, caplog):
     f.write_text(f.read_text().replace('"status"', '"statuz"'))
     with caplog.at_level("WARNING", logger="lagbench"):
         summary = runner.run(**kw)
-    assert summary["repaired"] == [f"dp_loss/jax/baseline/seed0: {f}: checksum mismatch"]
-    assert "redoing dp_loss/jax/baseline/seed0" in caplog.text
+    assert summary["repaired"] == [f"dp_loss/jax/baseline/seed1000: {f}: checksum mismatch"]
+    assert "redoing dp_loss/jax/baseline/seed1000" in caplog.text
     assert json.loads((tmp_path / "run.json").read_text())["repaired"] == summary["repaired"]
     (kept,) = (tmp_path / "runs").glob("run-*.json")
     assert json.loads(kept.read_text()) == first
