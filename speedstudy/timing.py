@@ -9,15 +9,8 @@ absolute timing compared across runs.
 each of several fns timed round by round (every fn once per round), for figures compared with each other
 (fast/paper/matmul, the sizes of a scaling fit).
 `jax_ready(fn)` / `torch_ready(fn)` wrap a framework call so that it blocks and returns nothing.
-`Sizes`: what the tiny / quick / full studies measure. Wall time on the 2 shared cores of the
-development machine (timings.json): quick 962 s on 2026-11-22 (inference 411 s with its AOTInductor
-compiles, fast vs paper 143 s, rollouts 124 s, train to target 108 s, scaling 78 s, latency 73 s), 1296 s
-on 2026-11-23 (inference 553 s, fast vs paper 305 s, train to target 150 s, rollouts 114 s, scaling 79 s,
-latency 72 s), 1399 s later that day with a compile per thread count and paired JAX timings (inference
-852 s, fast vs paper 232 s, train to target 110 s, rollouts 85 s); up to 1.5x more while another process
-holds the cores. Full: not timed here. gpu (`lagbench bench --gpu`, one
-H100, 2026-11-23): inference 195 s, training 78 s, scaling 278 s, fast vs paper 147 s, mostly JAX
-compiling one program per shape.
+`Sizes`: what the tiny / quick / full studies measure. Their measured wall times, stage by stage
+(each run writes its own to timings.json): `docs/decisions/speed_study_sizes.md`.
 """
 from __future__ import annotations
 

@@ -13,14 +13,10 @@ takes two rounds).
 The probes run on the device the units will train on (`replication.training.device`, from LAGBENCH_DEVICE),
 and PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
-one local job trains them here). Measured on the 2-core development machine (2026-11-26), `full`'s PyTorch
-double pendulum (6 trainings; they took 10 097 s when run): probed at this process's default 2 threads,
-3.9 h; at the workers' one thread, 1.9-2.1 h in three dry runs. With both cores busy, a step of that LNN took
-34x as long at 2 threads as at 1 (0.76 s against 0.023 s); idle, under the passive OpenMP wait this package
-sets on import, 1.4x (0.028 s against 0.020 s). What the estimate leaves out: two workers slow
-each other down (that run's units took about 1.4x their probed steps), and evaluation. A PyTorch probe runs
-its loss under torch.compile where the phase it stands for will (`compile_torch.like`); its first step then
-compiles, and that time (about 26 s a phase on a cold cache) is not counted either.
+one local job trains them here): probed at another thread count than the workers', a step on busy cores
+can take many times as long (measurements: `docs/decisions/run_estimate.md`). What the estimate leaves
+out: two workers slow each other down, evaluation, and the first step of a PyTorch phase under
+torch.compile (`compile_torch.like`: the probe compiles as the phase will), which compiles.
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
 """
