@@ -110,6 +110,18 @@ def variants_table(res: Results) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+def registration_table(res: Results) -> pd.DataFrame | None:
+    """Per claim: the hash of what decides it under this profile, and the registration it matches."""
+    rows = []
+    for claim in res.claims:
+        r = (res.verdicts.get(claim["id"]) or {}).get("preregistration")
+        if r:
+            rows.append({"claim": claim["id"], "protocol hash": r["protocol_hash"],
+                         "registered": f"yes, frozen {r['frozen']}" if r["registered"] else "NO: changed since",
+                         "tuned on": cell(r.get("tuned_on")), "registrations": r["registrations"]})
+    return pd.DataFrame(rows) if rows else None
+
+
 def headline(res: Results) -> str:
     out = []
     for kind, name in (("claim", "Paper claims"), ("check", "Checks (implementation and numerics)")):
@@ -162,6 +174,14 @@ def scorecard_section(res: Results) -> Section:
         s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
                     note="A variant is a model with a departure from the paper standing in for the paper's model; "
                          "the claim is judged again with it, on this line only. A variant never decides a claim."))
+    registered = registration_table(res)
+    if registered is not None:
+        s.add(Table("Registered protocols", registered, ["replication/claims/registrations.json"],
+                    note="What decides each claim under this profile (its models' specs and protocols, the "
+                         "evaluation, the seeds, the bars and the rules) is hashed and registered before a "
+                         "test-split run; a change after one is a new dated registration, never a silent edit. "
+                         "The protocols were tuned by hand on the development split, with unequal effort "
+                         "between models; an equal search per claim is not built yet."))
     flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
     s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
                "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else

@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication import results as R
-from replication.claims import CLAIMS
+from replication.claims import CLAIMS, registration
 from replication.claims.bars import competence
 from replication.claims.parts import claim_verdict, combine_frameworks
 from replication.claims.rules import Outcome, Stat
@@ -172,6 +172,8 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
     entry = {"id": claim.id, "kind": claim.kind, "verdict": "not run", "reason": "no finished units",
              "by_framework": {}, "parts": [], "variants": [], "flags": [], "values": {}, "competence": {},
              "failed_units": {}}
+    if profile is not None:
+        entry["preregistration"] = registration.status(claim, profile)
     if not len(sub):
         return entry
     entry["seeds"] = sorted({int(s) for s in sub["seed"]})

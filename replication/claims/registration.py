@@ -1,0 +1,100 @@
+"""Frozen protocols: what decides each claim under each profile, registered before its test-split run.
+
+`fingerprint(claim, profile) -> dict`: everything that decides the claim's numbers and its verdict under
+the profile: per model that runs, its model spec fields, widths and protocol; the evaluation config; the
+seed count; the competence bars; the parts (the models they read and control, their rule and the rule's
+parameters); the variants; the metric.
+`protocol_hash(claim, profile) -> str`: the first 16 hex digits of the sha256 of its canonical JSON.
+`registrations()`: the committed records (`registrations.json`): {claim id: [line, ...]} oldest first, a
+line {"profile", "protocol_hash", "frozen" (the date it was frozen), "tuned_on" (the split its choices
+read), "note" (how it was chosen)}.
+`status(claim, profile) -> dict`: {"protocol_hash", "registered" (a line holds this hash), "frozen" (that
+line's date, else None), "tuned_on", "note", "registrations" (lines of this profile: more than one means the
+protocol was changed after an earlier registration, each change disclosed)}. A protocol that matches no
+line is unregistered: the tests forbid it, so a changed protocol is a new, dated line, never a silent edit.
+`python -m replication.claims.registration --note "..."` appends a line for every claim and profile whose
+current protocol matches none (nothing else changes).
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+from datetime import date
+from functools import lru_cache
+from pathlib import Path
+
+from replication.claims.base import PROFILES
+
+FILE = Path(__file__).with_name("registrations.json")
+_SIMPLE = (str, int, float, bool, tuple, type(None))
+
+
+def _rule(rule) -> dict:
+    """A part's rule by name and the plain values it closes over (its models, metric and thresholds)."""
+    cells = [c.cell_contents for c in (getattr(rule, "__closure__", None) or ())]
+    return {"rule": getattr(rule, "__qualname__", repr(rule)),
+            "params": [repr(v) for v in cells if isinstance(v, _SIMPLE)]}
+
+
+def fingerprint(claim, profile: str) -> dict:
+    base = claim.protocol(profile)
+    models = {m.label: {"spec": m.spec_fields(profile), "hidden": list(m.widths(profile)),
+                        "protocol": m.protocol(base, profile).to_dict()}
+              for m in claim.models if m.runs_in(profile)}
+    return {"claim": claim.id, "profile": profile, "models": models, "eval": claim.evaluation_config(profile),
+            "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
+            "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],
+            "variants": [v.describe() for v in claim.variants]}
+
+
+def protocol_hash(claim, profile: str) -> str:
+    text = json.dumps(fingerprint(claim, profile), sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@lru_cache(maxsize=1)
+def registrations() -> dict:
+    return json.loads(FILE.read_text()) if FILE.is_file() else {}
+
+
+def status(claim, profile: str) -> dict:
+    h = protocol_hash(claim, profile)
+    lines = [x for x in registrations().get(claim.id, []) if x["profile"] == profile]
+    hit = next((x for x in reversed(lines) if x["protocol_hash"] == h), None)
+    return {"protocol_hash": h, "registered": hit is not None, "frozen": hit and hit["frozen"],
+            "tuned_on": hit and hit["tuned_on"], "note": hit and hit["note"], "registrations": len(lines)}
+
+
+def register(note: str, tuned_on: str = "dev", today: str | None = None) -> list[str]:
+    """Append a line for each claim and profile whose current protocol matches none; the names added."""
+    from replication.claims import CLAIMS
+
+    data = json.loads(FILE.read_text()) if FILE.is_file() else {}
+    added = []
+    for c in CLAIMS.values():
+        for profile in PROFILES:
+            if not status(c, profile)["registered"]:
+                data.setdefault(c.id, []).append({"profile": profile, "protocol_hash": protocol_hash(c, profile),
+                                                  "frozen": today or date.today().isoformat(),
+                                                  "tuned_on": tuned_on, "note": note})
+                added.append(f"{c.id}/{profile}")
+    if added:
+        FILE.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
+        registrations.cache_clear()
+    return added
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m replication.claims.registration",
+                                description="Register (freeze) every claim protocol that matches no registration.")
+    p.add_argument("--note", required=True, help="how the protocols were chosen")
+    p.add_argument("--tuned-on", default="dev", choices=("dev",), help="the split the choices read")
+    args = p.parse_args(argv)
+    added = register(args.note, args.tuned_on)
+    print(f"registered {len(added)}: {', '.join(added)}" if added else "every protocol is registered")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

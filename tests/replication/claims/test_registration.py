@@ -1,0 +1,55 @@
+"""Frozen protocols (`replication.claims.registration`): every claim's protocol under every profile
+matches a committed registration; changing a model's protocol, the evaluation or a rule's threshold
+changes the hash and leaves the claim unregistered until a new dated line discloses the change."""
+import dataclasses
+
+from replication.claims import CLAIMS, PROFILES, get
+from replication.claims import registration as reg
+
+
+def test_every_claim_and_profile_is_registered():
+    missing = [f"{c.id}/{p}" for c in CLAIMS.values() for p in PROFILES if not reg.status(c, p)["registered"]]
+    assert not missing, ("protocols changed without a registration (run `python -m replication.claims.registration "
+                         f"--note ...` and say why): {missing}")
+
+
+def test_a_changed_protocol_evaluation_or_threshold_is_unregistered(monkeypatch):
+    claim = get("dp_loss")
+    before = reg.status(claim, "quick")
+    assert before["registered"] and before["frozen"]
+    longer = dataclasses.replace(claim, protocols={**claim.protocols, "quick": claim.protocols["quick"].replace(steps=1)})
+    other_eval = dataclasses.replace(claim, eval_config={**claim.eval_config, "quick": {"n_ics": 1}})
+    from replication.claims.rules import similar
+    part = dataclasses.replace(claim.parts[0], rule=similar("lnn", "baseline", 3.5, claim.metric))
+    looser = dataclasses.replace(claim, parts=(part, *claim.parts[1:]))
+    hashes = {reg.protocol_hash(c, "quick") for c in (claim, longer, other_eval, looser)}
+    assert len(hashes) == 4
+    for changed in (longer, other_eval, looser):
+        s = reg.status(changed, "quick")
+        assert not s["registered"] and s["frozen"] is None and s["registrations"] == before["registrations"]
+
+
+def test_register_appends_a_dated_line_for_a_changed_protocol_only(tmp_path, monkeypatch):
+    monkeypatch.setattr(reg, "FILE", tmp_path / "registrations.json")
+    reg.registrations.cache_clear()
+    try:
+        assert len(reg.register("first", today="2026-01-01")) == len(CLAIMS) * len(PROFILES)
+        assert reg.register("again", today="2026-01-02") == []
+        claim = get("dp_loss")
+        monkeypatch.setitem(claim.protocols, "quick", claim.protocols["quick"].replace(steps=1))
+        added = reg.register("fewer steps", today="2026-01-03")   # claim 2 shares claim 1's protocols
+        assert "dp_loss/quick" in added and all(a.endswith("/quick") for a in added)
+        s = reg.status(claim, "quick")
+        assert s["registered"] and s["frozen"] == "2026-01-03" and s["note"] == "fewer steps" and s["registrations"] == 2
+    finally:
+        reg.registrations.cache_clear()
+
+
+def test_verdicts_carry_the_registration():
+    import pandas as pd
+
+    from replication.claims.verdicts import judge
+
+    v = judge(get("dp_loss"), pd.DataFrame(columns=["claim", "framework", "model", "seed", "status"]), "quick")
+    assert v["preregistration"]["registered"] and v["preregistration"]["protocol_hash"] == reg.protocol_hash(
+        get("dp_loss"), "quick")
