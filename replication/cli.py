@@ -129,10 +129,20 @@ def cmd_stiff(args):
     print(f"picked: {df.attrs.get('reason')}; written to {folder}")
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("lagbench")
+    except PackageNotFoundError:   # run from a source tree that is not installed
+        return "(not installed)"
+
+
 def build_parser():
     p = argparse.ArgumentParser(prog="lagbench", description="Replication suite for learned Lagrangian and "
                                 "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    p.add_argument("--version", action="version", version=f"lagbench {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("list", help="list systems, models, claims and profiles")
     s.set_defaults(func=cmd_list)

@@ -19,8 +19,16 @@ def test_help_describes_each_command(capsys):
     with pytest.raises(SystemExit):
         build_parser().parse_args(["run", "--help"])
     out = capsys.readouterr().out
-    for flag in ("--profile", "--claims", "--frameworks", "--seeds", "--out"):
+    for flag in ("--profile", "--claims", "--frameworks", "--seeds", "--split", "--out"):
         assert flag in out
+
+
+def test_version_names_the_installed_package(capsys):
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as done:
+        build_parser().parse_args(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == f"lagbench {version('lagbench')}"
 
 
 def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
