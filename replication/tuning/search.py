@@ -1,0 +1,43 @@
+"""The declared search: the same knobs and the same number of configurations for every model of a claim.
+
+`KNOBS`: each knob's values, as multipliers of (or alternatives to) the model's registered setting:
+  lr      peak learning rate x {1/3, 1, 3} (a scouting round's rate with it)
+  width   every hidden layer's width x {1/2, 1, 2} (at least 1)
+The sample budget, the restarts and the input scaling stay the registered ones: a knob that changed the
+budget (restarts or none) would compare configurations at unequal budgets, and input scales are per system.
+`configs(n, seed=0) -> [knob values]`: the registered setting first (all multipliers 1), then n - 1 other
+combinations drawn without replacement (generator `seed`); the same list for every model.
+`apply(entry, base, profile, knobs) -> ModelEntry`: the model with those knob values under `profile`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+
+import numpy as np
+
+from replication.claims.base import PROFILES, per_profile
+
+KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
+REGISTERED = {"lr": 1.0, "width": 1.0}
+
+
+def configs(n: int, seed: int = 0) -> list[dict]:
+    grid = [dict(zip(KNOBS, values, strict=True)) for values in itertools.product(*KNOBS.values())]
+    if not 1 <= n <= len(grid):
+        raise ValueError(f"--configs: {n!r} is not valid; expected 1 to {len(grid)} (the search's combinations)")
+    others = [c for c in grid if c != REGISTERED]
+    order = np.random.default_rng(seed).permutation(len(others))
+    return [dict(REGISTERED), *[others[i] for i in order[:n - 1]]]
+
+
+def apply(entry, base, profile: str, knobs: dict):
+    """`entry` (a claims.base.ModelEntry) with the knob values applied to its protocol and widths."""
+    p = entry.protocol(base, profile)
+    change = {"lr": p.lr * knobs["lr"]}
+    if p.scout_lr:
+        change["scout_lr"] = p.scout_lr * knobs["lr"]
+    common = {k: v for k, v in entry.overrides.items() if k not in PROFILES}
+    per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
+    hidden = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))
+    return dataclasses.replace(entry, overrides={**common, profile: {**per, **change}}, hidden=hidden)

@@ -1,0 +1,76 @@
+"""`lagbench tune --claim ID`: every model of a claim searched alike on the development split.
+
+`tune(claim, profile, n_configs, n_seeds, frameworks, out, progress) -> ledger`: for each configuration of
+`search.configs` (the same list for every model), each trained model of the claim under `profile` is
+trained with it on the development seeds (`splits.DEV`: seeds 0.., the development draws; never the test
+split) and scored by its development held-out error: `heldout_l1` where the evaluation gives it, else the
+claim's metric (lower is better), averaged over seeds and frameworks. The units go to
+OUT/config<k>/units/...; the ledger to OUT/ledger.json and OUT/ledger.csv: per model and configuration
+its knob values and score, and per model the configurations tried, the chosen one (the lowest score)
+and the split they were scored on ("dev").
+What it does not do: change a claim. A claim's protocol is what `replication/claims/<claim>.py` says and
+its registration freezes; a tuning result reaches it only by an edit and a new registration.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pandas as pd
+
+from replication import results as R
+from replication.claims import get as get_claim
+from replication.run import splits
+from replication.run.executor import run_units
+from replication.run.units import Unit
+from replication.tuning import search
+
+
+def score_metric(result: dict, claim) -> float | None:
+    m = result.get("metrics") or {}
+    v = m.get("heldout_l1", m.get(claim.metric))
+    return float(v) if isinstance(v, int | float) and math.isfinite(v) else None
+
+
+@R.writes
+def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int = 1, frameworks=("jax",),
+         out="results/tune", progress: bool = True) -> dict:
+    claim = get_claim(claim_id)
+    if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or n_seeds < 1:
+        raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer >= 1")
+    grid = search.configs(n_configs)
+    labels = [e.label for e in claim.models if e.runs_in(profile) and e.train]
+    if not labels:
+        raise ValueError(f"--claim {claim_id}: trains no model under profile {profile!r}")
+    out = R.output_folder(out, "--out")
+    base = claim.protocol(profile)
+    rows = []
+    for k, knobs in enumerate(grid):
+        models = tuple(search.apply(e, base, profile, knobs) if e.label in labels else e for e in claim.models)
+        variant = dataclasses.replace(claim, models=models)
+        units = [Unit(variant, e, fw, seed, profile) for e in models if e.label in labels for fw in frameworks
+                 for seed in splits.DEV.seeds(n_seeds)]
+        folder = out / f"config{k}"
+        run_units(units, folder, profile, progress, jobs=1)
+        for u in units:
+            try:
+                r = R.load_result(u.folder(folder))
+            except R.CorruptResult:
+                r = {}
+            rows.append({"model": u.entry.label, "config": k, **{f"knob_{n}": v for n, v in knobs.items()},
+                         "framework": u.framework, "seed": u.seed, "split": u.split, "status": r.get("status"),
+                         "score": score_metric(r, claim) if r.get("status") == "ok" else None})
+    df = pd.DataFrame(rows)
+    R.write_csv(out / "ledger.csv", df)
+    ledger = {"schema": R.SCHEMA, "claim": claim.id, "profile": profile, "split": "dev",
+              "search": {n: list(v) for n, v in search.KNOBS.items()}, "configs": grid,
+              "seeds": splits.DEV.seeds(n_seeds), "frameworks": list(frameworks), "models": {}}
+    for label, g in df.groupby("model", sort=False):
+        mean = g.groupby("config")["score"].mean()   # a failed unit scores nothing; a config of failures, NaN
+        best = int(mean.idxmin()) if mean.notna().any() else None
+        ledger["models"][label] = {"configs_tried": int(g["config"].nunique()), "scored_on": "dev",
+                                   "scores": {int(c): (None if pd.isna(v) else float(v)) for c, v in mean.items()},
+                                   "chosen": best, "chosen_knobs": grid[best] if best is not None else None}
+    R.write_json(Path(out) / "ledger.json", ledger)
+    return ledger

@@ -1,0 +1,65 @@
+"""`lagbench tune` (`replication.tuning`): the same declared configurations for every model of a claim,
+trained and scored on the development split only, the lowest development score chosen, the claim itself
+unchanged."""
+import json
+
+import pytest
+
+from replication.claims import get
+from replication.claims.registration import protocol_hash
+from replication.cli import main
+from replication.run import splits
+from replication.training import data as datamod
+from replication.tuning import search
+from replication.tuning.tune import tune
+
+
+def test_configs_start_from_the_registered_setting_and_are_distinct():
+    c = search.configs(5)
+    assert c[0] == search.REGISTERED and len({json.dumps(x, sort_keys=True) for x in c}) == 5
+    assert search.configs(5) == c   # the same list every time, for every model
+    with pytest.raises(ValueError, match="--configs"):
+        search.configs(0)
+
+
+def test_apply_changes_only_the_knobs():
+    claim = get("dp_loss")
+    entry = claim.entry("lnn")
+    base = claim.protocol("quick")
+    p0 = entry.protocol(base, "quick")
+    same = search.apply(entry, base, "quick", search.REGISTERED)
+    assert same.protocol(base, "quick") == p0 and same.widths("quick") == entry.widths("quick")
+    other = search.apply(entry, base, "quick", {"lr": 3.0, "width": 0.5})
+    p = other.protocol(base, "quick")
+    assert p.lr == pytest.approx(3 * p0.lr) and p.scout_lr == pytest.approx(3 * p0.scout_lr)
+    assert other.widths("quick") == tuple(w // 2 for w in entry.widths("quick"))
+    assert p.replace(lr=p0.lr, scout_lr=p0.scout_lr) == p0   # the budget and everything else as registered
+
+
+def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path, monkeypatch):
+    seen = []
+    real = datamod.heldout
+
+    def heldout(protocol, seed=datamod.HELDOUT_SEED, **kw):
+        seen.append(seed)
+        return real(protocol, seed, **kw)
+    monkeypatch.setattr(datamod, "heldout", heldout)
+    before = protocol_hash(get("dp_loss"), "smoke")
+    ledger = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
+    assert set(seen) == {splits.DEV.heldout_seed}   # never the test draw
+    assert ledger["split"] == "dev" and ledger["seeds"] == [0]
+    models = ledger["models"]
+    assert set(models) == {"lnn", "baseline"}
+    for m in models.values():
+        assert m["configs_tried"] == 2 and m["scored_on"] == "dev"
+        scores = {int(k): v for k, v in m["scores"].items()}
+        finite = {k: v for k, v in scores.items() if v is not None}
+        assert m["chosen"] == min(finite, key=finite.get)
+    assert json.loads((tmp_path / "ledger.json").read_text())["models"] == json.loads(json.dumps(models))
+    assert protocol_hash(get("dp_loss"), "smoke") == before   # the claim is untouched
+
+
+def test_tune_command_refuses_a_bad_count_in_one_line(tmp_path, capsys):
+    assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--configs", "99", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--configs" in err
