@@ -181,7 +181,7 @@ def scorecard_section(res: Results) -> Section:
                          "evaluation, the seeds, the bars and the rules) is hashed and registered before a "
                          "test-split run; a change after one is a new dated registration, never a silent edit. "
                          "The protocols were tuned by hand on the development split, with unequal effort "
-                         "between models; an equal search per claim is not built yet."))
+                         "between models; `lagbench tune` searches every model alike, but has not chosen these protocols."))
     flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
     s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
                "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else
