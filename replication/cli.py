@@ -96,7 +96,7 @@ def cmd_bench(args):
 
 
 def cmd_train_target(args):
-    from replication.fit.cli import widths
+    from replication.fit.options import widths
     from speedstudy.train_target_run import check_names, run_study
 
     if args.heldout < 1 or args.seed < 0:

@@ -6,16 +6,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from replication.fit.rows import HELDOUT, SPLITS
-from replication.fit.trajectories import POLYORDER, WINDOW
+from replication.fit import options as fit_options
 from replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
              "state file: columns (arrays) q, qdot, qddot and optional tau (format: README)")
-
-HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (longer trajectories are rolled "
-                "out and scored to there)")
 
 
 def _show_defaults(parser) -> None:
@@ -25,27 +21,6 @@ def _show_defaults(parser) -> None:
         if "default" in text or action.required or not action.option_strings or action.nargs == 0:
             continue
         action.help = text + (" (default: none)" if action.default is None else " (default: %(default)s)")
-
-
-def widths(text: str, option: str = "--hidden") -> tuple:
-    """Layer widths from "128,128"; a ValueError naming `option` otherwise (also `lagbench train-target`'s)."""
-    try:
-        out = tuple(int(x) for x in text.split(","))
-    except ValueError:
-        out = ()
-    if not out or min(out) < 1:
-        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
-    return out
-
-
-def _scale(text: str):
-    if text in ("none", "auto"):
-        return None if text == "none" else "auto"
-    try:
-        return tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise ValueError(f"--input-scale takes none, auto or comma-separated numbers such as 1,1,0.3,0.3; got "
-                         f"{text!r}") from None
 
 
 def cmd_simulate(args):
@@ -103,14 +78,7 @@ def cmd_fit(args):
             bar.close()
 
     try:
-        d = fit(args.data, model=args.model, out=args.out, framework=args.framework, steps=args.steps,
-                hidden=widths(args.hidden, "--hidden"), batch=args.batch, lr=args.lr, seed=args.seed, loss=args.loss,
-                activation=args.activation, weight_decay=args.weight_decay, schedule=args.schedule,
-                lr_min_ratio=args.lr_final, delan_eps=args.delan_eps, delan_offset=args.delan_offset,
-                angle_wrap=args.angle_wrap, input_scale=_scale(args.input_scale), split=args.split,
-                heldout=args.heldout, test=args.test, window=args.window, polyorder=args.polyorder,
-                system=args.system, substeps=args.substeps, energy=args.energy, horizon=args.horizon,
-                on_log=on_log, on_progress=rollouts)
+        d = fit(args.data, out=args.out, on_log=on_log, on_progress=rollouts, **fit_options.from_args(args))
     finally:
         for bar in bars:
             bar.close()
@@ -166,40 +134,8 @@ def add_commands(sub) -> None:
                        "superseded-<time>-seed<k>. Load the model in Python with "
                        "replication.fit.load.load_fitted(folder).")
     s.add_argument("--data", required=True, help=DATA_HELP)
-    s.add_argument("--model", required=True, help="lnn | hnn | delan | baseline (lnn and hnn refuse data with tau)")
-    s.add_argument("--test", help="a file of the same format evaluated as a whole after training (rollouts from "
-                   "each trajectory's first state)")
-    s.add_argument("--split", choices=SPLITS, help="how rows are held out: whole trajectories, random rows, or "
-                   "none (default: by-trajectory for a trajectory file, random for a state file)")
-    s.add_argument("--heldout", type=float, default=HELDOUT, help="fraction held out (of trajectories or rows)")
-    s.add_argument("--window", type=int, default=WINDOW, help="Savitzky-Golay window (odd, samples) for the "
-                   "derivatives of a trajectory file")
-    s.add_argument("--polyorder", type=int, default=POLYORDER, help="Savitzky-Golay polynomial degree (>= 2)")
     s.add_argument("--out", default="results/fit", help="results folder")
-    s.add_argument("--framework", default="jax", help="jax | torch")
-    s.add_argument("--steps", type=int, default=2000, help="optimiser steps, >= 1")
-    s.add_argument("--batch", type=int, default=256, help="batch size, >= 1; at most the training rows")
-    s.add_argument("--hidden", default="128,128", help="comma-separated MLP widths")
-    s.add_argument("--activation", default="softplus", help="softplus | relu | relu2 | relu3 | tanh | sigmoid")
-    s.add_argument("--lr", type=float, default=1e-3, help="peak learning rate, > 0")
-    s.add_argument("--schedule", default="onecycle", help="onecycle | constant")
-    s.add_argument("--lr-final", type=float, default=1e-4, help="one-cycle: final rate as a fraction of --lr")
-    s.add_argument("--weight-decay", type=float, default=0.0, help="L2 penalty: coefficient of sum(theta^2) added "
-                   "to the loss")
-    s.add_argument("--loss", default="l1", help="l1 | mse (per sample summed over components, mean over the batch)")
-    s.add_argument("--seed", type=int, default=0, help="initialisation and batch-order seed, >= 0")
-    s.add_argument("--delan-eps", type=float, default=0.01, help="DeLaN: epsilon of M = L L^T + eps I")
-    s.add_argument("--delan-offset", type=float, default=2.0, help="DeLaN: diag(L) = softplus(raw + offset)")
-    s.add_argument("--angle-wrap", action="store_true", help="input feature: wrap q to [-pi, pi) before the MLP")
-    s.add_argument("--input-scale", default="none", help="input feature: multipliers of the MLP inputs [q, qdot"
-                   "(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as "
-                   "1,1,0.3,0.3")
-    s.add_argument("--system", help="a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "
-                   "evaluation compares against (default: none)")
-    s.add_argument("--energy", help="your energy function E(q, qdot) as module:function (importable from here; "
-                   "(N, d) arrays to (N,)), compared along the rollouts in place of --system's")
-    s.add_argument("--substeps", type=int, default=2, help="RK4 steps per sample interval in the rollouts")
-    s.add_argument("--horizon", type=float, help=HORIZON_HELP + " (default: whole trajectories)")
+    fit_options.add_arguments(s)
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_fit)
@@ -217,7 +153,7 @@ def add_commands(sub) -> None:
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
-    s.add_argument("--horizon", type=float, help=HORIZON_HELP + " (default: the fit's)")
+    s.add_argument("--horizon", type=float, help=fit_options.HORIZON_HELP + " (default: the fit's)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")

@@ -19,17 +19,17 @@ from pathlib import Path
 
 from replication import results as R
 from replication.claims.base import Claim, ModelEntry
+from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
 from replication.fit import trajectories, userdata
 from replication.fit.load import fitted_folders, load_fitted
-from replication.fit.task import FRAMEWORKS, LOSS_NAMES, check_options
+from replication.fit.task import LOSS_NAMES
 from replication.run.units import Unit, run_unit
 
 
 def _check(framework, system, substeps, window, polyorder, horizon):
-    if framework is not None and framework not in FRAMEWORKS:
-        raise ValueError(f"--framework: {framework!r} is not valid; expected one of {', '.join(FRAMEWORKS)}")
-    check_options("lnn", "jax", 1, (1,), 1, 1.0, 0, "l1", substeps=substeps or 1, system=system, horizon=horizon)
+    given = {"framework": framework, "substeps": substeps, "system": system, "horizon": horizon}
+    fit_options.check({k: v for k, v in given.items() if v is not None})
     if window is not None or polyorder is not None:
         trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
 

@@ -1,0 +1,174 @@
+"""`lagbench fit`'s options, written once: the keyword of `fit`, the command-line flag, the default, the
+help, how the flag's text is read and what a valid value is.
+
+`OPTIONS`: the records, in the order of the command's help. `resolve(given) -> Options` (attribute access):
+every option's value, the default where not given; a TypeError names a keyword that is no option.
+`check(values)`: a ValueError naming the first invalid option of `values` (any subset, by keyword) and
+what it accepts. `add_arguments(parser)`: the flags of `lagbench fit`. `from_args(args) -> dict`: the
+keywords of `fit` from parsed flags (a flag's text read by the option's `parse`).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+from models import ACTIVATIONS
+from replication.fit.rows import HELDOUT, SPLITS
+from replication.fit.trajectories import POLYORDER, WINDOW
+
+MODELS = ("lnn", "hnn", "delan", "baseline")
+FRAMEWORKS = ("jax", "torch")
+LOSSES = ("l1", "mse")
+SCHEDULES = ("onecycle", "constant")
+
+
+HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (longer trajectories are rolled "
+                "out and scored to there)")
+
+
+def count(low):
+    return lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= low
+
+
+def real(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def one_of(values):
+    return lambda v: v in values
+
+
+def widths(text: str, option: str = "--hidden") -> tuple:
+    """Layer widths from "128,128"; a ValueError naming `option` otherwise (also `lagbench train-target`'s)."""
+    try:
+        out = tuple(int(x) for x in text.split(","))
+    except ValueError:
+        out = ()
+    if not out or min(out) < 1:
+        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
+    return out
+
+
+def scale(text: str):
+    """--input-scale: None (none), "auto" or a tuple of numbers."""
+    if text in ("none", "auto"):
+        return None if text == "none" else "auto"
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise ValueError(f"--input-scale takes none, auto or comma-separated numbers such as 1,1,0.3,0.3; got "
+                         f"{text!r}") from None
+
+
+@dataclass(frozen=True)
+class Option:
+    name: str                      # fit()'s keyword
+    default: object
+    help: str
+    valid: Callable | None = None  # value -> bool (None: any value)
+    expected: str = ""             # what `valid` accepts, for the error
+    flag: str = ""                 # the command-line spelling (default: --name with dashes)
+    parse: Callable | None = None  # the flag's text -> value (None: argparse's `type`)
+    kind: type | None = None       # argparse `type` where parse is None
+    text: str | None = None        # the flag's default text where parse is used
+    switch: bool = False           # a flag without a value (store_true)
+    required: bool = False         # on the command line
+
+    @property
+    def cli(self) -> str:
+        return self.flag or "--" + self.name.replace("_", "-")
+
+
+OPTIONS = (
+    Option("model", "lnn", "lnn | hnn | delan | baseline (lnn and hnn refuse data with tau)", one_of(MODELS),
+           f"one of {', '.join(MODELS)}", required=True),
+    Option("test", None, "a file of the same format evaluated as a whole after training (rollouts from each "
+           "trajectory's first state)"),
+    Option("split", None, "how rows are held out: whole trajectories, random rows, or none (default: "
+           "by-trajectory for a trajectory file, random for a state file)", lambda v: v is None or v in SPLITS,
+           f"one of {', '.join(SPLITS)}"),
+    Option("heldout", HELDOUT, "fraction held out (of trajectories or rows)", kind=float),
+    Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
+    Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
+    Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),
+    Option("steps", 2000, "optimiser steps, >= 1", count(1), "an integer >= 1", kind=int),
+    Option("batch", 256, "batch size, >= 1; at most the training rows", count(1), "an integer >= 1", kind=int),
+    Option("hidden", (128, 128), "comma-separated MLP widths",
+           lambda v: len(v) > 0 and all(count(1)(h) for h in v), "comma-separated layer widths >= 1 such as 128,128",
+           parse=widths, text="128,128"),
+    Option("activation", "softplus", "softplus | relu | relu2 | relu3 | tanh | sigmoid", one_of(ACTIVATIONS),
+           f"one of {', '.join(ACTIVATIONS)}"),
+    Option("lr", 1e-3, "peak learning rate, > 0", lambda v: real(v) and v > 0, "a finite number > 0", kind=float),
+    Option("schedule", "onecycle", "onecycle | constant", one_of(SCHEDULES), f"one of {', '.join(SCHEDULES)}"),
+    Option("lr_min_ratio", 1e-4, "one-cycle: final rate as a fraction of --lr", lambda v: real(v) and 0 < v <= 1,
+           "a fraction in (0, 1]", flag="--lr-final", kind=float),
+    Option("weight_decay", 0.0, "L2 penalty: coefficient of sum(theta^2) added to the loss",
+           lambda v: real(v) and v >= 0, "a finite number >= 0", kind=float),
+    Option("loss", "l1", "l1 | mse (per sample summed over components, mean over the batch)", one_of(LOSSES),
+           f"one of {', '.join(LOSSES)}"),
+    Option("seed", 0, "initialisation and batch-order seed, >= 0", count(0), "an integer >= 0", kind=int),
+    Option("delan_eps", 0.01, "DeLaN: epsilon of M = L L^T + eps I", lambda v: real(v) and v >= 0,
+           "a finite number >= 0", kind=float),
+    Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", real, "a finite number", kind=float),
+    Option("angle_wrap", False, "input feature: wrap q to [-pi, pi) before the MLP", switch=True),
+    Option("input_scale", None, "input feature: multipliers of the MLP inputs [q, qdot(, qddot)]: none, auto (1 / "
+           "standard deviation over the training rows) or numbers such as 1,1,0.3,0.3",
+           lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(real(x) and x > 0 for x in v)),
+           "none, auto or positive numbers such as 1,1,0.3,0.3", parse=scale, text="none"),
+    Option("system", None, "a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "
+           "evaluation compares against (default: none)"),
+    Option("energy", None, "your energy function E(q, qdot) as module:function (importable from here; (N, d) "
+           "arrays to (N,)), compared along the rollouts in place of --system's"),
+    Option("substeps", 2, "RK4 steps per sample interval in the rollouts", count(1), "an integer >= 1", kind=int),
+    Option("horizon", None, HORIZON_HELP + " (default: whole trajectories)", lambda v: v is None or (real(v) and v > 0),
+           "a number of seconds > 0", kind=float),
+)
+BY_NAME = {o.name: o for o in OPTIONS}
+
+
+def resolve(given: dict) -> SimpleNamespace:
+    unknown = sorted(set(given) - set(BY_NAME))
+    if unknown:
+        raise TypeError(f"fit() got unknown options {', '.join(unknown)}; valid: {', '.join(BY_NAME)}")
+    values = {o.name: given.get(o.name, o.default) for o in OPTIONS}
+    if isinstance(values["hidden"], list):
+        values["hidden"] = tuple(values["hidden"])
+    if isinstance(values["input_scale"], list):
+        values["input_scale"] = tuple(values["input_scale"])
+    return SimpleNamespace(**values)
+
+
+def check(values: dict) -> None:
+    for o in OPTIONS:
+        if o.name in values and o.valid is not None and not o.valid(values[o.name]):
+            v = values[o.name]
+            shown = ",".join(map(str, v)) if o.name == "hidden" and isinstance(v, tuple) else v
+            raise ValueError(f"{o.cli}: {shown!r} is not valid; expected {o.expected}")
+    system = values.get("system")
+    if system is not None:
+        import systems
+
+        if system not in systems.names():
+            raise ValueError(f"--system: unknown {system!r}; valid: {', '.join(systems.names())}")
+
+
+def add_arguments(parser) -> None:
+    for o in OPTIONS:
+        if o.switch:
+            parser.add_argument(o.cli, action="store_true", help=o.help)
+        elif o.parse is not None:
+            parser.add_argument(o.cli, default=o.text, help=o.help)
+        elif o.name == "split":
+            parser.add_argument(o.cli, choices=SPLITS, help=o.help)
+        else:
+            parser.add_argument(o.cli, type=o.kind, default=o.default, required=o.required, help=o.help)
+
+
+def from_args(args) -> dict:
+    out = {}
+    for o in OPTIONS:
+        v = getattr(args, o.cli[2:].replace("-", "_"))
+        out[o.name] = o.parse(v) if o.parse is not None else v
+    return out
