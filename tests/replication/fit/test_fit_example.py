@@ -1,7 +1,7 @@
-"""The README's worked example of bringing your own data (issue 26), run end to end from its own text:
+"""The worked example (docs/fit.md) of bringing your own data (issue 26), run end to end from its own text:
 the `lagbench` lines of the block after the marker, in a fresh folder. The default run shrinks the
 training (steps, widths, trajectories) to seconds; the slow test runs the block as written and checks
-what the README says of its results."""
+what the page says of its results."""
 import json
 import re
 import shlex
@@ -13,7 +13,7 @@ import pytest
 from replication.cli import main
 from replication.fit.load import load_fitted
 
-README = Path(__file__).resolve().parents[3] / "README.md"
+README = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 MARKER = "<!-- worked example: tests/replication/fit/test_fit_example.py runs this block -->"
 # the default run's smaller example (argparse takes the last of a repeated option)
 SMALL = {"simulate": ["--trajectories", "3", "--duration", "1.2"], "fit": ["--steps", "10", "--hidden", "8"]}
@@ -21,7 +21,7 @@ SMALL = {"simulate": ["--trajectories", "3", "--duration", "1.2"], "fit": ["--st
 
 def example_commands() -> list[list[str]]:
     text = README.read_text(encoding="utf-8")
-    assert MARKER in text, "the README lost the worked example's marker"
+    assert MARKER in text, "docs/fit.md lost the worked example's marker"
     block = re.search(r"```bash\n(.*?)```", text[text.index(MARKER):], re.S).group(1)
     lines = [ln.split("  #")[0].strip() for ln in block.splitlines()]
     return [shlex.split(ln)[1:] for ln in lines if ln.startswith("lagbench ")]

@@ -1,0 +1,83 @@
+"""The README's claims table, made from a run's `claims.json` and `summary/verdicts.json` (never by hand).
+
+`table(claims, verdicts) -> str`: one Markdown row per paper claim, then per check: number, title, where in
+the paper, the verdict, each counted part with its verdict, the key model's metric in JAX and PyTorch (the
+seed mean) and the published value with what kind of number it is; below it, one line per variant.
+`python -m reports.readme_table FOLDER` prints it from FOLDER/claims.json and FOLDER/verdicts.json (a
+sample-report folder) or FOLDER/summary/verdicts.json (a results folder). The README holds the output of
+the verdict-of-record run between the markers BEGIN and END; `tests/reports/test_readme_table.py` keeps
+it equal to this function's output on the committed `docs/sample_report/`.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+BEGIN = "<!-- claims table: made by `python -m reports.readme_table docs/sample_report`; do not edit by hand -->"
+END = "<!-- end of the claims table -->"
+FRAMEWORKS = (("jax", "JAX"), ("torch", "PyTorch"))
+
+
+def _num(v) -> str:
+    if v is None:
+        return "–"
+    v = float(v)
+    return f"{v:.3g}" if 1e-3 <= abs(v) < 1e4 or v == 0 else f"{v:.2e}"
+
+
+def _key_number(claim: dict, v: dict) -> str:
+    key, values = claim.get("key"), v.get("values") or {}
+    got = [f"{name} {_num((values.get(fw) or {}).get(key, {}).get('mean'))}" for fw, name in FRAMEWORKS
+           if key in (values.get(fw) or {})]
+    return f"{key} {claim.get('metric')}: " + ", ".join(got) if got else "not run"
+
+
+def _published(claim: dict) -> str:
+    p = (claim.get("published") or {}).get(claim.get("key"))
+    if not isinstance(p, dict) or p.get("value") is None:
+        return "none"
+    return f"{_num(p['value'])} ({p.get('kind', '?')}{', other data' if p.get('other_data') else ''})"
+
+
+def _parts(v: dict) -> str:
+    parts = [p for p in v.get("parts") or [] if not p.get("check")]
+    return "; ".join(f"{p['name']}: {p['verdict']}" for p in parts) or "–"
+
+
+def table(claims: list[dict], verdicts: dict) -> str:
+    by_id = {v["id"]: v for v in verdicts.get("claims") or []}
+    split = verdicts.get("split", "dev")
+    lines = [f"Profile `{verdicts.get('profile')}`, {split} split, seeds "
+             + ", ".join(sorted({str(s) for v in by_id.values() for s in v.get("seeds", [])}, key=int)) + ".", "",
+             "| # | claim | paper | verdict | parts | key number (seed mean) | published |",
+             "|---|---|---|---|---|---|---|"]
+    ordered = sorted(claims, key=lambda c: (c.get("kind", "claim") != "claim", c.get("number", 0)))
+    for c in ordered:
+        v = by_id.get(c["id"], {})
+        number = f"{c.get('number')}" + (" (check)" if c.get("kind") == "check" else "")
+        lines.append(f"| {number} | {c.get('title')} | {c.get('paper')} {c.get('section')} | "
+                     f"{v.get('verdict', 'not run')} | {_parts(v)} | {_key_number(c, v)} | {_published(c)} |")
+    variants = [f"- claim {c.get('number')}, variant \"{x['name']}\": {x['verdict']}"
+                for c in ordered for x in by_id.get(c["id"], {}).get("variants") or []]
+    if variants:
+        lines += ["", "Variants (a departure from the paper; never the claim's verdict):", *variants]
+    return "\n".join(lines)
+
+
+def read(folder) -> tuple[list[dict], dict]:
+    folder = Path(folder)
+    verdicts = folder / "verdicts.json"
+    if not verdicts.is_file():
+        verdicts = folder / "summary" / "verdicts.json"
+    return json.loads((folder / "claims.json").read_text())["claims"], json.loads(verdicts.read_text())
+
+
+def block(folder) -> str:
+    return f"{BEGIN}\n{table(*read(folder))}\n{END}"
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        raise SystemExit("usage: python -m reports.readme_table FOLDER (a results or sample-report folder)")
+    print(block(sys.argv[1]))
