@@ -122,6 +122,16 @@ def registration_table(res: Results) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+def made_by(res: Results) -> str:
+    """Which run this is: profile, split, commit, hardware and date, from run.json."""
+    run = res.run or {}
+    hw = run.get("hardware") or {}
+    where = f"{hw.get('cpu', 'unknown CPU')}, {hw.get('cores', '?')} cores" + (f", GPU {hw['gpu']}" if hw.get("gpu") else "")
+    return (f"Profile {run.get('profile') or res.verdict_profile or 'unknown'}, {res.split} split; commit "
+            f"{run.get('commit') or 'unknown'}; {where}; started {run.get('started') or 'unknown'}"
+            + (f", finished {run['finished']}." if run.get("finished") else ", not finished."))
+
+
 def headline(res: Results) -> str:
     out = []
     for kind, name in (("claim", "Paper claims"), ("check", "Checks (implementation and numerics)")):
@@ -150,6 +160,7 @@ SPLIT_TEXT = {
 def scorecard_section(res: Results) -> Section:
     s = Section("Scorecard")
     s.add(Para(headline(res)))
+    s.add(Para(made_by(res)))
     s.add(Para(SPLIT_TEXT.get(res.split, f"Split: {res.split}.")))
     s.add(Para("One line per paper claim, then one per check (checks test the implementation and the numerics "
                "and are not counted among the claims). The verdict is recomputed from the unit files by the "
