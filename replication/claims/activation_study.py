@@ -21,7 +21,7 @@ SMOKE_ACTS = ("softplus", "tanh", "relu")   # smoke: the reference, one smooth r
 MODELS = tuple(ModelEntry(f"lnn_act-{a}", {"kind": "lnn", "activation": a, "init": "cranmer2020",
                                             "angle_wrap": True}, hidden=init_study.W,
                           profile_spec=dp.VELOCITY_SCALE,
-                          profiles=("smoke", "quick", "paper") if a in SMOKE_ACTS else ("quick", "paper"))
+                          profiles=("smoke", "quick", "full", "paper") if a in SMOKE_ACTS else ("quick", "full", "paper"))
                for a in ACTS)
 
 

@@ -21,23 +21,18 @@ from replication.training.protocol import Protocol
 PROFILES = ("smoke", "quick", "full", "paper")
 # a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`
 # except where a claim says otherwise (longer budgets, more seeds, the paper's evaluation horizon)
-PROFILE_PARENT = {"full": "quick"}
 KINDS = ("claim", "check")
-__all__ = ["PROFILES", "PROFILE_PARENT", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
+__all__ = ["PROFILES", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
 
 
 def per_profile(table: dict, profile: str, default=None):
-    """`table[profile]`, else its parent's entry (`PROFILE_PARENT`), else `default`."""
-    while profile is not None:
-        if profile in table:
-            return table[profile]
-        profile = PROFILE_PARENT.get(profile)
-    return default
+    """`table[profile]`, else `default`: every profile a table serves is spelled out in it (no inheritance)."""
+    return table.get(profile, default)
 
 
 def in_profile(profiles: tuple, profile: str) -> bool:
-    """Whether a model limited to `profiles` runs in `profile` (or in the profile it inherits from)."""
-    return per_profile(dict.fromkeys(profiles, True), profile, False)
+    """Whether a model limited to `profiles` runs in `profile`."""
+    return profile in profiles
 
 
 @dataclass(frozen=True)

@@ -15,10 +15,10 @@ from replication.claims.published import Published
 from replication.claims.rules import better_by, bound
 from replication.training.protocol import Protocol
 
-W = {"smoke": (16, 16), "quick": (64, 64), "paper": (64, 64)}
+W = {"smoke": (16, 16), "quick": (64, 64), "full": (64, 64), "paper": (64, 64)}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
 _ff = {"kind": "baseline", "activation": "softplus", "init": "xavier", "extra_inputs": 2}
-SIZES = {"smoke": (), "quick": (256, 1024), "paper": (128, 512, 2048)}
+SIZES = {"smoke": (), "quick": (256, 1024), "full": (256, 1024), "paper": (128, 512, 2048)}
 
 
 def _models():
@@ -39,6 +39,7 @@ PROTOCOLS = {"smoke": _base,
              # 8000, FF n256 5.0 -> 3.2), and every pool gets the same steps, so that only the data differ
              "quick": _base.replace(steps=8000, batch=256, n_train=4096, n_heldout=4000, log_every=200, lr=1e-3),
              "paper": _base.replace(steps=40_000, batch=512, n_train=2459, n_heldout=4000, log_every=500)}
+PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 
 
 METRIC = "torque_mse_test"
@@ -66,5 +67,5 @@ CLAIM = Claim(
     # learned on the training family (the unseen family is what the claim measures)
     bars=(Bar(("delan", "ff"), "torque_mse_train"),
           Bar(tuple(f"{m}_n{n}" for n in POOLS for m in ("delan", "ff")), "torque_mse_train")),
-    seeds={"smoke": 1, "quick": 3, "paper": 3},
+    seeds={"smoke": 1, "quick": 3, "full": 3, "paper": 3},
 )

@@ -14,10 +14,11 @@ from replication.claims.base import Claim, ModelEntry, Part, Variant
 from replication.claims.rules import better_by
 from replication.training.protocol import Protocol
 
-W = {"smoke": (16, 16), "quick": (128, 128), "paper": (256, 256, 256)}
+W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (256, 256, 256)}
 # quick: the relativistic models (all alike) with restarts over initialisations, 8 scouts x 200 steps, the
 # best by training loss continued. The magnetic pair and DeLaN's control train without.
-REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),), "quick": {"scouts": 8, "scout_steps": 200}}
+REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),), "quick": {"scouts": 8, "scout_steps": 200},
+       "full": {"scouts": 8, "scout_steps": 200}}
 MAG = {"data": "charged_magnetic_iid"}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020"}
@@ -34,6 +35,7 @@ _base = Protocol(data="charged_magnetic_iid", steps=20, batch=32, n_train=640, n
 PROTOCOLS = {"smoke": _base,
              "quick": _base.replace(steps=1500, batch=256, n_train=256 * 200, n_heldout=10_000, log_every=50),
              "paper": _base.replace(steps=100_000, batch=512, n_train=512 * 1000, n_heldout=100_000, log_every=1000)}
+PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 
 
 CLAIM = Claim(
@@ -51,5 +53,5 @@ CLAIM = Claim(
                       "alone"),),
     # the claim is that the LNN can: it must have learned; DeLaN is expected not to, and its control must learn
     bars=(Bar(("lnn_relativistic", "lnn_relativistic_gamma", "lnn_magnetic", "delan_control"), "heldout_l1"),),
-    key="lnn_relativistic", seeds={"smoke": 1, "quick": 3, "paper": 3},
+    key="lnn_relativistic", seeds={"smoke": 1, "quick": 3, "full": 3, "paper": 3},
 )

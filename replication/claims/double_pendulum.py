@@ -21,7 +21,7 @@ WIDTHS = {"smoke": SMOKE_W, "quick": QUICK_W, "full": FULL_W, "paper": PAPER_W}
 # quick: the MLP's velocity inputs scaled by 0.3 (velocities are U[-10, 10], angles wrapped to [-pi, pi)),
 # as in the train-to-target variant (`docs/train_target_trials.md`); both models alike
 VELOCITY_SCALE = {"smoke": {"input_scale": (1.0, 1.0, 0.3, 0.3)}, "quick": {"input_scale": (1.0, 1.0, 0.3, 0.3)},
-                  "paper": {}}
+                  "full": {"input_scale": (1.0, 1.0, 0.3, 0.3)}, "paper": {}}
 
 MODELS = (
     ModelEntry("lnn", {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "angle_wrap": True,
@@ -64,7 +64,7 @@ _full = PROTOCOLS["quick"].replace(n_heldout=100_000, lr=2e-3, lr_start=0.2, sco
                                    track_every=5000)
 PROTOCOLS["full"] = _full.replace(steps=(FULL_SAMPLES - scouting_samples(_full)) // _full.batch)
 
-SEEDS = {"smoke": 1, "quick": 3, "paper": 3}
+SEEDS = {"smoke": 1, "quick": 3, "full": 3, "paper": 3}
 
 # both models must have learned q-double-dot on the training distribution before they are compared
 LEARNED = Bar(("lnn", "baseline"), "heldout_l1")

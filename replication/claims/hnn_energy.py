@@ -6,7 +6,7 @@ from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.rules import better_by
 from replication.training.protocol import Protocol
 
-W = {"smoke": (16, 16), "quick": (128, 128), "paper": (200, 200)}
+W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (200, 200)}
 _hnn = {"kind": "hnn", "activation": "tanh", "init": "xavier"}
 _base_m = {"kind": "baseline", "activation": "tanh", "init": "xavier"}
 HAM = {"task": "hamiltonian", "coords": "qp"}
@@ -19,9 +19,11 @@ _base = Protocol(data="spring_iid", steps=20, batch=32, n_train=640, n_heldout=5
 PROTOCOLS = {"smoke": _base,
              "quick": _base.replace(steps=2000, batch=128, n_train=128 * 200, n_heldout=5000, log_every=50),
              "paper": _base.replace(steps=20_000, batch=256, n_train=256 * 500, n_heldout=20_000, log_every=500)}
+PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 EVAL = {"smoke": {"n_ics": 3, "t_end": 2.0, "n_t": 21, "dt": 0.01, "energy_scale": 1.0},
         "quick": {"n_ics": 10, "t_end": 30.0, "n_t": 301, "dt": 0.02, "energy_scale": 1.0},  # RK4 drift ~1e-6
         "paper": {"n_ics": 25, "t_end": 100.0, "n_t": 1000, "dt": 0.01, "energy_scale": 1.0}}
+EVAL["full"] = EVAL["quick"]
 
 
 CLAIM = Claim(
@@ -35,5 +37,5 @@ CLAIM = Claim(
                 for s in ("spring", "pendulum")),
     bars=(Bar(tuple(m.label for m in MODELS), "heldout_l1"),
           Bar(("hnn_spring", "hnn_pendulum"), None, max_diverged=0)),
-    eval_config=EVAL, seeds={"smoke": 1, "quick": 3, "paper": 3},
+    eval_config=EVAL, seeds={"smoke": 1, "quick": 3, "full": 3, "paper": 3},
 )

@@ -19,11 +19,11 @@ from replication.claims.rules import faster
 from replication.training.scouting import scout_protocol
 
 INITS = ("cranmer2020", "xavier", "kaiming", "pytorch_default")
-W = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "paper": dp.PAPER_W}
+W = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "full": dp.QUICK_W, "paper": dp.PAPER_W}
 SMOKE_INITS = ("cranmer2020", "kaiming")   # smoke: two cohorts of two seeds, to keep the test run short
 MODELS = tuple(ModelEntry(f"lnn_init-{i}", {"kind": "lnn", "activation": "softplus", "init": i,
                                              "angle_wrap": True}, hidden=W, profile_spec=dp.VELOCITY_SCALE,
-                          profiles=("smoke", "quick", "paper") if i in SMOKE_INITS else ("quick", "paper"))
+                          profiles=("smoke", "quick", "full", "paper") if i in SMOKE_INITS else ("quick", "full", "paper"))
                for i in INITS)
 
 # quick: 1.6e5 samples a seed at batch 32, sized to the 45-minute budget. Measured (8 seeds, 3 x 64, JAX and

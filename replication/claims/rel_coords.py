@@ -27,7 +27,7 @@ from replication.claims.published import Published
 from replication.claims.rules import fails
 from replication.training.protocol import Protocol
 
-W = {"smoke": (16, 16), "quick": (128, 128, 128), "paper": (500, 500, 500, 500)}
+W = {"smoke": (16, 16), "quick": (128, 128, 128), "full": (128, 128, 128), "paper": (500, 500, 500, 500)}
 # inputs (q, qdot[, gamma], g): the LNNs see q unscaled, the HNNs on (q, qdot) q / 10; g / 10 for all
 CANONICAL_RATE = {"lr": 3e-3, "scout_lr": 3e-3}
 LORENTZ = {"lorentz_factor": True, "extra_inputs": 1, "activation": "softplus"}
@@ -38,8 +38,8 @@ MODELS = (
     ModelEntry("lnn", {**_lnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W),
     ModelEntry("hnn_qqdot", {**_hnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides=QQDOT),
     ModelEntry("hnn_qp", {**_hnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W,
-               overrides={"task": "hamiltonian", "coords": "qp", "quick": CANONICAL_RATE},
-               profile_spec={"quick": {"input_scale": (0.1, 0.01, 0.1)}}),   # and full; paper: the original's
+               overrides={"task": "hamiltonian", "coords": "qp", "quick": CANONICAL_RATE, "full": CANONICAL_RATE},
+               profile_spec={"quick": {"input_scale": (0.1, 0.01, 0.1)}, "full": {"input_scale": (0.1, 0.01, 0.1)}}),
     # positive control: the HNN on (q, qdot) of the pendulum (m = l = 1: qdot is the canonical momentum)
     ModelEntry("hnn_qqdot_control", {k: v for k, v in _hnn.items() if k != "extra_inputs"}, hidden=W,
                overrides={**QQDOT, "data": "pendulum_iid", "loss": "l1"}),
@@ -89,5 +89,5 @@ CLAIM = Claim(
                       "the paper's see qdot alone"),),
     # the models the claim says learn, the variant's LNN and the control; hnn_qqdot is expected not to
     bars=(Bar(("lnn", "hnn_qp", "lnn_gamma", "hnn_qqdot_control"), "heldout_l1_qddot"),),
-    seeds={"smoke": 1, "quick": 3, "paper": 3},
+    seeds={"smoke": 1, "quick": 3, "full": 3, "paper": 3},
 )

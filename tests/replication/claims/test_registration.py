@@ -53,3 +53,14 @@ def test_verdicts_carry_the_registration():
     v = judge(get("dp_loss"), pd.DataFrame(columns=["claim", "framework", "model", "seed", "status"]), "quick")
     assert v["preregistration"]["registered"] and v["preregistration"]["protocol_hash"] == reg.protocol_hash(
         get("dp_loss"), "quick")
+
+
+def test_every_claim_spells_out_every_profile():
+    """No profile inherits another's settings: each claim names its protocol and seed count in every profile,
+    and each model its widths in every profile it runs in."""
+    for c in CLAIMS.values():
+        for p in PROFILES:
+            assert p in c.protocols and p in c.seeds, f"{c.id}: no protocol or seeds for {p}"
+            for m in c.models:
+                if m.runs_in(p) and isinstance(m.hidden, dict):
+                    assert p in m.hidden, f"{c.id}/{m.label}: no widths for {p}"
