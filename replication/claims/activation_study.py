@@ -11,7 +11,7 @@ measure the budget, not the claim; its bar asks only that softplus ends off the 
 half the null's). ReLU's held-out L1 there is the null's, 46.6 in every seed.
 """
 from replication.claims import double_pendulum as dp
-from replication.claims import init_study
+from replication.claims import pace_study as pace
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.rules import faster, never
@@ -19,7 +19,7 @@ from replication.claims.rules import faster, never
 ACTS = ("softplus", "relu2", "relu3", "tanh", "sigmoid", "relu")
 SMOKE_ACTS = ("softplus", "tanh", "relu")   # smoke: the reference, one smooth rival and plain ReLU
 MODELS = tuple(ModelEntry(f"lnn_act-{a}", {"kind": "lnn", "activation": a, "init": "cranmer2020",
-                                            "angle_wrap": True}, hidden=init_study.W,
+                                            "angle_wrap": True}, hidden=pace.WIDTHS,
                           profile_spec=dp.VELOCITY_SCALE,
                           profiles=("smoke", "quick", "full", "paper") if a in SMOKE_ACTS else ("quick", "full", "paper"))
                for a in ACTS)
@@ -30,8 +30,8 @@ RIVALS = tuple(f"lnn_act-{a}" for a in ACTS if a != "softplus")   # the smooth o
 CLAIM = Claim(
     id="activation_study", number=7, paper="LNN", section="§4, activation functions",
     title="Softplus beats ReLU^2, ReLU^3, tanh, sigmoid; plain ReLU cannot work",
-    system="double_pendulum", models=MODELS, protocols=init_study.PROTOCOLS, evaluate="pace",
-    metric="left_plateau", metric_label=init_study.METRIC_LABEL,
+    system="double_pendulum", models=MODELS, protocols=pace.PROTOCOLS, evaluate="pace",
+    metric="left_plateau", metric_label=pace.METRIC_LABEL,
     published={},
     verdict_rule="softplus leaves the plateau in fewer samples than each other activation, relu included (a part "
                  "each: the Hodges-Lehmann ratio's exact two-sided interval at 0.05 / 5 below 1), and relu leaves it "
@@ -40,6 +40,6 @@ CLAIM = Claim(
                   reads=("lnn_act-softplus", r)) for r in RIVALS),
            Part("plain ReLU cannot learn", never("lnn_act-relu"), reads=("lnn_act-relu",),
                 controls=("lnn_act-softplus",))),
-    bars=(Bar(("lnn_act-softplus",), "heldout_l1", fraction=init_study.LEFT),),
-    seeds=init_study.SEEDS, pooled=True,
+    bars=(Bar(("lnn_act-softplus",), "heldout_l1", fraction=pace.LEFT),),
+    seeds=pace.SEEDS, pooled=True,
 )

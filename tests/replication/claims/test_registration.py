@@ -64,3 +64,21 @@ def test_every_claim_spells_out_every_profile():
             for m in c.models:
                 if m.runs_in(p) and isinstance(m.hidden, dict):
                     assert p in m.hidden, f"{c.id}/{m.label}: no widths for {p}"
+
+
+def test_no_claim_imports_another_claim():
+    """Claims share settings through constant modules (double_pendulum.py, pace_study.py), never by importing
+    each other."""
+    import ast
+    from pathlib import Path
+
+    folder = Path(__file__).resolve().parents[3] / "replication" / "claims"
+    claims = {f.stem for f in folder.glob("*.py") if "\nCLAIM = Claim(" in f.read_text()}
+    assert len(claims) == len(CLAIMS)
+    for name in claims:
+        tree = ast.parse((folder / f"{name}.py").read_text())
+        used = {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module == "replication.claims"
+                for a in n.names}
+        used |= {n.module.rsplit(".", 1)[1] for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module
+                 and n.module.startswith("replication.claims.")}
+        assert not used & (claims - {name}), f"{name} imports {used & claims}"
