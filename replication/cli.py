@@ -77,9 +77,10 @@ def cmd_report(args):
                          f"(or bench, stiff, train-target)")
     if not any((results / name).exists() for name in RESULT_ENTRIES):
         raise ValueError(f"--results {results}: holds no lagbench results (none of {', '.join(RESULT_ENTRIES)})")
-    paths = reports.build_report(results, args.out)
+    out = Path(args.out) if args.out else Path("report") / (results.resolve().name or "results")
+    paths = reports.build_report(results, out)
     for k, v in paths.items():
-        print(f"{k}: {len(v)} files in {Path(args.out) / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
+        print(f"{k}: {len(v)} files in {out / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
 
 def cmd_bench(args):
@@ -204,7 +205,8 @@ def build_parser():
                        "the result files in --results. Replaces only files an earlier report wrote there.")
     s.add_argument("--results", default="results/quick", help="a folder written by `lagbench run` (or bench, "
                    "stiff, train-target) (default: results/quick)")
-    s.add_argument("--out", default="report/quick", help="the report folder (default: report/quick)")
+    s.add_argument("--out", help="the report folder (default: report/<the results folder's name>, so that "
+                   "results/full gives report/full)")
     s.set_defaults(func=cmd_report)
     from replication.fit.cli import add_commands
 

@@ -94,3 +94,14 @@ def test_the_pdf_shows_characters_its_fonts_lack_as_code_points():
     assert "U+4E2D" in s and "U+D55C" in s and "U+30D5" in s and "U+1F600" in s
     assert not any(c in s for c in "中한フ😀")
     assert "q̇" in s and "γ × 3 − 1 ≈ 2" in s and '\\"' in s
+
+
+def test_the_default_report_folder_follows_the_results_folder(results_dir, tmp_path, monkeypatch):
+    """`report --results X/full` writes report/full, never over another run's report/quick."""
+    import shutil
+
+    full = tmp_path / "runs" / "full"
+    shutil.copytree(results_dir, full)
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "--results", str(full)]) in (0, None)
+    assert (tmp_path / "report" / "full" / "REPORT.md").is_file() and not (tmp_path / "report" / "quick").exists()
