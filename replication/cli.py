@@ -152,11 +152,26 @@ def _version() -> str:
 
 
 PROFILE_CHOICES = ("smoke", "quick", "full", "paper")
+EPILOG = """usual workflows:
+  lagbench run --profile quick --jobs 2 && lagbench report --results results/quick
+  lagbench run --profile quick --split dev --out results/dev     development numbers (what tuning reads)
+  lagbench tune --claim dp_loss                                  every model of a claim searched alike
+  lagbench fit --data FILE --model lnn && lagbench report --results results/fit
+
+environment variables:
+  LAGBENCH_CACHE          generated code, datasets and trainings cache (default .cache/)
+  LAGBENCH_DEVICE         auto | cpu | gpu, as --device
+  LAGBENCH_TORCH_COMPILE  off: PyTorch trains eagerly; on: compiles every phase it can
+  LAGBENCH_TF32           1: allow TF32 matrix products on a GPU (default: full float32)
+  LAGBENCH_WORKER_DIR     a Ray worker's private folder (default /tmp/lagbench-ray-<uid>)
+  LAGBENCH_BENCH_TINY     1: the speed study at its tiny preset (seconds)
+  LAGBENCH_COMMIT         the commit to record where the tree has no .git"""
 
 
 def build_parser():
     p = argparse.ArgumentParser(prog="lagbench", description="Replication suite for learned Lagrangian and "
-                                "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.")
+                                "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.",
+                                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     p.add_argument("--version", action="version", version=f"lagbench {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
