@@ -208,6 +208,16 @@ def _compiled(step, k, forced, batch):
     """`step` as one AOTInductor library for this batch size (`models.torch.compiled.compile_batched`: 15-40 s
     to build, then one call a step in place of ~100 eager operators), or None (with a warning naming why)
     where it cannot be built: the rollout then runs eagerly."""
+    import torch
+
+    from replication.training.compile_torch import compiler
+
+    if torch.get_default_device().type == "cpu" and compiler() is None:
+        import warnings
+
+        warnings.warn("the rollout runs eagerly: compiling its step needs a C++ compiler (set CXX or install g++)",
+                      stacklevel=2)
+        return None
     try:
         from models.torch.compiled import compile_batched
 

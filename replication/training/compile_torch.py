@@ -107,11 +107,28 @@ class CompiledLoss:
         return self.eager(model, batch)
 
 
+def compiler() -> str | None:
+    """The C++ compiler inductor would build with on the CPU ($CXX, else c++, g++, clang++ on PATH), or None."""
+    import shutil
+
+    found = [shutil.which(c) for c in (os.environ.get("CXX", ""), "c++", "g++", "clang++") if c]
+    return next((c for c in found if c), None)
+
+
+_WARNED: set = set()
+
+
 def compiled_loss(loss_fn, spec, protocol, members: int = 1):
-    """loss_fn, compiled where `wanted` and inductor has a private cache folder."""
-    if wanted(spec, protocol, members) and inductor_cache.private():
-        return CompiledLoss(loss_fn)
-    return loss_fn
+    """loss_fn, compiled where `wanted`, inductor has a private cache folder and, for the CPU, a C++ compiler
+    is on PATH (without one: eager, with one warning per process saying so)."""
+    if not (wanted(spec, protocol, members) and inductor_cache.private()):
+        return loss_fn
+    if torch.get_default_device().type == "cpu" and compiler() is None:
+        if "compiler" not in _WARNED:
+            _WARNED.add("compiler")
+            log.warning("torch.compile needs a C++ compiler (set CXX or install g++): PyTorch trains eagerly")
+        return loss_fn
+    return CompiledLoss(loss_fn)
 
 
 def step_mode(loss) -> str:

@@ -121,3 +121,18 @@ def test_estimate_probes_compile_where_the_phase_they_stand_for_will(monkeypatch
     with compile_torch.like(lnn, long):
         assert not compile_torch.wanted(lnn, probe)
     assert os.environ[compile_torch.ENV] == "off"
+
+
+def test_without_a_cxx_compiler_training_is_eager_with_one_warning(monkeypatch, caplog):
+    import shutil
+
+    from replication.training import compile_torch as ct
+
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    monkeypatch.setattr(ct, "_WARNED", set())
+    monkeypatch.setattr(ct, "wanted", lambda *a, **k: True)
+    monkeypatch.setattr(ct.inductor_cache, "private", lambda: True)
+    fn = lambda m, b: 0.0  # noqa: E731
+    with caplog.at_level("WARNING", logger="lagbench"):
+        assert ct.compiled_loss(fn, None, None) is fn and ct.compiled_loss(fn, None, None) is fn
+    assert sum("C++ compiler" in r.getMessage() for r in caplog.records) == 1
