@@ -54,9 +54,10 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
     _once("--frameworks", frameworks)
     _once("--claims", claims or ())
     _once("--models", models or ())
-    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1):
-        raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer >= 1 (or leave it out for "
-                         f"the profile's)")
+    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int)
+                              or not 1 <= seeds <= splits.SEEDS_PER_SPLIT):
+        raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer from 1 to "
+                         f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
     labels = sorted({e.label for c in chosen for e in c.models})
     unknown = sorted(set(models or ()) - set(labels))

@@ -12,8 +12,8 @@ ONE = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--mo
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--seeds", "0"], ["--seeds", ">= 1"]),
-    (["--seeds", "-1"], ["--seeds", ">= 1"]),
+    (["--seeds", "0"], ["--seeds", "from 1 to 1000"]),
+    (["--seeds", "-1"], ["--seeds", "from 1 to 1000"]),
     (["--models", "lnnn"], ["--models", "lnnn", "valid:", "baseline"]),
     (["--frameworks", "jax,jax"], ["--frameworks", "jax", "more than once"]),
     (["--claims", "dp_loss,dp_loss"], ["--claims", "more than once"]),

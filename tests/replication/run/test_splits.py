@@ -31,6 +31,11 @@ def test_unknown_split_is_refused_by_name():
         runner.plan("quick", split="val")
 
 
+def test_more_seeds_than_a_split_holds_are_refused():
+    with pytest.raises(ValueError, match="--seeds: 1001 is not valid"):
+        runner.plan("quick", split="dev", seeds=1001)
+
+
 @pytest.fixture()
 def reads(monkeypatch):
     """Every held-out draw read, with the phase (training or evaluation) that read it."""
