@@ -37,8 +37,8 @@ def score_metric(result: dict, claim) -> float | None:
 def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int = 1, frameworks=("jax",),
          out="results/tune", progress: bool = True) -> dict:
     claim = get_claim(claim_id)
-    if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or n_seeds < 1:
-        raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer >= 1")
+    if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
+        raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     grid = search.configs(n_configs)
     labels = [e.label for e in claim.models if e.runs_in(profile) and e.train]
     if not labels:
