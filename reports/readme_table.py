@@ -45,11 +45,26 @@ def _parts(v: dict) -> str:
     return "; ".join(f"{p['name']}: {p['verdict']}" for p in parts) or "–"
 
 
+def _seeds(claims: list[dict], by_id: dict) -> str:
+    """"seeds from 1000: 3 a model (8 in claims 6, 7; 1 in claim 5)": the usual count, then the others."""
+    counts = {c.get("number"): len(by_id.get(c["id"], {}).get("seeds") or []) for c in claims}
+    counts = {k: n for k, n in counts.items() if n}
+    if not counts:
+        return "no seeds ran"
+    first = min(s for v in by_id.values() for s in v.get("seeds") or [])
+    usual = max(set(counts.values()), key=lambda n: (list(counts.values()).count(n), n))
+    other = {}
+    for k, n in sorted(counts.items()):
+        if n != usual:
+            other.setdefault(n, []).append(str(k))
+    rest = "; ".join(f"{n} in claim{'s' if len(ks) > 1 else ''} {', '.join(ks)}" for n, ks in sorted(other.items()))
+    return f"seeds from {first}: {usual} a model" + (f" ({rest})" if rest else "")
+
+
 def table(claims: list[dict], verdicts: dict) -> str:
     by_id = {v["id"]: v for v in verdicts.get("claims") or []}
     split = verdicts.get("split", "dev")
-    lines = [f"Profile `{verdicts.get('profile')}`, {split} split, seeds "
-             + ", ".join(sorted({str(s) for v in by_id.values() for s in v.get("seeds", [])}, key=int)) + ".", "",
+    lines = [f"Profile `{verdicts.get('profile')}`, {split} split; {_seeds(claims, by_id)}.", "",
              "| # | claim | paper | verdict | parts | key number (seed mean) | published |",
              "|---|---|---|---|---|---|---|"]
     ordered = sorted(claims, key=lambda c: (c.get("kind", "claim") != "claim", c.get("number", 0)))

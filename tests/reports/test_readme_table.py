@@ -40,7 +40,7 @@ def test_table_lists_every_claim_with_its_verdict_and_variants():
          "variants": [{"name": "with gamma", "verdict": "reproduced"}]},
         {"id": "b", "verdict": "not run", "seeds": [1000]}]}
     out = readme_table.table(claims, verdicts)
-    assert "test split, seeds 1000, 1001" in out
+    assert "test split; seeds from 1000: 2 a model (1 in claim 2)" in out
     assert "| 1 | A | P §1 | partly | p1: reproduced; p2: not reproduced | m x: JAX 0.25, PyTorch 0.3 | 0.5 (held-out) |" in out
     assert "| 2 (check) | B | P §2 | not run | – | not run | none |" in out
     assert 'claim 1, variant "with gamma": reproduced' in out
