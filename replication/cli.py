@@ -119,18 +119,6 @@ def cmd_train_target(args):
     print(f"written to {folder}")
 
 
-def cmd_tune(args):
-    from replication.tuning.tune import tune
-
-    ledger = tune(args.claim, profile=args.profile, n_configs=args.configs, n_seeds=args.seeds,
-                  frameworks=_csv(args.frameworks) or ("jax",), out=args.out or f"results/tune/{args.claim}",
-                  progress=not args.quiet)
-    for label, m in ledger["models"].items():
-        scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in m["scores"].items())
-        print(f"{label:<22} chose config {m['chosen']} {m['chosen_knobs']} of {m['configs_tried']} ({scores})")
-    return 0
-
-
 def cmd_stiff(args):
     import systems
     from replication.studies.stiff_solvers import write_study
@@ -151,7 +139,6 @@ def _version() -> str:
         return "(not installed)"
 
 
-PROFILE_CHOICES = ("smoke", "quick", "full", "paper")
 EPILOG = """usual workflows:
   lagbench run --profile quick --jobs 2 && lagbench report --results results/quick
   lagbench run --profile quick --split dev --out results/dev     development numbers (what tuning reads)
@@ -201,20 +188,9 @@ def build_parser():
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_run)
-    s = sub.add_parser("tune", help="search every model of a claim alike on the development split",
-                       description="Train every model of a claim under the same declared search (peak rate x 1/3, "
-                       "1, 3; widths x 1/2, 1, 2; the registered setting first, then other combinations; budget, "
-                       "restarts and input scaling as registered) on the development seeds and draws, score each by its development held-out "
-                       "error, and write OUT/ledger.json and OUT/ledger.csv (configurations tried and chosen per "
-                       "model). It never reads the test split and never changes a claim.")
-    s.add_argument("--claim", required=True, help="a claim id (see `lagbench list`)")
-    s.add_argument("--profile", default="quick", choices=PROFILE_CHOICES, help="the budget to tune at (default: quick)")
-    s.add_argument("--configs", type=int, default=4, help="configurations per model, the same for every model (default: 4)")
-    s.add_argument("--seeds", type=int, default=1, help="development seeds per configuration (default: 1)")
-    s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")
-    s.add_argument("--out", help="results folder (default: results/tune/<claim>)")
-    s.add_argument("--quiet", action="store_true", help="no progress bars")
-    s.set_defaults(func=cmd_tune)
+    from replication.tuning.cli import add_command as add_tune
+
+    add_tune(sub)
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",
                        description="Write REPORT.md, REPORT.typ, REPORT.pdf and figures/*.png into --out from "
                        "the result files in --results. Replaces only files an earlier report wrote there.")
