@@ -6,7 +6,8 @@ is `rollout.rollout(f, z0, t_eval, dt)` (step rule "split") with f the model's f
 the same intervals and step sizes (`plan`), the state and the RK4 arithmetic in float64, the model called
 on the state cast to `dtype`, a row that turns non-finite frozen at NaN from then on.
   framework  "jax" (one jit-compiled `lax.scan` over BLOCK intervals a call, compiled once per batch shape)
-             or "torch" (the loop in torch tensors on the default device: no NumPy conversions, no padding)
+             or "torch" (the loop in torch tensors on the default device, no NumPy conversions; from
+             COMPILE_CALLS model calls on, its RK4 step as one AOTInductor library: `_compiled`)
   model      the framework model (`models.jax.build` / `models.torch.build`)
   field      "acceleration" (z = (q, qdot), dz/dt = (qdot, model.acceleration(q, qdot, tau))) or
              "time_derivative" (an HNN on (x, y) = (q, qdot): dz/dt = model.time_derivative(x, y))
@@ -23,7 +24,7 @@ import numpy as np
 from replication.evaluation.rollout import rk4_step, steps
 
 BLOCK = 256   # intervals a compiled JAX call advances; the progress bar moves once a block
-COMPILE_CALLS = 40_000   # model calls from which a PyTorch rollout compiles its model first (eager ~1 ms a call)
+COMPILE_CALLS = 40_000   # model calls from which a PyTorch rollout compiles its RK4 step (eager ~1 ms a call)
 SMALLEST = 16   # JAX batches are padded to a power of two >= this: a few compiled shapes
 
 
