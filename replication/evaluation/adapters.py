@@ -17,6 +17,12 @@ from __future__ import annotations
 import numpy as np
 
 CHUNK = 32768   # one chunk (one compiled shape) for every quick held-out set; 4 at paper scale
+SMALLEST = 16   # padded batches: a power of two >= this, so a JIT compiles a few shapes, not one per size
+
+
+def padded_size(n: int) -> int:
+    """The batch size n rows are padded to (`fit.load.Padded`, `rollout_native`): a power of two >= SMALLEST."""
+    return max(SMALLEST, 1 << max(n - 1, 0).bit_length())
 
 
 def qddot(model, kind: str, q, qdot):

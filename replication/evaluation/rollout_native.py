@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from replication.evaluation.adapters import padded_size
 from replication.evaluation.rollout import rk4_step, steps
 
 BLOCK = 256   # intervals a compiled JAX call advances; the progress bar moves once a block
 COMPILE_CALLS = 40_000   # model calls from which a PyTorch rollout compiles its RK4 step (eager ~1 ms a call)
-SMALLEST = 16   # JAX batches are padded to a power of two >= this: a few compiled shapes
 
 
 def plan(t_eval, dt):
@@ -79,7 +79,7 @@ def _jax(model, dtype, field, z0, t, n, h, tau, progress):
     import jax.numpy as jnp
 
     b, k = z0.shape
-    size = max(SMALLEST, 1 << max(b - 1, 0).bit_length())
+    size = padded_size(b)
     m = n.size
     total = -(-m // BLOCK) * BLOCK
 

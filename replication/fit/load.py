@@ -34,12 +34,11 @@ import numpy as np
 
 from models import ModelSpec
 from replication import results as R
-from replication.evaluation.adapters import adapter
+from replication.evaluation.adapters import adapter, padded_size
 from replication.evaluation.rollout_native import native_rollout
 from replication.training.protocol import Protocol
 
 ENERGY_STEP = 1e-4   # in float64: truncation ~1e-8 relative, round-off ~1e-12 x |L|
-SMALLEST = 16   # batches are padded to a power of two >= this: a few compiled shapes (JAX), not one per size
 
 
 class Padded:
@@ -61,7 +60,7 @@ class Padded:
 
         def call(*args):
             n = next(len(a) for a in args if a is not None)
-            size = max(SMALLEST, 1 << max(n - 1, 0).bit_length())
+            size = padded_size(n)
             pad = [None if a is None else np.concatenate([a, np.repeat(np.asarray(a)[:1], size - n, 0)])
                    for a in args]
             out = method(*pad)
