@@ -2,7 +2,7 @@
 it took (the SciML work-precision view of speed against error).
 
 ``work_precision(units, path)`` reads the tracked rows of ``train_log.csv`` (``samples``, ``train_s``,
-``heldout_loss``: `replication.training.tracking`, present where the protocol sets ``track_every``). Per model and
+``heldout_loss``: `replication.training.tracking`, present where the protocol sets ``tracking``). Per model and
 framework, the seeds share their tracking steps: the line is the mean over seeds of the held-out loss
 (plotted against the samples, and against the mean training seconds), the band the seed range.
 """

@@ -21,9 +21,10 @@ def _lookup(d, keys: set[str], prefix: str = "") -> dict[str, str]:
     if isinstance(d, dict):
         for k, v in d.items():
             name = f"{prefix}{k}"
-            if str(k).lower() in keys and not isinstance(v, dict):
-                out[name] = str(v)
-            out.update(_lookup(v, keys, name + "."))
+            if str(k).lower() in keys:   # a record (a protocol part) as its fields in one line
+                out[name] = " ".join(f"{a}={b}" for a, b in v.items() if b is not None) if isinstance(v, dict) else str(v)
+            else:
+                out.update(_lookup(v, keys, name + "."))
     return out
 
 

@@ -83,18 +83,18 @@ class _Loop:
 def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
     """Train for `scouting.budget_samples(protocol)` samples in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
     last, the final model: the last one with a finite loss); on_eval(log) after each evaluation.
-    protocol.scouts <= 1: one run from the init of `seed`. scouts = K > 1: restarts (`replication.training.scouting`)
-    over the inits seed .. seed + K - 1, trained side by side for `scouting.scout_steps` (a one-cycle over
+    Without `protocol.scouting`: one run from the init of `seed`. With K scouts: restarts (`replication.training.scouting`)
+    over the inits seed .. seed + K - 1, trained side by side for the scouting's steps (a one-cycle over
     the scout, each evaluated once at its end), the one with the lowest training loss over its last 5 % of
     batches (the held-out set plays no part) then continued for protocol.steps with a new one-cycle
     and fresh Adam state, from batches of its own stream (seed + 1000). Every scout's samples count; the
     scouts' wall time is the one program's."""
     loop = _Loop(name, spec, protocol, on_eval)
-    if protocol.scouts <= 1:
+    if not protocol.scouting:
         model = models.jax.build(spec, init_params(spec, seed=seed))
         loop.row(model, "train", seed, learning_rate(protocol, 0), np.nan)
         return loop.log, loop.phase(model, protocol, seed, "train", seed, N_EVALS)[0]
-    seeds, scout = list(range(seed, seed + protocol.scouts)), scouting.scout_protocol(protocol)
+    seeds, scout = list(range(seed, seed + protocol.scouting.count)), scouting.scout_protocol(protocol)
     loop.row(models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
     outcomes, tails = scouting.scout(train_jax, spec, protocol, seeds)
     loop.wall += max(o.step_seconds for o in outcomes)   # the kept scouts' time runs on past a cut

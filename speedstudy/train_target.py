@@ -26,7 +26,7 @@ study runs every protocol for the same `sizes.target_budget` samples and reports
       training loss tells which it is (`train_target_trials.md`, section 5).
   "restarts_fast": restarts, the scouts alike, the continuation at batch 256 and peak 2e-3 (the full
       profile's double-pendulum protocol): about three times the samples per second of batch 32.
-  "restarts_halved": restarts_fast with successive halving (`Protocol.scout_keep`, as the quick claims
+  "restarts_halved": restarts_fast with successive halving (`Scouting.keep`, as the quick claims
       scout): HALVED_SEEDS inits run half their scout, the HALVED_KEEP lowest by training loss go on to its
       end, the lowest of those continues as in restarts_fast. More inits for a quarter more scout samples:
       with 8 whole scouts a run finds no near-physical Lagrangian often enough to matter (all 8 missed,
@@ -79,6 +79,7 @@ from models import ModelSpec
 from replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
 from replication.training import scouting
 from replication.training.data import heldout
+from replication.training.protocol import Guard, Scouting
 from speedstudy.target_loop import N_EVALS, run_protocol
 
 PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's number (a training loss; held-out 6.9e-2); the code's samples
@@ -91,14 +92,15 @@ HELDOUT = {"tiny": 256, "quick": 4096, "full": 20_000}
 
 VARIANT_BATCH, VARIANT_LR, VELOCITY_SCALE = 32, 1e-3, 0.3
 GRAD_CLIP, SPIKE_SKIP = 100.0, 10.0
-RESTART_SEEDS = 8  # "restarts": inits scouted (each for scouting.SCOUT_SAMPLES samples)
+RESTART_SEEDS = 8  # "restarts": inits scouted (each for SCOUT_SAMPLES samples, at most half the budget in all)
+SCOUT_SAMPLES = 500_000
 HALVED_SEEDS, HALVED_KEEP = 16, 4   # "restarts_halved": inits scouted, and kept past half their scout
 FAST_BATCH, FAST_LR = 256, 2e-3   # "restarts_fast": the continuation's batch and peak rate
 
 
 class Entry(NamedTuple):
     """One protocol of the study: the Protocol (its steps: the whole budget), a description, ModelSpec
-    overrides, and the model label in `claims.double_pendulum.MODELS`; restarts are the protocol's `scouts`."""
+    overrides, and the model label in `claims.double_pendulum.MODELS`; restarts are the protocol's `scouting`."""
     protocol: object
     description: str
     overrides: dict
@@ -113,30 +115,30 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     steps = max(budget // VARIANT_BATCH, 3)
     var = PLAIN_QUICK.replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
                                      n_heldout=n_heldout, lr=VARIANT_LR, schedule="onecycle",
-                                     grad_clip=GRAD_CLIP, spike_skip=SPIKE_SKIP, log_every=10**9)
+                                     guard=Guard(clip=GRAD_CLIP, skip=SPIKE_SKIP), log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}
     var_text = (f"batch {var.batch}, one-cycle peak {var.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
-                f"gradient clip {var.grad_clip:g}, skip at "
-                f"{var.spike_skip:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
+                f"gradient clip {GRAD_CLIP:g}, skip at "
+                f"{SPIKE_SKIP:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
     # scouts: SCOUT_SAMPLES each, at most half the budget over all of them; the continuation the rest
-    scout = max(min(scouting.SCOUT_SAMPLES, budget // (2 * RESTART_SEEDS)) // var.batch, 3)
+    scout = max(min(SCOUT_SAMPLES, budget // (2 * RESTART_SEEDS)) // var.batch, 3)
     rest = max(var.steps - RESTART_SEEDS * scout, 1)
-    restarts = var.replace(scouts=RESTART_SEEDS, scout_steps=scout, steps=rest)
+    restarts = var.replace(scouting=Scouting(count=RESTART_SEEDS, steps=scout, batch=var.batch, lr=var.lr,
+                                             lr_start=var.lr_start), steps=rest)
     restarts_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each (one-cycle over the scout), the one with "
                      f"the lowest training loss (mean of its last 5 % of batches) continued for {rest} steps "
                      f"(a new one-cycle, fresh Adam state); otherwise the variant: batch {var.batch}, peak "
-                     f"{var.lr:g}, clip {var.grad_clip:g}, skip at {var.spike_skip:g} x median, velocity scale "
+                     f"{var.lr:g}, clip {GRAD_CLIP:g}, skip at {SPIKE_SKIP:g} x median, velocity scale "
                      f"{VELOCITY_SCALE:g}. Samples count every scout")
     # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak, same budget
     fast_rest = max((budget - RESTART_SEEDS * scout * var.batch) // FAST_BATCH, 1)
-    fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR,
-                            scout_batch=var.batch, scout_lr=var.lr)
+    fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR)
     fast_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each at batch {var.batch}, peak {var.lr:g}, as "
                  f"restarts; the chosen one continued for {fast_rest} steps at batch {FAST_BATCH}, peak {FAST_LR:g} "
                  f"(a new one-cycle, fresh Adam state). Samples count every scout")
     # restarts_halved: restarts_fast's scouts and continuation, HALVED_SEEDS scouts halved to HALVED_KEEP (at
     # 4e7 samples the full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`)
-    halved = fast.replace(scouts=HALVED_SEEDS, scout_keep=HALVED_KEEP)
+    halved = fast.replace(**{"scouting.count": HALVED_SEEDS, "scouting.keep": HALVED_KEEP})
     halved = halved.replace(steps=max((budget - scouting.scouting_samples(halved)) // FAST_BATCH, 1))
     halved_text = (f"{HALVED_SEEDS} seeds scouted at batch {var.batch}, peak {var.lr:g}, for {scout} steps; at step "
                    f"{scouting.cut_step(halved)} the {HALVED_KEEP} lowest by training loss go on to the end, the lowest "
@@ -250,7 +252,7 @@ def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eva
 
 def n_evaluations(entry: Entry) -> int:
     """Held-out evaluations after step 0 of one protocol (the CLI's progress bar)."""
-    return N_EVALS + (entry.protocol.scouts if entry.protocol.scouts > 1 else 0)
+    return N_EVALS + (entry.protocol.scouting.count if entry.protocol.scouting else 0)
 
 
 def n_cases(sizes) -> int:

@@ -12,13 +12,14 @@ its inputs: it gets no such feature.
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part, Variant
 from replication.claims.rules import better_by
-from replication.training.protocol import Protocol
+from replication.training.protocol import Protocol, Scouting
 
 W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (256, 256, 256)}
 # quick: the relativistic models (all alike) with restarts over initialisations, 8 scouts x 200 steps, the
 # best by training loss continued. The magnetic pair and DeLaN's control train without.
-REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),), "quick": {"scouts": 8, "scout_steps": 200},
-       "full": {"scouts": 8, "scout_steps": 200}}
+_SCOUTS = Scouting(count=8, steps=200, batch=256, lr=1e-3, lr_start=0.2)   # at quick's batch, rate and start
+REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),), "quick": {"scouting": _SCOUTS},
+       "full": {"scouting": _SCOUTS}}
 MAG = {"data": "charged_magnetic_iid"}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020"}

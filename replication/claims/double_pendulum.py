@@ -11,7 +11,7 @@ before they are compared.
 """
 from replication.claims.bars import Bar
 from replication.claims.base import ModelEntry
-from replication.training.protocol import Protocol
+from replication.training.protocol import Guard, Protocol, Scouting, Tracking
 from replication.training.scouting import scouting_samples
 
 PAPER_W, QUICK_W, SMOKE_W = (600, 600, 600), (64, 64, 64), (16, 16)
@@ -42,26 +42,27 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, n_train=128 * 1000, n_heldout
 
 # Restarts (`replication.training.scouting`) with the gradient-spike guard, for the LNN and the baseline alike (the
 # same budget and selection): 16 inits scouted at batch 32, peak 1e-3, a one-cycle of 15 625 steps from phase 0.2;
-# at its half the 4 lowest by training loss go on to its end (successive halving, `scout_keep`), and the lowest
+# at its half the 4 lowest by training loss go on to its end (successive halving, `Scouting.keep`), and the lowest
 # of those is continued at batch 256 for 6e6 samples (one-cycle, fresh Adam) at peak 1e-2 from phase 0.1 (lr 9.6e-4,
 # about the scouts' peak). 1.1e7 samples in all, a twenty-seventh of the original code's 3e8. Which init finds a
 # near-physical Lagrangian is luck, and only such a scout continues to a low held-out L1 at this budget; a fresh
 # Adam at a higher start throws a chosen scout off it. The measurements behind each number:
 # `docs/decisions/double_pendulum_protocol.md`.
-_guard = {"grad_clip": 100.0, "spike_skip": 10.0}
+GUARD = Guard(clip=100.0, skip=10.0)
 PROTOCOLS = {
-    "smoke": _base.replace(scouts=2, scout_steps=10, scout_batch=16, track_every=5, **_guard),
+    "smoke": _base.replace(scouting=Scouting(count=2, steps=10, batch=16, lr=1e-3, lr_start=0.2),
+                           tracking=Tracking(every=5), guard=GUARD),
     "quick": _base.replace(steps=6_000_000 // 256, batch=256, n_train=256 * 1000, n_heldout=20_000, log_every=250, lr=1e-2,
-                           lr_start=0.1, scouts=16, scout_keep=4, scout_steps=15_625, scout_batch=32, scout_lr=1e-3,
-                           scout_lr_start=0.2, track_every=1000, **_guard),
+                           lr_start=0.1, scouting=Scouting(count=16, steps=15_625, batch=32, lr=1e-3, lr_start=0.2, keep=4),
+                           tracking=Tracking(every=1000), guard=GUARD),
     "paper": _base.replace(steps=600_000, batch=512, n_train=512 * 2000, n_heldout=100_000, log_every=2000),
 }
 # full: quick's 16 scouts halved to 4, the continuation at peak 2e-3 (from phase 0.2, as the scouts) for 4e7
 # samples in all: the train-to-target study's `restarts_halved` at 3 x 128 (the same Protocol), judged on the
 # paper's 1e5 held-out states (`docs/decisions/double_pendulum_protocol.md`).
 FULL_SAMPLES = 40_000_000
-_full = PROTOCOLS["quick"].replace(n_heldout=100_000, lr=2e-3, lr_start=0.2, scout_lr_start=0.0, log_every=1000,
-                                   track_every=5000)
+_full = PROTOCOLS["quick"].replace(n_heldout=100_000, lr=2e-3, lr_start=0.2, log_every=1000,
+                                   tracking=Tracking(every=5000))
 PROTOCOLS["full"] = _full.replace(steps=(FULL_SAMPLES - scouting_samples(_full)) // _full.batch)
 
 SEEDS = {"smoke": 1, "quick": 3, "full": 3, "paper": 3}

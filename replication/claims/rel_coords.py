@@ -25,11 +25,11 @@ from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part, Variant
 from replication.claims.published import Published
 from replication.claims.rules import fails
-from replication.training.protocol import Protocol
+from replication.training.protocol import Protocol, Scouting, Tracking
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "full": (128, 128, 128), "paper": (500, 500, 500, 500)}
 # inputs (q, qdot[, gamma], g): the LNNs see q unscaled, the HNNs on (q, qdot) q / 10; g / 10 for all
-CANONICAL_RATE = {"lr": 3e-3, "scout_lr": 3e-3}
+CANONICAL_RATE = {"lr": 3e-3, "scouting.lr": 3e-3}
 LORENTZ = {"lorentz_factor": True, "extra_inputs": 1, "activation": "softplus"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1}
 _hnn = {"kind": "hnn", "activation": "softplus", "init": "xavier", "extra_inputs": 1}
@@ -56,12 +56,14 @@ PROTOCOLS = {
     "smoke": _base,
     # restarts over initialisations at a ten times higher rate, for every model alike: 8 scouts x 200 steps
     # at 1e-2, the best by training loss continued 1500 steps at 1e-2 (one-cycle)
-    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50, track_every=100,
-                           lr=1e-2, scouts=8, scout_steps=200, scout_lr=1e-2),
+    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50,
+                           tracking=Tracking(every=100), lr=1e-2,
+                           scouting=Scouting(count=8, steps=200, batch=256, lr=1e-2, lr_start=0.3)),
     "paper": _base.replace(steps=300_000, batch=512, n_train=512 * 3000, n_heldout=100_000, log_every=1000),
 }
 # full: 13x quick's continuation, judged on 1e5 held-out states
-PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, n_heldout=100_000, log_every=500, track_every=2000)
+PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, n_heldout=100_000, log_every=500,
+                                               tracking=Tracking(every=2000))
 
 BUDGET = "the original's 4 x 500 LNN left its plateau after 5.8e7 samples"
 

@@ -8,7 +8,7 @@ dx = 0.1); density MLP on 3 neighbours, 3x400 softplus, empirical init; i.i.d. w
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.rules import below_null, bound
-from replication.training.protocol import Protocol
+from replication.training.protocol import Protocol, Scouting
 
 W = {"smoke": (16, 16), "quick": (64, 64, 64), "full": (64, 64, 64), "paper": (400, 400, 400)}
 MODELS = (ModelEntry("lgn", {"kind": "lgn", "activation": "softplus", "init": "cranmer2020",
@@ -25,7 +25,7 @@ PROTOCOLS = {"smoke": _base,
              # 0.82, 0.67, 0.90, 0.81)
              "quick": _base.replace(steps=1500, batch=32, n_train=32 * 500, n_heldout=5000, log_every=50,
                                     schedule="step", lr=3e-3, lr_step_every=1000, lr_step_gamma=0.1,
-                                    scouts=8, scout_steps=200, scout_lr=1e-2),
+                                    scouting=Scouting(count=8, steps=200, batch=32, lr=1e-2, lr_start=0.3)),
              "paper": _base.replace(steps=500_000, batch=1, n_train=5000, n_heldout=20_000, log_every=5000)}
 PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 EVAL = {"smoke": {"n_big": 100, "t_end": 1.0, "n_t": 11, "dt": 0.05},

@@ -48,7 +48,7 @@ def _per_step(rows) -> float:
 def _plain_step(framework, spec, protocol) -> float:
     phase = continuation_protocol(protocol)
     p = phase.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
-                      track_every=0)
+                      tracking=None)
     # PyTorch's probe steps compiled where the phase's are, on the device the run trains on
     with compile_torch.like(spec, phase), dev.placed(framework, dev.resolve(dev.request(), framework)):
         return _per_step(run_training(framework, spec, p, 0).log)
@@ -57,7 +57,7 @@ def _plain_step(framework, spec, protocol) -> float:
 def _members_step(framework, spec, protocol, k: int) -> float:
     """Seconds per step of `k` members side by side (scouts, or a cohort of seeds)."""
     p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
-                         cohort=0, track_every=0)
+                         cohort=None, tracking=None)
     rows = []
     with compile_torch.like(spec, protocol, k), dev.placed(framework, dev.resolve(dev.request(), framework)):
         train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
@@ -66,12 +66,14 @@ def _members_step(framework, spec, protocol, k: int) -> float:
 
 # what does not change the cost of a step: the init, the step counts, the rates and the pool sizes (the
 # probes leave held-out tracking off: its evaluations, the first one compiling, would count as step time)
-_FREE = ("steps", "scout_steps", "lr", "scout_lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start",
-         "scout_lr_start", "lr_step_every", "lr_step_gamma", "track_every")
+_FREE = ("steps", "lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start", "lr_step_every", "lr_step_gamma",
+         "tracking")
 
 
 def _shape(framework, spec, protocol) -> str:
     p = {k: v for k, v in protocol.to_dict().items() if k not in _FREE}
+    if p["scouting"]:   # the scouts' count and batch set the cost of their steps
+        p["scouting"] = {k: v for k, v in p["scouting"].items() if k not in _FREE}
     return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
 
 
@@ -97,7 +99,7 @@ def _estimate(units, out, jobs: int) -> dict:
             continue
         shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
         if shape not in per_step:
-            if p.cohort > 1:
+            if p.cohort:
                 per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), {})
             else:   # a step of each scouting part's member count (`scout_parts`)
                 per_step[shape] = (_plain_step(u.framework, spec, p),

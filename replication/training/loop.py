@@ -14,8 +14,7 @@ A framework gives one optimiser step of K members (K >= 1 models trained side by
   mode (optional)                how its step runs: "jit" (JAX), "compiled" or "eager" (PyTorch,
                                  `compile_torch`), recorded as the outcome's `step_mode`
 A one-model stepper (`train_jax.Stepper`, `train_torch.Stepper`: scalars in, scalars out) runs through
-the same loop as a member set of one (`train`), with the protocol's rollback (`rollback.Rollback`) as its
-last hook.
+the same loop as a member set of one (`train`).
 
 `train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False) -> [TrainOutcome]`
 runs `protocol.steps` steps, member i drawing its batches from `streams[i]`: the learning rate of each
@@ -51,7 +50,6 @@ import time
 import numpy as np
 
 from replication.training.outcome import TrainOutcome, nonfinite_failure
-from replication.training.rollback import Rollback
 from replication.training.schedules import learning_rate
 from replication.training.spike_guard import SpikeGuard
 
@@ -61,10 +59,7 @@ log = logging.getLogger("lagbench")
 def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False,
                   snapshot=None, start_state=None) -> list[TrainOutcome]:
     n = len(streams)
-    if protocol.rollback and not (n == 1 and any(isinstance(h, Rollback) for h in hooks)):
-        raise ValueError(f"protocol rollback {protocol.rollback} with {n} member(s) and no rollback hook: rollback "
-                         f"restores one model's state, so it runs through `train`; members train without it")
-    guards = [SpikeGuard(protocol) for _ in range(n)]
+    guards = [SpikeGuard(protocol.guard) for _ in range(n)]
     logs, failures = [[] for _ in range(n)], [None] * n
     live, done = np.ones(n, bool), np.zeros(n, int)
     saved = snapshot.load(n, protocol.steps) if snapshot else None
@@ -221,6 +216,5 @@ def _scalar_hook(hook, stepper):
 
 
 def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome:
-    own = [Rollback(protocol)] if protocol.rollback else []   # last, so that the callers' hooks keep their places
     return train_members(_One(stepper), protocol, [stream], on_log,
-                         [*(_scalar_hook(h, stepper) for h in hooks), *own], compiled, snapshot)[0]
+                         [_scalar_hook(h, stepper) for h in hooks], compiled, snapshot)[0]

@@ -1,14 +1,14 @@
-"""Restarts over initialisations ("scouting"): a protocol option (`Protocol.scouts`), both frameworks.
+"""Restarts over initialisations ("scouting"): a protocol part (`Protocol.scouting`), both frameworks.
 
 Why: which initialisation of a black-box Lagrangian finds a near-physical L (a learned velocity Hessian
 close to the mass matrix) is luck, a run that found one trains on without gradient spikes, and its
 training loss tells which it is (`docs/train_target_trials.md`, section 5). So a protocol
-with `scouts` = K > 1:
+with `scouting` (`protocol.Scouting`, K = its count):
   1. trains the K initialisations `init_seeds(protocol, seed)` side by side for `scout_steps(protocol)`
      steps each, as one program (`loop.train_members`; each member's numbers are its own run's), at
-     `scout_batch`, peak rate `scout_lr` and one-cycle start `scout_lr_start` (0: the protocol's), a
-     schedule over the scout (the protocol's shape over scout_steps), batches from a stream per init seed.
-     With `scout_keep` = k (successive halving), all K stop at `cut_step` (half the schedule) and only the k
+     the scouting's batch, peak rate and one-cycle start, a schedule over the scout (the protocol's shape
+     over its steps), batches from a stream per init seed.
+     With `keep` = k (successive halving), all K stop at `cut_step` (half the schedule) and only the k
      lowest by training loss over the last `TAIL` of those steps go on to its end, from their exact state:
      a near-physical scout leads by then (`docs/train_target_trials.md` section 8), so more inits are
      tried for the samples of fewer whole scouts (`scouting_samples`);
@@ -36,33 +36,34 @@ import numpy as np
 from replication.training import loop
 from replication.training.outcome import joined_modes
 
-SCOUT_SAMPLES = 500_000   # samples per scout when the protocol does not say (at most half the budget in all)
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
 CONTINUATION_STREAM = 1000  # the chosen init seed + this: the continuation's batch stream
 
 
 def scout_steps(protocol) -> int:
-    """Steps of each scout: `protocol.scout_steps`, or SCOUT_SAMPLES samples at the scout batch."""
-    return int(protocol.scout_steps) or max(SCOUT_SAMPLES // (protocol.scout_batch or protocol.batch), 1)
+    """Steps of each scout."""
+    return protocol.scouting.steps
 
 
 def cut_step(protocol) -> int | None:
-    """The step after which only `scout_keep` scouts go on (half their schedule); None: no cut."""
-    return scout_steps(protocol) // 2 if protocol.scouts > 1 and protocol.scout_keep else None
+    """The step after which only `scouting.keep` scouts go on (half their schedule); None: no cut."""
+    s = protocol.scouting
+    return s.steps // 2 if s and s.keep else None
 
 
 def scout_parts(protocol) -> list[tuple[int, int]]:
-    """The scouting as (members side by side, steps) parts: [(K, scout_steps)], with a cut
-    [(K, half), (scout_keep, the rest)]; [] without scouts. The budget and the duration estimate read it."""
-    if protocol.scouts <= 1:
+    """The scouting as (members side by side, steps) parts: [(K, steps)], with a cut
+    [(K, half), (keep, the rest)]; [] without scouting. The budget and the duration estimate read it."""
+    s = protocol.scouting
+    if not s:
         return []
-    per, half = scout_steps(protocol), cut_step(protocol)
-    return [(protocol.scouts, per)] if half is None else [(protocol.scouts, half), (protocol.scout_keep, per - half)]
+    half = cut_step(protocol)
+    return [(s.count, s.steps)] if half is None else [(s.count, half), (s.keep, s.steps - half)]
 
 
 def scouting_samples(protocol) -> int:
     """Samples of every scout, at the scout batch (`scout_parts`)."""
-    return sum(m * n for m, n in scout_parts(protocol)) * (protocol.scout_batch or protocol.batch)
+    return sum(m * n for m, n in scout_parts(protocol)) * protocol.scouting.batch if protocol.scouting else 0
 
 
 def budget_samples(protocol) -> int:
@@ -77,20 +78,18 @@ def progress_steps(protocol) -> int:
 
 def init_seeds(protocol, seed: int) -> list[int]:
     """The K initialisations scouted for a run of `seed`: seed * K .. seed * K + K - 1 (disjoint per seed)."""
-    return [seed * protocol.scouts + i for i in range(protocol.scouts)]
-
-
-_OFF = {"scouts": 0, "scout_steps": 0, "scout_batch": 0, "scout_lr": 0.0, "scout_lr_start": 0.0, "scout_keep": 0}
+    k = protocol.scouting.count
+    return [seed * k + i for i in range(k)]
 
 
 def scout_protocol(protocol):
-    return protocol.replace(steps=scout_steps(protocol), batch=protocol.scout_batch or protocol.batch,
-                            lr=protocol.scout_lr or protocol.lr, lr_start=protocol.scout_lr_start or protocol.lr_start,
-                            rollback=0.0, **_OFF)   # rollback is one model's: the continuation's
+    """The protocol each scout trains under: the scouting's steps, batch, rate and start, no scouting."""
+    s = protocol.scouting
+    return protocol.replace(steps=s.steps, batch=s.batch, lr=s.lr, lr_start=s.lr_start, scouting=None)
 
 
 def continuation_protocol(protocol):
-    return protocol.replace(**_OFF)
+    return protocol.replace(scouting=None)
 
 
 class _Losses:
@@ -153,7 +152,7 @@ def _tails(losses, outcomes) -> list[float]:
 def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, record=None):
     """Phase 1: (outcomes, tail losses), one per init seed in `seeds`, trained as one program for
     `scout_protocol(protocol).steps`; the tail loss is inf for a scout that stopped. With
-    `protocol.scout_keep` = k, every scout runs to `cut_step` (snapshot phase `snapshot`), then the k
+    `protocol.scouting.keep` = k, every scout runs to `cut_step` (snapshot phase `snapshot`), then the k
     lowest tails there go on from their exact state (optimiser, guard, log, batch stream) to the end
     (phase "scouts-kept"): each kept scout's numbers are those of its uncut run. The scouts left behind
     keep their outcome at the cut and the tail inf (they are never chosen); `record` (a dict) gets
@@ -173,7 +172,7 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
     if half is None:
         return outcomes, tails
     go_on = sorted(sorted((i for i, t in enumerate(tails) if math.isfinite(t)), key=lambda i: tails[i])
-                   [:protocol.scout_keep])
+                   [:protocol.scouting.keep])
     if record is not None:
         record.update({"cut_step": half, "cut_tail_loss": tails, "kept": [seeds[i] for i in go_on]})
     if not go_on:

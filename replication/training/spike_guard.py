@@ -5,15 +5,15 @@ state at which the learned H is nearly singular, the gradient norm jumps by 4 to
 (measured on the double pendulum, 3 x 128: median about 60, single batches up to 4e10). Adam bounds the
 step size but not its direction, and a run of such steps throws the model off (held-out L1 16 -> 176).
 
-Two protocol knobs, both off at 0 (`Protocol.grad_clip`, `Protocol.spike_skip`):
-  clip: the gradient is scaled by min(1, grad_clip / ||g||) (global norm over all parameters), as
+Two knobs, the protocol's `guard` (`protocol.Guard`; the guard or either knob None = off):
+  clip: the gradient is scaled by min(1, clip / ||g||) (global norm over all parameters), as
         optax.clip_by_global_norm does;
-  skip: a step whose ||g|| (before clipping) is at least spike_skip x the median of the last `WINDOW`
+  skip: a step whose ||g|| (before clipping) is at least skip x the median of the last `WINDOW`
         gradient norms (skipped ones included) is not taken: parameters and Adam state stay as they are.
         No step is skipped before `MIN_HISTORY` norms are recorded. With skip on, a step whose gradient
         norm is not finite (but whose loss is) is skipped instead of ending the run.
 
-`SpikeGuard(protocol)`: `threshold(dtype)` -> the skip bound for the next step (inf when off or warming up);
+`SpikeGuard(guard)` (a `protocol.Guard` or None): `threshold(dtype)` -> the skip bound for the next step (inf when off or warming up);
 `record(gnorm, threshold)` -> True if that step is taken (gnorm < threshold), counting skips in
 `skipped`; `fails(loss, gnorm)` -> whether the loop stops there; `clip_scale(gnorm)` -> the factor the
 gradient is multiplied by; `restore(history, skipped)` puts a snapshot's window back. The window is also
@@ -32,9 +32,9 @@ WINDOW, MIN_HISTORY = 200, 20
 
 
 class SpikeGuard:
-    def __init__(self, protocol):
-        self.clip = float(protocol.grad_clip)
-        self.factor = float(protocol.spike_skip)
+    def __init__(self, guard):
+        self.clip = guard.clip if guard and guard.clip else 0.0
+        self.factor = guard.skip if guard and guard.skip else 0.0
         self.history: deque = deque(maxlen=WINDOW)
         self._sorted: list[float] = []   # the history's values in increasing order
         self.skipped = 0

@@ -1,12 +1,12 @@
 """Held-out error during training, for work-precision curves (error against samples and training time).
 
-`Tracker(framework, spec, protocol)` is a loop hook (`replication.training.loop`): every `protocol.track_every`
+`Tracker(framework, spec, protocol)` is a loop hook (`replication.training.loop`): every `protocol.tracking.every`
 steps and at the last, it evaluates each member's data loss (the protocol's own loss, no L2 term) on the
 first `TRACK_STATES` held-out states through a NumPy adapter (`replication.evaluation.adapters`; JAX compiles it once
 per spec). It records step, samples, the training seconds so far (the loop's `step_seconds`: optimiser
 steps only, the first compiling step and these evaluations left out) and `heldout_loss`. `merge(logs)`
 writes them into the training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of
-the same step (a tracking step is also a log step: `track_every` is a multiple of `log_every`).
+the same step (a tracking step is also a log step: `tracking.every` is a multiple of `log_every`).
 The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
 Its rows travel in a training's snapshots (`snapshot_state`, `restore_snapshot`; `replication.training.snapshots`).
 """
@@ -24,9 +24,6 @@ TRACK_STATES = 2000
 class Tracker:
     def __init__(self, framework, spec, protocol, offset_steps: int = 0, offset_samples: int = 0,
                  offset_seconds: float = 0.0):
-        if protocol.track_every % protocol.log_every:
-            raise ValueError(f"protocol track_every {protocol.track_every} is not a multiple of log_every "
-                             f"{protocol.log_every}")
         held = datamod.heldout(protocol)
         self.batch = {k: v[:TRACK_STATES] if hasattr(v, "shape") and v.ndim else v for k, v in held.items()}
         self.framework, self.spec, self.protocol = framework, spec, protocol
@@ -41,7 +38,7 @@ class Tracker:
 
     def __call__(self, k, stepper, info) -> bool:
         p = self.protocol
-        if k % p.track_every and k != p.steps - 1:
+        if k % p.tracking.every and k != p.steps - 1:
             return False
         params = stepper.params()
         members = params if isinstance(params, list) else [params]

@@ -8,8 +8,6 @@ resumes each training from its last one, and they are removed once the training 
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import logging
 from pathlib import Path
 
@@ -20,6 +18,7 @@ from replication import results as R
 from replication.training import device as dev
 from replication.training.data import BatchStream, targets_version
 from replication.training.outcome import TrainOutcome, log_frame
+from replication.training.protocol import canonical_hash
 from replication.training.scouting import train_scouted
 from replication.training.snapshots import Snapshots
 from replication.training.tracking import Tracker
@@ -35,8 +34,7 @@ def train_key(framework, spec, protocol, seed) -> str:
     targets = targets_version(protocol)
     if targets:
         key["targets"] = targets
-    blob = json.dumps(key, sort_keys=True, default=str).encode()
-    return hashlib.sha256(blob).hexdigest()[:20]
+    return canonical_hash(key, 20)
 
 
 def trainer(framework):
@@ -52,19 +50,19 @@ def trainer(framework):
 
 def tracker_for(framework, spec):
     """`make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0) -> Tracker | None`: the tracking hook of a
-    protocol with `track_every` (`replication.training.tracking`), else None."""
+    protocol with `tracking` (`replication.training.tracking`), else None."""
     def make(protocol, offset_steps=0, offset_samples=0, offset_seconds=0.0):
-        if not protocol.track_every:
+        if not protocol.tracking:
             return None
         return Tracker(framework, spec, protocol, offset_steps, offset_samples, offset_seconds)
     return make
 
 
 def run_training(framework, spec, protocol, seed, on_log=None, snapshot=None) -> TrainOutcome:
-    """One run of a protocol from the init of `seed`; with `protocol.scouts` > 1, restarts over inits
+    """One run of a protocol from the init of `seed`; with `protocol.scouting`, restarts over inits
     (`replication.training.scouting`). `snapshot`: where it keeps snapshots and resumes from them."""
     track = tracker_for(framework, spec)
-    if protocol.scouts > 1:
+    if protocol.scouting:
         return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track,
                              snapshot=snapshot)
     t = track(protocol)
@@ -77,8 +75,8 @@ def run_training(framework, spec, protocol, seed, on_log=None, snapshot=None) ->
 
 def cohort_seeds(protocol, seed: int) -> list[int]:
     """The seeds trained together with `seed` (`protocol.cohort`: groups g*K .. g*K + K - 1; else itself)."""
-    k = int(protocol.cohort)
-    if k <= 1:
+    k = protocol.cohort
+    if not k:
         return [seed]
     return list(range(seed // k * k, seed // k * k + k))
 

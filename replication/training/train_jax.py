@@ -2,7 +2,7 @@
 `train_torch.py` line for line.
 
 `Stepper(spec, params, protocol, step=None)`: an Adam step (optax.scale_by_adam, scaled by the learning
-rate the loop passes; clipped to `protocol.grad_clip` and skipped above the spike guard's bound inside the
+rate the loop passes; clipped to the guard's clip (`protocol.grad_clip`) and skipped above the spike guard's bound inside the
 compiled step, `replication.training.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
 `make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
 stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome`: `replication.training.loop.train` with this
@@ -62,7 +62,7 @@ def _compiled_per_objective(make):
 @_compiled_per_objective
 def make_step(spec, protocol):
     """(optax transform, step). step(model, opt_state, batch, lr, skip_above=inf) -> (model, opt_state, loss,
-    gnorm): one Adam step on the gradient clipped to protocol.grad_clip (if set); not taken (model and state
+    gnorm): one Adam step on the gradient clipped to protocol.grad_clip (unless None); not taken (model and state
     returned unchanged) when gnorm >= skip_above (`replication.training.spike_guard`)."""
     loss_fn = make_loss(spec, protocol)
     opt = optax.scale_by_adam(b1=protocol.b1, b2=protocol.b2, eps=protocol.eps)
@@ -72,7 +72,7 @@ def make_step(spec, protocol):
     def step(model, opt_state, batch, lr, skip_above=jnp.inf):
         loss, grads = eqx.filter_value_and_grad(loss_fn)(model, batch)
         gnorm = optax.global_norm(grads)
-        if clip > 0:
+        if clip is not None:
             scale = jnp.where(gnorm > clip, clip / gnorm, 1.0)
             grads = jax.tree_util.tree_map(lambda g: g * scale.astype(g.dtype), grads)
         updates, new_state = opt.update(grads, opt_state)

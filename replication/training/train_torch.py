@@ -81,7 +81,7 @@ class Stepper:
         self.look = make_probe(spec, protocol)
         self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
                                     eps=protocol.eps, weight_decay=0.0, **ADAM_KERNEL)
-        self.clip_to, self._grads = float(protocol.grad_clip), []
+        self.clip_to, self._grads = protocol.grad_clip, []   # None: no clip (the guard's scale stays 1)
 
     def propose(self, batch, lr, bound):
         batch = self._batch = _to_torch(batch, self.dtype)
@@ -173,7 +173,7 @@ class Members:
         self.moments = {k: (torch.zeros_like(p), torch.zeros_like(p)) for k, p in self.stacked.items()}
         self.count = torch.zeros(self.n, dtype=torch.int64)
         self.look = make_probe(spec, protocol)
-        self.clip_to, self._cache = float(protocol.grad_clip), {}
+        self.clip_to, self._cache = protocol.grad_clip, {}
 
     def _views(self, key):
         """The members' slices of parameter `key` and of its two moments (cached: all three are only ever

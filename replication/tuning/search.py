@@ -35,8 +35,8 @@ def apply(entry, base, profile: str, knobs: dict):
     """`entry` (a claims.base.ModelEntry) with the knob values applied to its protocol and widths."""
     p = entry.protocol(base, profile)
     change = {"lr": p.lr * knobs["lr"]}
-    if p.scout_lr:
-        change["scout_lr"] = p.scout_lr * knobs["lr"]
+    if p.scouting:
+        change["scouting.lr"] = p.scouting.lr * knobs["lr"]
     common = {k: v for k, v in entry.overrides.items() if k not in PROFILES}
     per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
     hidden = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))

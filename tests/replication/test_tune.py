@@ -31,9 +31,9 @@ def test_apply_changes_only_the_knobs():
     assert same.protocol(base, "quick") == p0 and same.widths("quick") == entry.widths("quick")
     other = search.apply(entry, base, "quick", {"lr": 3.0, "width": 0.5})
     p = other.protocol(base, "quick")
-    assert p.lr == pytest.approx(3 * p0.lr) and p.scout_lr == pytest.approx(3 * p0.scout_lr)
+    assert p.lr == pytest.approx(3 * p0.lr) and p.scouting.lr == pytest.approx(3 * p0.scouting.lr)
     assert other.widths("quick") == tuple(w // 2 for w in entry.widths("quick"))
-    assert p.replace(lr=p0.lr, scout_lr=p0.scout_lr) == p0   # the budget and everything else as registered
+    assert p.replace(lr=p0.lr, **{"scouting.lr": p0.scouting.lr}) == p0   # the budget and everything else as registered
 
 
 def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path, monkeypatch):

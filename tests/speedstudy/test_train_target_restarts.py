@@ -15,7 +15,7 @@ from speedstudy import train_target as TT
 @pytest.fixture(scope="module")
 def restarts():
     entry = TT.protocols(4096, 64)["restarts"]
-    entry = entry._replace(protocol=entry.protocol.replace(scouts=3))
+    entry = entry._replace(protocol=entry.protocol.replace(**{"scouting.count": 3}))
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=(8, 8), dtype=entry.protocol.dtype, **{**lnn.spec, **entry.overrides})
     log, model = TL.run_protocol("restarts", spec, entry.protocol)
@@ -50,7 +50,7 @@ def test_scouting_takes_at_most_half_the_budget():
         assert 3 <= n and TT.RESTART_SEEDS * n * p.batch <= max(budget / 2, TT.RESTART_SEEDS * 3 * p.batch)
         assert scouting.budget_samples(p) == max(int(budget) // p.batch, TT.RESTART_SEEDS * n + 1) * p.batch
     p = TT.protocols(int(3e7), 64)["restarts"].protocol
-    assert scouting.scout_steps(p) * p.batch == pytest.approx(scouting.SCOUT_SAMPLES, abs=p.batch)
+    assert scouting.scout_steps(p) * p.batch == pytest.approx(TT.SCOUT_SAMPLES, abs=p.batch)
 
 
 def test_summary_names_the_chosen_seed(restarts):
@@ -73,7 +73,7 @@ def test_a_scout_that_fails_is_logged_and_never_chosen(monkeypatch):
         calls["k"] += 1
         return calls["k"] == 2 or real(self, loss, gnorm)
     monkeypatch.setattr(SpikeGuard, "fails", fails)
-    log, _ = TL.run_protocol("r", spec, entry.protocol.replace(scouts=2))
+    log, _ = TL.run_protocol("r", spec, entry.protocol.replace(**{"scouting.count": 2}))
     ends = [r for r in log if "scout_loss" in r]
     assert [r["seed"] for r in ends] == [0, 1] and np.isfinite(ends[0]["scout_loss"])
     assert ends[1]["scout_loss"] == np.inf and "stopped" in ends[1]["phase"]
@@ -85,7 +85,7 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
     at most the budget it is given (the continuation takes what the scouts leave)."""
     for budget in (4096, 3e7):
         p = TT.protocols(int(budget), 64)["restarts_halved"].protocol
-        assert (p.scouts, p.scout_keep) == (TT.HALVED_SEEDS, TT.HALVED_KEEP)
+        assert (p.scouting.count, p.scouting.keep) == (TT.HALVED_SEEDS, TT.HALVED_KEEP)
         parts = scouting.scout_parts(p)
         assert parts[0][0] == TT.HALVED_SEEDS and parts[-1][0] == TT.HALVED_KEEP
         if budget == 3e7:
@@ -108,7 +108,7 @@ def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured(
     from replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
     full = PROTOCOLS["full"]
     entry = TT.protocols(FULL_SAMPLES, full.n_heldout)["restarts_halved"]
-    logging_only = {"log_every": 1, "track_every": 1, "lr_step_every": 1}   # lr_step_every: step schedules only
+    logging_only = {"log_every": 1, "tracking": None, "lr_step_every": 1}   # lr_step_every: step schedules only
     assert full.schedule == "onecycle"
     assert full.replace(**logging_only) == entry.protocol.replace(**logging_only)
     assert scouting.scouting_samples(full) + full.steps * full.batch <= FULL_SAMPLES

@@ -167,9 +167,9 @@ def table(rows) -> str:
         p, tol = row.protocol, row.tolerance
         form = row.spec.formulation if row.spec.kind in ("lnn", "lgn") else "-"
         task = p.task + (f" ({p.coords})" if p.task == "hamiltonian" else "")
-        guard = " + guard" if p.grad_clip or p.spike_skip else ""
+        guard = " + guard" if p.guard else ""
         steps = {"one": f"{d['steps']}", "members": f"{d['steps']} (x{len(row.seeds)} members)",
-                 "scouted": f"{p.scout_steps} (x{p.scouts} scouts) + {d['steps'] - p.scout_steps}"}[row.mode]
+                 "scouted": f"{p.scouting.steps} (x{p.scouting.count} scouts) + {d['steps'] - p.scouting.steps}"}[row.mode]
         lines.append(f"| {row.name} | {row.spec.kind} | {form} | {task} | {p.loss} | {p.schedule} | "
                      f"{row.mode}{guard} | {p.dtype} | {steps} | {d['loss']:.1e} | {d['grad_norm']:.1e} | "
                      f"{d['params']:.1e} | {tol['loss']:.0e} / {tol['grad_norm']:.0e} / {tol['params']:.0e} | "

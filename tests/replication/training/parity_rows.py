@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from models import ModelSpec
-from replication.training.protocol import Protocol
+from replication.training.protocol import Guard, Protocol, Scouting
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
@@ -58,10 +58,10 @@ DP = {"resample": True, "l2": 1e-6 / 512}                       # the double-pen
 REL = {"loss": "l1_gamma", "lr_start": 0.3}                     # the relativistic protocol
 LNN = _s("lnn", 2, angle_wrap=True)
 C = {"chaotic": True}
-GUARD = {"grad_clip": 30.0, "spike_skip": 1.0}   # clip below the norms, skip at the median: both act often
+GUARD = {"guard": Guard(clip=30.0, skip=1.0)}   # clip below the norms, skip at the median: both act often
 GUARDED = _p("double_pendulum_iid", **DP, **GUARD, steps=40)
 MEMBERS = GUARDED.replace(batch=8)
-SCOUTED = GUARDED.replace(scouts=4, scout_steps=10, scout_batch=8, scout_lr=3e-3, steps=20)
+SCOUTED = GUARDED.replace(scouting=Scouting(count=4, steps=10, batch=8, lr=3e-3, lr_start=GUARDED.lr_start), steps=20)
 WAVE = {"system_params": (("n", 10), ("variant", "code")), "batch": 8, "lr_start": 0.3}
 ARM = {"task": "inverse_dynamics", "loss": "mse", "n_train": 400}
 
@@ -98,8 +98,8 @@ F64 = [
 
 def in_float32(row: Row, steps: int = F32_STEPS, slow: bool | None = None) -> Row:
     p = row.protocol.replace(dtype="float32", steps=steps)
-    if p.scouts:
-        p = p.replace(scout_steps=min(p.scout_steps, steps))
+    if p.scouting:
+        p = p.replace(**{"scouting.steps": min(p.scouting.steps, steps)})
     return dataclasses.replace(row, name=row.name + "_f32", spec=dataclasses.replace(row.spec, dtype="float32"),
                                protocol=p, slow=row.slow if slow is None else slow)
 

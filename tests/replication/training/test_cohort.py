@@ -6,7 +6,7 @@ from parity_rows import BY_NAME
 
 from replication.training import scouting
 from replication.training import train as training
-from replication.training.protocol import Protocol
+from replication.training.protocol import Protocol, Scouting
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PROTOCOL = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=8, log_every=1, cohort=2)
@@ -16,7 +16,7 @@ def test_a_cohort_trains_each_seed_as_alone_and_caches_every_member(tmp_path, mo
     assert SPEC.dtype == "float64" and training.cohort_seeds(PROTOCOL, 3) == [2, 3]
     got = training.train_cached(tmp_path, "jax", SPEC, PROTOCOL, seed=3)
     assert got.cohort == {"seeds": [2, 3]} and got.failure is None and got.steps_done == PROTOCOL.steps
-    alone = training.run_training("jax", SPEC, PROTOCOL.replace(cohort=0), 3)
+    alone = training.run_training("jax", SPEC, PROTOCOL.replace(cohort=None), 3)
     for k in alone.params:
         np.testing.assert_allclose(got.params[k], alone.params[k], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose([r["loss"] for r in got.log], [r["loss"] for r in alone.log], rtol=1e-9)
@@ -34,13 +34,15 @@ def test_a_cohort_trains_each_seed_as_alone_and_caches_every_member(tmp_path, mo
 def test_a_cohort_is_one_chain_and_one_estimate():
     assert training.group_key("jax", SPEC, PROTOCOL, 2) == training.group_key("jax", SPEC, PROTOCOL, 3)
     assert training.group_key("jax", SPEC, PROTOCOL, 3) != training.group_key("jax", SPEC, PROTOCOL, 4)
-    alone = PROTOCOL.replace(cohort=0)
+    alone = PROTOCOL.replace(cohort=None)
     assert training.group_key("jax", SPEC, alone, 3) == training.train_key("jax", SPEC, alone, 3)
-    assert "cohort" not in alone.to_dict() and PROTOCOL.to_dict()["cohort"] == 2   # older keys hold
+    assert alone.to_dict()["cohort"] is None and PROTOCOL.to_dict()["cohort"] == 2
 
 
 def test_a_cohort_and_scouts_are_refused_together():
-    with pytest.raises(ValueError, match="cohort 2 with scouts 4"):
-        Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=2, scouts=4)
-    with pytest.raises(ValueError, match="cohort"):
-        Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=-1)
+    with pytest.raises(ValueError, match="cohort 2 with scouting"):
+        Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=2,
+                 scouting=Scouting(count=4, steps=2, batch=2, lr=1e-3, lr_start=0.2))
+    for bad in (-1, 0, 1):   # one seed at a time is None, not a number
+        with pytest.raises(ValueError, match="cohort"):
+            Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=bad)

@@ -48,7 +48,7 @@ def test_every_member_equals_its_own_run(fw):
 @pytest.mark.parametrize("name", ["lgn_banded", "baseline_dp", "baseline_invdyn", "lnn_l1_gamma"])
 def test_other_kinds_as_members_equal_their_own_runs(fw, name):
     """The banded LGN under vmap (its out-of-place tangents, its implicit banded solve, its fallback with no
-    branch on data: what `Protocol.scouts` runs for the wave claim); and the other kinds and losses that
+    branch on data: what `Protocol.scouting` runs for the wave claim); and the other kinds and losses that
     PyTorch stacks without vmap (`models.torch.stacks`): the baseline (relu, and the inverse-dynamics map
     with extra inputs under MSE) and the LNN with extra inputs under the relativistic weighted L1."""
     row = BY_NAME[name]

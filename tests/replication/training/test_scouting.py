@@ -1,4 +1,4 @@
-"""Restarts over initialisations as a protocol option (`Protocol.scouts`, `replication.training.scouting`)."""
+"""Restarts over initialisations as a protocol part (`Protocol.scouting`, `replication.training.scouting`)."""
 import numpy as np
 import pytest
 from parity_kit import Recorder
@@ -7,7 +7,7 @@ from parity_rows import BY_NAME
 from models import init_params
 from replication.training import scouting
 from replication.training.data import BatchStream
-from replication.training.protocol import Protocol
+from replication.training.protocol import Protocol, Scouting
 
 # the parity table's scouted row (JAX against PyTorch there), longer: the same compiled steps
 SPEC = BY_NAME["lnn_scouted"].spec
@@ -36,10 +36,10 @@ def test_the_run_is_its_scout_then_a_plain_continuation(runs):
     rec = runs["jax"].scouting
     s = rec["chosen"]
     scout = scouting.scout_protocol(PROTOCOL)
-    assert (scout.batch, scout.lr, scout.steps, scout.scouts) == (8, 3e-3, 10, 0)
+    assert (scout.batch, scout.lr, scout.steps, scout.scouting) == (8, 3e-3, 10, None)
     alone = Recorder("jax").train(SPEC, init_params(SPEC, seed=s), scout, BatchStream(scout, s))
     rest = scouting.continuation_protocol(PROTOCOL)
-    assert rest.steps == 60 and rest.batch == 16 and rest.lr == PROTOCOL.lr and rest.scouts == 0
+    assert rest.steps == 60 and rest.batch == 16 and rest.lr == PROTOCOL.lr and rest.scouting is None
     then = Recorder("jax").train(SPEC, alone.params, rest, BatchStream(rest, s + scouting.CONTINUATION_STREAM))
     for k in then.params:
         np.testing.assert_allclose(runs["jax"].params[k], then.params[k], rtol=1e-9, atol=1e-12)
@@ -51,39 +51,40 @@ def test_a_failed_scout_is_never_chosen():
 
 
 def test_protocol_checks_and_keys():
-    with pytest.raises(ValueError, match="scouts"):
-        PROTOCOL.replace(scouts=-1)
-    with pytest.raises(ValueError, match="scout_batch"):
-        PROTOCOL.replace(scout_batch=65)
-    with pytest.raises(ValueError, match="scout_lr"):
-        PROTOCOL.replace(scout_lr=float("nan"))
-    plain = PROTOCOL.replace(scouts=0, scout_steps=0, scout_batch=0, scout_lr=0.0)
-    assert "scouts" not in plain.to_dict() and "scout_steps" not in plain.to_dict()
-    assert PROTOCOL.key() != plain.key()
+    for bad, name in ((1, "count"), (-1, "count")):
+        with pytest.raises(ValueError, match=f"scouting {name}"):
+            PROTOCOL.replace(**{"scouting.count": bad})
+    with pytest.raises(ValueError, match="scouting batch"):
+        PROTOCOL.replace(**{"scouting.batch": 65})
+    with pytest.raises(ValueError, match="scouting lr"):
+        PROTOCOL.replace(**{"scouting.lr": float("nan")})
+    plain = PROTOCOL.replace(scouting=None)
+    assert plain.to_dict()["scouting"] is None and PROTOCOL.key() != plain.key()
+    with pytest.raises(ValueError, match="has no scouting"):
+        plain.replace(**{"scouting.lr": 1e-3})
     assert Protocol.from_dict(PROTOCOL.to_dict()) == PROTOCOL
 
 
 def test_scouts_and_continuation_start_their_one_cycles_apart():
-    """scout_lr_start sets the scouts' starting phase (0: the protocol's lr_start); the continuation starts at
+    """The scouting's lr_start sets the scouts' starting phase; the continuation starts at the protocol's
     lr_start, so it can warm up from below the rate a fresh Adam would be thrown by."""
     from replication.training.schedules import learning_rate
 
-    p = PROTOCOL.replace(schedule="onecycle", lr=1e-2, lr_start=0.1, scout_lr=1e-3, scout_lr_start=0.2)
+    p = PROTOCOL.replace(schedule="onecycle", lr=1e-2, lr_start=0.1,
+                         **{"scouting.lr": 1e-3, "scouting.lr_start": 0.2})
     scout, rest = scouting.scout_protocol(p), scouting.continuation_protocol(p)
-    assert (scout.lr_start, rest.lr_start, scout.scout_lr_start, rest.scout_lr_start) == (0.2, 0.1, 0.0, 0.0)
+    assert (scout.lr_start, rest.lr_start, scout.scouting, rest.scouting) == (0.2, 0.1, None, None)
     assert learning_rate(rest, 0) < learning_rate(p.replace(lr_start=0.2), 0) / 3
-    assert scouting.scout_protocol(p.replace(scout_lr_start=0.0)).lr_start == 0.1
-    # 0 is left out of the key, so protocols written before the field keep theirs
-    assert "scout_lr_start" not in PROTOCOL.to_dict() and "scout_lr_start" in p.to_dict()
+    assert scouting.scout_protocol(p.replace(**{"scouting.lr_start": 0.0})).lr_start == 0.0   # 0 is a phase, not "inherit"
     for bad in (1.0, -0.1, float("nan")):
-        with pytest.raises(ValueError, match="scout_lr_start"):
-            PROTOCOL.replace(scout_lr_start=bad)
+        with pytest.raises(ValueError, match="scouting lr_start"):
+            PROTOCOL.replace(**{"scouting.lr_start": bad})
         with pytest.raises(ValueError, match="lr_start"):
             PROTOCOL.replace(lr_start=bad)
 
 
-# successive halving (`Protocol.scout_keep`): 4 scouts of 10 steps, the 2 lowest at the cut (step 5) go on
-CUT = PROTOCOL.replace(scout_keep=2)
+# successive halving (`Scouting.keep`): 4 scouts of 10 steps, the 2 lowest at the cut (step 5) go on
+CUT = PROTOCOL.replace(**{"scouting.keep": 2})
 
 
 class _Steps:
@@ -132,8 +133,8 @@ def test_a_cut_counts_its_budget():
     out = scouting.train_scouted(Recorder("jax"), SPEC, CUT.replace(steps=6), seed=1)
     assert out.samples == scouting.budget_samples(CUT.replace(steps=6))
     assert out.scouting["chosen"] in out.scouting["kept"] and out.scouting["cut_step"] == 5
-    for bad in ({"scout_keep": 4}, {"scout_keep": -1}, {"scout_keep": 2, "scout_steps": 1}):
-        with pytest.raises(ValueError, match="scout_keep"):
-            PROTOCOL.replace(**bad)
-    assert "scout_keep" not in PROTOCOL.to_dict() and CUT.key() != PROTOCOL.key()
-    assert scouting.scout_protocol(CUT).scout_keep == 0 and scouting.continuation_protocol(CUT).scout_keep == 0
+    for bad in ({"keep": 4}, {"keep": -1}, {"keep": 2, "steps": 1}):
+        with pytest.raises(ValueError, match="keep"):
+            Scouting(**{**vars(PROTOCOL.scouting), **bad})
+    assert PROTOCOL.scouting.keep is None and CUT.key() != PROTOCOL.key()
+    assert scouting.scout_protocol(CUT).scouting is None and scouting.continuation_protocol(CUT).scouting is None

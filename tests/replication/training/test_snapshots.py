@@ -10,13 +10,14 @@ import pytest
 from parity_rows import GUARDED, LNN
 
 from replication.training import snapshots
+from replication.training.protocol import Scouting, Tracking
 from replication.training.train import train_cached, train_key
 
 SPEC = LNN                                            # the chaotic double-pendulum LNN: any drift would show
-ONE = GUARDED.replace(steps=30, track_every=5)        # guard acting often, held-out tracking
+ONE = GUARDED.replace(steps=30, tracking=Tracking(every=5))        # guard acting often, held-out tracking
 COHORT = GUARDED.replace(steps=24, batch=8, cohort=3)
-SCOUTED = GUARDED.replace(scouts=3, scout_steps=8, scout_batch=8, scout_lr=3e-3, steps=16)
-SCOUTED_CUT = SCOUTED.replace(scout_keep=2)           # 3 scouts to step 4, the 2 lowest on to 8
+SCOUTED = GUARDED.replace(scouting=Scouting(count=3, steps=8, batch=8, lr=3e-3, lr_start=GUARDED.lr_start), steps=16)
+SCOUTED_CUT = SCOUTED.replace(**{"scouting.keep": 2})           # 3 scouts to step 4, the 2 lowest on to 8
 TIMING = {"wall_s", "train_s"}                        # clocks: the only columns allowed to differ
 
 
@@ -91,8 +92,8 @@ def test_a_scouted_run_resumes_in_either_phase(tmp_path, fw, at):
     """at 5: killed among the scouts (8 logged steps); at 12: in the continuation, which must not scout again."""
     ref, out, steps = _resumed(tmp_path, fw, SPEC, SCOUTED, 1, at=at)
     _same(ref, out)
-    if at >= SCOUTED.scout_steps:
-        assert len(steps) == SCOUTED.steps - (at - SCOUTED.scout_steps), "the scouts were trained again"
+    if at >= SCOUTED.scouting.steps:
+        assert len(steps) == SCOUTED.steps - (at - SCOUTED.scouting.steps), "the scouts were trained again"
 
 
 @pytest.mark.parametrize(("fw", "at"), [("jax", 2), ("jax", 6), ("jax", 10), ("torch", 6)])
@@ -120,7 +121,7 @@ def _only_snapshot(tmp_path, fw, protocol, seed):
 
 
 def test_a_damaged_or_foreign_snapshot_is_not_used(tmp_path, caplog):
-    protocol = ONE.replace(track_every=0, steps=12)
+    protocol = ONE.replace(tracking=None, steps=12)
     ref = train_cached(tmp_path / "ref", "torch", SPEC, protocol, 0)
     with pytest.raises(Killed):
         train_cached(tmp_path / "cut", "torch", SPEC, protocol, 0, on_log=_killer(6))
@@ -138,7 +139,7 @@ def test_a_damaged_or_foreign_snapshot_is_not_used(tmp_path, caplog):
 
 def test_a_snapshot_of_another_training_is_not_used(tmp_path, caplog):
     from replication.training.snapshots import Snapshots
-    protocol = ONE.replace(track_every=0, steps=12)
+    protocol = ONE.replace(tracking=None, steps=12)
     with pytest.raises(Killed):
         train_cached(tmp_path / "cut", "jax", SPEC, protocol, 0, on_log=_killer(6))
     path = _only_snapshot(tmp_path, "jax", protocol, 0)

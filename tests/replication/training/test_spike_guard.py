@@ -11,14 +11,14 @@ import models.jax
 from models import ModelSpec, init_params
 from replication.training import train_jax
 from replication.training.data import BatchStream
-from replication.training.protocol import Protocol
+from replication.training.protocol import Guard, Protocol
 from replication.training.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
 
 BASE = Protocol(data="double_pendulum_iid", steps=5, batch=8, n_train=32, dtype="float64", resample=True)
 
 
 def test_off_by_default():
-    guard = SpikeGuard(BASE)
+    guard = SpikeGuard(None)
     assert not guard.active and guard.clip_scale(1e9) == 1.0
     for g in [1.0] * 50 + [1e12]:
         assert guard.record(g, guard.threshold())
@@ -26,7 +26,7 @@ def test_off_by_default():
 
 
 def test_skip_bound_is_factor_times_recent_median():
-    guard = SpikeGuard(BASE.replace(spike_skip=10.0))
+    guard = SpikeGuard(Guard(skip=10.0))
     for k in range(MIN_HISTORY):
         assert guard.threshold() == math.inf  # warming up
         guard.record(float(k + 1), guard.threshold())
@@ -45,11 +45,11 @@ def test_the_sorted_window_gives_numpy_median_at_every_step_and_after_a_restore(
     rng = np.random.default_rng(3)
     norms = np.exp(rng.normal(size=3 * WINDOW + 7)).round(2)   # rounding: ties in the window
     norms[[5, 50, 400]] = [np.inf, np.nan, np.inf]
-    guard = SpikeGuard(BASE.replace(spike_skip=3.0))
+    guard = SpikeGuard(Guard(skip=3.0))
     seen = []
     for k, g in enumerate(norms):
         if k == WINDOW + 11:
-            restored = SpikeGuard(BASE.replace(spike_skip=3.0))
+            restored = SpikeGuard(Guard(skip=3.0))
             restored.restore(list(guard.history), guard.skipped)
             guard = restored
         bound = guard.threshold()
@@ -62,7 +62,7 @@ def test_the_sorted_window_gives_numpy_median_at_every_step_and_after_a_restore(
 
 
 def test_non_finite_norm_is_a_skipped_spike_only_when_skipping():
-    off, on = SpikeGuard(BASE.replace(grad_clip=5.0)), SpikeGuard(BASE.replace(spike_skip=10.0))
+    off, on = SpikeGuard(Guard(clip=5.0)), SpikeGuard(Guard(skip=10.0))
     assert off.fails(1.0, float("inf")) and off.fails(float("nan"), 1.0)
     assert not on.fails(1.0, float("nan")) and not on.fails(1.0, float("inf")) and on.fails(float("inf"), 1.0)
     for g in [2.0] * MIN_HISTORY:
@@ -72,18 +72,22 @@ def test_non_finite_norm_is_a_skipped_spike_only_when_skipping():
 
 
 def test_clip_scale():
-    guard = SpikeGuard(BASE.replace(grad_clip=5.0))
+    guard = SpikeGuard(Guard(clip=5.0))
     assert guard.clip_scale(4.0) == 1.0 and guard.clip_scale(20.0) == pytest.approx(0.25)
 
 
-def test_protocol_fields_validated_and_keys_kept():
-    for bad in (-1.0, float("nan"), float("inf"), "3"):
-        with pytest.raises(ValueError, match="grad_clip"):
-            BASE.replace(grad_clip=bad)
-        with pytest.raises(ValueError, match="spike_skip"):
-            BASE.replace(spike_skip=bad)
-    assert "grad_clip" not in BASE.to_dict() and "spike_skip" not in BASE.to_dict()
-    guarded = BASE.replace(grad_clip=100.0, spike_skip=10.0)
+def test_guard_fields_validated_and_keyed():
+    for bad in (-1.0, 0.0, float("nan"), float("inf"), "3"):
+        with pytest.raises(ValueError, match="guard clip"):
+            Guard(clip=bad)
+        with pytest.raises(ValueError, match="guard skip"):
+            Guard(skip=bad)
+    with pytest.raises(ValueError, match="needs clip or skip"):
+        Guard()
+    with pytest.raises(ValueError, match="protocol guard must be a Guard"):
+        BASE.replace(guard={"clip": 1.0})
+    assert BASE.to_dict()["guard"] is None
+    guarded = BASE.replace(guard=Guard(clip=100.0, skip=10.0))
     assert guarded.key() != BASE.key()
     assert Protocol.from_dict(guarded.to_dict()) == guarded and Protocol.from_dict(BASE.to_dict()) == BASE
 

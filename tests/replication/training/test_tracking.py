@@ -1,4 +1,4 @@
-"""Held-out tracking during training (`Protocol.track_every`, `replication.training.tracking`): it reads the model
+"""Held-out tracking during training (`Protocol.tracking`, `replication.training.tracking`): it reads the model
 and changes no training number; its last point is the final model's held-out loss; the report draws it."""
 import numpy as np
 import pandas as pd
@@ -8,6 +8,7 @@ from parity_rows import BY_NAME
 from replication.evaluation.adapters import adapter
 from replication.training import scouting
 from replication.training.objective import loss_value, predict
+from replication.training.protocol import Tracking
 from replication.training.tracking import TRACK_STATES, Tracker
 from replication.training.train import run_training
 
@@ -18,7 +19,7 @@ PLAIN = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=9
 @pytest.mark.parametrize("framework", ["jax", "torch"])
 def test_tracking_changes_no_training_number_and_ends_at_the_final_models_loss(framework):
     off = run_training(framework, SPEC, PLAIN, 1)
-    on = run_training(framework, SPEC, PLAIN.replace(track_every=4), 1)
+    on = run_training(framework, SPEC, PLAIN.replace(tracking=Tracking(every=4)), 1)
     for k in off.params:
         np.testing.assert_array_equal(on.params[k], off.params[k])
     assert [r["loss"] for r in on.log] == [r["loss"] for r in off.log]
@@ -26,7 +27,7 @@ def test_tracking_changes_no_training_number_and_ends_at_the_final_models_loss(f
     assert [r["step"] for r in tracked] == [0, 4, 8]
     assert [r["samples"] for r in tracked] == [PLAIN.batch, 5 * PLAIN.batch, 9 * PLAIN.batch]
     assert tracked[0]["train_s"] <= tracked[1]["train_s"] <= tracked[2]["train_s"]
-    t = Tracker(framework, SPEC, PLAIN.replace(track_every=4))
+    t = Tracker(framework, SPEC, PLAIN.replace(tracking=Tracking(every=4)))
     pred = predict(adapter(framework, SPEC, on.params), SPEC.kind, PLAIN.task, t.batch, np.concatenate)
     final = loss_value(pred, t.batch["target"], t.batch.get("weight"), PLAIN.loss)
     assert len(t.batch["target"]) == min(TRACK_STATES, PLAIN.n_heldout)
@@ -34,17 +35,17 @@ def test_tracking_changes_no_training_number_and_ends_at_the_final_models_loss(f
 
 
 def test_a_scouted_run_tracks_its_continuation_with_the_scouts_samples_counted():
-    p = BY_NAME["lnn_scouted"].protocol.replace(steps=6, log_every=3, track_every=3)
+    p = BY_NAME["lnn_scouted"].protocol.replace(steps=6, log_every=3, tracking=Tracking(every=3))
     out = run_training("jax", SPEC, p, 0)
     tracked = [r for r in out.log if "heldout_loss" in r]
-    scouts = p.scouts * scouting.scout_steps(p) * scouting.scout_protocol(p).batch
+    scouts = p.scouting.count * scouting.scout_steps(p) * scouting.scout_protocol(p).batch
     assert tracked[0]["samples"] == scouts + p.batch and tracked[-1]["samples"] == scouting.budget_samples(p)
     assert tracked[0]["train_s"] > 0   # the scouts' time counts
 
 
 def test_tracking_must_fall_on_logged_steps():
     with pytest.raises(ValueError, match="not a multiple of log_every"):
-        Tracker("jax", SPEC, PLAIN.replace(track_every=3))
+        PLAIN.replace(tracking=Tracking(every=3))
 
 
 class _Unit:

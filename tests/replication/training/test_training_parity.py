@@ -28,7 +28,7 @@ def test_frameworks_agree_at_every_step(row):
     diffs, mismatches = run_row(row)
     assert not mismatches, mismatches[:5]
     p = row.protocol
-    assert diffs["steps"] == p.steps + (p.scout_steps if row.mode == "scouted" else 0)   # per member
+    assert diffs["steps"] == p.steps + (p.scouting.steps if row.mode == "scouted" else 0)   # per member
     assert within(row, diffs), f"{diffs} beyond {row.tolerance}"
 
 
@@ -46,7 +46,7 @@ def test_the_table_covers_every_kind_formulation_loss_schedule_and_mode():
         assert {r.protocol.schedule for r in rows} == set(SCHEDULES)
         assert {r.protocol.dtype for r in rows} == set(DTYPES)
         assert {r.mode for r in rows} == {"one", "members", "scouted"}
-        assert any(r.protocol.grad_clip and r.protocol.spike_skip for r in rows)
+        assert any(r.protocol.guard and r.protocol.guard.clip and r.protocol.guard.skip for r in rows)
     # every float64 row also has its float32 twin (default or slow)
     assert {r.name for r in F32} == {r.name + "_f32" for r in F64}
     assert {r.protocol.dtype for r in F64} == {"float64"} and {r.protocol.dtype for r in F32} == {"float32"}
