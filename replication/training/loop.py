@@ -1,43 +1,30 @@
 """The training loop, written once for both frameworks and for any number of stacked members.
 
-A framework gives one optimiser step of K members (K >= 1 models trained side by side as one program:
-`train_jax.Members`, `train_torch.Members`, mirrors) as a *stepper*:
-  propose(batches, lr, bounds) -> (loss (K,), gnorm (K,))   each member's loss and global gradient norm on
-                                 its own batch (a list of K dicts of NumPy float64 arrays), the update
-                                 prepared but not applied; bounds (K,): the spike guard's skip thresholds
-  commit(taken (K,) bool, scale (K,))   apply the prepared update of the members `taken`, each gradient
-                                 scaled by its `scale` (the guard's clip factor); the others keep their
-                                 parameters and optimiser state exactly
-  probe() -> list[dict | None] | None   the velocity-Hessian health columns (`hessian_probe`) of each member
-                                 on the batch last proposed
-  params() -> list[dict]         the current parameters of each member, `models.params` layout (NumPy)
-  mode (optional)                how its step runs: "jit" (JAX), "compiled" or "eager" (PyTorch,
-                                 `compile_torch`), recorded as the outcome's `step_mode`
-A one-model stepper (`train_jax.Stepper`, `train_torch.Stepper`: scalars in, scalars out) runs through
-the same loop as a member set of one (`train`).
+A framework gives one optimiser step of K members (K >= 1 models trained side by side as one program) as
+a stepper (`loop_state.MemberStepper`: `train_jax.Members`, `train_torch.Members`, mirrors). A one-model
+stepper (`train_jax.Stepper`, `train_torch.Stepper`: scalars in, scalars out) runs through the same loop as
+a member set of one (`train`).
 
-`train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False) -> [TrainOutcome]`
-runs `protocol.steps` steps, member i drawing its batches from `streams[i]`: the learning rate of each
-step (`schedules.learning_rate`, the same for every member), one spike guard per member
-(`spike_guard.SpikeGuard`), a member's stop at its first non-finite loss (its parameters from before that
-step kept, its later steps not taken; the run ends when no member is left), a log row per member every
-`protocol.log_every` steps and at the first and last (step, loss, grad_norm, lr, wall_s, and the probe's
-columns, timed apart), then `on_log(row)` (with "member": i when K > 1). After every step each hook is
-called as `hook(k, stepper, info)`, info = {loss (K,), lr, step_seconds, skipped_steps (K,), live (K,)};
-a hook returning True stops the run there (early stop). Held-out evaluations, checkpoints and scout
-selection are hooks and callers of this one loop (`replication.training.scouting`, `speedstudy.target_loop`).
+`train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False, snapshot=None,
+start_state=None) -> [TrainOutcome]` runs `protocol.steps` steps, member i drawing its batches from
+`streams[i]`: the learning rate of each step (`schedules.learning_rate`, the same for every member), one
+spike guard per member (`spike_guard.SpikeGuard` of `protocol.guard`), a member's stop at its first
+non-finite loss (its parameters from before that step kept, its later steps not taken; the run ends when
+no member is left), a log row per member every `protocol.log_every` steps and at the first and last
+(step, loss, grad_norm, lr, wall_s, and the probe's columns, timed apart), then `on_log(row)` (with
+"member": i when K > 1). After every step each hook (`loop_state.Hook`) is called as
+`hook(k, stepper, info)`, info = {loss (K,), lr, step_seconds, skipped_steps (K,), live (K,)}; a hook
+returning True stops the run there (early stop). Held-out evaluations, checkpoints and scout selection are
+hooks and callers of this one loop (`replication.training.scouting`, `tracking`, `speedstudy.target_loop`).
 `step_seconds` is the time spent in propose + commit (of all members together), the first step of the
 process left out (it compiles) unless `compiled` says the step already is.
 
-`start_state` (meta, arrays), a snapshot's state held in memory (`narrow` of another run's end state: the
-scouts that go on after a cut, `scouting`), is where the loop begins when `snapshot` has none of its own.
-
-With `snapshot` (a `replication.training.snapshots.Snapshots`), the loop first puts back that store's
-snapshot if it has one for this run (the stepper's `load_state_arrays`, the guards, logs, failures, hooks
-with a `restore_snapshot`) and goes on from its step; it saves one after a step when the store says it is
-due and once at the end (an ended phase resumed returns its outcomes without a step). A stepper for
-snapshots also gives `state_arrays() -> [np.ndarray]` (parameters and optimiser state, in a fixed order)
-and `load_state_arrays(arrays)`.
+All the loop carries from step to step is one `loop_state.TrainState`. With `snapshot` (a
+`replication.training.snapshots.Snapshots`), the loop first puts back that store's snapshot if it has one
+for this run and goes on from its step; it saves the state after a step when the store says it is due and
+once at the end (an ended phase resumed returns its outcomes without a step). `start_state` (meta, arrays),
+a snapshot's state held in memory (`narrow` of another run's end state: the scouts that go on after a cut),
+is where the loop begins when `snapshot` has none of its own.
 
 `train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome`:
 one model; its hooks see that stepper and scalar info.
@@ -49,129 +36,96 @@ import time
 
 import numpy as np
 
+from replication.training.loop_state import StatefulHook, TrainState, fits, narrow
 from replication.training.outcome import TrainOutcome, nonfinite_failure
 from replication.training.schedules import learning_rate
-from replication.training.spike_guard import SpikeGuard
 
 log = logging.getLogger("lagbench")
+
+__all__ = ["narrow", "train", "train_members"]
 
 
 def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False,
                   snapshot=None, start_state=None) -> list[TrainOutcome]:
-    n = len(streams)
-    guards = [SpikeGuard(protocol.guard) for _ in range(n)]
-    logs, failures = [[] for _ in range(n)], [None] * n
-    live, done = np.ones(n, bool), np.zeros(n, int)
+    state = _start(len(streams), protocol, stepper, hooks, snapshot, start_state)
+    t0, t_probe, start = time.perf_counter() - state.wall, 0.0, state.step
+    k = start
+    for k in range(start, protocol.steps if not state.ended else start):
+        lr = learning_rate(protocol, k)
+        ts = time.perf_counter()
+        loss, gnorm = _step(state, stepper, protocol, [stream.batch(k) for stream in streams], lr, k)
+        if loss is None:   # no member left
+            break
+        if k > start or compiled:   # the first step of a process compiles
+            state.step_seconds += time.perf_counter() - ts
+        if k % protocol.log_every == 0 or k == protocol.steps - 1:
+            tp = time.perf_counter()
+            _log(state, stepper, k, loss, gnorm, lr, tp - t0 - t_probe, on_log)
+            t_probe += time.perf_counter() - tp
+        info = {"loss": loss, "lr": lr, "step_seconds": state.step_seconds, "live": state.live.copy(),
+                "skipped_steps": np.array([g.skipped for g in state.guards])}
+        if any([hook(k, stepper, info) for hook in hooks]):
+            break
+        if snapshot and k + 1 < protocol.steps and snapshot.due():
+            state.step, state.wall = k + 1, time.perf_counter() - t0 - t_probe
+            snapshot.save(*state.snapshot(stepper, hooks, protocol.steps))
+    total = time.perf_counter() - t0 - t_probe
+    if snapshot and not state.ended:   # the end, so that a later phase resumes without redoing this one
+        state.step, state.ended, state.wall = k + 1, True, total
+        snapshot.save(*state.snapshot(stepper, hooks, protocol.steps))
+    return [TrainOutcome(params=p, log=state.logs[i], failure=state.failures[i], train_time_s=total,
+                         steps_done=int(state.done[i]), batch=protocol.batch, step_seconds=state.step_seconds,
+                         skipped_steps=state.guards[i].skipped, step_mode=getattr(stepper, "mode", None))
+            for i, p in enumerate(stepper.params())]
+
+
+def _start(n, protocol, stepper, hooks, snapshot, start_state) -> TrainState:
+    """The state the run begins from: its own snapshot, else `start_state`, else a fresh one."""
     saved = snapshot.load(n, protocol.steps) if snapshot else None
-    if saved and not _fits(saved[1], stepper):
+    if saved and not fits(saved[1], stepper):
         log.warning("training snapshot in %s not used, starting over: its arrays do not fit this model and "
                     "optimiser", snapshot.folder)
         saved = None
     if not saved and start_state is not None:
-        if not _fits(start_state[1], stepper):
+        if not fits(start_state[1], stepper):
             raise ValueError("the state to start from does not fit this model and optimiser")
         saved = ({**start_state[0], "ended": False}, start_state[1])
-    start, ended, wall, t_steps = 0, False, 0.0, 0.0
     if saved:
-        start, ended, wall, t_steps = _restore(*saved, stepper, guards, logs, failures, live, done, hooks)
-    t0, t_probe = time.perf_counter() - wall, 0.0
-    k = start
-    for k in range(start, protocol.steps if not ended else start):
-        lr = learning_rate(protocol, k)
-        batches = [stream.batch(k) for stream in streams]
-        # a stopped member gets the bound -inf: no step of it is ever taken again
-        bounds = np.array([g.threshold(protocol.dtype) if on else -np.inf for g, on in zip(guards, live, strict=True)])
-        ts = time.perf_counter()
-        loss, gnorm = stepper.propose(batches, lr, bounds)
-        for i in np.flatnonzero(live):
-            if guards[i].fails(loss[i], gnorm[i]):
-                failures[i], live[i] = nonfinite_failure(k, loss[i], gnorm[i]), False
-        if not live.any():
-            break
-        taken = np.array([on and g.record(gnorm[i], bounds[i]) for i, (g, on) in enumerate(zip(guards, live, strict=True))])
-        stepper.commit(taken, np.array([g.clip_scale(gnorm[i]) for i, g in enumerate(guards)]))
-        if k > start or compiled:   # the first step of a process compiles
-            t_steps += time.perf_counter() - ts
-        done[live] = k + 1
-        if k % protocol.log_every == 0 or k == protocol.steps - 1:
-            wall = time.perf_counter() - t0 - t_probe
-            tp = time.perf_counter()
-            probes = stepper.probe() or [None] * n
-            t_probe += time.perf_counter() - tp
-            for i in np.flatnonzero(live):
-                row = {"step": k, "loss": float(loss[i]), "grad_norm": float(gnorm[i]), "lr": lr, "wall_s": wall}
-                if guards[i].active:
-                    row["skipped_steps"] = guards[i].skipped
-                row.update(probes[i] or {})
-                logs[i].append(row)
-                if on_log:
-                    on_log(row if n == 1 else {**row, "member": int(i)})
-        info = {"loss": loss, "lr": lr, "step_seconds": t_steps, "live": live.copy(),
-                "skipped_steps": np.array([g.skipped for g in guards])}
-        if any([hook(k, stepper, info) for hook in hooks]):
-            break
-        if snapshot and k + 1 < protocol.steps and snapshot.due():
-            snapshot.save(*_state(k + 1, False, time.perf_counter() - t0 - t_probe, t_steps, stepper, guards,
-                                  logs, failures, live, done, hooks, protocol.steps))
-    total = time.perf_counter() - t0 - t_probe
-    if snapshot and not ended:   # the end, so that a later phase resumes without redoing this one
-        snapshot.save(*_state(k + 1, True, total, t_steps, stepper, guards, logs, failures, live, done, hooks,
-                              protocol.steps))
-    return [TrainOutcome(params=p, log=logs[i], failure=failures[i], train_time_s=total, steps_done=int(done[i]),
-                         batch=protocol.batch, step_seconds=t_steps, skipped_steps=guards[i].skipped,
-                         step_mode=getattr(stepper, "mode", None))
-            for i, p in enumerate(stepper.params())]
+        return TrainState.restore(*saved, stepper, hooks, protocol.guard)
+    return TrainState.fresh(n, protocol.guard)
 
 
-def narrow(state, members) -> tuple[dict, dict]:
-    """A snapshot's (meta, arrays) cut down to the stacked `members` (indices), to start a run of those
-    alone from it (`start_state`): the stepper's arrays, logs, failures, guards, liveness and steps done of
-    those members; the hooks' state is left behind (their owner carries what it needs)."""
-    meta, arrays = state
-    idx = np.asarray(members, int)
-    each = {name: [meta[name][i] for i in idx] for name in ("logs", "failures", "guards")}
-    return ({**meta, **each, "members": len(idx), "ended": False, "hooks": [],
-             "live": np.asarray(meta["live"])[idx], "done": np.asarray(meta["done"])[idx]},
-            {k: np.asarray(a)[idx] for k, a in arrays.items() if k.startswith("stepper_")})
+def _step(state: TrainState, stepper, protocol, batches, lr, k):
+    """One optimiser step of the live members, guarded -> (loss (K,), gnorm (K,)), or (None, None) when
+    every member has stopped."""
+    # a stopped member gets the bound -inf: no step of it is ever taken again
+    bounds = np.array([g.threshold(protocol.dtype) if on else -np.inf
+                       for g, on in zip(state.guards, state.live, strict=True)])
+    loss, gnorm = stepper.propose(batches, lr, bounds)
+    for i in np.flatnonzero(state.live):
+        if state.guards[i].fails(loss[i], gnorm[i]):
+            state.failures[i], state.live[i] = nonfinite_failure(k, loss[i], gnorm[i]), False
+    if not state.live.any():
+        return None, None
+    taken = np.array([on and g.record(gnorm[i], bounds[i])
+                      for i, (g, on) in enumerate(zip(state.guards, state.live, strict=True))])
+    stepper.commit(taken, np.array([g.clip_scale(gnorm[i]) for i, g in enumerate(state.guards)]))
+    state.done[state.live] = k + 1
+    return loss, gnorm
 
 
-def _fits(arrays, stepper) -> bool:
-    mine = [np.shape(a) for a in stepper.state_arrays()]
-    return [np.shape(arrays[k]) for k in sorted(arrays) if k.startswith("stepper_")] == mine
-
-
-def _state(step, ended, wall, t_steps, stepper, guards, logs, failures, live, done, hooks,
-           steps) -> tuple[dict, dict]:
-    """(meta, arrays) of a snapshot (`replication.training.snapshots`): all the next step reads."""
-    arrays = {f"stepper_{j:04d}": a for j, a in enumerate(stepper.state_arrays())}
-    hook_meta = []
-    for h, hook in enumerate(hooks):
-        state = getattr(hook, "snapshot_state", None)
-        meta, extra = state() if state else (None, {})
-        hook_meta.append(meta)
-        arrays.update({f"hook{h}_{name}": a for name, a in extra.items()})
-    meta = {"step": step, "steps": steps, "ended": ended, "wall_s": wall, "step_seconds": t_steps,
-            "members": len(guards),
-            "logs": logs, "failures": failures, "live": live, "done": done, "hooks": hook_meta,
-            "guards": [{"history": list(g.history), "skipped": g.skipped} for g in guards]}
-    return meta, arrays
-
-
-def _restore(meta, arrays, stepper, guards, logs, failures, live, done, hooks):
-    """Put a snapshot's state back in place -> (next step, ended, wall seconds, step seconds)."""
-    stepper.load_state_arrays([arrays[k] for k in sorted(arrays) if k.startswith("stepper_")])
-    for g, saved in zip(guards, meta["guards"], strict=True):
-        g.restore(saved["history"], saved["skipped"])
-    for i in range(len(guards)):
-        logs[i].extend(meta["logs"][i])
-        failures[i] = meta["failures"][i]
-    live[:], done[:] = meta["live"], meta["done"]
-    for h, hook in enumerate(hooks[:len(meta["hooks"])]):   # none for a `narrow`ed state
-        restore = getattr(hook, "restore_snapshot", None)
-        if restore:
-            prefix = f"hook{h}_"
-            restore(meta["hooks"][h], {k[len(prefix):]: a for k, a in arrays.items() if k.startswith(prefix)})
-    return int(meta["step"]), bool(meta["ended"]), float(meta["wall_s"]), float(meta["step_seconds"])
+def _log(state: TrainState, stepper, k, loss, gnorm, lr, wall, on_log) -> None:
+    """A log row per live member (the probe's columns with it), passed on to `on_log`."""
+    n = state.members
+    probes = stepper.probe() or [None] * n
+    for i in np.flatnonzero(state.live):
+        row = {"step": k, "loss": float(loss[i]), "grad_norm": float(gnorm[i]), "lr": lr, "wall_s": wall}
+        if state.guards[i].active:
+            row["skipped_steps"] = state.guards[i].skipped
+        row.update(probes[i] or {})
+        state.logs[i].append(row)
+        if on_log:
+            on_log(row if n == 1 else {**row, "member": int(i)})
 
 
 class _One:
@@ -204,17 +158,26 @@ class _One:
         self.stepper.load_state_arrays(arrays)
 
 
-def _scalar_hook(hook, stepper):
-    def call(k, _, info):
-        return hook(k, stepper, {"loss": float(info["loss"][0]), "lr": info["lr"],
-                                 "step_seconds": info["step_seconds"],
-                                 "skipped_steps": int(info["skipped_steps"][0])})
-    for name in ("snapshot_state", "restore_snapshot"):   # a hook's state travels through the wrapper
-        if hasattr(hook, name):
-            setattr(call, name, getattr(hook, name))
-    return call
+class _ScalarHook:
+    """A one-model run's hook, seen by the loop: the one-model stepper and scalar info; its state (if it
+    has any) travels in snapshots as the hook's own."""
+
+    def __init__(self, hook, stepper):
+        self.hook, self.stepper = hook, stepper
+
+    def __call__(self, k, _, info):
+        return self.hook(k, self.stepper, {"loss": float(info["loss"][0]), "lr": info["lr"],
+                                           "step_seconds": info["step_seconds"],
+                                           "skipped_steps": int(info["skipped_steps"][0])})
+
+    def snapshot_state(self):
+        return self.hook.snapshot_state() if isinstance(self.hook, StatefulHook) else (None, {})
+
+    def restore_snapshot(self, meta, arrays):
+        if isinstance(self.hook, StatefulHook):
+            self.hook.restore_snapshot(meta, arrays)
 
 
 def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome:
     return train_members(_One(stepper), protocol, [stream], on_log,
-                         [_scalar_hook(h, stepper) for h in hooks], compiled, snapshot)[0]
+                         [_ScalarHook(h, stepper) for h in hooks], compiled, snapshot)[0]
