@@ -1,7 +1,8 @@
 """ratios.csv (JAX against PyTorch, per measured operation) and targets.json (issue targets, met or not).
 
-`ratio_rows(inference, training, scaling, fastpaper, matmul, notes) -> rows {operation, jax, torch, ratio,
-note}`: jax and torch are throughputs (samples/s, steps/s for training, GFLOP/s for the roofline rows);
+`ratio_rows(inference, training, scaling, fastpaper, matmul, notes) -> rows {operation, kind, dof, jax, torch,
+ratio, note}`: `operation` is for readers; `kind` (`KINDS`) and `dof` (where the row has one) say what the row
+measures, and are what `speedstudy.targets` selects by; jax and torch are throughputs (samples/s, steps/s for training, GFLOP/s for the roofline rows);
 ratio = jax / torch (above 1: JAX faster). A ratio beyond 2x either way carries a reason in `note`, made
 from the data: for q'' rows, the call time fitted over the case's batch sizes (fixed per-call cost +
 batch x per-sample cost, per framework; which term makes the difference) and the kernels per call
@@ -10,6 +11,9 @@ the thread counts.
 Also rows for the fast/paper speedups (jax, torch = each framework's fast/paper ratio; ratio empty),
 the fast LNN's achieved GFLOP/s (XLA's FLOP count for both frameworks), the attainable (matrix products)
 GFLOP/s and the achieved fraction.
+KINDS: latency (one-sample DeLaN), inference (batched q''), training (steps/s), scaling, fast_paper (the
+3 x 600 q'' rows per formulation), fast_over_paper (the speedup), matmul (the roofline), achieved (the fast
+LNN's GFLOP/s), roofline_fraction, note.
 The issue's numeric targets are checked in `speedstudy.targets`.
 """
 from __future__ import annotations
@@ -20,6 +24,9 @@ import numpy as np
 
 from speedstudy.bounds import TARGETS
 from speedstudy.timing import TORCH_THREADS
+
+KINDS = ("latency", "inference", "training", "scaling", "fast_paper", "fast_over_paper", "matmul", "achieved",
+         "roofline_fraction", "note")
 
 
 def _fit_call_cost(rows) -> dict:
@@ -129,14 +136,15 @@ def _generic_note(op: str, ratio: float, batch=None, call_s=None, torch_threads=
             f"PyTorch eager runs each operator separately; {threads}")
 
 
-def _row(op, j, t, batch=None, note=None, torch_threads=None, torch_mode=None):
-    """j, t: throughputs (per second); with a batch, the slower call time is batch / min(j, t)."""
+def _row(op, j, t, kind, batch=None, note=None, torch_threads=None, torch_mode=None, dof=None):
+    """j, t: throughputs (per second); with a batch, the slower call time is batch / min(j, t). `kind` and
+    `dof` are the row's structured key (`KINDS`; the targets select rows by them, never by `operation`)."""
     r = j / t if (np.isfinite(j) and np.isfinite(t) and t > 0) else np.nan
     beyond = np.isfinite(r) and not 0.5 <= r <= 2.0
     call_s = batch / min(j, t) if batch is not None and beyond else None
     text = ((note if note is not None else _generic_note(op, r, batch, call_s, torch_threads, torch_mode))
             if beyond else "")
-    return {"operation": op, "jax": j, "torch": t, "ratio": r, "note": text}
+    return {"operation": op, "kind": kind, "dof": dof, "jax": j, "torch": t, "ratio": r, "note": text}
 
 
 def _pairs(rows, keys, value):
@@ -163,7 +171,7 @@ def _latency_ratios(latency) -> list[dict]:
                 f"{_count(j.get('ops'))} XLA kernels in one dispatch; PyTorch {t['mode']}: {_us(1 / t['evals_per_s'])} "
                 f"per call, {how} (eager: {_us(1 / eager['evals_per_s'])}, {_count(eager.get('ops'))} ATen operators)")
         out.append(_row(f"single sample delan {meth} {dt} (evals/s)", j["evals_per_s"], t["evals_per_s"],
-                        batch=1, note=note))
+                        "latency", batch=1, note=note))
     return out
 
 
@@ -198,40 +206,43 @@ def ratio_rows(inference, training, scaling, fastpaper, matmul, notes, latency=(
         how = (f"threads: PyTorch {tr['threads']} ({tr.get('mode', 'eager')}, {within}), XLA default "
                f"({os.cpu_count()} cores)" if "threads" in tr else "")
         note = _inference_note((sy, m, f, dt), b, v["jax"], v["torch"], fit, ops, how) if v["torch"] > 0 else None
-        out.append(_row(f"q'' {sy} {m}/{f} {dt} batch {b}", v["jax"], v["torch"], batch=b, note=note))
+        out.append(_row(f"q'' {sy} {m}/{f} {dt} batch {b}", v["jax"], v["torch"], "inference", batch=b, note=note))
     jit = {(r["model"], r["batch"]): r["steps_per_s"] for r in training if r["mode"] == "jit"}
     for r in training:
         if r["framework"] == "torch" and (r["model"], r["batch"]) in jit:
             out.append(_row(f"train {r['system']} {r['model']} jit vs {r['mode']} batch {r['batch']} (steps/s)",
-                            jit[r["model"], r["batch"]], r["steps_per_s"]))
+                            jit[r["model"], r["batch"]], r["steps_per_s"], "training"))
     batch_of = {(r["study"], r["formulation"], r["n"]): r.get("batch") for r in scaling}
     for (st, f, n), v in _pairs(scaling, ("study", "formulation", "n"), "samples_per_s").items():
-        out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"], batch=batch_of.get((st, f, n))))
+        out.append(_row(f"scaling {st} {f} n={n}", v["jax"], v["torch"], "scaling", batch=batch_of.get((st, f, n))))
     for (d, f), v in _pairs(fastpaper, ("dof", "formulation"), "samples_per_s").items():
         out.append(_row(f"q'' lnn/{f} d={d} float32 batch {fastpaper[0]['batch']} (3x600 target)",
-                        v["jax"], v["torch"], batch=fastpaper[0]["batch"],
+                        v["jax"], v["torch"], "fast_paper", batch=fastpaper[0]["batch"], dof=d,
                         torch_threads=_threads_of(fastpaper, dof=d, framework="torch", formulation=f),
                         torch_mode=_mode_of(fastpaper, dof=d, framework="torch", formulation=f)))
     for d in sorted({r["dof"] for r in fastpaper}):
         sp = {fw: row_value(fastpaper, dof=d, framework=fw, formulation="fast") /
               row_value(fastpaper, dof=d, framework=fw, formulation="paper") for fw in ("jax", "torch")}
         tgt = TARGETS["fast_over_paper"].get(d)
-        out.append({"operation": f"fast/paper speedup d={d}", "jax": sp["jax"], "torch": sp["torch"],
+        out.append({"operation": f"fast/paper speedup d={d}", "kind": "fast_over_paper", "dof": d,
+                    "jax": sp["jax"], "torch": sp["torch"],
                     "ratio": np.nan, "note": f"target >= {tgt}" if tgt else ""})
     for d in sorted({r["dof"] for r in matmul}):
         mm = {fw: row_value(matmul, "gflops", dof=d, framework=fw) for fw in ("jax", "torch")}
         flops = row_value(fastpaper, "flops_per_sample", dof=d, framework="jax", formulation="fast")
         ach = {fw: flops * row_value(fastpaper, dof=d, framework=fw, formulation="fast") / 1e9 for fw in mm}
         out.append(_row(f"matmul roofline: matrix products of the layer shapes d={d} (GFLOP/s)", mm["jax"], mm["torch"],
-                        torch_threads=_threads_of(matmul, dof=d, framework="torch")))
+                        "matmul", torch_threads=_threads_of(matmul, dof=d, framework="torch"), dof=d))
         out.append(_row(f"fast LNN achieved d={d} (GFLOP/s; {flops:.3g} FLOP/sample from XLA cost analysis)",
-                        ach["jax"], ach["torch"],
+                        ach["jax"], ach["torch"], "achieved", dof=d,
                         torch_threads=_threads_of(fastpaper, dof=d, framework="torch", formulation="fast"),
                         torch_mode=_mode_of(fastpaper, dof=d, framework="torch", formulation="fast")))
-        out.append({"operation": f"fast LNN fraction of roofline d={d}", "jax": ach["jax"] / mm["jax"],
+        out.append({"operation": f"fast LNN fraction of roofline d={d}", "kind": "roofline_fraction", "dof": d,
+                    "jax": ach["jax"] / mm["jax"],
                     "torch": ach["torch"] / mm["torch"], "ratio": np.nan,
                     "note": "target >= 0.8 (JAX); each framework against its own matrix-product rate"})
-    out += [{"operation": "note", "jax": np.nan, "torch": np.nan, "ratio": np.nan, "note": n} for n in notes]
+    out += [{"operation": "note", "kind": "note", "dof": None, "jax": np.nan, "torch": np.nan, "ratio": np.nan, "note": n}
+            for n in notes]
     return out
 
 

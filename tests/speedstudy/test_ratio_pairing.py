@@ -82,3 +82,15 @@ def test_paired_rows_compare_within_their_own_rounds():
     t = targets.targets(list(rows.values()), [], [], paired, [])
     assert t["torch_within_1.5x_of_jax_inference"] == {"worst_jax_over_torch": pytest.approx(1.5), "n_ops": 2,
                                                        "n_beyond": 0, "met": True}
+
+
+def test_targets_read_rows_by_their_fields_not_their_display_names():
+    """Renaming every row's `operation` changes no target: the targets select by kind and dof."""
+    matmul = [{"dof": 2, "framework": fw, "rows": 3, "seconds": 1.0, "gflops": 20.0, "threads": 1} for fw in ("jax", "torch")]
+    rows = tables.ratio_rows(ROWS, [], [], FP, matmul, ["a note"])
+    assert {r["kind"] for r in rows} <= set(tables.KINDS)
+    t = targets.targets(rows, [], [], ROWS, [])
+    assert "fast_over_paper_d2" in t and "fast_LNN_fraction_of_roofline_d=2" in t
+    assert t["torch_within_1.5x_of_jax_inference"]["n_ops"] == 4   # two batched rows, two 3 x 600 rows
+    renamed = [{**r, "operation": f"row {i}"} for i, r in enumerate(rows)]
+    assert targets.targets(renamed, [], [], ROWS, []) == t

@@ -20,7 +20,7 @@ COLUMNS = {
     "train_target_log": ["protocol", "samples", "heldout_l1"],
     "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
     "scaling_fit": ["study", "formulation", "framework", "exponent"],
-    "ratios": ["operation", "jax", "torch", "ratio", "note"],
+    "ratios": ["operation", "kind", "dof", "jax", "torch", "ratio", "note"],
     "structure": ["system", "quadratic_kinetic", "separable", "local_coupling", "structured_model",
                   "general_model", "speedup"],
     "fast_paper": ["dof", "framework", "formulation", "samples_per_s", "flops_per_sample", "threads"],
