@@ -38,7 +38,7 @@ def _case(sizes):
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=tuple(sizes.members_hidden), dtype="float32", **lnn.spec_fields("quick"))
     scout = scouting.scout_protocol(PROTOCOLS["quick"])   # a scout of the quick double-pendulum protocol
-    return spec, scout.replace(steps=sizes.members_steps, n_train=scout.batch * 1000, log_every=10**9)
+    return spec, scout.replace(steps=sizes.members_steps, n_train=scout.batch * 1000, log_every=10**9, tracking=None)
 
 
 def _make_step(framework, spec, protocol, k):

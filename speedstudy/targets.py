@@ -52,26 +52,56 @@ def members_target(rows) -> dict:
 
 
 def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train_target=(), members=()) -> dict:
-    def of(kind):
-        return [r for r in ratios if r["kind"] == kind]
     t: dict = {}
-    speedup = {r["dof"]: r for r in of("fast_over_paper")}
+    t.update(_fast_over_paper(ratios))
+    t.update(_inference_within(ratios))
+    t.update(_lgn(scaling_fit, scaling))
+    t.update(_delan(inference, latency))
+    t.update(_train_target(train_target))
+    if members:
+        t["members_cost_vs_one"] = members_target(members)
+    one_batch = len({r["batch"] for r in training}) <= 1
+    t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}"
+                                   + ("" if one_batch else f"/batch {r['batch']}"): r["samples_per_s"]
+                                   for r in training}
+    return t
+
+
+def _of(ratios, kind) -> list[dict]:
+    return [r for r in ratios if r["kind"] == kind]
+
+
+def _fast_over_paper(ratios) -> dict:
+    """The fast/paper speedups per d (both frameworks) and the fast LNN's share of the roofline (JAX)."""
+    t = {}
+    speedup = {r["dof"]: r for r in _of(ratios, "fast_over_paper")}
     for d, tgt in TARGETS["fast_over_paper"].items():
         r = speedup.get(d)
         if r:
             t[f"fast_over_paper_d{d}"] = {"jax": r["jax"], "torch": r["torch"], "target": tgt,
                                           "met": bool(r["jax"] >= tgt and r["torch"] >= tgt)}
-    for r in of("roofline_fraction"):
-        bound = TARGETS["roofline_fraction"]
+    bound = TARGETS["roofline_fraction"]
+    for r in _of(ratios, "roofline_fraction"):
         t[f"fast_LNN_fraction_of_roofline_d={r['dof']}"] = {"jax": r["jax"], "torch": r["torch"], "target": bound,
                                                             "met": bool(r["jax"] >= bound)}
-    # the batched inference rows and the 3x600 fast/paper rows: every q'' throughput both frameworks measured
-    inf_ratios = [r["ratio"] for r in of("inference") + of("fast_paper") if np.isfinite(r["ratio"])]
-    if inf_ratios:
-        t["torch_within_1.5x_of_jax_inference"] = {"worst_jax_over_torch": max(inf_ratios),
-                                                   "n_ops": len(inf_ratios),
-                                                   "n_beyond": sum(x > TARGETS["jax_over_torch"] for x in inf_ratios),
-                                                   "met": bool(max(inf_ratios) <= TARGETS["jax_over_torch"])}
+    return t
+
+
+def _inference_within(ratios) -> dict:
+    """The worst JAX/PyTorch ratio over every q'' throughput both frameworks measured (the batched inference
+    rows and the 3 x 600 fast/paper rows)."""
+    inf_ratios = [r["ratio"] for r in _of(ratios, "inference") + _of(ratios, "fast_paper") if np.isfinite(r["ratio"])]
+    if not inf_ratios:
+        return {}
+    bound = TARGETS["jax_over_torch"]
+    return {"torch_within_1.5x_of_jax_inference": {"worst_jax_over_torch": max(inf_ratios), "n_ops": len(inf_ratios),
+                                                   "n_beyond": sum(x > bound for x in inf_ratios),
+                                                   "met": bool(max(inf_ratios) <= bound)}}
+
+
+def _lgn(scaling_fit, scaling) -> dict:
+    """The banded LGN's cost exponent in n, and its speedup over the dense one at n = 1024 (or the largest n)."""
+    t = {}
     for r in scaling_fit:
         if r["study"] == "lgn_grid" and r["formulation"] == "banded":
             t[f"lgn_banded_exponent_{r['framework']}_{r.get('fit_range', 'all')}"] = {
@@ -79,26 +109,39 @@ def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train
                 "target": TARGETS["lgn_banded_exponent"], "met": bool(r["exponent"] <= TARGETS["lgn_banded_exponent"])}
     for fw in ("jax", "torch"):
         ns = [r["n"] for r in scaling if r["study"] == "lgn_grid" and r["framework"] == fw]
-        n = 1024 if 1024 in ns else (max(ns) if ns else None)
-        if n is not None:
-            sp = (row_value(scaling, study="lgn_grid", formulation="banded", framework=fw, n=n)
-                  / row_value(scaling, study="lgn_grid", formulation="dense", framework=fw, n=n))
-            bound = TARGETS["lgn_banded_over_dense"]
-            t[f"lgn_banded_over_dense_n{n}_{fw}"] = {"speedup": sp, "target": bound, "met": bool(sp >= bound)}
+        if not ns:
+            continue
+        n = 1024 if 1024 in ns else max(ns)
+        sp = (row_value(scaling, study="lgn_grid", formulation="banded", framework=fw, n=n)
+              / row_value(scaling, study="lgn_grid", formulation="dense", framework=fw, n=n))
+        bound = TARGETS["lgn_banded_over_dense"]
+        t[f"lgn_banded_over_dense_n{n}_{fw}"] = {"speedup": sp, "target": bound, "met": bool(sp >= bound)}
+    return t
+
+
+def _delan(inference, latency) -> dict:
+    """DeLaN's best one-sample evaluations per second per framework, beside its batched rates."""
+    t = {}
+    bound = TARGETS["delan_single_sample_per_s"]
     for fw in ("jax", "torch"):
         dl = {r["batch"]: r["samples_per_s"] for r in fastest_per_batch(inference) if r["model"] == "delan" and
               r["framework"] == fw and r["dtype"] == "float32" and r["system"] == "double_pendulum"
               and r.get("source", "random_init") == "random_init"}
         single = {f"{r['method']}/{r['mode']}/{r['dispatch']}": r["evals_per_s"] for r in latency
                   if r["framework"] == fw and r["dtype"] == "float32"}
-        if dl or single:
-            best = max(single.items(), key=lambda kv: kv[1]) if single else (None, dl.get(1) or 0.0)
-            t[f"delan_{fw}"] = {"single_sample_per_s": best[1], "best_mode": best[0], "single_sample": single,
-                                "batched_acceleration": {str(b): v for b, v in dl.items()},
-                                "target_single": TARGETS["delan_single_sample_per_s"],
-                                "met": bool(best[1] >= TARGETS["delan_single_sample_per_s"]),
-                                "met_by": sorted(k for k, v in single.items()
-                                                 if v >= TARGETS["delan_single_sample_per_s"])}
+        if not (dl or single):
+            continue
+        best = max(single.items(), key=lambda kv: kv[1]) if single else (None, dl.get(1) or 0.0)
+        t[f"delan_{fw}"] = {"single_sample_per_s": best[1], "best_mode": best[0], "single_sample": single,
+                            "batched_acceleration": {str(b): v for b, v in dl.items()}, "target_single": bound,
+                            "met": bool(best[1] >= bound), "met_by": sorted(k for k, v in single.items() if v >= bound)}
+    return t
+
+
+def _train_target(train_target) -> dict:
+    """Per train-to-target protocol of the LNN: the samples to each threshold, met if the paper's L1 came
+    within TARGET_SAMPLES."""
+    t = {}
     for proto in sorted({r["protocol"] for r in train_target if r.get("model", "lnn") == "lnn"}):
         rs = sorted((r for r in train_target if r["protocol"] == proto), key=lambda r: -r["threshold"])
         paper = [r for r in rs if abs(r["threshold"] - PAPER_L1) < 1e-9]
@@ -112,10 +155,4 @@ def targets(ratios, scaling_fit, scaling, inference, training, latency=(), train
             "samples_to_reach": {f"{r['threshold']:g}": r["samples_to_reach"] for r in rs},
             "extrapolated_samples_NOT_MEASURED": {f"{r['threshold']:g}": r["extrapolated_samples"] for r in rs},
             "met": hit}
-    if members:
-        t["members_cost_vs_one"] = members_target(members)
-    one_batch = len({r["batch"] for r in training}) <= 1
-    t["training_samples_per_s"] = {f"{r['model']}/{r['framework']}/{r['mode']}"
-                                   + ("" if one_batch else f"/batch {r['batch']}"): r["samples_per_s"]
-                                   for r in training}
     return t

@@ -23,12 +23,13 @@ folder before training (a ValueError naming the option and its valid values).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from replication import results as R
-from replication.claims.base import Claim, ModelEntry
+from replication.claims.base import ModelEntry
 from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
 from replication.fit import trajectories, userdata
@@ -64,17 +65,64 @@ def metric_of(counts: dict, has_test: bool, loss: str) -> tuple[str, str]:
     return f"{where}_{loss}", f"{SET_NAMES[where]} {LOSS_NAMES[loss]}"
 
 
+@dataclass(frozen=True, eq=False)
+class FitSource:
+    """What a fit's unit belongs to (`replication.run.units.UnitSource`): the id "fit", the fit's protocol
+    and evaluation config (the same under any profile), the "fit" evaluation routine."""
+    base: Protocol
+    cfg: dict
+    id: str = "fit"
+    evaluate: str = "fit"
+
+    def protocol(self, profile: str) -> Protocol:
+        return self.base
+
+    def evaluation_config(self, profile: str) -> dict:
+        return self.cfg
+
+
 @R.writes
 def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
     their defaults where not given)."""
     o = fit_options.resolve(options)
+    path = str(Path(data).resolve())
+    task = _checked_task(o, path)   # every check that needs no work, before the output folder is made
+    out = R.output_folder(out, "--out")
+    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype)
+    tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test") if o.test else None
+    if tprep is not None and tprep.dof != prep.dof:
+        raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
+    n_train = prep.counts["train"]
+    protocol = Protocol(data=prep.reference, task=task, coords="qqdot", steps=o.steps, batch=min(o.batch, n_train),
+                        n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)),  # the file's split decides
+                        loss=o.loss, lr=o.lr, schedule=o.schedule, lr_min_ratio=o.lr_min_ratio, l2=o.weight_decay, dtype=dtype,
+                        log_every=max(1, o.steps // 100))
+    metric, label = metric_of(prep.counts, tprep is not None, o.loss)
+    cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
+           "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
+           "derivatives": {"window": o.window, "polyorder": o.polyorder}, "rows": prep.counts,
+           "trajectories": prep.trajectories}
+    if o.horizon is not None:   # recorded only when given: fits without it keep their keys
+        cfg["horizon"] = float(o.horizon)
+    if tprep is not None:  # the user's test file and its rows, for the report
+        cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
+    entry = ModelEntry(o.model, _model_spec(o, prep, task), hidden=o.hidden)
+    unit = Unit(FitSource(protocol, cfg), entry, o.framework, o.seed, "quick")
+    from replication.run.runner import is_current
+
+    if is_current(unit, out):
+        return dict(R.load_result(unit.folder(out)), reused=True, metric=metric, metric_label=label)
+    return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
+
+
+def _checked_task(o, path: str) -> str:
+    """The task the data and model give, after every check that needs no work done: the options, the
+    input scale's width, the energy function, the test file's columns."""
     fit_options.check(vars(o))
     if o.split is not None:
         fit_data.check_options(o.split, o.heldout)
     trajectories.check_options(o.window, o.polyorder)
-    out = R.output_folder(out, "--out")
-    path = str(Path(data).resolve())
     raw = userdata.read(path)[1]
     task = task_of(o.model, "tau" in raw, path)
     if isinstance(o.input_scale, tuple):
@@ -94,10 +142,11 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype)
-    tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test") if o.test else None
-    if tprep is not None and tprep.dof != prep.dof:
-        raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
+    return task
+
+
+def _model_spec(o, prep, task: str) -> dict:
+    """The model's spec fields from the options and the prepared data."""
     spec = {"kind": o.model, "dof": prep.dof, "activation": o.activation, "angle_wrap": bool(o.angle_wrap),
             "init": "cranmer2020" if o.model == "lnn" else "xavier"}
     if o.model == "delan":
@@ -106,28 +155,4 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         spec["extra_inputs"] = prep.dof
     if o.input_scale is not None:
         spec["input_scale"] = auto_scale(prep.reference, task, o.model) if o.input_scale == "auto" else o.input_scale
-    n_train = prep.counts["train"]
-    protocol = Protocol(data=prep.reference, task=task, coords="qqdot", steps=o.steps, batch=min(o.batch, n_train),
-                        n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)),  # the file's split decides
-                        loss=o.loss, lr=o.lr, schedule=o.schedule, lr_min_ratio=o.lr_min_ratio, l2=o.weight_decay, dtype=dtype,
-                        log_every=max(1, o.steps // 100))
-    metric, label = metric_of(prep.counts, tprep is not None, o.loss)
-    cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
-           "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
-           "derivatives": {"window": o.window, "polyorder": o.polyorder}, "rows": prep.counts,
-           "trajectories": prep.trajectories}
-    if o.horizon is not None:   # recorded only when given: fits without it keep their keys
-        cfg["horizon"] = float(o.horizon)
-    if tprep is not None:  # the user's test file and its rows, for the report
-        cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
-    entry = ModelEntry(o.model, spec, hidden=o.hidden)
-    claim = Claim(id="fit", number=0, paper="user", section="-", title=f"{o.model} on {Path(data).name}",
-                  system=o.system or Path(data).name, models=(entry,), protocols={"quick": protocol}, evaluate="fit",
-                  metric=metric, metric_label=label, published={}, verdict_rule="none",
-                  parts=(), eval_config={"quick": cfg})
-    unit = Unit(claim, entry, o.framework, o.seed, "quick")
-    from replication.run.runner import is_current
-
-    if is_current(unit, out):
-        return dict(R.load_result(unit.folder(out)), reused=True, metric=metric, metric_label=label)
-    return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
+    return spec

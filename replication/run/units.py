@@ -1,9 +1,15 @@
-"""Units of work: claim x framework x model x seed, and how one unit is run and written."""
+"""Units of work: claim x framework x model x seed, and how one unit is run and written.
+
+A unit reads four things of what it belongs to (`UnitSource`): its id, the profile's protocol, the
+evaluation routine's name and the profile's evaluation config. A claim (`replication.claims.base.Claim`)
+is one; a user's fit (`replication.fit.task.FitSource`) is another.
+"""
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 from models import ModelSpec
 from replication import results as R
@@ -18,9 +24,18 @@ from replication.training.outcome import log_frame
 from replication.training.train import train_cached
 
 
+class UnitSource(Protocol):
+    id: str
+    evaluate: str   # a name in `replication.evaluation.registry.EVALUATIONS`
+
+    def protocol(self, profile: str): ...
+
+    def evaluation_config(self, profile: str) -> dict: ...
+
+
 @dataclass(frozen=True)
 class Unit:
-    claim: object
+    claim: UnitSource
     entry: object
     framework: str
     seed: int

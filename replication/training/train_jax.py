@@ -71,7 +71,7 @@ def make_step(spec, protocol):
     @eqx.filter_jit
     def step(model, opt_state, batch, lr, skip_above=jnp.inf):
         loss, grads = eqx.filter_value_and_grad(loss_fn)(model, batch)
-        gnorm = optax.global_norm(grads)
+        gnorm = optax.tree.norm(grads)
         if clip is not None:
             scale = jnp.where(gnorm > clip, clip / gnorm, 1.0)
             grads = jax.tree_util.tree_map(lambda g: g * scale.astype(g.dtype), grads)

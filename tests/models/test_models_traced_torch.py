@@ -49,7 +49,7 @@ def test_traced_solve_keeps_the_pinv_fallback():
     assert int(n_bad) == 1
     graph = trace_flat(lambda h, r: solve_with_fallback(h, r)[0], (hess, rhs))
     np.testing.assert_allclose(graph(hess, rhs).numpy(), want.numpy(), rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(want[1].numpy(), torch.linalg.pinv(hess[1]) @ rhs[1].numpy(), rtol=1e-12)
+    np.testing.assert_allclose(want[1].numpy(), torch.linalg.pinv(hess[1]).numpy() @ rhs[1].numpy(), rtol=1e-12)
 
 
 def test_roll_neighbours_are_the_periodic_gather():
