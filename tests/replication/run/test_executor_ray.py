@@ -15,9 +15,10 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-import ray
 
 from replication.run import executor_ray, runner
+
+ray = pytest.importorskip("ray", reason="Ray is an optional extra (pip install 'lagbench[ray]')")
 
 KW = dict(profile="smoke", claims=["dp_loss", "dp_energy", "appendix_b"], models=["baseline", "lnn_exact_fast"],
           frameworks=("torch",), progress=False)
