@@ -263,13 +263,18 @@ def _from_flat(d: dict) -> dict:
     if flat["s"] > 1:
         batch = flat["_batch"] or d["batch"]
         d["scouting"] = {"count": flat["s"], "steps": flat["_steps"] or max(V1_SCOUT_SAMPLES // batch, 1), "batch": batch,
-                         "lr": flat["_lr"] or d.get("lr", 1e-3), "lr_start": flat["_lr_start"] or d.get("lr_start", 0.2),
+                         "lr": flat["_lr"] or d.get("lr", _default("lr")),
+                         "lr_start": flat["_lr_start"] or d.get("lr_start", _default("lr_start")),
                          "keep": flat["_keep"] or None}
     cohort = d.pop("cohort", 0)
     d["cohort"] = cohort if cohort and cohort > 1 else None
     every = d.pop("track_every", 0)
     d["tracking"] = {"every": every} if every else None
     return d
+
+
+def _default(name: str):
+    return Protocol.__dataclass_fields__[name].default
 
 
 def _check(ok: bool, message: str) -> None:
