@@ -78,7 +78,7 @@ def cmd_report(args):
     if not any((results / name).exists() for name in RESULT_ENTRIES):
         raise ValueError(f"--results {results}: holds no lagbench results (none of {', '.join(RESULT_ENTRIES)})")
     out = Path(args.out) if args.out else Path("report") / (results.resolve().name or "results")
-    paths = reports.build_report(results, out)
+    paths = reports.build_report(results, out, pdf=not args.no_pdf)
     for k, v in paths.items():
         print(f"{k}: {len(v)} files in {out / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
@@ -198,6 +198,7 @@ def build_parser():
                    "stiff, train-target) (default: results/quick)")
     s.add_argument("--out", help="the report folder (default: report/<the results folder's name>, so that "
                    "results/full gives report/full)")
+    s.add_argument("--no-pdf", action="store_true", help="write REPORT.md and the figures only (no typesetting)")
     s.set_defaults(func=cmd_report)
     from replication.fit.cli import add_commands
 

@@ -89,7 +89,11 @@ def render_typst(title: str, sections: list[Section], root: Path = Path(".")) ->
 
 def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path, Path]:
     """Write ``REPORT.typ`` and compile ``REPORT.pdf`` in ``out_dir``; returns both paths."""
-    import typst  # the report extra; imported here so Markdown-only use never needs it
+    try:
+        import typst  # a core dependency, imported here so that importing `reports` stays light
+    except ImportError as e:
+        raise ValueError(f"the PDF report needs typst ({e}): pip install typst, or write the Markdown report "
+                         f"alone with `lagbench report --no-pdf`") from e
 
     out_dir = Path(out_dir)
     typ = out_dir / "REPORT.typ"

@@ -2,6 +2,8 @@
 only files an earlier build wrote and nobody has changed since (issue 25, case 4); `--results` must
 name a results folder (case 5)."""
 
+import sys
+
 import pytest
 
 from replication.cli import main
@@ -105,3 +107,16 @@ def test_the_default_report_folder_follows_the_results_folder(results_dir, tmp_p
     monkeypatch.chdir(tmp_path)
     assert main(["report", "--results", str(full)]) in (0, None)
     assert (tmp_path / "report" / "full" / "REPORT.md").is_file() and not (tmp_path / "report" / "quick").exists()
+
+
+def test_no_pdf_writes_the_markdown_alone_and_a_missing_typst_says_what_to_do(results_dir, tmp_path, monkeypatch,
+                                                                               capsys):
+    out = tmp_path / "md"
+    assert main(["report", "--results", str(results_dir), "--out", str(out), "--no-pdf"]) in (0, None)
+    assert (out / "REPORT.md").is_file() and not (out / "REPORT.pdf").exists() and not (out / "REPORT.typ").exists()
+    monkeypatch.setitem(sys.modules, "typst", None)   # `import typst` raises ImportError
+    capsys.readouterr()
+    assert main(["report", "--results", str(results_dir), "--out", str(tmp_path / "nopdf")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("lagbench: error: the PDF report needs typst") and "--no-pdf" in err and "\n" not in err
+    assert (tmp_path / "nopdf" / "REPORT.md").is_file()   # written before the PDF: nothing computed is lost
