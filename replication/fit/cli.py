@@ -3,6 +3,7 @@
 one line naming the option (raised as ValueError, printed by `cli.main`)."""
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -92,12 +93,26 @@ def cmd_fit(args):
     print(f"ok: {d['metric_label']} {value:.6g}, written to {folder}{again}")
 
 
+def _fitted_folder(args) -> str:
+    """--fitted, or its old spelling --model (read, with a deprecation notice)."""
+    if args.fitted_old is not None:
+        if args.fitted is not None:
+            raise ValueError("--model: give the fitted models once, as --fitted")
+        print("lagbench: evaluate --model is deprecated; use --fitted (in `fit`, --model is the model kind)",
+              file=sys.stderr)
+        return args.fitted_old
+    if args.fitted is None:
+        raise ValueError("--fitted: required; give a fit's unit folder or a `lagbench fit` results folder")
+    return args.fitted
+
+
 def cmd_evaluate(args):
     from replication.fit.evaluate_file import evaluate
 
+    fitted = _fitted_folder(args)
     rollouts = RolloutBars(args.quiet, "lagbench evaluate")
     try:
-        done = evaluate(args.model, args.data, out=args.out, framework=args.framework, system=args.system,
+        done = evaluate(fitted, args.data, out=args.out, framework=args.framework, system=args.system,
                         substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy,
                         device=args.device, horizon=args.horizon, on_progress=rollouts)
     finally:
@@ -145,11 +160,13 @@ def add_commands(sub) -> None:
                        description="Evaluate fitted models on a data file: one-step errors per component, rollouts "
                        "from each trajectory's first state, energy drift (and the true energy error with --system), "
                        "DeLaN's decomposition. Writes OUT/units/evaluate/<framework>/<model>/seed<k>/ and OUT/data/.")
-    s.add_argument("--model", required=True, help="a fit's unit folder, or a `lagbench fit` results folder (every "
+    s.add_argument("--fitted", help="required: a fit's unit folder, or a `lagbench fit` results folder (every "
                    "fitted model in it)")
+    # `--model` names a model kind in `fit`; here it is the old spelling of --fitted, still read
+    s.add_argument("--model", dest="fitted_old", help=argparse.SUPPRESS)
     s.add_argument("--data", required=True, help=DATA_HELP)
     s.add_argument("--out", default="results/evaluate", help="results folder")
-    s.add_argument("--framework", help="jax | torch (default: the one each model was trained in)")
+    s.add_argument("--framework", choices=("jax", "torch"), help="default: the one each model was trained in")
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")

@@ -1,4 +1,4 @@
-"""`lagbench evaluate --model DIR --data FILE`: fitted models judged on a new data file.
+"""`lagbench evaluate --fitted DIR --data FILE`: fitted models judged on a new data file.
 
 `evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
 energy=None, device="auto", horizon=None, on_progress=None)`

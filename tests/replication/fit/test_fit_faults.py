@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from replication import results as R
-from replication.cli import main
+from replication.cli import build_parser, main
 from replication.fit.task import fit
 
 FAST = {"model": "baseline", "steps": 4, "hidden": (8,), "batch": 16}
@@ -123,3 +123,21 @@ def test_a_moved_folder_or_a_renamed_copy_of_the_data_reuses_the_fit(tmp_path):
     # other bytes are another fit
     _pendulum(copy, scale=2.0)
     assert "reused" not in fit(copy, out=moved, **FAST)
+
+
+def test_evaluate_takes_fitted_and_reads_the_old_model_spelling_with_a_notice(tmp_path, capsys):
+    """`evaluate --fitted DIR`; `--model DIR` (its old spelling; in `fit`, --model is the model kind) still
+    works and says so; neither, or both, is one line naming --fitted."""
+    from replication.fit import cli
+
+    parser = build_parser()
+    args = parser.parse_args(["evaluate", "--model", "results/fit", "--data", "d.csv"])
+    assert cli._fitted_folder(args) == "results/fit"
+    assert "evaluate --model is deprecated; use --fitted" in capsys.readouterr().err
+    args = parser.parse_args(["evaluate", "--fitted", "results/fit", "--data", "d.csv"])
+    assert cli._fitted_folder(args) == "results/fit" and capsys.readouterr().err == ""
+    for argv in (["--data", "d.csv"], ["--fitted", "a", "--model", "b", "--data", "d.csv"]):
+        assert main(["evaluate", *argv, "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("lagbench: error: --") and "--fitted" in err
+    assert not (tmp_path / "o").exists()
