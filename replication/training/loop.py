@@ -23,7 +23,7 @@ All the loop carries from step to step is one `loop_state.TrainState`. With `sna
 `replication.training.snapshots.Snapshots`), the loop first puts back that store's snapshot if it has one
 for this run and goes on from its step; it saves the state after a step when the store says it is due and
 once at the end (an ended phase resumed returns its outcomes without a step). `start_state` (meta, arrays),
-a snapshot's state held in memory (`narrow` of another run's end state: the scouts that go on after a cut),
+a snapshot's state held in memory (`loop_state.narrow` of another run's end state: the scouts that go on after a cut),
 is where the loop begins when `snapshot` has none of its own.
 
 `train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome`:
@@ -36,13 +36,11 @@ import time
 
 import numpy as np
 
-from replication.training.loop_state import StatefulHook, TrainState, fits, narrow
+from replication.training.loop_state import StatefulHook, TrainState, fits
 from replication.training.outcome import TrainOutcome, nonfinite_failure
 from replication.training.schedules import learning_rate
 
 log = logging.getLogger("lagbench")
-
-__all__ = ["narrow", "train", "train_members"]
 
 
 def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=False,
@@ -52,8 +50,9 @@ def train_members(stepper, protocol, streams, on_log=None, hooks=(), compiled=Fa
     k = start
     for k in range(start, protocol.steps if not state.ended else start):
         lr = learning_rate(protocol, k)
-        ts = time.perf_counter()
-        loss, gnorm = _step(state, stepper, protocol, [stream.batch(k) for stream in streams], lr, k)
+        batches = [stream.batch(k) for stream in streams]
+        ts = time.perf_counter()   # step time: propose + commit, not the batches' drawing
+        loss, gnorm = _step(state, stepper, protocol, batches, lr, k)
         if loss is None:   # no member left
             break
         if k > start or compiled:   # the first step of a process compiles

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from replication.training import loop
+from replication.training.loop_state import narrow
 from replication.training.outcome import joined_modes
 
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
@@ -182,7 +182,7 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
     kept = trainer.train_members(spec, [outcomes[i].params for i in go_on], p, [streams[i] for i in go_on],
                                  on_log=on_log, hooks=(keep2, *hooks),
                                  snapshot=snapshot.phase("scouts-kept") if snapshot else None,
-                                 start_state=loop.narrow(held.state, go_on))
+                                 start_state=narrow(held.state, go_on))
     tails = [math.inf] * len(seeds)
     for i, o, t in zip(go_on, kept, _tails(keep2.losses, kept), strict=True):
         o.step_mode = joined_modes(outcomes[i].step_mode, o.step_mode)
