@@ -153,7 +153,7 @@ def size_metrics(units: list[Unit], metric: str | None) -> dict[str, list[tuple[
         bases = {m["base"] for m in sized.values() if m}
         for u in units:
             m, value = sized[u.model], u.metric(metric)
-            n_train = (u.result.get("protocol") or {}).get("n_train")
+            n_train = u.protocol.data.n_train if u.protocol else None
             if value is None:
                 continue
             if m:

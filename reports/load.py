@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from replication.training.protocol import Protocol
 from reports.integrity import verify_unit
 
 BENCH_COLUMNS = {
@@ -45,6 +46,14 @@ TRAIN_TARGET_COLUMNS = {k: BENCH_COLUMNS[k] for k in ("train_target", "train_tar
 UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
 
 
+def protocol_of(result: dict) -> Protocol | None:
+    """A result's training protocol (any recorded version), or None where none is readable."""
+    try:
+        return Protocol.from_dict(result["protocol"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
 @dataclass(frozen=True)
 class Unit:
     """One claim x framework x model x seed. ``rel`` is the unit folder relative to the results root."""
@@ -58,6 +67,10 @@ class Unit:
     status: str
     reason: str | None = None
     result: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def protocol(self) -> Protocol | None:
+        return protocol_of(self.result)
 
     def metric(self, name: str) -> float | None:
         value = (self.result.get("metrics") or {}).get(name)

@@ -20,7 +20,7 @@ import pandas as pd
 from reports import figures as F
 from reports.document import Figure, Para, Section, Table
 from reports.fmt import cell, num
-from reports.load import Results
+from reports.load import Results, protocol_of
 from reports.tables import problem_units_table
 
 CLAIMS = ("fit", "evaluate")
@@ -44,6 +44,10 @@ def _name(u) -> str:
     return f"{u.model} ({u.framework}, seed {u.seed})"
 
 
+def _schedule(protocol) -> str:
+    return f"{protocol.schedule.kind}, peak {num(protocol.schedule.lr)}" if protocol else cell(None)
+
+
 def _models_table(units) -> pd.DataFrame:
     rows = []
     for u in units:
@@ -54,7 +58,7 @@ def _models_table(units) -> pd.DataFrame:
         rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
                      "steps": str(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
-                     "weight decay (l2)": num(p.get("l2")), "schedule": f"{p.get('schedule')}, peak {num(p.get('lr'))}",
+                     "weight decay (l2)": num(p.get("l2")), "schedule": _schedule(protocol_of(r)),
                      "rows (train/held-out/test)": "/".join(str(counts.get(k, 0))
                                                             for k in ("train", "heldout", "test")),
                      "final training loss": num(r.get("final_train_loss")), "train time (s)": num(r.get("train_time_s"))})

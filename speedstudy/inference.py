@@ -108,6 +108,7 @@ def inference_cases(sizes) -> list[Case]:
 def trained_cases(out: Path, batches: tuple) -> list[Case]:
     """Double-pendulum checkpoints of a previous `lagbench run` in OUT/units (seed 0 only)."""
     from replication.results import load_npz
+    from replication.training.protocol import Protocol
 
     cases = []
     for res_path in sorted(Path(out).glob("units/*/*/*/seed0/result.json")):
@@ -115,10 +116,13 @@ def trained_cases(out: Path, batches: tuple) -> list[Case]:
             res = json.loads(res_path.read_text())
         except (OSError, ValueError):
             continue
-        data = str((res.get("protocol") or {}).get("data", ""))
+        try:
+            protocol = Protocol.from_dict(res["protocol"])
+        except (KeyError, TypeError, ValueError):
+            continue
         ckpt = res_path.parent / "checkpoint.npz"
-        if res.get("status") != "ok" or "model_spec" not in res or not data.startswith("double_pendulum") \
-                or (res.get("protocol") or {}).get("task", "acceleration") != "acceleration" or not ckpt.is_file():
+        if res.get("status") != "ok" or "model_spec" not in res or not protocol.data.recipe.startswith("double_pendulum") \
+                or protocol.task != "acceleration" or not ckpt.is_file():
             continue
         spec = ModelSpec.from_dict(res["model_spec"])
         if spec.dof != 2 or spec.extra_inputs:

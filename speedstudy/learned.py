@@ -32,15 +32,16 @@ TINY_STEPS = {"tiny": 10, "quick": 600, "full": 3000}
 def find_trained(folder) -> dict:
     """{label: (spec, params, source)} from folder/trained/jax/*; the entry with the most steps per label."""
     from replication.results import load_npz
+    from replication.training.protocol import Protocol
 
     found: dict = {}
     for res in sorted(Path(folder).glob("trained/jax/*/result.json")) if folder else []:
         try:
             meta = json.loads(res.read_text())
-            proto, spec = meta.get("protocol") or {}, ModelSpec.from_dict(meta["spec"])
+            proto, spec = Protocol.from_dict(meta["protocol"]), ModelSpec.from_dict(meta["spec"])
         except (OSError, ValueError, KeyError, TypeError):
             continue
-        if (proto.get("data") != "double_pendulum_iid" or proto.get("task", "acceleration") != "acceleration"
+        if (proto.data.recipe != "double_pendulum_iid" or proto.task != "acceleration"
                 or spec.kind not in LABELS or spec.dof != 2 or spec.extra_inputs or meta.get("failure")
                 or not (res.parent / "checkpoint.npz").is_file()):
             continue
@@ -59,7 +60,8 @@ def tiny_models(sizes, labels=LABELS) -> dict:
     from replication.training.train_jax import train
 
     steps = TINY_STEPS.get(sizes.name, 300)
-    proto = PLAIN_QUICK.replace(steps=steps, n_train=128 * 50, n_heldout=256, lr_step_every=steps * 2 // 3)
+    proto = PLAIN_QUICK.replace(steps=steps, data=PLAIN_QUICK.data.replace(n_train=128 * 50, n_heldout=256),
+                                **{"schedule.every": steps * 2 // 3})
     out = {}
     for entry in MODELS:
         if entry.label in labels:

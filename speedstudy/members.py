@@ -38,7 +38,8 @@ def _case(sizes):
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=tuple(sizes.members_hidden), dtype="float32", **lnn.spec_fields("quick"))
     scout = scouting.scout_protocol(PROTOCOLS["quick"])   # a scout of the quick double-pendulum protocol
-    return spec, scout.replace(steps=sizes.members_steps, n_train=scout.batch * 1000, log_every=10**9, tracking=None)
+    return spec, scout.replace(steps=sizes.members_steps, data=scout.data.replace(n_train=scout.batch * 1000),
+                               log_every=10**9, tracking=None)
 
 
 def _make_step(framework, spec, protocol, k):
@@ -67,7 +68,7 @@ def _cases(protocol):
     """(members, protocol): one model, MEMBERS members, and one model at MEMBERS x the batch (the same samples
     per step as the members: what batching alone costs, the floor of what vectorising can reach)."""
     wide = protocol.batch * MEMBERS
-    return [(1, protocol), (MEMBERS, protocol), (1, protocol.replace(batch=wide, n_train=wide * 1000))]
+    return [(1, protocol), (MEMBERS, protocol), (1, protocol.replace(batch=wide, data=protocol.data.replace(n_train=wide * 1000)))]
 
 
 def _mode_rows(fw, mode, spec, protocol, rounds) -> list[dict]:

@@ -80,6 +80,7 @@ from replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
 from replication.training import scouting
 from replication.training.data import heldout
 from replication.training.protocol import Guard, Scouting
+from replication.training.schedules import OneCycle
 from speedstudy.target_loop import N_EVALS, run_protocol
 
 PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's number (a training loss; held-out 6.9e-2); the code's samples
@@ -110,41 +111,43 @@ class Entry(NamedTuple):
 def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
     """{name: Entry} for a budget in samples."""
     paper = PROTOCOLS["paper"]
-    pool = min(paper.n_train, max(paper.batch, budget // paper.batch * paper.batch))
-    orig = paper.replace(steps=max(budget // paper.batch, 2), n_train=pool, n_heldout=n_heldout, log_every=10**9)
+    pool = min(paper.data.n_train, max(paper.batch, budget // paper.batch * paper.batch))
+    orig = paper.replace(steps=max(budget // paper.batch, 2), data=paper.data.replace(n_train=pool, n_heldout=n_heldout),
+                         log_every=10**9)
     steps = max(budget // VARIANT_BATCH, 3)
-    var = PLAIN_QUICK.replace(steps=steps, batch=VARIANT_BATCH, n_train=VARIANT_BATCH * 1000,
-                                     n_heldout=n_heldout, lr=VARIANT_LR, schedule="onecycle",
-                                     guard=Guard(clip=GRAD_CLIP, skip=SPIKE_SKIP), log_every=10**9)
+    var = PLAIN_QUICK.replace(steps=steps, batch=VARIANT_BATCH,
+                              data=PLAIN_QUICK.data.replace(n_train=VARIANT_BATCH * 1000, n_heldout=n_heldout),
+                              schedule=OneCycle(lr=VARIANT_LR), guard=Guard(clip=GRAD_CLIP, skip=SPIKE_SKIP),
+                              log_every=10**9)
     scale = {"input_scale": (1.0, 1.0, VELOCITY_SCALE, VELOCITY_SCALE)}
-    var_text = (f"batch {var.batch}, one-cycle peak {var.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
+    var_text = (f"batch {var.batch}, one-cycle peak {var.schedule.lr:g} over {var.steps} steps, l2 {var.l2:.3g}, "
                 f"gradient clip {GRAD_CLIP:g}, skip at "
                 f"{SPIKE_SKIP:g} x median gradient norm; MLP input velocities scaled by {VELOCITY_SCALE:g}")
     # scouts: SCOUT_SAMPLES each, at most half the budget over all of them; the continuation the rest
     scout = max(min(SCOUT_SAMPLES, budget // (2 * RESTART_SEEDS)) // var.batch, 3)
     rest = max(var.steps - RESTART_SEEDS * scout, 1)
-    restarts = var.replace(scouting=Scouting(count=RESTART_SEEDS, steps=scout, batch=var.batch, lr=var.lr,
-                                             lr_start=var.lr_start), steps=rest)
+    restarts = var.replace(scouting=Scouting(count=RESTART_SEEDS, steps=scout, batch=var.batch, schedule=var.schedule),
+                           steps=rest)
     restarts_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each (one-cycle over the scout), the one with "
                      f"the lowest training loss (mean of its last 5 % of batches) continued for {rest} steps "
                      f"(a new one-cycle, fresh Adam state); otherwise the variant: batch {var.batch}, peak "
-                     f"{var.lr:g}, clip {GRAD_CLIP:g}, skip at {SPIKE_SKIP:g} x median, velocity scale "
+                     f"{var.schedule.lr:g}, clip {GRAD_CLIP:g}, skip at {SPIKE_SKIP:g} x median, velocity scale "
                      f"{VELOCITY_SCALE:g}. Samples count every scout")
     # restarts_fast: the scouts as in restarts, the continuation at a wider batch and a higher peak, same budget
     fast_rest = max((budget - RESTART_SEEDS * scout * var.batch) // FAST_BATCH, 1)
-    fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, n_train=FAST_BATCH * 1000, lr=FAST_LR)
-    fast_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each at batch {var.batch}, peak {var.lr:g}, as "
+    fast = restarts.replace(steps=fast_rest, batch=FAST_BATCH, **{"data.n_train": FAST_BATCH * 1000, "schedule.lr": FAST_LR})
+    fast_text = (f"{RESTART_SEEDS} seeds scouted for {scout} steps each at batch {var.batch}, peak {var.schedule.lr:g}, as "
                  f"restarts; the chosen one continued for {fast_rest} steps at batch {FAST_BATCH}, peak {FAST_LR:g} "
                  f"(a new one-cycle, fresh Adam state). Samples count every scout")
     # restarts_halved: restarts_fast's scouts and continuation, HALVED_SEEDS scouts halved to HALVED_KEEP (at
     # 4e7 samples the full profile's double-pendulum protocol, `claims.double_pendulum.PROTOCOLS["full"]`)
     halved = fast.replace(**{"scouting.count": HALVED_SEEDS, "scouting.keep": HALVED_KEEP})
     halved = halved.replace(steps=max((budget - scouting.scouting_samples(halved)) // FAST_BATCH, 1))
-    halved_text = (f"{HALVED_SEEDS} seeds scouted at batch {var.batch}, peak {var.lr:g}, for {scout} steps; at step "
+    halved_text = (f"{HALVED_SEEDS} seeds scouted at batch {var.batch}, peak {var.schedule.lr:g}, for {scout} steps; at step "
                    f"{scouting.cut_step(halved)} the {HALVED_KEEP} lowest by training loss go on to the end, the lowest "
                    f"of those continued for {halved.steps} steps at batch {FAST_BATCH}, peak {FAST_LR:g} (a new "
                    f"one-cycle, fresh Adam state). Samples count every scout")
-    return {"original_scaled": Entry(orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.lr:g} over "
+    return {"original_scaled": Entry(orig, f"code protocol: batch {orig.batch}, one-cycle peak {orig.schedule.lr:g} over "
                                            f"{orig.steps} steps, l2 {orig.l2:.3g}", {}, "lnn"),
             "variant": Entry(var, var_text, scale, "lnn"),
             "restarts": Entry(restarts, restarts_text, scale, "lnn"),
@@ -162,7 +165,7 @@ def hessian_rel_err(model, spec, protocol) -> float:
     data = heldout(protocol)
     q, qd = (jnp.asarray(data[k], protocol.dtype) for k in ("q", "qdot"))
     h = np.asarray(model.velocity_hessian(q, qd), float)
-    h_true = np.asarray(systems.get("double_pendulum", **dict(protocol.system_params))
+    h_true = np.asarray(systems.get("double_pendulum", **dict(protocol.data.system_params))
                         .velocity_hessian(data["q"], data["qdot"]), float)
     c = float(np.sum(h * h_true) / np.sum(h_true * h_true))
     if not (np.isfinite(c) and c != 0.0):

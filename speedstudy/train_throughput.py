@@ -36,7 +36,7 @@ def measure(claim: str = "dp_loss", model: str = "lnn", profile: str = "paper", 
         unit = Unit(c, entry, fw, 0, profile)
         spec, protocol = unit.spec(), unit.protocol()
         p = protocol.replace(steps=steps, log_every=max(steps // 10, 1), scouting=None, tracking=None,
-                             n_train=protocol.batch * steps)
+                             data=protocol.data.replace(n_train=protocol.batch * steps))
         # PyTorch compiles where the protocol's own training would (its full length decides, not these steps)
         with compile_torch.like(spec, protocol), dev.placed(fw, where[fw]):
             out = run_training(fw, spec, p, 0)

@@ -81,7 +81,7 @@ def training_rows(sizes, notes: list, progress=None) -> list[dict]:
 
 
 def _rows_at(sizes, batch_size, notes, progress) -> list[dict]:
-    protocol = PROTOCOLS["paper"].replace(batch=batch_size, n_train=batch_size * 4)
+    protocol = PROTOCOLS["paper"].replace(batch=batch_size, **{"data.n_train": batch_size * 4})
     batch = BatchStream(protocol, seed=0).batch(0)
     rows = []
     modes = [("jax", "jit"), ("torch", "eager")] + ([("torch", "compile")] if sizes.torch_compile else [])

@@ -6,11 +6,11 @@ through each framework's Euler-Lagrange routine, in both formulations, in float6
 from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.published import Published
 from replication.claims.rules import bound
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
 
 MODELS = (ModelEntry("lnn_exact_paper", {"kind": "lnn", "formulation": "paper"}, train=False),
           ModelEntry("lnn_exact_fast", {"kind": "lnn", "formulation": "fast"}, train=False))
-_p = Protocol(data="free_fall_iid", steps=1, batch=1, n_train=1, n_heldout=256, dtype="float64")
+_p = Protocol(data=Data("free_fall_iid", n_train=1, n_heldout=256), steps=1, batch=1, dtype="float64")
 
 
 CLAIM = Claim(

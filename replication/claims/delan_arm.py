@@ -13,7 +13,8 @@ from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.published import Published
 from replication.claims.rules import better_by, bound
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import Constant
 
 W = {"smoke": (16, 16), "quick": (64, 64), "full": (64, 64), "paper": (64, 64)}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
@@ -24,21 +25,23 @@ SIZES = {"smoke": (), "quick": (256, 1024), "full": (256, 1024), "paper": (128, 
 def _models():
     out = [ModelEntry("delan", _delan, hidden=W), ModelEntry("ff", _ff, hidden=W)]
     for n in sorted({n for v in SIZES.values() for n in v}):
-        prof = {p: {"n_train": n, "batch": min(n, 256)} for p, v in SIZES.items() if n in v}
+        prof = {p: {"data.n_train": n, "batch": min(n, 256)} for p, v in SIZES.items() if n in v}
         out.append(ModelEntry(f"delan_n{n}", _delan, hidden=W, overrides=prof, profiles=tuple(prof)))
         out.append(ModelEntry(f"ff_n{n}", _ff, hidden=W, overrides=prof, profiles=tuple(prof)))
     return tuple(out)
 
 
 MODELS = _models()
-_base = Protocol(data="two_link_arm", task="inverse_dynamics", steps=20, batch=32, n_train=512, n_heldout=512,
-                 loss="mse", lr=5e-4, schedule="constant", l2=1e-5, log_every=5)
+_data = Data("two_link_arm", n_train=512, n_heldout=512)
+_base = Protocol(data=_data, task="inverse_dynamics", steps=20, batch=32, loss="mse", l2=1e-5,
+                 schedule=Constant(lr=5e-4), log_every=5)
 PROTOCOLS = {"smoke": _base,
              # 8000 steps for every pool: at 2000 the small pools were under-trained (JAX, 3 seeds, torque MSE
              # on the training family's held-out states against the null's 34.7: DeLaN n256 3.9 -> 0.22 at
              # 8000, FF n256 5.0 -> 3.2), and every pool gets the same steps, so that only the data differ
-             "quick": _base.replace(steps=8000, batch=256, n_train=4096, n_heldout=4000, log_every=200, lr=1e-3),
-             "paper": _base.replace(steps=40_000, batch=512, n_train=2459, n_heldout=4000, log_every=500)}
+             "quick": _base.replace(steps=8000, batch=256, data=_data.replace(n_train=4096, n_heldout=4000), log_every=200,
+                                    schedule=Constant(lr=1e-3)),
+             "paper": _base.replace(steps=40_000, batch=512, data=_data.replace(n_train=2459, n_heldout=4000), log_every=500)}
 PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 
 

@@ -12,18 +12,19 @@ its inputs: it gets no such feature.
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part, Variant
 from replication.claims.rules import better_by
-from replication.training.protocol import Protocol, Scouting
+from replication.training.protocol import Data, Protocol, Scouting
+from replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (256, 256, 256)}
 # quick: the relativistic models (all alike) with restarts over initialisations, 8 scouts x 200 steps, the
 # best by training loss continued. The magnetic pair and DeLaN's control train without.
-_SCOUTS = Scouting(count=8, steps=200, batch=256, lr=1e-3, lr_start=0.2)   # at quick's batch, rate and start
-REL = {"data": "relativistic_iid", "system_params": (("g", 9.8),), "quick": {"scouting": _SCOUTS},
+_SCOUTS = Scouting(count=8, steps=200, batch=256, schedule=OneCycle(lr=1e-3, start=0.2))   # at quick's batch, rate and start
+REL = {"data.recipe": "relativistic_iid", "data.system_params": (("g", 9.8),), "quick": {"scouting": _SCOUTS},
        "full": {"scouting": _SCOUTS}}
-MAG = {"data": "charged_magnetic_iid"}
+MAG = {"data.recipe": "charged_magnetic_iid"}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020"}
-CONTROL = {"data": "pendulum_iid"}   # kinetic energy q-dot^2 / 2: DeLaN's form holds
+CONTROL = {"data.recipe": "pendulum_iid"}   # kinetic energy q-dot^2 / 2: DeLaN's form holds
 MODELS = (ModelEntry("delan_relativistic", _delan, hidden=W, overrides=REL),
           ModelEntry("lnn_relativistic", _lnn, hidden=W, overrides=REL),
           ModelEntry("lnn_relativistic_gamma", {**_lnn, "lorentz_factor": True, "input_scale": (1.0, 1.0, 0.01)},
@@ -31,11 +32,12 @@ MODELS = (ModelEntry("delan_relativistic", _delan, hidden=W, overrides=REL),
           ModelEntry("delan_magnetic", _delan, hidden=W, overrides=MAG),
           ModelEntry("lnn_magnetic", _lnn, hidden=W, overrides=MAG),
           ModelEntry("delan_control", _delan, hidden=W, overrides=CONTROL))
-_base = Protocol(data="charged_magnetic_iid", steps=20, batch=32, n_train=640, n_heldout=512, loss="l1",
-                 lr=1e-3, schedule="onecycle", log_every=5)
+_data = Data("charged_magnetic_iid", n_train=640, n_heldout=512)
+_base = Protocol(data=_data, steps=20, batch=32, loss="l1", schedule=OneCycle(lr=1e-3), log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=1500, batch=256, n_train=256 * 200, n_heldout=10_000, log_every=50),
-             "paper": _base.replace(steps=100_000, batch=512, n_train=512 * 1000, n_heldout=100_000, log_every=1000)}
+             "quick": _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 200, n_heldout=10_000), log_every=50),
+             "paper": _base.replace(steps=100_000, batch=512, data=_data.replace(n_train=512 * 1000, n_heldout=100_000),
+                                    log_every=1000)}
 PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 
 

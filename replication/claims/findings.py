@@ -78,7 +78,7 @@ FINDINGS = [
             "and p / 100; restarts over 8 inits at peak 1e-2 (the canonical HNN 3e-3) for every model. A variant "
             "beside each claim also feeds the models on (q, q̇) the Lorentz factor γ(q̇) x 0.01, with the same "
             "protocol, on its own verdict line. The paper profile keeps the code's rate without restarts",
-            ("relativ",), ("lorentz_factor", "input_scale", "lr", "scouting")),
+            ("relativ",), ("lorentz_factor", "input_scale", "schedule", "scouting")),
     Finding("Relativistic data quirk", "not stated",
             "q̇ drawn from a fixed key: the same 1.536 M velocities every epoch; loss weighted by 1 + γ",
             "the 1 + γ weighting is kept", ("relativ",), ("weighting", "fixed_velocities")),
@@ -91,7 +91,7 @@ FINDINGS = [
             "gradient-spike guard (clip 100, skip at 10x the median norm) and velocity inputs scaled by 0.3; 1.1e7 "
             "samples in all against the code's 3e8 (full: the same halving, 4e7, continued at peak 2e-3). The paper "
             "profile keeps the code's recipe",
-            ("double_pendulum",), ("scouting", "lr", "lr_start", "guard", "input_scale")),
+            ("double_pendulum",), ("scouting", "schedule", "guard", "input_scale")),
     Finding("Hidden wrappers", "not stated", "NaN guards, seed restarts, l2 penalty 1e-6·||θ||²/512",
             "the l2 penalty as each protocol records it (the double-pendulum protocols keep 1e-6/512); non-finite "
             "losses are reported as failed units, excluded from verdicts, not restarted silently",

@@ -4,21 +4,23 @@ mass-spring and the pendulum. HNN on canonical (q, p) with targets (qdot, pdot);
 from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part
 from replication.claims.rules import better_by
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (200, 200)}
 _hnn = {"kind": "hnn", "activation": "tanh", "init": "xavier"}
 _base_m = {"kind": "baseline", "activation": "tanh", "init": "xavier"}
-HAM = {"task": "hamiltonian", "coords": "qp"}
-MODELS = (ModelEntry("hnn_spring", _hnn, hidden=W, overrides={"data": "spring_iid", **HAM}),
-          ModelEntry("baseline_spring", _base_m, hidden=W, overrides={"data": "spring_iid"}),
-          ModelEntry("hnn_pendulum", _hnn, hidden=W, overrides={"data": "pendulum_iid", **HAM}),
-          ModelEntry("baseline_pendulum", _base_m, hidden=W, overrides={"data": "pendulum_iid"}))
-_base = Protocol(data="spring_iid", steps=20, batch=32, n_train=640, n_heldout=512, loss="mse", lr=1e-3,
-                 schedule="onecycle", log_every=5)
+HAM = {"task": "hamiltonian", "data.coords": "qp"}
+MODELS = (ModelEntry("hnn_spring", _hnn, hidden=W, overrides={"data.recipe": "spring_iid", **HAM}),
+          ModelEntry("baseline_spring", _base_m, hidden=W, overrides={"data.recipe": "spring_iid"}),
+          ModelEntry("hnn_pendulum", _hnn, hidden=W, overrides={"data.recipe": "pendulum_iid", **HAM}),
+          ModelEntry("baseline_pendulum", _base_m, hidden=W, overrides={"data.recipe": "pendulum_iid"}))
+_data = Data("spring_iid", n_train=640, n_heldout=512)
+_base = Protocol(data=_data, steps=20, batch=32, loss="mse", schedule=OneCycle(lr=1e-3), log_every=5)
 PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=2000, batch=128, n_train=128 * 200, n_heldout=5000, log_every=50),
-             "paper": _base.replace(steps=20_000, batch=256, n_train=256 * 500, n_heldout=20_000, log_every=500)}
+             "quick": _base.replace(steps=2000, batch=128, data=_data.replace(n_train=128 * 200, n_heldout=5000), log_every=50),
+             "paper": _base.replace(steps=20_000, batch=256, data=_data.replace(n_train=256 * 500, n_heldout=20_000),
+                                    log_every=500)}
 PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 EVAL = {"smoke": {"n_ics": 3, "t_end": 2.0, "n_t": 21, "dt": 0.01, "energy_scale": 1.0},
         "quick": {"n_ics": 10, "t_end": 30.0, "n_t": 301, "dt": 0.02, "energy_scale": 1.0},  # RK4 drift ~1e-6

@@ -10,9 +10,10 @@ WIDTHS = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "full": dp.QUICK_W, "paper":
 PACE_STEPS = 5000
 _scout = scout_protocol(dp.PROTOCOLS["quick"])   # the claims 1-2 scouts: batch 32, peak 1e-3, guard
 PROTOCOLS = {"smoke": scout_protocol(dp.PROTOCOLS["smoke"]).replace(cohort=2),
-             "quick": _scout.replace(steps=PACE_STEPS, n_heldout=10_000, log_every=100, cohort=8,
+             "quick": _scout.replace(steps=PACE_STEPS, data=_scout.data.replace(n_heldout=10_000), log_every=100, cohort=8,
                                      tracking=Tracking(every=500)),
-             "full": _scout.replace(n_heldout=20_000, log_every=100, cohort=8, tracking=Tracking(every=500)),
+             "full": _scout.replace(data=_scout.data.replace(n_heldout=20_000), log_every=100, cohort=8,
+                                    tracking=Tracking(every=500)),
              "paper": dp.PROTOCOLS["paper"].replace(steps=40_000)}
 # seeds a model: at least `stats.seeds_needed(0.05, rivals)` (7 for 3 or 5 rivals) in every profile that
 # decides (`tests/replication/claims/test_claims_records.py`); smoke's 2 decide nothing, by design

@@ -4,7 +4,7 @@
 the profile: per model that runs, its model spec fields, widths and protocol; the evaluation config; the
 seed count; the competence bars; the parts (the models they read and control, their rule and the rule's
 parameters); the variants; the metric.
-`protocol_hash(claim, profile) -> str`: the first 16 hex digits of the sha256 of its canonical JSON.
+`protocol_hash(claim, profile) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its canonical JSON).
 `registrations()`: the committed records (`registrations.json`): {claim id: [line, ...]} oldest first, a
 line {"profile", "protocol_hash", "frozen" (the date it was frozen), "tuned_on" (the split its choices
 read), "note" (how it was chosen)}.
@@ -18,13 +18,13 @@ current protocol matches none (nothing else changes).
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 from datetime import date
 from functools import lru_cache
 from pathlib import Path
 
 from replication.claims.base import PROFILES
+from replication.training.protocol import canonical_hash
 
 FILE = Path(__file__).with_name("registrations.json")
 _SIMPLE = (str, int, float, bool, tuple, type(None))
@@ -49,8 +49,7 @@ def fingerprint(claim, profile: str) -> dict:
 
 
 def protocol_hash(claim, profile: str) -> str:
-    text = json.dumps(fingerprint(claim, profile), sort_keys=True, default=repr)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return canonical_hash(fingerprint(claim, profile), 16)
 
 
 @lru_cache(maxsize=1)

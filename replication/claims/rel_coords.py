@@ -25,45 +25,47 @@ from replication.claims.bars import Bar
 from replication.claims.base import Claim, ModelEntry, Part, Variant
 from replication.claims.published import Published
 from replication.claims.rules import fails
-from replication.training.protocol import Protocol, Scouting, Tracking
+from replication.training.protocol import Data, Protocol, Scouting, Tracking
+from replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "full": (128, 128, 128), "paper": (500, 500, 500, 500)}
 # inputs (q, qdot[, gamma], g): the LNNs see q unscaled, the HNNs on (q, qdot) q / 10; g / 10 for all
-CANONICAL_RATE = {"lr": 3e-3, "scouting.lr": 3e-3}
+CANONICAL_RATE = {"schedule.lr": 3e-3, "scouting.schedule.lr": 3e-3}
 LORENTZ = {"lorentz_factor": True, "extra_inputs": 1, "activation": "softplus"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1}
 _hnn = {"kind": "hnn", "activation": "softplus", "init": "xavier", "extra_inputs": 1}
-QQDOT = {"task": "hamiltonian", "coords": "qqdot"}
+QQDOT = {"task": "hamiltonian", "data.coords": "qqdot"}
 MODELS = (
     ModelEntry("lnn", {**_lnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W),
     ModelEntry("hnn_qqdot", {**_hnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides=QQDOT),
     ModelEntry("hnn_qp", {**_hnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W,
-               overrides={"task": "hamiltonian", "coords": "qp", "quick": CANONICAL_RATE, "full": CANONICAL_RATE},
+               overrides={"task": "hamiltonian", "data.coords": "qp", "quick": CANONICAL_RATE, "full": CANONICAL_RATE},
                profile_spec={"quick": {"input_scale": (0.1, 0.01, 0.1)}, "full": {"input_scale": (0.1, 0.01, 0.1)}}),
     # positive control: the HNN on (q, qdot) of the pendulum (m = l = 1: qdot is the canonical momentum)
     ModelEntry("hnn_qqdot_control", {k: v for k, v in _hnn.items() if k != "extra_inputs"}, hidden=W,
-               overrides={**QQDOT, "data": "pendulum_iid", "loss": "l1"}),
+               overrides={**QQDOT, "data.recipe": "pendulum_iid", "loss": "l1"}),
     # the variant: the models on (q, qdot) also see gamma(qdot)
     ModelEntry("lnn_gamma", {**_lnn, "input_scale": (1.0, 1.0, 0.01, 0.1), **LORENTZ}, hidden=W),
     ModelEntry("hnn_qqdot_gamma", {"kind": "hnn", "init": "xavier", "input_scale": (0.1, 1.0, 0.01, 0.1), **LORENTZ},
                hidden=W, overrides=QQDOT),
 )
 
-_base = Protocol(data="relativistic_iid", steps=20, batch=32, n_train=640, n_heldout=512, loss="l1_gamma",
-                 lr=1e-3, schedule="onecycle", lr_start=0.3, log_every=5)
+_data = Data("relativistic_iid", n_train=640, n_heldout=512)
+_base = Protocol(data=_data, steps=20, batch=32, loss="l1_gamma", schedule=OneCycle(lr=1e-3, start=0.3), log_every=5)
 _SRC = "original code, SpecialRelativity notebooks, weighted-L1 training loss: "
 PROTOCOLS = {
     "smoke": _base,
     # restarts over initialisations at a ten times higher rate, for every model alike: 8 scouts x 200 steps
     # at 1e-2, the best by training loss continued 1500 steps at 1e-2 (one-cycle)
-    "quick": _base.replace(steps=1500, batch=256, n_train=256 * 400, n_heldout=20_000, log_every=50,
-                           tracking=Tracking(every=100), lr=1e-2,
-                           scouting=Scouting(count=8, steps=200, batch=256, lr=1e-2, lr_start=0.3)),
-    "paper": _base.replace(steps=300_000, batch=512, n_train=512 * 3000, n_heldout=100_000, log_every=1000),
+    "quick": _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 400, n_heldout=20_000), log_every=50,
+                           tracking=Tracking(every=100), schedule=OneCycle(lr=1e-2, start=0.3),
+                           scouting=Scouting(count=8, steps=200, batch=256, schedule=OneCycle(lr=1e-2, start=0.3))),
+    "paper": _base.replace(steps=300_000, batch=512, data=_data.replace(n_train=512 * 3000, n_heldout=100_000),
+                           log_every=1000),
 }
 # full: 13x quick's continuation, judged on 1e5 held-out states
-PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, n_heldout=100_000, log_every=500,
-                                               tracking=Tracking(every=2000))
+PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, data=PROTOCOLS["quick"].data.replace(n_heldout=100_000),
+                                               log_every=500, tracking=Tracking(every=2000))
 
 BUDGET = "the original's 4 x 500 LNN left its plateau after 5.8e7 samples"
 

@@ -22,7 +22,7 @@ def lagrangian_callable(s):
 def eval_exact_lagrangian(ctx) -> Evaluation:
     s = system_of(ctx.protocol)
     rng = np.random.default_rng(ctx.split.draw_offset)
-    st = s.sample_states(ctx.protocol.n_heldout, rng)
+    st = s.sample_states(ctx.protocol.data.n_heldout, rng)
     q, qdot = st["q"], st["qdot"]
     L = lagrangian_callable(s)
     form = ctx.spec.formulation

@@ -54,8 +54,8 @@ class Evaluation:
 
 
 def system_of(protocol, **extra):
-    name = protocol.data.removesuffix("_iid")
-    return systems.get(name, **{**dict(protocol.system_params), **extra})
+    name = protocol.data.recipe.removesuffix("_iid")
+    return systems.get(name, **{**dict(protocol.data.system_params), **extra})
 
 
 def heldout_of(ctx, protocol=None, **kw) -> dict:
@@ -68,7 +68,7 @@ def truth_key(ctx) -> tuple:
     initial conditions' seed (`ic_seed`, default 0) moved by the split's offset."""
     cfg = dict(ctx.cfg)
     cfg["ic_seed"] = cfg.get("ic_seed", 0) + ctx.split.draw_offset
-    return ctx.protocol.data.removesuffix("_iid"), tuple(sorted(ctx.protocol.system_params)), tuple(sorted(cfg.items()))
+    return ctx.protocol.data.recipe.removesuffix("_iid"), tuple(sorted(ctx.protocol.data.system_params)), tuple(sorted(cfg.items()))
 
 
 def pdot_to_qddot(protocol, q, qdot, pdot):
@@ -91,7 +91,7 @@ def eval_heldout(ctx) -> Evaluation:
     if p.task == "hamiltonian":
         d = batch["q"].shape[-1]
         ydot = pred[:, d:]
-        qdd = ydot if p.coords == "qqdot" else pdot_to_qddot(p, batch["q"], _qdot(batch, p), ydot)
+        qdd = ydot if p.data.coords == "qqdot" else pdot_to_qddot(p, batch["q"], _qdot(batch, p), ydot)
     elif p.task == "acceleration":
         qdd = pred
     else:
@@ -136,7 +136,7 @@ def _truth(name, params, cfg_items):
 
 def _model_rollout(ctx, s, q0, qd0, t):
     p, m, d = ctx.protocol, ctx.model, s.dof
-    if p.task == "hamiltonian" and p.coords == "qp":
+    if p.task == "hamiltonian" and p.data.coords == "qp":
         p0 = s.canonical_momentum(q0, qd0, backend="numpy")
         z = rollout(hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d),
                     np.concatenate([q0, p0], 1), t, ctx.cfg["dt"])

@@ -13,11 +13,11 @@ from replication.evaluation.routines import Evaluation, eval_heldout, heldout_of
 def eval_wave(ctx) -> Evaluation:
     out = eval_heldout(ctx)
     p, cfg, m = ctx.protocol, ctx.cfg, ctx.model
-    n_small = int(dict(p.system_params).get("n", 10))
+    n_small = int(dict(p.data.system_params).get("n", 10))
     n_big = int(cfg["n_big"])
     out.metrics["heldout_l1_per_node"] = out.metrics["heldout_l1"] / n_small
-    big = p.replace(system_params=tuple(sorted({**dict(p.system_params), "n": n_big}.items())),
-                    n_heldout=min(p.n_heldout, 2000))
+    big = p.replace(**{"data.system_params": tuple(sorted({**dict(p.data.system_params), "n": n_big}.items())),
+                    "data.n_heldout": min(p.data.n_heldout, 2000)})
     b = heldout_of(ctx, big)
     tl1 = heldout_errors(m.acceleration(b["q"], b["qdot"], None), b["target"])["l1"] / n_big
     out.metrics["transfer_l1_per_node"] = tl1

@@ -238,7 +238,7 @@ def eval_fit(ctx) -> Evaluation:
     true_energy = energy_function(cfg, f.spec.dof)
     sets = {}
     if cfg.get("heldout"):
-        sets["heldout"] = userdata.rows(ctx.protocol.data, "heldout")
+        sets["heldout"] = userdata.rows(ctx.protocol.data.recipe, "heldout")
     if cfg.get("test"):
         sets["test"] = userdata.rows(cfg["test"], "test")
     sets = {k: v for k, v in sets.items() if len(v["q"])}

@@ -34,7 +34,8 @@ from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
 from replication.fit import trajectories, userdata
 from replication.run.units import Unit, run_unit
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
 SET_NAMES = {"heldout": "held-out", "test": "test"}
@@ -94,10 +95,10 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     n_train = prep.counts["train"]
-    protocol = Protocol(data=prep.reference, task=task, coords="qqdot", steps=o.steps, batch=min(o.batch, n_train),
-                        n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)),  # the file's split decides
-                        loss=o.loss, lr=o.lr, schedule=o.schedule, lr_min_ratio=o.lr_min_ratio, l2=o.weight_decay, dtype=dtype,
-                        log_every=max(1, o.steps // 100))
+    data = Data(recipe=prep.reference, n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)))  # the file's split
+    schedule = OneCycle(lr=o.lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
+    protocol = Protocol(data=data, task=task, steps=o.steps, batch=min(o.batch, n_train), loss=o.loss, l2=o.weight_decay,
+                        schedule=schedule, dtype=dtype, log_every=max(1, o.steps // 100))
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,

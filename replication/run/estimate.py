@@ -32,6 +32,7 @@ from replication.run.chains import chains
 from replication.run.environment import torch_threads as threads_of_torch
 from replication.training import compile_torch
 from replication.training import device as dev
+from replication.training.schedules import Constant
 from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
 from replication.training.train import group_key, run_training, train_cohort, train_key
 
@@ -47,8 +48,8 @@ def _per_step(rows) -> float:
 
 def _plain_step(framework, spec, protocol) -> float:
     phase = continuation_protocol(protocol)
-    p = phase.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
-                      tracking=None)
+    p = phase.replace(steps=PROBE_STEPS, log_every=1, schedule=Constant(phase.schedule.lr), tracking=None,
+                      **{"data.n_train": protocol.batch * PROBE_STEPS})
     # PyTorch's probe steps compiled where the phase's are, on the device the run trains on
     with compile_torch.like(spec, phase), dev.placed(framework, dev.resolve(dev.request(), framework)):
         return _per_step(run_training(framework, spec, p, 0).log)
@@ -56,8 +57,8 @@ def _plain_step(framework, spec, protocol) -> float:
 
 def _members_step(framework, spec, protocol, k: int) -> float:
     """Seconds per step of `k` members side by side (scouts, or a cohort of seeds)."""
-    p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule="constant", n_train=protocol.batch * PROBE_STEPS,
-                         cohort=None, tracking=None)
+    p = protocol.replace(steps=PROBE_STEPS, log_every=1, schedule=Constant(protocol.schedule.lr), cohort=None,
+                         tracking=None, **{"data.n_train": protocol.batch * PROBE_STEPS})
     rows = []
     with compile_torch.like(spec, protocol, k), dev.placed(framework, dev.resolve(dev.request(), framework)):
         train_cohort(framework, spec, p, list(range(k)), on_log=rows.append)
@@ -66,12 +67,12 @@ def _members_step(framework, spec, protocol, k: int) -> float:
 
 # what does not change the cost of a step: the init, the step counts, the rates and the pool sizes (the
 # probes leave held-out tracking off: its evaluations, the first one compiling, would count as step time)
-_FREE = ("steps", "lr", "log_every", "n_train", "n_heldout", "schedule", "lr_start", "lr_step_every", "lr_step_gamma",
-         "tracking")
+_FREE = ("steps", "log_every", "n_train", "n_heldout", "schedule", "tracking")
 
 
 def _shape(framework, spec, protocol) -> str:
     p = {k: v for k, v in protocol.to_dict().items() if k not in _FREE}
+    p["data"] = {k: v for k, v in p["data"].items() if k not in _FREE}
     if p["scouting"]:   # the scouts' count and batch set the cost of their steps
         p["scouting"] = {k: v for k, v in p["scouting"].items() if k not in _FREE}
     return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)

@@ -36,7 +36,7 @@ def _with_coords(s, st, protocol, qddot, extra=None, weight=None):
     q, qdot = st["q"], st["qdot"]
     out = {"qddot": qddot}
     if protocol.task == "hamiltonian":
-        if protocol.coords == "qp":
+        if protocol.data.coords == "qp":
             kw = {k: v for k, v in st.items() if k not in ("q", "qdot")}
             p = s.canonical_momentum(q, qdot, backend="numpy", **kw)
             pdot = _pdot(s, q, qdot, qddot, kw)
@@ -61,9 +61,9 @@ def _pdot(s, q, qdot, qddot, kw):
 def targets_version(protocol) -> str:
     """What changed in a protocol's targets since its results were first cached ("" = nothing): part of
     the training cache key, so a model trained on old targets is never reused."""
-    if protocol.task == "hamiltonian" and protocol.coords == "qp":
+    if protocol.task == "hamiltonian" and protocol.data.coords == "qp":
         return "pdot-exact"
-    if protocol.data.startswith("two_link_arm") and arm_trajectories(protocol.n_train) > protocol.n_train // ARM_POINTS:
+    if protocol.data.recipe.startswith("two_link_arm") and arm_trajectories(protocol.data.n_train) > protocol.data.n_train // ARM_POINTS:
         return f"arm-min-{ARM_MIN_TRAJECTORIES}-trajectories"
     return ""
 
@@ -82,8 +82,8 @@ def arm_trajectories(n: int) -> int:
 
 def recipe_iid(protocol, n, rng):
     """i.i.d. states from the system's declared distribution, exact targets."""
-    name = protocol.data.removesuffix("_iid")
-    params = tuple(sorted(protocol.system_params))
+    name = protocol.data.recipe.removesuffix("_iid")
+    params = tuple(sorted(protocol.data.system_params))
     s, st = _states(name, params, n, rng)
     fixed = dict(params)
     kw = {k: v for k, v in st.items() if k not in ("q", "qdot") and k not in fixed}
@@ -113,26 +113,26 @@ def recipe_file(protocol, n, rng, kind="train"):
     """A user's data file (see `replication.fit.userdata`): the train or held-out rows, as a batch dict."""
     from replication.fit.userdata import split_rows
 
-    return split_rows(protocol.data.removeprefix("file:"), protocol.task, kind)
+    return split_rows(protocol.data.recipe.removeprefix("file:"), protocol.task, kind)
 
 
 def recipe_for(protocol):
-    if protocol.data.startswith("file:"):
+    if protocol.data.recipe.startswith("file:"):
         return recipe_file
-    if protocol.data.endswith("_iid"):
+    if protocol.data.recipe.endswith("_iid"):
         return recipe_iid
-    if protocol.data.startswith("two_link_arm"):
+    if protocol.data.recipe.startswith("two_link_arm"):
         return recipe_arm
-    raise ValueError(f"unknown data recipe {protocol.data!r}; valid: <system>_iid, two_link_arm")
+    raise ValueError(f"unknown data recipe {protocol.data.recipe!r}; valid: <system>_iid, two_link_arm")
 
 
 def heldout(protocol, seed: int = HELDOUT_SEED, **kw) -> dict:
     """The fixed held-out set of a protocol (the same for every seed and model): the draw of generator
     `seed` (`replication.run.splits`: the development draw unless a test run's evaluation asks for its own);
     a user's file: its held-out rows."""
-    if protocol.data.startswith("file:"):
+    if protocol.data.recipe.startswith("file:"):
         kw = {"kind": "heldout", **kw}
-    return recipe_for(protocol)(protocol, protocol.n_heldout, np.random.default_rng(seed), **kw)
+    return recipe_for(protocol)(protocol, protocol.data.n_heldout, np.random.default_rng(seed), **kw)
 
 
 class BatchStream:
@@ -141,19 +141,19 @@ class BatchStream:
     def __init__(self, protocol, seed: int):
         self.p = protocol
         self.seed = int(seed)
-        self.per_epoch = protocol.n_train // protocol.batch
+        self.per_epoch = protocol.data.n_train // protocol.batch
         self._epoch = None
         self._pool = None
         self._order = None
         self._fixed = None
 
     def _load_epoch(self, epoch):
-        if self.p.resample or self._fixed is None:
-            rng = np.random.default_rng([self.seed, 7919, epoch if self.p.resample else 0])
-            self._pool = recipe_for(self.p)(self.p, self.p.n_train, rng)
-            if not self.p.resample:
+        if self.p.data.resample or self._fixed is None:
+            rng = np.random.default_rng([self.seed, 7919, epoch if self.p.data.resample else 0])
+            self._pool = recipe_for(self.p)(self.p, self.p.data.n_train, rng)
+            if not self.p.data.resample:
                 self._fixed = self._pool
-        self._order = np.random.default_rng([self.seed, 104729, epoch]).permutation(self.p.n_train)
+        self._order = np.random.default_rng([self.seed, 104729, epoch]).permutation(self.p.data.n_train)
         self._epoch = epoch
 
     def batch(self, step: int) -> dict:

@@ -83,9 +83,9 @@ def init_seeds(protocol, seed: int) -> list[int]:
 
 
 def scout_protocol(protocol):
-    """The protocol each scout trains under: the scouting's steps, batch, rate and start, no scouting."""
+    """The protocol each scout trains under: the scouting's steps, batch and schedule, no scouting."""
     s = protocol.scouting
-    return protocol.replace(steps=s.steps, batch=s.batch, lr=s.lr, lr_start=s.lr_start, scouting=None)
+    return protocol.replace(steps=s.steps, batch=s.batch, schedule=s.schedule, scouting=None)
 
 
 def continuation_protocol(protocol):

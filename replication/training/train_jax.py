@@ -65,7 +65,7 @@ def make_step(spec, protocol):
     gnorm): one Adam step on the gradient clipped to protocol.grad_clip (unless None); not taken (model and state
     returned unchanged) when gnorm >= skip_above (`replication.training.spike_guard`)."""
     loss_fn = make_loss(spec, protocol)
-    opt = optax.scale_by_adam(b1=protocol.b1, b2=protocol.b2, eps=protocol.eps)
+    opt = optax.scale_by_adam(b1=protocol.optimiser.b1, b2=protocol.optimiser.b2, eps=protocol.optimiser.eps)
     clip = protocol.grad_clip
 
     @eqx.filter_jit

@@ -79,8 +79,8 @@ class Stepper:
         self.model = models.torch.build(spec, params)
         self.loss_fn = compiled_loss(make_loss(spec, protocol), spec, protocol)
         self.look = make_probe(spec, protocol)
-        self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.lr, betas=(protocol.b1, protocol.b2),
-                                    eps=protocol.eps, weight_decay=0.0, **ADAM_KERNEL)
+        self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.schedule.lr, betas=(protocol.optimiser.b1, protocol.optimiser.b2),
+                                    eps=protocol.optimiser.eps, weight_decay=0.0, **ADAM_KERNEL)
         self.clip_to, self._grads = protocol.grad_clip, []   # None: no clip (the guard's scale stays 1)
 
     def propose(self, batch, lr, bound):
@@ -154,8 +154,8 @@ class _Objective(nn.Module):
 def _fused_adam(params, grads, exp_avgs, exp_avg_sqs, steps, lr, protocol):
     """torch.optim.Adam(fused=True)'s kernel on lists of tensors, each with its step count after this step
     (0-d float32 tensors, as Adam's state holds them): one pass over each tensor."""
-    torch._fused_adam_(params, grads, exp_avgs, exp_avg_sqs, [], steps, lr=lr, beta1=protocol.b1, beta2=protocol.b2,
-                       weight_decay=0.0, eps=protocol.eps, amsgrad=False, maximize=False)
+    torch._fused_adam_(params, grads, exp_avgs, exp_avg_sqs, [], steps, lr=lr, beta1=protocol.optimiser.b1, beta2=protocol.optimiser.b2,
+                       weight_decay=0.0, eps=protocol.optimiser.eps, amsgrad=False, maximize=False)
 
 
 class Members:

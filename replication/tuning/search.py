@@ -34,9 +34,9 @@ def configs(n: int, seed: int = 0) -> list[dict]:
 def apply(entry, base, profile: str, knobs: dict):
     """`entry` (a claims.base.ModelEntry) with the knob values applied to its protocol and widths."""
     p = entry.protocol(base, profile)
-    change = {"lr": p.lr * knobs["lr"]}
+    change = {"schedule.lr": p.schedule.lr * knobs["lr"]}
     if p.scouting:
-        change["scouting.lr"] = p.scouting.lr * knobs["lr"]
+        change["scouting.schedule.lr"] = p.scouting.schedule.lr * knobs["lr"]
     common = {k: v for k, v in entry.overrides.items() if k not in PROFILES}
     per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
     hidden = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))

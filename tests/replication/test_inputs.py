@@ -7,7 +7,7 @@ from replication.cli import main
 from replication.fit import userdata
 from replication.fit.task import fit
 from replication.run.runner import plan
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
 
 
 @pytest.mark.parametrize("kwargs, words", [
@@ -23,10 +23,11 @@ def test_unknown_names_list_valid_ones(kwargs, words):
 
 
 @pytest.mark.parametrize("field, value", [("loss", "huber"), ("schedule", "warm"), ("dtype", "float16"),
-                                          ("steps", 0), ("batch", -1), ("lr", -1.0)])
+                                          ("steps", 0), ("batch", -1), ("schedule.lr", -1.0)])
 def test_protocol_rejects_bad_fields(field, value):
-    with pytest.raises(ValueError, match=field if field not in ("lr",) else "learning rate"):
-        Protocol(**{"data": "spring_iid", "steps": 10, "batch": 4, "n_train": 16, field: value})
+    ok = Protocol(data=Data("spring_iid", n_train=16), steps=10, batch=4)
+    with pytest.raises(ValueError, match=field if field != "schedule.lr" else "learning rate"):
+        ok.replace(**{field: value})
 
 
 def test_cli_reports_errors_without_a_traceback(capsys):

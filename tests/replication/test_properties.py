@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 import systems
 from replication.evaluation import metrics
 from replication.fit import userdata
-from replication.training.protocol import Protocol
-from replication.training.schedules import learning_rate
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import SCHEDULES, Constant, OneCycle, StepDecay, learning_rate
 
 CLEAN = (ValueError, TypeError, KeyError)
 FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -35,22 +35,25 @@ def _clean(err):
        schedule=st.sampled_from(["constant", "step", "onecycle", "cosine"]), every=weird_numbers)
 def test_protocol_is_valid_or_rejected_cleanly(steps, batch, n_train, lr, dtype, schedule, every):
     try:
-        p = Protocol(data="spring_iid", steps=steps, batch=batch, n_train=n_train, lr=lr, dtype=dtype,
-                     schedule=schedule, lr_step_every=every)
+        sched = SCHEDULES[schedule](**{"lr": lr, **({"every": every, "gamma": 0.1} if schedule == "step" else {})})
+        p = Protocol(data=Data("spring_iid", n_train=n_train), steps=steps, batch=batch, dtype=dtype, schedule=sched)
     except Exception as e:  # noqa: BLE001 - the property is the exception's type and message
         _clean(e)
         return
-    assert int(p.steps) >= 1 and 1 <= int(p.batch) <= int(p.n_train)
-    assert math.isfinite(p.lr) and p.lr > 0 and p.dtype in ("float32", "float64")
+    assert int(p.steps) >= 1 and 1 <= int(p.batch) <= int(p.data.n_train)
+    assert math.isfinite(p.schedule.lr) and p.schedule.lr > 0 and p.dtype in ("float32", "float64")
     assert Protocol.from_dict(p.to_dict()) == p
 
 
 @pytest.mark.parametrize("field, value", [("steps", math.inf), ("steps", math.nan), ("steps", 2.5), ("batch", None),
-                                          ("lr", math.inf), ("lr", math.nan), ("lr", "1e-3"), ("lr_step_every", 0),
-                                          ("log_every", -1), ("n_heldout", True)])
+                                          ("schedule.lr", math.inf), ("schedule.lr", math.nan), ("schedule.lr", "1e-3"),
+                                          ("log_every", -1), ("data.n_heldout", True), ("data.n_train", 0.5)])
 def test_protocol_rejects_non_finite_or_non_integer_fields(field, value):
-    with pytest.raises(ValueError, match="learning rate" if field == "lr" else field):
-        Protocol(**{"data": "spring_iid", "steps": 10, "batch": 1, "n_train": 4, field: value})
+    ok = Protocol(data=Data("spring_iid", n_train=4), steps=10, batch=1)
+    with pytest.raises(ValueError, match="learning rate" if field == "schedule.lr" else field.split(".")[-1]):
+        ok.replace(**{field: value})
+    with pytest.raises(ValueError, match="step schedule every"):
+        StepDecay(lr=1e-3, every=0, gamma=0.1)
 
 
 # --- learning-rate schedules --------------------------------------------------------------------------
@@ -62,8 +65,9 @@ def test_protocol_rejects_non_finite_or_non_integer_fields(field, value):
        ratio=st.floats(0.0, 1.0), frac=st.lists(st.floats(0.0, 1.0), min_size=2, max_size=8))
 def test_schedules_are_finite_bounded_pure_functions_of_the_step(lr, steps, schedule, gamma, every, start, ratio,
                                                                  frac):
-    p = Protocol(data="spring_iid", steps=steps, batch=1, n_train=1, lr=lr, schedule=schedule, lr_step_gamma=gamma,
-                 lr_step_every=every, lr_start=start, lr_min_ratio=ratio)
+    sched = {"constant": Constant(lr=lr), "step": StepDecay(lr=lr, every=every, gamma=gamma),
+             "onecycle": OneCycle(lr=lr, start=start, min_ratio=ratio)}[schedule]
+    p = Protocol(data=Data("spring_iid", n_train=1), steps=steps, batch=1, schedule=sched)
     ks = sorted({int(round(f * steps)) for f in frac})
     vals = [learning_rate(p, k) for k in ks]
     assert vals == [learning_rate(p, k) for k in ks]            # pure: same step, same float
@@ -81,7 +85,7 @@ def test_schedules_are_finite_bounded_pure_functions_of_the_step(lr, steps, sche
 @given(step=st.one_of(st.integers(max_value=-1), st.floats(allow_nan=True, allow_infinity=True).filter(
     lambda x: not (math.isfinite(x) and x >= 0))))
 def test_schedule_rejects_negative_or_non_finite_steps(step):
-    p = Protocol(data="spring_iid", steps=10, batch=1, n_train=1, schedule="step")
+    p = Protocol(data=Data("spring_iid", n_train=1), steps=10, batch=1, schedule=StepDecay(lr=1e-3, every=1000, gamma=0.1))
     with pytest.raises(ValueError, match="step"):
         learning_rate(p, step)
 

@@ -31,9 +31,10 @@ def test_apply_changes_only_the_knobs():
     assert same.protocol(base, "quick") == p0 and same.widths("quick") == entry.widths("quick")
     other = search.apply(entry, base, "quick", {"lr": 3.0, "width": 0.5})
     p = other.protocol(base, "quick")
-    assert p.lr == pytest.approx(3 * p0.lr) and p.scouting.lr == pytest.approx(3 * p0.scouting.lr)
+    assert p.schedule.lr == pytest.approx(3 * p0.schedule.lr)
+    assert p.scouting.schedule.lr == pytest.approx(3 * p0.scouting.schedule.lr)
     assert other.widths("quick") == tuple(w // 2 for w in entry.widths("quick"))
-    assert p.replace(lr=p0.lr, **{"scouting.lr": p0.scouting.lr}) == p0   # the budget and everything else as registered
+    assert p.replace(**{"schedule.lr": p0.schedule.lr, "scouting.schedule.lr": p0.scouting.schedule.lr}) == p0   # the budget and everything else as registered
 
 
 def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path, monkeypatch):

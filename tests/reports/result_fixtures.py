@@ -16,7 +16,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from replication.training.protocol import Data, Protocol
+
 FRAMEWORKS = ["jax", "torch"]
+PROTOCOL = Protocol(data=Data("double_pendulum_iid", n_train=10000), steps=100, batch=32).to_dict()
 SEEDS = [0, 1]
 CORRUPT = ("dp_loss", "torch", "lnn", 2)
 NOT_RUN_CLAIM = "activation_study"
@@ -123,7 +126,7 @@ def write_unit(root: Path, cid: str, fw: str, model: str, seed: int, rng) -> dic
         "status": "ok", "failure": None, "metrics": metrics, "counters": {"hessian_fallbacks": 0},
         "model_spec": {"kind": model.split("_")[0], "dof": 2, "hidden": [16, 16], "activation": "softplus",
                        "init": "cranmer2020"},
-        "protocol": {"steps": 100, "batch": 32, "n_train": 10000, "variant": "code"}, "dtype": "float32",
+        "protocol": PROTOCOL, "dtype": "float32",
         "wall_time_s": 2.0, "train_time_s": 1.5 + seed, "train_steps": 100,
         "train_samples_per_s": (1000.0 if fw == "jax" else 800.0) * (2 if "baseline" in model else 1),
         "versions": {"python": "3.11.7", "numpy": "2.4", fw: "1.0"}, "commit": "abc1234",

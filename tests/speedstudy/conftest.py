@@ -7,7 +7,10 @@ import pytest
 
 from models import ModelSpec, init_params
 from replication.results import write_npz
+from replication.training.protocol import Data, Protocol
 from speedstudy import run_bench
+
+PROTOCOL = Protocol(data=Data("double_pendulum_iid", n_train=64), steps=10, batch=8).to_dict()
 
 
 def _fake_trained_unit(out):
@@ -18,7 +21,7 @@ def _fake_trained_unit(out):
     write_npz(unit / "checkpoint.npz", init_params(spec, seed=3))
     (unit / "result.json").write_text(json.dumps({
         "claim": "dp_loss", "framework": "jax", "model": "lnn", "seed": 0, "status": "ok",
-        "model_spec": spec.to_dict(), "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+        "model_spec": spec.to_dict(), "protocol": PROTOCOL}))
 
 
 def _fake_training_cache(out):
@@ -30,7 +33,7 @@ def _fake_training_cache(out):
     write_npz(folder / "checkpoint.npz", init_params(spec, seed=4))
     (folder / "result.json").write_text(json.dumps({
         "failure": None, "steps_done": 10, "batch": 8, "spec": spec.to_dict(), "seed": 0,
-        "protocol": {"data": "double_pendulum_iid", "task": "acceleration"}}))
+        "protocol": PROTOCOL}))
 
 
 @pytest.fixture(scope="session")

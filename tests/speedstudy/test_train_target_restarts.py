@@ -107,9 +107,9 @@ def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured(
     """full's claims 1-2 train what restarts_halved trains at FULL_SAMPLES (4e7): the same protocol."""
     from replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
     full = PROTOCOLS["full"]
-    entry = TT.protocols(FULL_SAMPLES, full.n_heldout)["restarts_halved"]
-    logging_only = {"log_every": 1, "tracking": None, "lr_step_every": 1}   # lr_step_every: step schedules only
-    assert full.schedule == "onecycle"
+    entry = TT.protocols(FULL_SAMPLES, full.data.n_heldout)["restarts_halved"]
+    logging_only = {"log_every": 1, "tracking": None}
+    assert full.schedule.kind == "onecycle"
     assert full.replace(**logging_only) == entry.protocol.replace(**logging_only)
     assert scouting.scouting_samples(full) + full.steps * full.batch <= FULL_SAMPLES
     assert entry.overrides.get("input_scale") == VELOCITY_SCALE["quick"]["input_scale"]

@@ -43,7 +43,7 @@ def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
             **options, **TINY)
     assert d["status"] == "ok" and d["protocol"]["task"] == "inverse_dynamics" and d["metric"] == "test_l1"
     p, s = d["protocol"], d["model_spec"]
-    assert (s["activation"], p["l2"], p["schedule"], s["delan_eps"], s["delan_diag_offset"]) == ("tanh", 1e-5,
+    assert (s["activation"], p["l2"], p["schedule"]["kind"], s["delan_eps"], s["delan_diag_offset"]) == ("tanh", 1e-5,
                                                                                                  "constant", 0.1, 1.0)
     t = np.arange(40)[7:33] * 0.02  # the samples with a centred derivative window (15) of each trajectory
     q_train = np.concatenate([np.stack([np.sin(t + k), np.cos(2 * t + k)], 1) for k in range(3)])

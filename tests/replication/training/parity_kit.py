@@ -31,7 +31,7 @@ _JAX_STEPS: dict = {}
 
 
 def _jax_step(spec, protocol, members: bool):
-    key = (spec, protocol.task, protocol.loss, protocol.l2, protocol.b1, protocol.b2, protocol.eps,
+    key = (spec, protocol.task, protocol.loss, protocol.l2, protocol.optimiser,
            protocol.grad_clip, members)
     if key not in _JAX_STEPS:
         _JAX_STEPS[key] = (train_jax.make_members_step if members else train_jax.make_step)(spec, protocol)
@@ -166,7 +166,7 @@ def table(rows) -> str:
         d, bad = run_row(row)
         p, tol = row.protocol, row.tolerance
         form = row.spec.formulation if row.spec.kind in ("lnn", "lgn") else "-"
-        task = p.task + (f" ({p.coords})" if p.task == "hamiltonian" else "")
+        task = p.task + (f" ({p.data.coords})" if p.task == "hamiltonian" else "")
         guard = " + guard" if p.guard else ""
         steps = {"one": f"{d['steps']}", "members": f"{d['steps']} (x{len(row.seeds)} members)",
                  "scouted": f"{p.scouting.steps} (x{p.scouting.count} scouts) + {d['steps'] - p.scouting.steps}"}[row.mode]

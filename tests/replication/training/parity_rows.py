@@ -13,7 +13,8 @@ import dataclasses
 from dataclasses import dataclass
 
 from models import ModelSpec
-from replication.training.protocol import Guard, Protocol, Scouting
+from replication.training.protocol import Data, Guard, Protocol, Scouting
+from replication.training.schedules import Constant, OneCycle, StepDecay
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
@@ -45,9 +46,14 @@ class Row:
         return TOLERANCE[dtype + " chaotic" if dtype == "float32" and self.chaotic else dtype]
 
 
-def _p(data, **kw) -> Protocol:
-    base = {"steps": F64_STEPS, "batch": 16, "n_train": 64, "n_heldout": 16, "dtype": "float64", "log_every": 1}
-    return Protocol(data=data, **{**base, **kw})
+DATA_FIELDS = ("n_train", "n_heldout", "resample", "system_params", "coords")
+
+
+def _p(recipe, **kw) -> Protocol:
+    """A protocol of short float64 runs; the `Data` fields given among the keywords."""
+    kw = {"steps": F64_STEPS, "batch": 16, "n_train": 64, "n_heldout": 16, "dtype": "float64", "log_every": 1, **kw}
+    data = Data(recipe, **{k: kw.pop(k) for k in DATA_FIELDS if k in kw})
+    return Protocol(data=data, **kw)
 
 
 def _s(kind, dof, **kw) -> ModelSpec:
@@ -55,20 +61,20 @@ def _s(kind, dof, **kw) -> ModelSpec:
 
 
 DP = {"resample": True, "l2": 1e-6 / 512}                       # the double-pendulum protocol (l1, one-cycle)
-REL = {"loss": "l1_gamma", "lr_start": 0.3}                     # the relativistic protocol
+REL = {"loss": "l1_gamma", "schedule": OneCycle(lr=1e-3, start=0.3)}                     # the relativistic protocol
 LNN = _s("lnn", 2, angle_wrap=True)
 C = {"chaotic": True}
 GUARD = {"guard": Guard(clip=30.0, skip=1.0)}   # clip below the norms, skip at the median: both act often
 GUARDED = _p("double_pendulum_iid", **DP, **GUARD, steps=40)
 MEMBERS = GUARDED.replace(batch=8)
-SCOUTED = GUARDED.replace(scouting=Scouting(count=4, steps=10, batch=8, lr=3e-3, lr_start=GUARDED.lr_start), steps=20)
-WAVE = {"system_params": (("n", 10), ("variant", "code")), "batch": 8, "lr_start": 0.3}
+SCOUTED = GUARDED.replace(scouting=Scouting(count=4, steps=10, batch=8, schedule=OneCycle(lr=3e-3, start=GUARDED.schedule.start)), steps=20)
+WAVE = {"system_params": (("n", 10), ("variant", "code")), "batch": 8, "schedule": OneCycle(lr=1e-3, start=0.3)}
 ARM = {"task": "inverse_dynamics", "loss": "mse", "n_train": 400}
 
 F64 = [
     Row("baseline_acc", _s("baseline", 1, activation="tanh", init="xavier"), _p("spring_iid", loss="mse")),
     Row("baseline_invdyn", _s("baseline", 2, activation="softplus", init="xavier", extra_inputs=2),
-        _p("two_link_arm", **ARM, schedule="constant", l2=1e-5)),
+        _p("two_link_arm", **ARM, schedule=Constant(lr=1e-3), l2=1e-5)),
     Row("baseline_dp", _s("baseline", 2, activation="relu", init="xavier", angle_wrap=True),
         _p("double_pendulum_iid", **DP)),
     Row("lnn_fast", LNN, _p("double_pendulum_iid", **DP), **C),
@@ -82,10 +88,10 @@ F64 = [
         _p("spring_iid", task="hamiltonian", coords="qp", loss="mse")),
     Row("hnn_qqdot", _s("hnn", 1, init="xavier", extra_inputs=1, input_scale=(0.1, 1.0, 0.1)),
         _p("relativistic_iid", task="hamiltonian", coords="qqdot", **REL)),
-    Row("delan_inverse", _s("delan", 2, init="xavier"), _p("two_link_arm", **ARM, schedule="constant", l2=1e-5)),
+    Row("delan_inverse", _s("delan", 2, init="xavier"), _p("two_link_arm", **ARM, schedule=Constant(lr=1e-3), l2=1e-5)),
     Row("delan_forward", _s("delan", 2, init="xavier"), _p("charged_magnetic_iid")),
     Row("lgn_banded", _s("lgn", 10, formulation="banded"),
-        _p("wave_iid", **WAVE, schedule="step", lr_step_every=5, lr_step_gamma=0.5)),
+        _p("wave_iid", **{**WAVE, "schedule": StepDecay(lr=1e-3, every=5, gamma=0.5)})),
     Row("lgn_dense", _s("lgn", 10, formulation="dense"), _p("wave_iid", **WAVE)),
     Row("lgn_paper", _s("lgn", 10, formulation="paper"), _p("wave_iid", **WAVE), slow=True),
     # K = 4 seeds as one program, each its own init and batches (what `Protocol.cohort` runs,

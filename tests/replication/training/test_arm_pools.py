@@ -3,10 +3,10 @@ samples over several trajectories, and the cache key sees the change."""
 import numpy as np
 
 from replication.training import data as datamod
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import Constant
 
-ARM = Protocol(data="two_link_arm", task="inverse_dynamics", steps=10, batch=32, n_train=256, n_heldout=512,
-               loss="mse", lr=1e-3, schedule="constant")
+ARM = Protocol(data=Data("two_link_arm", n_train=256, n_heldout=512), task="inverse_dynamics", steps=10, batch=32, loss="mse", schedule=Constant(lr=1e-3))
 
 
 def test_a_small_pool_is_several_trajectories():
@@ -20,5 +20,5 @@ def test_a_small_pool_is_several_trajectories():
 
 def test_the_training_cache_key_changes_with_the_pool_rule_and_only_for_small_pools():
     assert datamod.targets_version(ARM) == "arm-min-8-trajectories"
-    assert datamod.targets_version(ARM.replace(n_train=4096)) == ""
-    assert datamod.targets_version(ARM.replace(n_train=1600)) == ""
+    assert datamod.targets_version(ARM.replace(**{"data.n_train": 4096})) == ""
+    assert datamod.targets_version(ARM.replace(**{"data.n_train": 1600})) == ""

@@ -6,7 +6,8 @@ from parity_rows import BY_NAME
 
 from replication.training import scouting
 from replication.training import train as training
-from replication.training.protocol import Protocol, Scouting
+from replication.training.protocol import Data, Protocol, Scouting
+from replication.training.schedules import OneCycle
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PROTOCOL = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=8, log_every=1, cohort=2)
@@ -41,8 +42,7 @@ def test_a_cohort_is_one_chain_and_one_estimate():
 
 def test_a_cohort_and_scouts_are_refused_together():
     with pytest.raises(ValueError, match="cohort 2 with scouting"):
-        Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=2,
-                 scouting=Scouting(count=4, steps=2, batch=2, lr=1e-3, lr_start=0.2))
+        Protocol(data=Data("double_pendulum_iid", n_train=4), steps=2, batch=2, cohort=2, scouting=Scouting(count=4, steps=2, batch=2, schedule=OneCycle(lr=1e-3, start=0.2)))
     for bad in (-1, 0, 1):   # one seed at a time is None, not a number
         with pytest.raises(ValueError, match="cohort"):
-            Protocol(data="double_pendulum_iid", steps=2, batch=2, n_train=4, cohort=bad)
+            Protocol(data=Data("double_pendulum_iid", n_train=4), steps=2, batch=2, cohort=bad)

@@ -86,12 +86,12 @@ def test_describe_records_the_device():
 
 def test_a_training_records_where_it_computed(tmp_path, monkeypatch):
     from models import ModelSpec
-    from replication.training.protocol import Protocol
+    from replication.training.protocol import Data, Protocol
     from replication.training.train import train_cached
 
     monkeypatch.setenv(device.ENV, "cpu")
     spec = ModelSpec(kind="baseline", dof=1, hidden=(8,), activation="tanh", init="xavier")
-    p = Protocol(data="spring_iid", steps=3, batch=4, n_train=16, n_heldout=8, log_every=1)
+    p = Protocol(data=Data("spring_iid", n_train=16, n_heldout=8), steps=3, batch=4, log_every=1)
     for fw in ("jax", "torch"):
         out = train_cached(tmp_path, fw, spec, p, 0)
         assert out.device["device"] == "cpu" and np.isfinite(out.log[-1]["loss"])

@@ -6,15 +6,15 @@ import pytest
 import systems
 from models import ModelSpec, init_params
 from replication.training import hessian_probe
-from replication.training.protocol import Protocol
+from replication.training.protocol import Data, Protocol
+from replication.training.schedules import Constant
 from replication.training.train import run_training
 
 
 @pytest.mark.parametrize("framework", ["jax", "torch"])
 def test_blow_up_is_caught_at_its_step_and_keeps_the_last_good_parameters(framework):
     spec = ModelSpec(kind="baseline", dof=2, hidden=(8,), activation="relu", init="xavier")
-    p = Protocol(data="double_pendulum_iid", steps=10, batch=8, n_train=80, lr=1e30, schedule="constant",
-                 log_every=1)
+    p = Protocol(data=Data("double_pendulum_iid", n_train=80), steps=10, batch=8, log_every=1, schedule=Constant(lr=1e30))
     o = run_training(framework, spec, p, seed=0)
     assert o.failure is not None and o.failure["kind"].startswith("non_finite")
     k = o.failure["step"]
@@ -52,8 +52,7 @@ def test_training_logs_the_hessian_health_alike_in_both_frameworks():
     """Float64, same init and batches: the probe sees the same Hessians in JAX and PyTorch at every
     logged step, and the fraction is the measured one of a freshly initialised LNN (well above 0)."""
     spec = ModelSpec(kind="lnn", dof=2, hidden=(64, 64), dtype="float64", angle_wrap=True)
-    p = Protocol(data="double_pendulum_iid", steps=6, batch=64, n_train=640, lr=1e-3, schedule="constant",
-                 log_every=2, dtype="float64")
+    p = Protocol(data=Data("double_pendulum_iid", n_train=640), steps=6, batch=64, log_every=2, dtype="float64", schedule=Constant(lr=1e-3))
     logs = {fw: run_training(fw, spec, p, seed=0).log for fw in ("jax", "torch")}
     for col in hessian_probe.COLUMNS:
         a, b = [np.array([r[col] for r in logs[fw]]) for fw in ("jax", "torch")]

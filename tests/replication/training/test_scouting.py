@@ -36,10 +36,10 @@ def test_the_run_is_its_scout_then_a_plain_continuation(runs):
     rec = runs["jax"].scouting
     s = rec["chosen"]
     scout = scouting.scout_protocol(PROTOCOL)
-    assert (scout.batch, scout.lr, scout.steps, scout.scouting) == (8, 3e-3, 10, None)
+    assert (scout.batch, scout.schedule.lr, scout.steps, scout.scouting) == (8, 3e-3, 10, None)
     alone = Recorder("jax").train(SPEC, init_params(SPEC, seed=s), scout, BatchStream(scout, s))
     rest = scouting.continuation_protocol(PROTOCOL)
-    assert rest.steps == 60 and rest.batch == 16 and rest.lr == PROTOCOL.lr and rest.scouting is None
+    assert rest.steps == 60 and rest.batch == 16 and rest.schedule == PROTOCOL.schedule and rest.scouting is None
     then = Recorder("jax").train(SPEC, alone.params, rest, BatchStream(rest, s + scouting.CONTINUATION_STREAM))
     for k in then.params:
         np.testing.assert_allclose(runs["jax"].params[k], then.params[k], rtol=1e-9, atol=1e-12)
@@ -56,31 +56,31 @@ def test_protocol_checks_and_keys():
             PROTOCOL.replace(**{"scouting.count": bad})
     with pytest.raises(ValueError, match="scouting batch"):
         PROTOCOL.replace(**{"scouting.batch": 65})
-    with pytest.raises(ValueError, match="scouting lr"):
-        PROTOCOL.replace(**{"scouting.lr": float("nan")})
+    with pytest.raises(ValueError, match="learning rate must be positive"):
+        PROTOCOL.replace(**{"scouting.schedule.lr": float("nan")})
     plain = PROTOCOL.replace(scouting=None)
     assert plain.to_dict()["scouting"] is None and PROTOCOL.key() != plain.key()
     with pytest.raises(ValueError, match="has no scouting"):
-        plain.replace(**{"scouting.lr": 1e-3})
+        plain.replace(**{"scouting.schedule.lr": 1e-3})
     assert Protocol.from_dict(PROTOCOL.to_dict()) == PROTOCOL
 
 
 def test_scouts_and_continuation_start_their_one_cycles_apart():
-    """The scouting's lr_start sets the scouts' starting phase; the continuation starts at the protocol's
-    lr_start, so it can warm up from below the rate a fresh Adam would be thrown by."""
-    from replication.training.schedules import learning_rate
+    """The scouting's schedule sets the scouts' starting phase; the continuation starts at the protocol's
+    schedule's, so it can warm up from below the rate a fresh Adam would be thrown by."""
+    from replication.training.schedules import OneCycle, learning_rate
 
-    p = PROTOCOL.replace(schedule="onecycle", lr=1e-2, lr_start=0.1,
-                         **{"scouting.lr": 1e-3, "scouting.lr_start": 0.2})
+    p = PROTOCOL.replace(schedule=OneCycle(lr=1e-2, start=0.1),
+                         **{"scouting.schedule": OneCycle(lr=1e-3, start=0.2)})
     scout, rest = scouting.scout_protocol(p), scouting.continuation_protocol(p)
-    assert (scout.lr_start, rest.lr_start, scout.scouting, rest.scouting) == (0.2, 0.1, None, None)
-    assert learning_rate(rest, 0) < learning_rate(p.replace(lr_start=0.2), 0) / 3
-    assert scouting.scout_protocol(p.replace(**{"scouting.lr_start": 0.0})).lr_start == 0.0   # 0 is a phase, not "inherit"
+    assert (scout.schedule.start, rest.schedule.start, scout.scouting, rest.scouting) == (0.2, 0.1, None, None)
+    assert learning_rate(rest, 0) < learning_rate(p.replace(**{"schedule.start": 0.2}), 0) / 3
+    assert scouting.scout_protocol(p.replace(**{"scouting.schedule.start": 0.0})).schedule.start == 0.0
     for bad in (1.0, -0.1, float("nan")):
-        with pytest.raises(ValueError, match="scouting lr_start"):
-            PROTOCOL.replace(**{"scouting.lr_start": bad})
-        with pytest.raises(ValueError, match="lr_start"):
-            PROTOCOL.replace(lr_start=bad)
+        with pytest.raises(ValueError, match="one-cycle start"):
+            p.replace(**{"scouting.schedule.start": bad})
+        with pytest.raises(ValueError, match="one-cycle start"):
+            p.replace(**{"schedule.start": bad})
 
 
 # successive halving (`Scouting.keep`): 4 scouts of 10 steps, the 2 lowest at the cut (step 5) go on

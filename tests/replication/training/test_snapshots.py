@@ -11,12 +11,13 @@ from parity_rows import GUARDED, LNN
 
 from replication.training import snapshots
 from replication.training.protocol import Scouting, Tracking
+from replication.training.schedules import OneCycle
 from replication.training.train import train_cached, train_key
 
 SPEC = LNN                                            # the chaotic double-pendulum LNN: any drift would show
 ONE = GUARDED.replace(steps=30, tracking=Tracking(every=5))        # guard acting often, held-out tracking
 COHORT = GUARDED.replace(steps=24, batch=8, cohort=3)
-SCOUTED = GUARDED.replace(scouting=Scouting(count=3, steps=8, batch=8, lr=3e-3, lr_start=GUARDED.lr_start), steps=16)
+SCOUTED = GUARDED.replace(scouting=Scouting(count=3, steps=8, batch=8, schedule=OneCycle(lr=3e-3, start=GUARDED.schedule.start)), steps=16)
 SCOUTED_CUT = SCOUTED.replace(**{"scouting.keep": 2})           # 3 scouts to step 4, the 2 lowest on to 8
 TIMING = {"wall_s", "train_s"}                        # clocks: the only columns allowed to differ
 

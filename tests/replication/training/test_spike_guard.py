@@ -11,10 +11,10 @@ import models.jax
 from models import ModelSpec, init_params
 from replication.training import train_jax
 from replication.training.data import BatchStream
-from replication.training.protocol import Guard, Protocol
+from replication.training.protocol import Data, Guard, Protocol
 from replication.training.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
 
-BASE = Protocol(data="double_pendulum_iid", steps=5, batch=8, n_train=32, dtype="float64", resample=True)
+BASE = Protocol(data=Data("double_pendulum_iid", n_train=32, resample=True), steps=5, batch=8, dtype="float64")
 
 
 def test_off_by_default():

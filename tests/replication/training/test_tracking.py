@@ -30,7 +30,7 @@ def test_tracking_changes_no_training_number_and_ends_at_the_final_models_loss(f
     t = Tracker(framework, SPEC, PLAIN.replace(tracking=Tracking(every=4)))
     pred = predict(adapter(framework, SPEC, on.params), SPEC.kind, PLAIN.task, t.batch, np.concatenate)
     final = loss_value(pred, t.batch["target"], t.batch.get("weight"), PLAIN.loss)
-    assert len(t.batch["target"]) == min(TRACK_STATES, PLAIN.n_heldout)
+    assert len(t.batch["target"]) == min(TRACK_STATES, PLAIN.data.n_heldout)
     np.testing.assert_allclose(tracked[-1]["heldout_loss"], final, rtol=1e-10)
 
 

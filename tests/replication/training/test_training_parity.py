@@ -20,7 +20,8 @@ from parity_rows import BY_NAME, F32, F64, ROWS, Row
 from models import FORMULATIONS, KINDS, ModelSpec, init_params
 from replication.claims import rel_coords
 from replication.training.data import BatchStream
-from replication.training.protocol import DTYPES, LOSSES, SCHEDULES, Protocol
+from replication.training.protocol import DTYPES, LOSSES, Data, Protocol
+from replication.training.schedules import SCHEDULES
 
 
 @pytest.mark.parametrize("row", [pytest.param(r, id=r.name, marks=[pytest.mark.slow] * r.slow) for r in ROWS])
@@ -39,11 +40,11 @@ def test_the_table_covers_every_kind_formulation_loss_schedule_and_mode():
     # the LGN's "fast" is an alias of "banded"
     assert {f for k, f in forms if k == "lnn"} == {"fast", "paper"}
     assert {f for k, f in forms if k == "lgn"} == set(FORMULATIONS) - {"fast"}
-    assert {(r.protocol.task, r.protocol.coords) for r in ROWS if r.spec.kind == "hnn"} == {
+    assert {(r.protocol.task, r.protocol.data.coords) for r in ROWS if r.spec.kind == "hnn"} == {
         ("hamiltonian", "qp"), ("hamiltonian", "qqdot")}
     for rows in (ROWS, default):
         assert {r.protocol.loss for r in rows} == set(LOSSES)
-        assert {r.protocol.schedule for r in rows} == set(SCHEDULES)
+        assert {r.protocol.schedule.kind for r in rows} == set(SCHEDULES)
         assert {r.protocol.dtype for r in rows} == set(DTYPES)
         assert {r.mode for r in rows} == {"one", "members", "scouted"}
         assert any(r.protocol.guard and r.protocol.guard.clip and r.protocol.guard.skip for r in rows)
@@ -95,7 +96,7 @@ def test_an_exact_fit_has_the_same_l1_gradient(loss):
              "target": np.stack([np.zeros(4), rng.normal(size=4)], -1), "weight": 1.0 + rng.random(4)}
     if loss == "l1":
         del batch["weight"]
-    protocol = Protocol(data="spring_iid", steps=3, batch=4, n_train=4, dtype="float64", log_every=1, loss=loss)
+    protocol = Protocol(data=Data("spring_iid", n_train=4), steps=3, batch=4, dtype="float64", log_every=1, loss=loss)
     runs = [Recorder(fw) for fw in ("jax", "torch")]
     for run in runs:
         run.train(spec, params, protocol, _Fixed(batch))
@@ -116,8 +117,7 @@ def test_relu_at_zero_has_the_same_derivative(kind, activation, formulation):
     if kind == "hnn":
         batch["target"] = rng.normal(size=(4, 4))
     task = "hamiltonian" if kind == "hnn" else "acceleration"
-    protocol = Protocol(data="spring_iid", steps=3, batch=4, n_train=4, dtype="float64", log_every=1, loss="mse",
-                        task=task)
+    protocol = Protocol(data=Data("spring_iid", n_train=4), steps=3, batch=4, dtype="float64", log_every=1, loss="mse", task=task)
     runs = [Recorder(fw) for fw in ("jax", "torch")]
     for run in runs:
         run.train(spec, init_params(spec, seed=0), protocol, _Fixed(batch))
