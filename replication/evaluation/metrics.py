@@ -42,9 +42,9 @@ def bounded_relative_error(z_pred, z_true):
     z_pred, z_true = np.asarray(z_pred), np.asarray(z_true)
     if z_pred.shape != z_true.shape or z_pred.ndim < 1:
         raise ValueError(f"bounded_relative_error: shapes must match (..., k); got {z_pred.shape} and {z_true.shape}")
-    num = np.linalg.norm(z_pred - z_true, axis=-1)
-    den = np.linalg.norm(z_pred, axis=-1) + np.linalg.norm(z_true, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # a huge prediction's norms overflow to inf
+        num = np.linalg.norm(z_pred - z_true, axis=-1)
+        den = np.linalg.norm(z_pred, axis=-1) + np.linalg.norm(z_true, axis=-1)
         err = np.where(den > 0, num / den, 0.0)
     return np.where(np.isfinite(num) & np.isfinite(den), err, 1.0)
 

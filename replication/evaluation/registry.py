@@ -12,7 +12,8 @@ from replication.evaluation.wave import eval_wave
 from replication.fit.evaluate import eval_fit
 
 # 2: null-predictor metrics for the competence bars; diverged rollouts count as +inf in the energy means
-EVALUATION_VERSION = 2
+# 3: valid prediction time, the chaos floor's from a 1e-8 perturbation and the Lyapunov time (energy rollouts)
+EVALUATION_VERSION = 3
 
 EVALUATIONS = {"heldout": eval_heldout, "pace": eval_pace, "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,

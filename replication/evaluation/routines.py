@@ -24,6 +24,7 @@ from replication.evaluation.metrics import (
     null_errors,
 )
 from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
+from replication.evaluation.valid_time import PERTURBATION, valid_times
 from replication.run.splits import DEV
 from replication.training import data as datamod
 from replication.training.objective import predict
@@ -134,6 +135,13 @@ def _truth(name, params, cfg_items):
     return s, t, q, qd, qc, qdc
 
 
+@lru_cache(maxsize=16)
+def _floor(name, params, cfg_items):
+    """The truth from the truth's initial states with PERTURBATION added to every angle: the chaos floor."""
+    s, t, q, qd, _, _ = _truth(name, params, cfg_items)
+    return systems.trajectories.integrate(s, q[:, 0] + PERTURBATION, qd[:, 0], t)
+
+
 def _model_rollout(ctx, s, q0, qd0, t):
     p, m, d = ctx.protocol, ctx.model, s.dof
     if p.task == "hamiltonian" and p.data.coords == "qp":
@@ -157,13 +165,16 @@ def eval_energy_rollout(ctx) -> Evaluation:
     cfg = ctx.cfg
     s, t, q, qd, qc, qdc = _truth(*truth_key(ctx))
     qp, qdp = _model_rollout(ctx, s, q[:, 0], qd[:, 0], t)
-    E_true, E_pred = s.energy(q, qd, backend="numpy"), s.energy(qp, qdp, backend="numpy")
+    with np.errstate(over="ignore", invalid="ignore"):   # a diverged rollout's energy is inf or nan: counted as such
+        E_true, E_pred = s.energy(q, qd, backend="numpy"), s.energy(qp, qdp, backend="numpy")
     out.metrics.update(energy_errors(E_pred, E_true, cfg["energy_scale"]))
     z_true, z_pred = np.concatenate([q, qd], -1), np.concatenate([qp, qdp], -1)
     err = bounded_relative_error(z_pred, z_true)
     floor = bounded_relative_error(np.concatenate([qc, qdc], -1), z_true)
     out.metrics["rollout_gmean_err"] = float(np.nanmean(geometric_mean_over_time(err)))
     out.metrics["chaos_floor_gmean_err"] = float(np.mean(geometric_mean_over_time(floor)))
+    vpt, vpt_columns = valid_times(t, z_pred, z_true, np.concatenate(_floor(*truth_key(ctx)), -1))
+    out.metrics.update(vpt)
     idx = np.unique(np.linspace(0, t.size - 1, min(t.size, 200)).astype(int))
     rows = []
     for b in range(q.shape[0]):
@@ -175,6 +186,7 @@ def eval_energy_rollout(ctx) -> Evaluation:
         "traj": np.arange(q.shape[0]), "energy_err_final": np.abs(E_pred[:, -1] - E_true[:, -1]) / cfg["energy_scale"],
         "energy_err_max": np.max(np.abs(E_pred - E_true), 1) / cfg["energy_scale"],
         "diverged": ~np.all(np.isfinite(E_pred), axis=1),
-        "gmean_err": geometric_mean_over_time(err), "chaos_floor_gmean_err": geometric_mean_over_time(floor)})
+        "gmean_err": geometric_mean_over_time(err), "chaos_floor_gmean_err": geometric_mean_over_time(floor),
+        **vpt_columns})
     out.arrays = {"t": t, "q_true": q[:3], "q_pred": qp[:3]}
     return out

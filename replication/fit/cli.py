@@ -7,6 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from replication.claims.base import PROFILES
 from replication.fit import options as fit_options
 from replication.training.device import HELP as DEVICE_HELP
 
@@ -106,9 +107,33 @@ def _fitted_folder(args) -> str:
     return args.fitted
 
 
+def cmd_predict(args):
+    """`evaluate --predict module:function --system NAME`: a predictor from outside scored on a system."""
+    from replication.predictor.score import score
+    from replication.user_functions import import_function
+
+    given = [o for o, v in (("--data", args.data), ("--fitted", args.fitted or args.fitted_old), ("--energy", args.energy),
+                            ("--framework", args.framework)) if v is not None]
+    if given:
+        raise ValueError(f"{given[0]}: not used with --predict (the predictor is scored on --system's own states)")
+    if not args.system:
+        raise ValueError("--system: required with --predict; see `lagbench list` for the systems")
+    fn = import_function(args.predict, "--predict")
+    d = score(fn, args.system, profile=args.profile, out=args.out, label=args.label, name=args.predict)
+    m = d["metrics"]
+    keys = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
+            "lyapunov_time_s")
+    print(f"{d['model']} on {args.system} (scored as {d['scored_like']['claim']}'s {d['scored_like']['model']}, "
+          f"test split): " + ", ".join(f"{k} {m[k]:.4g}" if m[k] is not None else f"{k} -" for k in keys if k in m) + f"; written to {d['folder']}")
+
+
 def cmd_evaluate(args):
     from replication.fit.evaluate_file import evaluate
 
+    if args.predict is not None:
+        return cmd_predict(args)
+    if args.data is None:
+        raise ValueError("--data: required; give the trajectory file to evaluate on (or --predict to score a function)")
     fitted = _fitted_folder(args)
     rollouts = RolloutBars(args.quiet, "lagbench evaluate")
     try:
@@ -156,18 +181,28 @@ def add_commands(sub) -> None:
     s.set_defaults(func=cmd_fit)
     _show_defaults(s)
 
-    s = sub.add_parser("evaluate", help="judge fitted models on a data file",
+    s = sub.add_parser("evaluate", help="judge fitted models on a data file, or score your own predictor",
                        description="Evaluate fitted models on a data file: one-step errors per component, rollouts "
                        "from each trajectory's first state, energy drift (and the true energy error with --system), "
-                       "DeLaN's decomposition. Writes OUT/units/evaluate/<framework>/<model>/seed<k>/ and OUT/data/.")
+                       "DeLaN's decomposition. Writes OUT/units/evaluate/<framework>/<model>/seed<k>/ and OUT/data/. "
+                       "With --predict module:function --system NAME: your function (NumPy q, qdot of shape (N, d) "
+                       "-> qddot (N, d), from any framework) scored as the suite scores its own models on that "
+                       "system (test split): one-step error beside the null predictor's, RK4 rollouts, energy "
+                       "error, valid prediction time against the chaos floor; writes OUT/predict/<system>/<label>/.")
     s.add_argument("--fitted", help="required: a fit's unit folder, or a `lagbench fit` results folder (every "
                    "fitted model in it)")
     # `--model` names a model kind in `fit`; here it is the old spelling of --fitted, still read
     s.add_argument("--model", dest="fitted_old", help=argparse.SUPPRESS)
-    s.add_argument("--data", required=True, help=DATA_HELP)
+    s.add_argument("--data", help="required without --predict: " + DATA_HELP)
+    s.add_argument("--predict", metavar="MODULE:FUNCTION", help="score your function qddot = f(q, qdot) on --system "
+                   "(module importable from the working folder, or path/to/file.py:function)")
+    s.add_argument("--profile", default="quick", choices=PROFILES,
+                   help="with --predict: whose held-out set and rollouts to score on")
+    s.add_argument("--label", help="with --predict: the name of its results folder (default: the function's name)")
     s.add_argument("--out", default="results/evaluate", help="results folder")
     s.add_argument("--framework", choices=("jax", "torch"), help="default: the one each model was trained in")
-    s.add_argument("--system", help="a system name for the true energy (default: the fit's --system)")
+    s.add_argument("--system", help="a system name for the true energy (default: the fit's --system); with "
+                   "--predict, the system to score on")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
     s.add_argument("--horizon", type=float, help=fit_options.HORIZON_HELP + " (default: the fit's)")

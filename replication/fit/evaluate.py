@@ -92,13 +92,9 @@ def energy_function(cfg, dof):
         import systems
 
         return systems.get(cfg["system"]).energy
-    import importlib
+    from replication.user_functions import import_function
 
-    module, _, attr = str(spec).partition(":")
-    try:
-        fn = getattr(importlib.import_module(module), attr)
-    except (ImportError, AttributeError, ValueError) as e:
-        raise ValueError(f"--energy {spec}: cannot import it ({e}); give module:function, importable from here") from None
+    fn = import_function(spec, "--energy")
     probe = np.asarray(fn(np.zeros((2, dof)), np.zeros((2, dof))))
     if probe.shape != (2,):
         raise ValueError(f"--energy {spec}: must map q, qdot of shape (N, {dof}) to (N,), gave shape {probe.shape}")

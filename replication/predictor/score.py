@@ -1,0 +1,119 @@
+"""Score a predictor from outside the suite: any function mapping NumPy (q, qdot), each (N, d), to qddot (N, d).
+
+`setup(system, profile) -> Setup`: how the suite scores its own models on `system`: the first claim (in
+claim order) with a model that learns q-double-dot of `system` from (q, qdot) alone, evaluated by
+"energy_rollout" where a claim does so, else by "heldout"; that model's protocol (its held-out set) and the
+claim's evaluation config (rollout initial conditions, horizon, step) under `profile`.
+`score(function, system, profile="quick", out=None, label=None) -> dict`: the predictor evaluated exactly as
+that model is, on the test split (`replication.run.splits.TEST`: its held-out draw and initial conditions):
+one-step errors beside the null predictor's, rollouts with the suite's RK4, the energy error along them,
+valid prediction time against the chaos floor (`replication.evaluation.valid_time`), and the seconds per
+state of one call. With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the
+evaluation's tables). `lagbench evaluate --predict module:function --system NAME` runs it.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from replication import results as R
+from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
+from replication.evaluation.routines import Context, heldout_of, system_of
+from replication.run import environment as env
+from replication.run.splits import TEST
+
+SCORED_BY = ("energy_rollout", "heldout")   # the evaluations a (q, qdot) -> qddot predictor can be put through
+
+
+@dataclass(frozen=True)
+class Setup:
+    claim: object
+    entry: object
+    protocol: object
+    evaluate: str
+    cfg: dict
+
+
+@dataclass(frozen=True)
+class External:
+    """What the evaluation routines read of a model's spec: a predictor from outside is of no suite kind."""
+    dof: int
+    kind: str = "external"
+
+
+class Predictor:
+    """A user's function as the evaluation routines call a model: float64 (..., d) arrays in and out."""
+
+    def __init__(self, function, dof: int, name: str):
+        self.function, self.dof, self.name = function, dof, name
+
+    def acceleration(self, q, qdot, extra=None):
+        q, qdot = np.asarray(q, np.float64), np.asarray(qdot, np.float64)
+        n = int(np.prod(q.shape[:-1]))
+        try:
+            out = np.asarray(self.function(q.reshape(n, self.dof), qdot.reshape(n, self.dof)), dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"--predict {self.name}: its output is not an array of numbers ({e})") from None
+        if out.shape != (n, self.dof):
+            raise ValueError(f"--predict {self.name}: must map q, qdot of shape (N, {self.dof}) to qddot of shape "
+                             f"(N, {self.dof}); for N = {n} it gave shape {out.shape}")
+        return out.reshape(q.shape)
+
+
+def _candidates(profile: str):
+    from replication.claims import CLAIMS
+
+    for c in CLAIMS.values():
+        if c.evaluate not in SCORED_BY:
+            continue
+        for m in c.models:
+            if not (m.train and m.runs_in(profile)):
+                continue
+            p, fields = m.protocol(c.protocol(profile), profile), m.spec_fields(profile)
+            if (p.task == "acceleration" and p.data.coords == "qqdot" and not fields.get("extra_inputs")
+                    and not fields.get("lorentz_factor")):
+                yield p.data.recipe.removesuffix("_iid"), Setup(c, m, p, c.evaluate, c.evaluation_config(profile))
+
+
+def setup(system: str, profile: str = "quick") -> Setup:
+    found = {}
+    for name, s in _candidates(profile):
+        if name not in found or (found[name].evaluate != "energy_rollout" and s.evaluate == "energy_rollout"):
+            found[name] = s
+    if system not in found:
+        raise ValueError(f"--system {system}: no claim scores a (q, qdot) -> qddot model on it under profile "
+                         f"{profile}; valid: {', '.join(sorted(found))}")
+    return found[system]
+
+
+def score(function, system: str, profile: str = "quick", out=None, label: str | None = None, name: str = "") -> dict:
+    """The predictor's record (see the module's doc); `name` is how errors name it (its module:function)."""
+    s = setup(system, profile)
+    label = label or getattr(function, "__name__", "predictor")
+    if not label.replace("_", "").replace("-", "").isalnum():
+        raise ValueError(f"--label {label}: use letters, digits, - and _ only (it names a folder)")
+    folder = R.output_folder(out) / "predict" / system / label if out is not None else None
+    dof = system_of(s.protocol).dof
+    model = Predictor(function, dof, name or label)
+    ctx = Context(claim=s.claim, entry=s.entry, framework="numpy", spec=External(dof), params=None,
+                  protocol=s.protocol, profile=profile, cfg=s.cfg, model=model, split=TEST)
+    batch = heldout_of(ctx)
+    t0 = time.perf_counter()
+    model.acceleration(batch["q"], batch["qdot"])
+    per_state = (time.perf_counter() - t0) / len(batch["q"])
+    ev = EVALUATIONS[s.evaluate](ctx)
+    record = {"schema": R.SCHEMA, "claim": "predict", "system": system, "predictor": name or label, "model": label,
+              "split": TEST.name, "profile": profile, "status": "ok",
+              "scored_like": {"claim": s.claim.id, "model": s.entry.label, "evaluation": s.evaluate},
+              "metrics": {**ev.metrics, "predict_s_per_state": per_state}, "counters": ev.counters,
+              "protocol": s.protocol.to_dict(), "eval_config": s.cfg, "evaluation_version": EVALUATION_VERSION,
+              "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now()}
+    if folder is None:
+        return record
+    files = {n: R.write_csv(folder / n, df) for n, df in ev.tables.items()}
+    if ev.arrays:
+        files["arrays.npz"] = R.write_npz(folder / "arrays.npz", ev.arrays)
+    return {**R.write_json(Path(folder) / "result.json", {**record, "files": files}, checksum=True), "folder": str(folder)}
