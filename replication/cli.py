@@ -65,7 +65,7 @@ def cmd_run(args):
     return 1 if summary.get("errors") else 0
 
 
-RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target")
+RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict")
 
 
 def cmd_report(args):

@@ -26,6 +26,7 @@ from reports.sections_claims import summary_sections, theme_sections
 from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
+from reports.sections_predict import predict_sections
 from reports.sections_speed import speed_sections
 from reports.sections_stiff import stiff_sections
 
@@ -34,8 +35,9 @@ TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
 def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
     res = load_results(results_dir)
-    if is_fit_results(res):  # `lagbench fit` / `evaluate` folders: their own section, no paper claims
-        sections = fit_sections(res, out_dir) + environment_sections(res, now)
+    mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
+    if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
+        sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
         return sections + sources_sections(res, sections)
     sections = [scorecard_section(res)] + summary_sections(res)
     sections += theme_sections(res, out_dir)
@@ -44,6 +46,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     sections += hessian_sections(res)
     sections += stiff_sections(res)
     sections += findings_sections(res)
+    sections += mine
     sections += environment_sections(res, now)
     return sections + sources_sections(res, sections)
 

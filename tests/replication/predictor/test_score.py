@@ -78,3 +78,18 @@ def test_the_command_writes_the_record_and_names_bad_input(tmp_path, monkeypatch
         assert main(["evaluate", *argv, "--profile", "smoke", "--out", str(out)]) != 0
         err = capsys.readouterr().err
         assert words in err and "Traceback" not in err
+
+
+def test_the_report_shows_verified_predictors_and_names_a_tampered_one(tmp_path):
+    from reports.build import build_sections
+
+    for name, fn in (("exact", exact), ("zero", zero)):
+        score(fn, "double_pendulum", "smoke", out=tmp_path, label=name)
+    sections = build_sections(tmp_path, tmp_path / "report")
+    table = next(b for s in sections if s.title == "Your predictors" for b in s.blocks if hasattr(b, "df"))
+    assert list(table.df["predictor"]) == ["exact", "zero"] and table.df["held-out L1"].iloc[0] == "0"
+    path = tmp_path / "predict" / "double_pendulum" / "zero" / "result.json"
+    path.write_text(path.read_text().replace('"profile": "smoke"', '"profile": "quick"'))
+    sections = build_sections(tmp_path, tmp_path / "report")
+    texts = [b.text for s in sections if s.title == "Your predictors" for b in s.blocks if hasattr(b, "text")]
+    assert any("zero: result.json checksum mismatch; not used" in t for t in texts)
