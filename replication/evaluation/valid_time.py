@@ -25,9 +25,10 @@ PERTURBATION = 1e-8   # added to the initial angles of the chaos floor's truth
 _GROWTH = 1e4         # the separation must grow this much for a Lyapunov time
 
 
-def normalised_rmse(z_pred, z_true):
+def normalised_rmse(z_pred, z_true, var=None):
+    """`var`: the components' variances (default: of `z_true`), for sets rolled out in parts."""
     z_pred, z_true = np.asarray(z_pred, np.float64), np.asarray(z_true, np.float64)
-    var = np.var(z_true.reshape(-1, z_true.shape[-1]), axis=0)
+    var = np.var(z_true.reshape(-1, z_true.shape[-1]), axis=0) if var is None else np.asarray(var, np.float64)
     var = np.where(var > 0, var, 1.0)
     with np.errstate(over="ignore", invalid="ignore"):
         err = np.sqrt(np.mean((z_pred - z_true) ** 2 / var, axis=-1))

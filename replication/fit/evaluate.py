@@ -19,6 +19,8 @@ rollouts   (sets with whole trajectories) every trajectory from its first state 
            `metrics.bounded_relative_error` of (q, qdot) against the data per time; S_rollout_gmean_err
            is its geometric mean over time (`geometric_mean_over_time`), averaged over trajectories;
            S_rollout_final_err the mean final-time error (a diverged rollout counts 1).
+           S_vpt_s (S_vpt_nmse_s): the median over trajectories of the time from its start until the error
+           normalised by the set's spread first exceeds normalised RMSE 0.4 (MSE 0.025), `valid_time`.
 energy     (no torques) the model's own energy along its rollout (`Fitted.energy`): S_learned_energy_drift
            = mean over trajectories of max_t |E(t) - E(0)| / scale, scale = the mean learned kinetic energy
            E(q, qdot) - E(q, 0) over S's states (energy offsets cancel). With a system: its energy along the
@@ -44,6 +46,7 @@ from replication.evaluation.metrics import (
     null_errors,
 )
 from replication.evaluation.routines import Evaluation
+from replication.evaluation.valid_time import VPT_NMSE, VPT_NRMSE, normalised_rmse, valid_time
 from replication.fit import userdata
 from replication.fit.load import Fitted, Padded, load_fitted
 from replication.fit.trajectories import starts
@@ -130,7 +133,8 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
     def advanced(n):
         if progress is not None:
             progress(name, done[0] + n, total)
-    errs, finals, drifts, e_sys = [], [], [], []
+    errs, finals, drifts, e_sys, vpts = [], [], [], [], []
+    spread = np.var(np.concatenate([r["q"], r["qdot"]], 1), axis=0)   # the set's, over all its rows
     for k, (tgrid, members) in enumerate(groups.items()):
         t = np.asarray(tgrid)
         z_data = np.stack([np.concatenate([r["q"][i], r["qdot"][i]], 1) for i in members])
@@ -140,6 +144,8 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
         err = bounded_relative_error(z, z_data)
         errs.append(geometric_mean_over_time(err))
         finals.append(err[:, -1])
+        nrmse = normalised_rmse(z, z_data, spread)
+        vpts.append([valid_time(nrmse, t - t[0], VPT_NRMSE), valid_time(nrmse, t - t[0], np.sqrt(VPT_NMSE))])
         sub = np.unique(np.linspace(0, t.size - 1, min(t.size, 200)).astype(int))
         for b, i in enumerate(members):
             series.append(pd.DataFrame({"set": name, "traj": r["traj"][i[0]], "t": t[sub], "quantity": "state_err",
@@ -156,6 +162,9 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
     table = pd.DataFrame({"set": name, "traj": ids, "gmean_err": np.concatenate(errs), "final_err": np.concatenate(finals)})
     out.metrics[f"{name}_rollout_gmean_err"] = float(table["gmean_err"].mean())
     out.metrics[f"{name}_rollout_final_err"] = float(table["final_err"].mean())
+    table["vpt_s"], table["vpt_nmse_s"] = (np.concatenate([v[j] for v in vpts]) for j in (0, 1))
+    out.metrics[f"{name}_vpt_s"] = float(table["vpt_s"].median())
+    out.metrics[f"{name}_vpt_nmse_s"] = float(table["vpt_nmse_s"].median())
     if drifts:
         table["learned_energy_drift"] = np.concatenate(drifts)
         out.metrics[f"{name}_learned_energy_drift"] = float(table["learned_energy_drift"].mean())

@@ -54,7 +54,8 @@ def test_the_worked_example_runs_end_to_end(tmp_path, monkeypatch, capsys):
                             ("evaluate", "torch", "baseline")}
     for model in ("lnn", "baseline"):
         fitted, judged = metrics[("fit", "jax", model)], metrics[("evaluate", "torch", model)]
-        assert {"test_l1", "test_rollout_gmean_err", "test_energy_err_final"} <= set(judged)
+        assert {"test_l1", "test_rollout_gmean_err", "test_energy_err_final", "test_vpt_s"} <= set(judged)
+        assert 0 <= judged["test_vpt_s"] and judged["test_vpt_nmse_s"] <= judged["test_vpt_s"]
         # the model trained in JAX, loaded in PyTorch, judged on the same test file: the same one-step numbers
         # (an untrained model's rollouts may blow up, where float32 differences grow without bound)
         assert judged["test_l1"] == pytest.approx(fitted["test_l1"], rel=1e-4)
