@@ -10,6 +10,7 @@ from pathlib import Path
 
 from replication.results import DiskFull, writing
 from replication.training.device import HELP as DEVICE_HELP
+from speedstudy.train_target_cli import add_train_target
 
 
 def _csv(s):
@@ -94,29 +95,6 @@ def cmd_bench(args):
     except NoGPUError as e:
         print(f"lagbench: error: {e}", file=sys.stderr)
         return 2
-
-
-def cmd_train_target(args):
-    from replication.fit.options import widths
-    from speedstudy.train_target_run import check_names, run_study
-
-    if args.heldout < 1 or args.seed < 0:
-        raise ValueError(f"--heldout takes an integer >= 1 and --seed one >= 0; got {args.heldout} and {args.seed}")
-    names = _csv(args.protocols)
-    hidden = list(widths(args.hidden))
-    check_names(names)  # here too, so that --out is not made for nothing
-    from replication.training import device
-
-    where = device.apply(args.device, ("jax",))["jax"]   # the study trains in JAX
-    folder = write_folder(Path(args.out) / "train_target")
-    with device.placed("jax", where):
-        df = run_study(folder, args.budget, hidden, args.heldout, names=names, seed=args.seed,
-                       progress=not args.quiet)
-    per = df.drop_duplicates("protocol")[["protocol", "budget", "best_l1", "final_l1", "seed", "hessian_rel_err",
-                                           "skipped_steps", "samples_per_s"]]
-    print(per.to_string(index=False))
-    print(df.pivot(index="protocol", columns="threshold", values="samples_to_reach").to_string())
-    print(f"written to {folder}")
 
 
 def cmd_stiff(args):
@@ -218,23 +196,7 @@ def build_parser():
                    "preset (inference to batch 65536, training, scaling, fast vs paper); writes OUT/bench_gpu/ "
                    "(LAGBENCH_BENCH_TINY=1: a seconds-long check of the same stages)")
     s.set_defaults(func=cmd_bench)
-    s = sub.add_parser("train-target", help="the train-to-target study alone, at any budget (writes "
-                                            "OUT/train_target/train_target.csv and its log, the log after every "
-                                            "held-out evaluation, and each protocol's final model as "
-                                            "<protocol>.npz with <protocol>.spec.json)")
-    s.add_argument("--out", default="results/train_target", help="results folder; writes OUT/train_target/ "
-                   "(default: results/train_target)")
-    s.add_argument("--budget", type=float, default=5e5, help="training samples per protocol (default 5e5; the "
-                                                             "issue's target is 3e7)")
-    s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
-    s.add_argument("--heldout", type=int, default=4096, help="held-out states, >= 1 (default 4096)")
-    s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, restarts_fast, "
-                                       "restarts_halved, baseline_reference (default all)")
-    s.add_argument("--seed", type=int, default=0, help="init seed (restarts: this seed and the next 7, 15 for "
-                                                            "restarts_halved; default 0)")
-    s.add_argument("--quiet", action="store_true", help="no progress bar")
-    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
-    s.set_defaults(func=cmd_train_target)
+    add_train_target(sub)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
                                      "(writes OUT/stiff/solvers.csv for the report)")
     s.add_argument("--out", default="results/quick", help="results folder; writes OUT/stiff/ (default: "

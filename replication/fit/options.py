@@ -10,6 +10,7 @@ keywords of `fit` from parsed flags (a flag's text read by the option's `parse`)
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -75,6 +76,7 @@ class Option:
     text: str | None = None        # the flag's default text where parse is used
     switch: bool = False           # a flag without a value (store_true)
     required: bool = False         # on the command line
+    old: str = ""                  # an earlier spelling, still read with a deprecation notice
 
     @property
     def cli(self) -> str:
@@ -88,8 +90,9 @@ OPTIONS = (
            "trajectory's first state)"),
     Option("split", None, "how rows are held out: whole trajectories, random rows, or none (default: "
            "by-trajectory for a trajectory file, random for a state file)", lambda v: v is None or v in SPLITS,
-           f"one of {', '.join(SPLITS)}"),
-    Option("heldout", HELDOUT, "fraction held out (of trajectories or rows)", kind=float),
+           f"one of {', '.join(SPLITS)}", flag="--holdout", old="--split"),
+    Option("heldout", HELDOUT, "fraction held out (of trajectories or rows)", kind=float, flag="--holdout-fraction",
+           old="--heldout"),
     Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
     Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
     Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),
@@ -155,12 +158,17 @@ def check(values: dict) -> None:
 
 
 def add_arguments(parser) -> None:
+    import argparse
+
     for o in OPTIONS:
+        if o.old:   # `run --split` is the development or test split and `train-target --heldout` a count of states
+            parser.add_argument(o.old, dest="old_" + o.name, type=o.kind, choices=SPLITS if o.name == "split" else None,
+                                help=argparse.SUPPRESS)
         if o.switch:
             parser.add_argument(o.cli, action="store_true", help=o.help)
         elif o.parse is not None:
             parser.add_argument(o.cli, default=o.text, help=o.help)
-        elif o.name == "split":
+        elif o.name == "split":   # no default: the file's kind decides
             parser.add_argument(o.cli, choices=SPLITS, help=o.help)
         else:
             parser.add_argument(o.cli, type=o.kind, default=o.default, required=o.required, help=o.help)
@@ -170,5 +178,11 @@ def from_args(args) -> dict:
     out = {}
     for o in OPTIONS:
         v = getattr(args, o.cli[2:].replace("-", "_"))
+        old = getattr(args, "old_" + o.name, None) if o.old else None
+        if old is not None:
+            if v != (o.text if o.parse is not None else o.default):
+                raise ValueError(f"{o.old}: give it once, as {o.cli}")
+            print(f"lagbench: {o.old} is deprecated; use {o.cli}", file=sys.stderr)
+            v = old
         out[o.name] = o.parse(v) if o.parse is not None else v
     return out

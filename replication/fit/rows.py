@@ -47,10 +47,10 @@ class Prepared:
 
 def check_options(split, heldout) -> None:
     if split not in SPLITS:
-        raise ValueError(f"--split: {split!r} is not valid; expected one of {', '.join(SPLITS)}")
+        raise ValueError(f"--holdout: {split!r} is not valid; expected one of {', '.join(SPLITS)}")
     ok = isinstance(heldout, (int, float)) and not isinstance(heldout, bool) and math.isfinite(heldout)
     if not (ok and 0 < heldout < 1):
-        raise ValueError(f"--heldout: {heldout!r} is not valid; expected a fraction between 0 and 1 (default "
+        raise ValueError(f"--holdout-fraction: {heldout!r} is not valid; expected a fraction between 0 and 1 (default "
                          f"{HELDOUT})")
 
 
@@ -62,12 +62,12 @@ def _assign(path, d, split, heldout) -> np.ndarray:
         labels[rng.permutation(n)[:max(1, round(heldout * n))]] = "heldout"
     elif split == "by-trajectory":
         if "traj" not in d:
-            raise ValueError(f"{path}: --split by-trajectory needs a trajectory file (columns traj, t, q0..); "
-                             f"use --split random or none for state samples")
+            raise ValueError(f"{path}: --holdout by-trajectory needs a trajectory file (columns traj, t, q0..); "
+                             f"use --holdout random or none for state samples")
         ids = np.unique(d["traj"])
         if ids.size < 2:
             raise ValueError(f"{path}: one trajectory only, so none can be held out whole; give more trajectories, "
-                             f"a --test file with --split none, or --split random")
+                             f"a --test file with --holdout none, or --holdout random")
         k = min(ids.size - 1, max(1, round(heldout * ids.size)))
         labels[np.isin(d["traj"], rng.choice(ids, size=k, replace=False))] = "heldout"
     return labels

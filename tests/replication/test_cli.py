@@ -109,7 +109,7 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     import pandas as pd
 
     out = tmp_path / "tt"
-    assert main(["train-target", "--budget", "1024", "--hidden", "8,8", "--heldout", "64", "--protocols",
+    assert main(["train-target", "--budget", "1024", "--hidden", "8,8", "--heldout-states", "64", "--protocols",
                  "variant", "--out", str(out), "--quiet"]) == 0
     rows = pd.read_csv(out / "train_target" / "train_target.csv")
     log = pd.read_csv(out / "train_target" / "train_target_log.csv")
@@ -131,13 +131,31 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     assert "variant" in capsys.readouterr().out
 
 
-def test_train_target_command_takes_the_init_seed(tmp_path):
+def test_train_target_command_takes_the_init_seed_and_reads_the_old_heldout(tmp_path, capsys):
     import pandas as pd
 
     out = tmp_path / "tt"
     assert main(["train-target", "--budget", "256", "--hidden", "8", "--heldout", "64", "--protocols", "variant",
                  "--seed", "3", "--out", str(out), "--quiet"]) == 0
     assert set(pd.read_csv(out / "train_target" / "train_target.csv")["seed"]) == {3}
+    assert "--heldout is deprecated; use --heldout-states" in capsys.readouterr().err
+
+
+def test_one_meaning_per_option_name_and_the_old_spellings_still_read(capsys):
+    """`run --split` is the development or test split, `train-target --heldout-states` a count of states, so
+    fit's row hold-out is --holdout and its fraction --holdout-fraction; their old spellings are read with a
+    notice, never both at once."""
+    from replication.cli import build_parser
+    from replication.fit import options
+
+    args = build_parser().parse_args(["fit", "--data", "x.csv", "--model", "lnn", "--split", "random", "--heldout", "0.3"])
+    got = options.from_args(args)
+    assert (got["split"], got["heldout"]) == ("random", 0.3)
+    err = capsys.readouterr().err
+    assert "--split is deprecated; use --holdout" in err and "--heldout is deprecated; use --holdout-fraction" in err
+    both = build_parser().parse_args(["fit", "--data", "x.csv", "--model", "lnn", "--split", "none", "--holdout", "none"])
+    with pytest.raises(ValueError, match="--split: give it once, as --holdout"):
+        options.from_args(both)
 
 
 def test_train_target_command_names_an_unknown_protocol(tmp_path, capsys):
@@ -173,7 +191,7 @@ def test_every_option_has_help_and_shows_its_default(command, option):
 
 
 @pytest.mark.parametrize("argv", [["stiff", "--system", "nope"], ["train-target", "--protocols", "bogus"],
-                                  ["train-target", "--heldout", "0"], ["bench"]])
+                                  ["train-target", "--heldout-states", "0"], ["bench"]])
 def test_out_is_not_made_for_an_invalid_command(tmp_path, capsys, argv):
     (tmp_path / "file").write_text("x")
     out = tmp_path / "file" if argv == ["bench"] else tmp_path / "out"

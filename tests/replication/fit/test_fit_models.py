@@ -91,7 +91,7 @@ def test_every_fit_option_shows_its_default():
     helps = {a.option_strings[-1]: a.help for a in parser._actions
              if a.option_strings and not a.required and a.nargs != 0}
     assert {"--activation", "--weight-decay", "--schedule", "--lr-final", "--delan-eps", "--delan-offset",
-            "--input-scale", "--split", "--heldout", "--test", "--window", "--polyorder"} <= set(helps)
+            "--input-scale", "--holdout", "--holdout-fraction", "--test", "--window", "--polyorder"} <= set(helps)
     missing = [k for k, h in helps.items() if "default" not in h]
     assert not missing, missing
 

@@ -101,5 +101,5 @@ def test_splits_hold_out_whole_trajectories_random_rows_or_nothing(tmp_path):
     one = _file(tmp_path / "e.csv", n_traj=1)
     with pytest.raises(ValueError, match="one trajectory only"):
         fit_data.prepare(tmp_path / "out", one)
-    with pytest.raises(ValueError, match="--heldout"):
+    with pytest.raises(ValueError, match="--holdout-fraction"):
         fit_data.prepare(tmp_path / "out", path, "random", heldout=1.5)
