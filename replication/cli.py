@@ -69,19 +69,41 @@ def cmd_run(args):
 RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict")
 
 
-def cmd_report(args):
-    import reports
-
-    results = Path(args.results)
+def _results_folder(results: Path) -> Path:
+    """--results, checked: a folder holding lagbench results (a one-line error otherwise)."""
     if not results.is_dir():
         raise ValueError(f"--results {results}: no such folder; give a folder written by `lagbench run` "
                          f"(or bench, stiff, train-target)")
     if not any((results / name).exists() for name in RESULT_ENTRIES):
         raise ValueError(f"--results {results}: holds no lagbench results (none of {', '.join(RESULT_ENTRIES)})")
+    return results
+
+
+def cmd_report(args):
+    import reports
+
+    results = _results_folder(Path(args.results))
     out = Path(args.out) if args.out else Path("report") / (results.resolve().name or "results")
     paths = reports.build_report(results, out, pdf=not args.no_pdf)
     for k, v in paths.items():
         print(f"{k}: {len(v)} files in {out / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
+
+
+def cmd_table(args):
+    from replication.results import output_folder, write_csv
+    from reports.systems_table import shown, systems_table
+
+    results = _results_folder(Path(args.results))
+    df = systems_table(results)
+    if args.system:
+        df = df[df["system"] == args.system]
+    if df.empty:
+        raise ValueError(f"--results {results}: no model of {args.system or 'any system'} in it")
+    for system, g in df.groupby("system", sort=True):
+        print(f"{system}\n{shown(g).to_string(index=False)}\n")
+    path = output_folder(results / "summary", "--results") / "systems.csv"
+    write_csv(path, df)
+    print(f"written to {path}")
 
 
 def cmd_bench(args):
@@ -178,6 +200,13 @@ def build_parser():
                    "results/full gives report/full)")
     s.add_argument("--no-pdf", action="store_true", help="write REPORT.md and the figures only (no typesetting)")
     s.set_defaults(func=cmd_report)
+    s = sub.add_parser("table", help="every model of a results folder per system, the suite's and yours (writes "
+                       "RESULTS/summary/systems.csv)", description="A table per system: each claim's model and "
+                       "framework over its seeds (median [min, max]) and each predictor scored by evaluate --predict.")
+    s.add_argument("--results", default="results/quick", help="a folder written by `lagbench run` or evaluate "
+                   "--predict (default: results/quick)")
+    s.add_argument("--system", help="one system only (default: every system in the folder)")
+    s.set_defaults(func=cmd_table)
     from replication.fit.cli import add_commands
 
     add_commands(sub)  # simulate, fit, evaluate

@@ -29,6 +29,7 @@ from reports.sections_hessian import hessian_sections
 from reports.sections_predict import predict_sections
 from reports.sections_speed import speed_sections
 from reports.sections_stiff import stiff_sections
+from reports.systems_table import systems_sections
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
@@ -46,7 +47,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     sections += hessian_sections(res)
     sections += stiff_sections(res)
     sections += findings_sections(res)
-    sections += mine
+    sections += systems_sections(results_dir) + mine
     sections += environment_sections(res, now)
     return sections + sources_sections(res, sections)
 

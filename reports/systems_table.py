@@ -1,0 +1,93 @@
+"""Every model a results folder holds, per system: the suite's (one row per claim, model and framework, over
+its seeds) and predictors scored by `lagbench evaluate --predict`.
+
+``systems_table(root) -> DataFrame``: columns system, source ("claim" or "predictor"), claim, model,
+framework, seeds, params (the checkpoint's numbers), train_samples and train_time_s (medians over seeds), and
+for each of ``METRICS`` its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
+NaN where the claim's evaluation does not compute it). `lagbench table` writes it to
+``summary/systems.csv`` and prints a table per system; the report shows it (``systems_sections``).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from reports.document import Para, Section, Table
+from reports.fmt import num
+from reports.load import load_results, protocol_of
+from reports.sections_predict import predictor_results
+
+METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
+           "lyapunov_time_s", "torque_mse_test")
+
+
+def _params(unit) -> float:
+    path = unit.path / "checkpoint.npz"
+    if not path.is_file():
+        return np.nan
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            return float(sum(npz[k].size for k in npz.files))
+    except (ValueError, OSError):
+        return np.nan
+
+
+def _spread(values) -> dict:
+    v = np.asarray([x for x in values if x is not None], float)
+    if v.size == 0:
+        return {"": np.nan, "_min": np.nan, "_max": np.nan}
+    return {"": float(np.median(v)), "_min": float(np.min(v)), "_max": float(np.max(v))}
+
+
+def systems_table(root) -> pd.DataFrame:
+    res, groups = load_results(root), {}
+    for u in res.usable():
+        p = protocol_of(u.result)
+        if p is None or p.data.recipe.startswith("file:"):
+            continue
+        groups.setdefault((p.data.recipe.removesuffix("_iid"), u.claim, u.model, u.framework), []).append(u)
+    rows = []
+    for (system, claim, model, fw), units in sorted(groups.items()):
+        r = {"system": system, "source": "claim", "claim": claim, "model": model, "framework": fw,
+             "seeds": len(units), "params": _params(units[0]),
+             "train_samples": _spread([u.result.get("train_time_s", 0) * (u.result.get("train_samples_per_s") or 0)
+                                       for u in units])[""],
+             "train_time_s": _spread([u.result.get("train_time_s") for u in units])[""]}
+        for m in METRICS:
+            r.update({m + k: v for k, v in _spread([u.metric(m) for u in units]).items()})
+        rows.append(r)
+    for d in predictor_results(Path(root))[0]:
+        r = {"system": d["system"], "source": "predictor", "claim": d["scored_like"]["claim"], "model": d["model"],
+             "framework": "-", "seeds": 1, "params": np.nan, "train_samples": np.nan, "train_time_s": np.nan}
+        for m in METRICS:
+            v = d["metrics"].get(m)
+            r.update({m + k: (np.nan if v is None else float(v)) for k in ("", "_min", "_max")})
+        rows.append(r)
+    return pd.DataFrame(rows)
+
+
+def shown(df: pd.DataFrame) -> pd.DataFrame:
+    """One system's rows for reading: each metric as "median [min, max]" over seeds, empty columns left out."""
+    out = df[["source", "claim", "model", "framework", "seeds"]].copy()
+    out["params"] = [num(v) for v in df["params"]]
+    out["train samples"] = [num(v) for v in df["train_samples"]]
+    for m in METRICS:
+        if df[m].notna().any():
+            out[m] = [num(a) if not (a == a) or n == 1 or lo == hi else f"{num(a)} [{num(lo)}, {num(hi)}]"
+                      for a, lo, hi, n in zip(df[m], df[m + "_min"], df[m + "_max"], df["seeds"], strict=True)]
+    return out
+
+
+def systems_sections(root) -> list[Section]:
+    df = systems_table(root)
+    if df.empty:
+        return []
+    s = Section("Results by system")
+    s.add(Para("Every model this folder holds, per system: median [min, max] over seeds; valid times in seconds "
+               "against the chaos floor's (`docs/RESULTS.md`); `summary/systems.csv` (`lagbench table`) holds the "
+               "numbers."))
+    for system, g in df.groupby("system", sort=True):
+        s.add(Table(f"{system}", shown(g), ["units/*/*/*/seed*/result.json", "predict/*/*/result.json"]))
+    return [s]

@@ -1,0 +1,36 @@
+"""`lagbench table` and the report's "Results by system" (`reports.systems_table`): every model per system,
+over its seeds, beside the predictors scored into the same folder."""
+import shutil
+
+import numpy as np
+import pandas as pd
+
+from replication.cli import main
+from replication.predictor.score import score
+from reports.systems_table import shown, systems_table
+
+
+def test_one_row_per_claim_model_and_framework_with_its_seeds_spread(results_dir, tmp_path, capsys):
+    root = tmp_path / "r"
+    shutil.copytree(results_dir, root)
+    score(lambda q, qd: np.zeros_like(q), "double_pendulum", "smoke", out=root, label="zero")
+    df = systems_table(root)
+    claims = df[df["source"] == "claim"]
+    assert set(claims["system"]) == {"double_pendulum"}   # every fixture unit records the double pendulum's protocol
+    row = claims[(claims["claim"] == "dp_loss") & (claims["model"] == "lnn") & (claims["framework"] == "jax")].iloc[0]
+    assert row["seeds"] == 2 and row["heldout_l1_min"] <= row["heldout_l1"] <= row["heldout_l1_max"]
+    assert row["heldout_l1_min"] < row["heldout_l1_max"]   # two seeds, two values
+    zero = df[df["source"] == "predictor"].iloc[0]
+    assert zero["model"] == "zero" and zero["heldout_l1"] >= zero["null_heldout_l1"] and zero["vpt_s"] >= 0
+    assert "[" in shown(claims)["heldout_l1"].iloc[0]
+    assert main(["table", "--results", str(root), "--system", "double_pendulum"]) == 0
+    out = capsys.readouterr().out
+    assert "double_pendulum" in out and "zero" in out
+    assert len(pd.read_csv(root / "summary" / "systems.csv")) == len(df)
+    assert main(["table", "--results", str(root), "--system", "wave"]) == 2
+    assert "no model of wave" in capsys.readouterr().err
+
+
+def test_the_report_has_the_table(built):
+    text = built["markdown"].read_text()
+    assert "## Results by system" in text and "**double_pendulum**" in text
