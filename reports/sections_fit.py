@@ -65,6 +65,25 @@ def _models_table(units) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _competence_para(units) -> Para | None:
+    """The fits and evaluations not clearly better than the null predictor on the set they report, named."""
+    from replication.fit.competence import competence, describe
+
+    flagged = []
+    for u in units:
+        m = u.result.get("metrics") or {}
+        loss = (u.result.get("protocol") or {}).get("loss", "l1")
+        for metric in (f"test_{loss}", f"heldout_{loss}"):   # the set the fit reports: the test file's, else held-out
+            c = competence(m, metric)
+            if c is not None:
+                if not c["learned"]:
+                    flagged.append(f"{_name(u)} ({u.claim}), {metric}: {describe(c)}")
+                break
+    if not flagged:
+        return None
+    return Para("Not clearly better than the null predictor (at most half its error): " + "; ".join(flagged) + ".")
+
+
 def _one_step_table(units) -> pd.DataFrame | None:
     frames = []
     for u in units:
@@ -163,7 +182,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
         s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))
     if not units:
         return [s]
-    s.add(_data_para(units))
+    s.add(_data_para(units), _competence_para(units))
     s.add(Table("The models side by side", _models_table(units), [SRC.format(claim="*") + "result.json"]))
     out = [s]
     e = Section("Errors", level=2)

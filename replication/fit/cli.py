@@ -89,9 +89,14 @@ def cmd_fit(args):
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
         return 1
+    from replication.fit.competence import competence, describe
+
     again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
     value = d.get("final_train_loss") if d["metric"] == "final_train_loss" else d["metrics"].get(d["metric"])
-    print(f"ok: {d['metric_label']} {value:.6g}, written to {folder}{again}")
+    c = competence(d["metrics"], d["metric"])
+    print(f"{'ok' if c is None or c['learned'] else 'done'}: {d['metric_label']} {value:.6g}"
+          f"{f' ({describe(c)})' if c else ''}, written to {folder}{again}")
+    return 1 if args.strict and c is not None and not c["learned"] else 0
 
 
 def _fitted_folder(args) -> str:
@@ -142,12 +147,16 @@ def cmd_evaluate(args):
                         device=args.device, horizon=args.horizon, on_progress=rollouts)
     finally:
         rollouts.close()
+    from replication.fit.competence import competence, describe
+
     for d in done:
-        m = d["metrics"]
-        parts = [f"{k} {m[k]:.4g}" for k in (f"test_{d['protocol']['loss']}", "test_rollout_gmean_err",
+        m, loss = d["metrics"], f"test_{d['protocol']['loss']}"
+        parts = [f"{k} {m[k]:.4g}" for k in (loss, "test_rollout_gmean_err",
                                              "test_learned_energy_drift", "test_energy_err_final") if m.get(k) is not None]
+        c = competence(m, loss)
         again = " (the earlier evaluation)" if d.get("reused") else ""
-        print(f"{d['model']} ({d['framework']}): {', '.join(parts)}; written to {d['folder']}{again}")
+        print(f"{d['model']} ({d['framework']}): {', '.join(parts)}{f' ({loss}: {describe(c)})' if c else ''}; "
+              f"written to {d['folder']}{again}")
 
 
 def add_commands(sub) -> None:
@@ -177,6 +186,8 @@ def add_commands(sub) -> None:
     s.add_argument("--out", default="results/fit", help="results folder")
     fit_options.add_arguments(s)
     s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--strict", action="store_true", help="exit with status 1 when the model is not clearly better "
+                   "than the null predictor (at most half its error on the reported set)")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_fit)
     _show_defaults(s)
