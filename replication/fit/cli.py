@@ -32,7 +32,8 @@ def cmd_simulate(args):
     path = Path(args.out)
     if path.suffix != ".csv":
         raise ValueError(f"--out {path}: give a .csv file name")
-    df = simulate(args.system, args.trajectories, args.duration, args.rate, args.noise, args.seed, args.velocities)
+    df = simulate(args.system, args.trajectories, args.duration, args.rate, args.noise, args.seed, args.velocities,
+                  args.dropped, args.decimals)
     write_csv(path, df)
     print(f"{args.trajectories} trajectories of {args.system}, {len(df)} rows, written to {path}")
 
@@ -169,6 +170,10 @@ def add_commands(sub) -> None:
     s.add_argument("--rate", type=float, default=50.0, help="samples per second")
     s.add_argument("--noise", type=float, default=0.01, help="standard deviation of the noise added to q (and qdot)")
     s.add_argument("--velocities", action="store_true", help="also write noisy velocities qdot0..")
+    s.add_argument("--dropped", type=float, default=0.0, help="share of samples left out at random, as a logger "
+                   "that drops frames (never a trajectory's first or last)")
+    s.add_argument("--decimals", type=int, help="round the written times to this many decimals, as a real log "
+                   "(default: full precision)")
     s.add_argument("--seed", type=int, default=0, help="seed of the initial states and the noise")
     s.add_argument("--out", required=True, help="the .csv file to write")
     s.set_defaults(func=cmd_simulate)

@@ -61,7 +61,8 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         deriv = (r.get("eval_config") or {}).get("derivatives") or {}
         w = window or deriv.get("window", trajectories.WINDOW)
         p = polyorder or deriv.get("polyorder", trajectories.POLYORDER)
-        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test")
+        g = deriv.get("gaps", "interpolate")
+        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test", gaps=g)
         if prep.dof != f.spec.dof:
             raise ValueError(f"--data {data}: has {prep.dof} degrees of freedom, the model in {f.folder} {f.spec.dof}")
         fields = {k: v for k, v in r["model_spec"].items() if k not in ("hidden", "dtype")}
@@ -70,7 +71,7 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         cfg = {"heldout": False, "test": prep.reference, "system": system or fcfg.get("system"),
                "energy": energy or fcfg.get("energy"),
                "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
-               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p},
+               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p, **({"gaps": g} if g != "interpolate" else {})},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
         if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys
             cfg["horizon"] = float(horizon or fcfg["horizon"])

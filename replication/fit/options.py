@@ -17,7 +17,7 @@ from types import SimpleNamespace
 
 from models import ACTIVATIONS
 from replication.fit.rows import HELDOUT, SPLITS
-from replication.fit.trajectories import POLYORDER, WINDOW
+from replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
 FRAMEWORKS = ("jax", "torch")
@@ -93,6 +93,9 @@ OPTIONS = (
            f"one of {', '.join(SPLITS)}", flag="--holdout", old="--split"),
     Option("heldout", HELDOUT, "fraction held out (of trajectories or rows)", kind=float, flag="--holdout-fraction",
            old="--heldout"),
+    Option("gaps", "interpolate", f"dropped frames in a trajectory file: interpolate (up to {MAX_GAP} in a row, cubic "
+           "spline; the filled rows are not trained on), split (each piece its own trajectory) or refuse",
+           one_of(GAPS), f"one of {', '.join(GAPS)}"),
     Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
     Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
     Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),

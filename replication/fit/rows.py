@@ -1,6 +1,6 @@
 """The rows `lagbench fit` trains and evaluates on: derivatives, the split, and the prepared file.
 
-`prepare(out, path, split, heldout, window, polyorder, dtype, kind)` reads the user's file
+`prepare(out, path, split, heldout, window, polyorder, dtype, kind, gaps)` reads the user's file
 (`replication.fit.userdata`), turns a trajectory file into state samples (`replication.fit.trajectories`),
 assigns every row to "train" or "heldout" (kind "fit") or to "test" (kind "test", a `--test` or
 `lagbench evaluate --data` file), and writes the rows to `OUT/data/<name>-<kind>-<hash>.csv` (columns
@@ -85,12 +85,12 @@ def _frame(d: dict, labels) -> pd.DataFrame:
 
 
 def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, polyorder=trajectories.POLYORDER,
-            dtype="float32", kind="fit") -> Prepared:
+            dtype="float32", kind="fit", gaps="interpolate") -> Prepared:
     path = str(Path(path).resolve())
     digest, d = userdata.read(path)
     is_traj = "t" in d
     if is_traj:
-        d = trajectories.with_derivatives(d, path, window, polyorder)
+        d = trajectories.with_derivatives(d, path, window, polyorder, gaps)
     userdata.check_range(path, d, dtype)
     if kind == "test":
         labels = np.full(len(d["q"]), "test", dtype=object)
@@ -104,6 +104,8 @@ def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, 
             raise ValueError(f"{path}: no rows left to train on")
     if is_traj:
         options.update(window=window, polyorder=polyorder)
+        if gaps != "interpolate":   # a file without dropped frames gives the same rows under any
+            options["gaps"] = gaps
     tag = hashlib.sha256(json.dumps({"source": digest, "kind": kind, **options}, sort_keys=True).encode())
     target = Path(out) / "data" / f"{Path(path).stem}-{kind}-{tag.hexdigest()[:12]}.csv"
     prepared_digest = R.write_csv(target, _frame(d, labels))

@@ -6,7 +6,9 @@ traj, t, q0..q{d-1} (and qdot0.. with `velocities`): each trajectory starts from
 system's own distribution (`System.sample_states`, generator seeded by `seed`) and is integrated in
 float64 by diffrax at tight tolerances (`systems.trajectories.integrate`), sampled every 1 / rate
 seconds from t = 0 to `duration`; independent Gaussian noise of standard deviation `noise` (in the
-units of q, and of qdot) is then added to every sample. A ValueError names a bad option.
+units of q, and of qdot) is then added to every sample. As a real recording: `dropped`, the share of
+samples (never a trajectory's first or last) left out at random, as a logger that drops frames; `decimals`,
+the times rounded to that many decimals when written. A ValueError names a bad option.
 """
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 
-def check_options(system, trajectories, duration, rate, noise, seed) -> None:
+def check_options(system, trajectories, duration, rate, noise, seed, dropped=0.0, decimals=None) -> None:
     import systems
 
     if system not in systems.names():
@@ -30,18 +32,21 @@ def check_options(system, trajectories, duration, rate, noise, seed) -> None:
               ("--rate", rate > 0 and duration * rate >= 2, "a number > 0 with duration x rate >= 2 (samples per "
                "second)", rate),
               ("--noise", noise >= 0, "a number >= 0", noise),
-              ("--seed", isinstance(seed, int) and seed >= 0, "an integer >= 0", seed)]
+              ("--seed", isinstance(seed, int) and seed >= 0, "an integer >= 0", seed),
+              ("--dropped", isinstance(dropped, (int, float)) and 0 <= dropped < 0.5, "a share in [0, 0.5)", dropped),
+              ("--decimals", decimals is None or (isinstance(decimals, int) and decimals >= 1), "an integer >= 1",
+               decimals)]
     for option, ok, valid, value in checks:
         if not ok:
             raise ValueError(f"{option}: {value!r} is not valid; expected {valid}")
 
 
 def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0.0, seed=0,
-             velocities=False) -> pd.DataFrame:
+             velocities=False, dropped=0.0, decimals=None) -> pd.DataFrame:
     import systems
     import systems.trajectories
 
-    check_options(system, trajectories, duration, rate, noise, seed)
+    check_options(system, trajectories, duration, rate, noise, seed, dropped, decimals)
     s = systems.get(system)
     rng = np.random.default_rng(seed)
     st = s.sample_states(trajectories, rng)
@@ -54,4 +59,10 @@ def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0
     cols.update({f"q{j}": q[..., j].ravel() for j in range(d)})
     if velocities:
         cols.update({f"qdot{j}": qd[..., j].ravel() for j in range(d)})
-    return pd.DataFrame(cols)
+    df = pd.DataFrame(cols)
+    if decimals is not None:
+        df["t"] = df["t"].round(decimals)
+    if dropped:   # drawn after the noise: the kept rows are those of the recording without drops
+        inner = (df["t"] > 0) & (np.tile(np.arange(n), b) < n - 1)
+        df = df[~(inner & (np.random.default_rng([seed, 1]).random(len(df)) < dropped))].reset_index(drop=True)
+    return df

@@ -90,8 +90,9 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     path = str(Path(data).resolve())
     task = _checked_task(o, path)   # every check that needs no work, before the output folder is made
     out = R.output_folder(out, "--out")
-    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype)
-    tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test") if o.test else None
+    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps)
+    tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test",
+                             gaps=o.gaps) if o.test else None
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     n_train = prep.counts["train"]
@@ -102,7 +103,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
-           "derivatives": {"window": o.window, "polyorder": o.polyorder}, "rows": prep.counts,
+           "derivatives": {"window": o.window, "polyorder": o.polyorder,
+                           **({"gaps": o.gaps} if o.gaps != "interpolate" else {})}, "rows": prep.counts,
            "trajectories": prep.trajectories}
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)

@@ -20,8 +20,18 @@ Checked against analytic trajectories with noise in tests/replication/fit/test_f
 
 Requirements (a ValueError naming the problem otherwise): an odd window >= polyorder + 2 >= 3 (so
 that the second derivative exists and the fit is overdetermined), at least window + 1 samples per
-trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory, and a uniform spacing (relative spread
-below 1e-6; resample a non-uniform recording first).
+trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory, and
+samples on a uniform grid: the step h is the median step, a step within `JITTER_RTOL` (0.1 %) of h is h (real
+clocks, times rounded when written), and a step within that of n x h (n >= 2) is a gap of n - 1 dropped
+frames. Gaps (`gaps`, `GAPS`):
+  interpolate  (default) fill gaps of at most `MAX_GAP` frames: each recorded array (q, and qdot, qddot,
+               tau where given) by a cubic spline through the trajectory's samples, at the missing grid
+               times; the filled rows serve the derivative windows of their neighbours and are then
+               dropped (their values are made up); a longer gap is refused.
+  split        the trajectory is cut at each gap into pieces, each its own trajectory (piece s of
+               trajectory k gets the id k + s / 1000); pieces too short for a derivative window are dropped.
+  refuse       a gap is an error.
+Any other spacing is refused: resample such a recording onto a uniform grid first.
 """
 from __future__ import annotations
 
@@ -29,7 +39,9 @@ import numpy as np
 
 WINDOW = 15
 POLYORDER = 3
-UNIFORM_RTOL = 1e-6
+JITTER_RTOL = 1e-3   # a step within this fraction of the median step is that step
+MAX_GAP = 3          # the most dropped frames in a row that "interpolate" fills
+GAPS = ("interpolate", "split", "refuse")
 
 
 def check_options(window, polyorder) -> None:
@@ -47,47 +59,109 @@ def derivative(x, h: float, order: int, window: int = WINDOW, polyorder: int = P
                          mode="interp")
 
 
-def spacing(t, where: str) -> float:
-    """The uniform step of the times t (T,); a ValueError naming `where` if they are not uniform."""
+def grid(t, where: str, gaps: str = "refuse") -> tuple[float, np.ndarray]:
+    """(h, frame): the step of the times t (T,) and each sample's frame on the grid t[0] + frame x h; a
+    ValueError naming `where` if they are not on one (see the module doc), or hold a gap `gaps` refuses."""
     dt = np.diff(t)
     if not np.all(dt > 0):
         raise ValueError(f"{where}: times are not strictly increasing")
-    h = float(np.mean(dt))
-    if np.max(np.abs(dt - h)) > UNIFORM_RTOL * h:
-        raise ValueError(f"{where}: times are not uniformly spaced (steps from {dt.min():.6g} to {dt.max():.6g}); "
-                         f"resample the trajectory onto a uniform grid first")
-    return h
+    h = float(np.median(dt))
+    n = np.rint(dt / h)
+    off = np.abs(dt - n * h) > JITTER_RTOL * h
+    if np.any(off):
+        i = int(np.argmax(off))
+        raise ValueError(f"{where}: times are not uniformly spaced (a step of {dt[i]:.6g} at t = {t[i]:.6g} against "
+                         f"the median step {h:.6g}; steps within {JITTER_RTOL:g} of it, or of a whole multiple of it "
+                         f"(dropped frames), are accepted); resample the trajectory onto a uniform grid first")
+    if np.any(n > 1):
+        i = int(np.argmax(n))
+        missing = int(n[i]) - 1
+        if gaps == "refuse" or (gaps == "interpolate" and missing > MAX_GAP):
+            hint = f"--gaps split ({MAX_GAP} at most are interpolated)" if gaps == "interpolate" else \
+                "--gaps interpolate or split"
+            raise ValueError(f"{where}: {missing} dropped frame(s) after t = {t[i]:.6g}; {hint}")
+    if np.all(n == 1):   # no gap: the mean step (the same derivatives as for an exactly uniform grid)
+        h = float(np.mean(dt))
+    return h, np.concatenate([[0], np.cumsum(n)]).astype(int)
 
 
-def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = POLYORDER) -> dict:
+def _filled(part: dict, frame: np.ndarray, h: float) -> dict:
+    """`part` on the whole grid: the dropped frames' arrays by cubic splines through the samples, `filled` marks
+    them."""
+    from scipy.interpolate import CubicSpline
+
+    full = np.arange(frame[-1] + 1)
+    t = part["t"][0] + full * h
+    t[frame] = part["t"]
+    missing = np.setdiff1d(full, frame)
+    out = {"t": t, "filled": np.isin(full, missing)}
+    for key, v in part.items():
+        if key == "t":
+            continue
+        if key == "traj":
+            out[key] = np.full(full.size, v[0])
+            continue
+        w = np.empty((full.size, *v.shape[1:]))
+        w[frame] = v
+        w[missing] = CubicSpline(part["t"], v, axis=0)(t[missing])
+        out[key] = w
+    return out
+
+
+def _pieces(part: dict, frame: np.ndarray, h: float, gaps: str) -> list[dict]:
+    """The trajectory as the pieces `gaps` makes of it: itself (no gap), filled, or cut at its gaps."""
+    if frame[-1] == frame.size - 1:
+        return [part]
+    if gaps == "interpolate":
+        return [_filled(part, frame, h)]
+    cuts = np.flatnonzero(np.diff(frame) > 1) + 1
+    bounds = zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [frame.size]]), strict=True)
+    return [{k: (v[a:b] + s / 1000 if k == "traj" else v[a:b]) for k, v in part.items()}
+            for s, (a, b) in enumerate(bounds)]
+
+
+def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = POLYORDER,
+                     gaps: str = "interpolate") -> dict:
     """State samples (q, qdot, qddot[, tau], traj, t) from a trajectory file's arrays `d` (see module doc)."""
     check_options(window, polyorder)
+    if gaps not in GAPS:
+        raise ValueError(f"--gaps: {gaps!r} is not valid; expected one of {', '.join(GAPS)}")
     traj = d.get("traj", np.zeros(len(d["q"])))
+    estimate = "qdot" not in d or "qddot" not in d
     parts = []
     for k in np.unique(traj):
         rows = np.flatnonzero(traj == k)
         rows = rows[np.argsort(d["t"][rows], kind="stable")]
         where = f"{path}: trajectory {k:g}"
-        estimate = "qdot" not in d or "qddot" not in d
-        if estimate and rows.size < window + 1:
-            raise ValueError(f"{where} has {rows.size} samples; estimating its derivatives needs at least "
-                             f"{window + 1} (--window {window}, whose first and last {window // 2} are dropped)")
-        t = d["t"][rows]
-        h = spacing(t, where)
-        part = {"traj": np.full(rows.size, float(k)), "t": t, "q": d["q"][rows]}
-        part["qdot"] = d["qdot"][rows] if "qdot" in d else derivative(part["q"], h, 1, window, polyorder)
-        if "qddot" in d:
-            part["qddot"] = d["qddot"][rows]
-        elif "qdot" in d:
-            part["qddot"] = derivative(part["qdot"], h, 1, window, polyorder)
-        else:
-            part["qddot"] = derivative(part["q"], h, 2, window, polyorder)
-        if "tau" in d:
-            part["tau"] = d["tau"][rows]
-        if estimate:  # no centred window at the ends
-            part = {key: v[window // 2: rows.size - window // 2] for key, v in part.items()}
-        parts.append(part)
+        h, frame = grid(d["t"][rows], where, gaps)
+        whole = {"traj": np.full(rows.size, float(k)), **{key: d[key][rows] for key in ("t", "q", "qdot", "qddot", "tau")
+                                                          if key in d}}
+        pieces = _pieces(whole, frame, h, gaps)
+        long_enough = [p for p in pieces if not estimate or p["t"].size >= window + 1]
+        if not long_enough:
+            n = max(p["t"].size for p in pieces)
+            raise ValueError(f"{where} has {n} samples{' in its longest piece between gaps' if len(pieces) > 1 else ''}; "
+                             f"estimating its derivatives needs at least {window + 1} (--window {window}, whose first "
+                             f"and last {window // 2} are dropped)")
+        parts += [_derivatives(p, h, window, polyorder, estimate) for p in long_enough]
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _derivatives(part: dict, h: float, window: int, polyorder: int, estimate: bool) -> dict:
+    """One piece of a trajectory with what it lacks estimated, the ends and any filled rows dropped."""
+    part = dict(part)
+    filled = part.pop("filled", None)
+    if "qddot" not in part:   # of the given qdot, else the second derivative of q
+        given = "qdot" in part
+        part["qddot"] = derivative(part["qdot"] if given else part["q"], h, 1 if given else 2, window, polyorder)
+    if "qdot" not in part:
+        part["qdot"] = derivative(part["q"], h, 1, window, polyorder)
+    keep = np.ones(part["t"].size, bool)
+    if estimate:  # no centred window at the ends
+        keep[: window // 2], keep[part["t"].size - window // 2:] = False, False
+    if filled is not None:
+        keep &= ~filled
+    return {key: part[key][keep] for key in ("traj", "t", "q", "qdot", "qddot", "tau") if key in part}
 
 
 def starts(traj) -> list[np.ndarray]:
