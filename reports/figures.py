@@ -2,7 +2,8 @@
 
 Every function takes the claim's usable units and a PNG path, writes the figure and returns True, or
 returns False (writing nothing) when the units lack the data it needs. Inputs:
-- ``energy_drift``: ``timeseries.csv`` rows with ``quantity == "energy_err"`` (traj, t, value).
+- ``energy_drift``: ``timeseries.csv`` rows with ``quantity == "energy_err"`` (traj, t, value): |error| on a
+  log axis, medians over rollouts and seeds, diverged rollouts counted apart.
 - ``trajectory``: ``arrays.npz`` keys ``t`` (T,), ``q_true`` and ``q_pred`` ((T, n) or (n_traj, T, n)).
 - ``wave_spacetime``: ``arrays.npz`` keys ``x`` (n,), ``t`` (T,), ``field_true``/``field_pred`` (T, n).
 - ``delan_decomposition``: ``arrays.npz`` pairs ``M_true/M_pred``, ``c_true/c_pred``, ``g_true/g_pred``
@@ -16,6 +17,7 @@ import io
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from matplotlib.figure import Figure
 
 from reports.load import Unit
@@ -77,38 +79,57 @@ def _groups(units: list[Unit]) -> dict[tuple[str, str], list[Unit]]:
     return out
 
 
+DIVERGED = 1e3   # |energy error| above this (or non-finite) at any time: a diverged rollout, left out of the curves
+
+
+def _energy_per_seed(u: Unit):
+    """(t, median over the seed's rollouts of |energy error| per time, rollouts, diverged), or None."""
+    ts = u.table("timeseries.csv")
+    if ts is None or not {"t", "quantity", "value", "traj"} <= set(ts.columns):
+        return None
+    e = ts[ts["quantity"] == "energy_err"]
+    if "set" in e.columns and len(e):   # a fit's: its test file's rollouts where it has them
+        e = e[e["set"] == ("test" if (e["set"] == "test").any() else e["set"].iloc[0])]
+    if not len(e):
+        return None
+    per = {k: g.set_index("t")["value"].abs() for k, g in e.groupby("traj")}
+    bad = [k for k, v in per.items() if not (np.isfinite(v).all() and (v <= DIVERGED).all())]
+    kept = pd.DataFrame({k: v for k, v in per.items() if k not in bad}).sort_index()
+    t = np.unique(e["t"].to_numpy(float))
+    curve = kept.reindex(t).median(axis=1).to_numpy(float) if kept.shape[1] else np.full(t.size, np.nan)
+    return t, curve, len(per), len(bad)
+
+
 def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative energy error") -> bool:
+    """|energy error| against time on a log axis, as the LNN paper's Fig. 4: per model and framework the median
+    over seeds of each seed's median over its rollouts, the band from the lowest to the highest seed; a rollout
+    whose error ever exceeds `DIVERGED` is left out of the curves and counted in the legend."""
     curves = {}
     for key, group in _groups(units).items():
-        per_seed = []
-        for u in group:
-            ts = u.table("timeseries.csv")
-            if ts is None or not {"t", "quantity", "value"} <= set(ts.columns):
-                continue
-            e = ts[ts["quantity"] == "energy_err"]
-            if len(e):
-                per_seed.append(e.groupby("t")["value"].mean())
-        if per_seed:
-            curves[key] = per_seed
+        seeds = [c for c in (_energy_per_seed(u) for u in group) if c is not None]
+        if seeds:
+            curves[key] = seeds
     if not curves:
         return False
     fig, (ax,) = new_figure()
     models = style_index([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
-    allv = []
     for (model, fw), seeds in curves.items():
-        t = seeds[0].index.to_numpy(dtype=float)
-        stack = np.vstack([s.reindex(seeds[0].index).to_numpy(dtype=float) for s in seeds])
-        mean = np.nanmean(stack, axis=0)
-        allv.extend(stack.ravel())
+        t = seeds[0][0]
+        stack = np.vstack([np.interp(t, c[0], c[1]) if c[0].size > 1 else c[1] for c in seeds])
+        n, bad = sum(c[2] for c in seeds), sum(c[3] for c in seeds)
         kw = {"color": colour(models[model]), "ls": LINESTYLES[fws[fw] % 4]}
-        ax.plot(t, mean, label=f"{model} ({fw}, {len(seeds)} seed{'s' * (len(seeds) > 1)})", **kw)
+        label = f"{model} ({fw}, {len(seeds)} seed{'s' * (len(seeds) > 1)}" + (f"; {bad} of {n} rollouts diverged"
+                                                                              if bad else "") + ")"
+        after = slice(1, None)   # the start is exact by construction: no point on a log axis
+        ax.plot(t[after], np.nanmedian(stack, axis=0)[after], label=label, **kw)
         if len(seeds) > 1:
-            ax.fill_between(t, np.nanmin(stack, 0), np.nanmax(stack, 0), color=kw["color"], alpha=0.15, lw=0)
-    log_if_spread(ax, allv)
+            ax.fill_between(t[after], np.nanmin(stack, 0)[after], np.nanmax(stack, 0)[after], color=kw["color"],
+                            alpha=0.15, lw=0)
+    ax.set_yscale("log")
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel(f"{scale_label} (–)")
-    ax.set_title("Energy drift against truth", fontsize=10)
+    ax.set_ylabel(f"|{scale_label}| (–)")
+    ax.set_title("Energy error against truth (median over rollouts and seeds)", fontsize=10)
     ax.legend(fontsize=7)
     return save(fig, path)
 

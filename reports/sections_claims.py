@@ -111,8 +111,9 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
     if rt is not None:
         s.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
     figs = [
-        ("energy", F.energy_drift, "Energy drift over time against truth (mean over trajectories; "
-                                  "line: mean over seeds, band: seed range)", "timeseries.csv"),
+        ("energy", F.energy_drift, "|Energy error| over time against truth, log axis (as LNN Fig. 4; line: median "
+                                  "over seeds of each seed's median over its rollouts, band: seed range; diverged "
+                                  "rollouts counted in the legend, not in the line)", "timeseries.csv"),
         ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
         ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
         ("decomposition", F.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
