@@ -22,7 +22,7 @@ from reports.load import load_results
 from reports.markdown import render_markdown
 from reports.pdf import write_pdf
 from reports.scorecard import scorecard_section
-from reports.sections_claims import summary_sections, theme_sections
+from reports.sections_claims import metrics_appendix, summary_sections, theme_sections
 from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
@@ -49,6 +49,7 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
     sections += findings_sections(res)
     sections += systems_sections(results_dir) + mine
     sections += environment_sections(res, now)
+    sections += metrics_appendix(res)
     return sections + sources_sections(res, sections)
 
 

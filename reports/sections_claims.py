@@ -74,7 +74,14 @@ def _rollout_table(units) -> pd.DataFrame | None:
     return pd.DataFrame(rows)
 
 
-def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
+def _trainings(units) -> tuple:
+    """What identifies a claim's trainings: claims sharing them (the double pendulum's 1 and 2) share this."""
+    return tuple(sorted((u.framework, u.model, u.seed, u.result.get("final_train_loss")) for u in units))
+
+
+def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None) -> Section:
+    """The claim's section; `drawn` maps the trainings whose work-precision figure is already in the report to
+    its claim, so a figure of the same trainings is drawn once."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
@@ -104,9 +111,6 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
         return s
     s.add(Table(f"{cid}: {claim.get('metric', 'metric')} per model and framework", claim_table(res, claim),
                 ["claims.json", src + "result.json"]))
-    mt = metrics_table(res, claim)
-    if mt is not None:
-        s.add(Table(f"{cid}: all recorded metrics (mean ± std over seeds)", mt, [src + "result.json"]))
     rt = _rollout_table(units)
     if rt is not None:
         s.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
@@ -120,20 +124,41 @@ def claim_section(res: Results, claim: dict, out_dir: Path) -> Section:
                                                  "(predicted against true)", "arrays.npz"),
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
          "Data efficiency: error against training samples (bars: seed range)", "result.json"),
-        ("training", F.training_curves, "Training curves (mean over seeds)", "train_log.csv"),
-        ("work_precision", FP.work_precision, "Work-precision: held-out loss against training samples and "
-         "against training time (line: mean over seeds, band: seed range)", "train_log.csv"),
     ]
     for kind, fn, caption, file in figs:
         rel = f"figures/{slug(cid)}_{kind}.png"
         if fn(units, out_dir / rel):
             s.add(Figure(rel, f"{cid}: {caption}.", [src + file]))
+    drawn = {} if drawn is None else drawn
+    key = _trainings(units)
+    if key in drawn:
+        s.add(Para(f"Training: the same trainings as {drawn[key]}'s; its training figure shows them."))
+        return s
+    rel = f"figures/{slug(cid)}_work_precision.png"
+    if FP.work_precision(units, out_dir / rel):   # it shows the training curve; a separate one would repeat it
+        drawn[key] = cid
+        s.add(Figure(rel, f"{cid}: Work-precision: held-out loss against training samples and against training "
+                          f"time (line: mean over seeds, band: seed range).", [src + "train_log.csv"]))
+    elif F.training_curves(units, out_dir / (rel := f"figures/{slug(cid)}_training.png")):
+        drawn[key] = cid
+        s.add(Figure(rel, f"{cid}: Training curves (mean over seeds).", [src + "train_log.csv"]))
     return s
+
+
+def metrics_appendix(res: Results) -> list[Section]:
+    """Every metric each claim's units recorded (mean ± std over seeds): the dump behind the claims' tables."""
+    s = Section("Appendix: all recorded metrics")
+    for claim in res.claims:
+        mt = metrics_table(res, claim) if res.usable(claim["id"]) else None
+        if mt is not None:
+            s.add(Table(f"{claim['id']}: all recorded metrics (mean ± std over seeds)", mt,
+                        [RESULT_FILES.format(claim=claim["id"]) + "result.json"]))
+    return [s] if s.blocks else []
 
 
 def theme_sections(res: Results, out_dir: Path) -> list[Section]:
     groups = assign(res.claims)
-    out = []
+    out, drawn = [], {}
     for key, title, blurb, _ in THEMES:
         claims = groups[key]
         if key == "other" and not claims:
@@ -142,5 +167,5 @@ def theme_sections(res: Results, out_dir: Path) -> list[Section]:
         if not claims:
             s.add(Para(f"Result: {NOT_RUN} (no claim of this kind in claims.json)."))
         out.append(s)
-        out.extend(claim_section(res, c, out_dir) for c in claims)
+        out.extend(claim_section(res, c, out_dir, drawn) for c in claims)
     return out

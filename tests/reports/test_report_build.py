@@ -174,3 +174,22 @@ def test_cross_framework_table_flags_a_difference_beyond_the_seed_spread(results
         r = df.loc[(claim, model)]
         gap = abs(float(r["jax"]) - float(r["torch"]))
         assert (flag == "yes") == (gap > float(r["seed spread (std)"])), (claim, model)
+
+
+def test_the_metric_dumps_sit_in_an_appendix_and_shared_trainings_are_drawn_once(results_dir, tmp_path):
+    from reports.build import build_sections
+    from reports.load import load_results
+    from reports.sections_claims import claim_section
+
+    titles = [s.title for s in build_sections(results_dir, tmp_path / "a")]
+    dumps = [t for s in build_sections(results_dir, tmp_path / "b") for b in s.blocks
+             if "all recorded metrics" in getattr(b, "title", "") for t in [s.title]]
+    assert dumps and set(dumps) == {"Appendix: all recorded metrics"}
+    assert titles.index("Appendix: all recorded metrics") > titles.index("Environment")
+    res = load_results(results_dir)
+    claim = next(c for c in res.claims if c["id"] == "dp_loss")
+    drawn = {}
+    first = claim_section(res, claim, tmp_path / "c", drawn)
+    again = claim_section(res, claim, tmp_path / "c", drawn)   # the same trainings a second time
+    assert any("train" in getattr(b, "path", "") for b in first.blocks)   # its training figure
+    assert any("the same trainings as dp_loss's" in getattr(b, "text", "") for b in again.blocks)
