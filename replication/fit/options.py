@@ -115,6 +115,18 @@ OPTIONS = (
     Option("loss", "l1", "l1 | mse (per sample summed over components, mean over the batch)", one_of(LOSSES),
            f"one of {', '.join(LOSSES)}"),
     Option("seed", 0, "initialisation and batch-order seed, >= 0", count(0), "an integer >= 0", kind=int),
+    Option("restarts", None, "restarts over initialisations, as the claims train LNNs off their qddot ~ 0 plateau: "
+           "this many inits (>= 2) train side by side for --restart-steps steps, the lowest training loss goes on "
+           "for --steps (default: none)", lambda v: v is None or count(2)(v), "an integer >= 2", kind=int),
+    Option("restart_steps", None, "steps of each restart (default: --steps / 8)",
+           lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
+    Option("restart_keep", None, "successive halving: at half their steps only this many restarts (the lowest "
+           "training losses) go on (default: all)", lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
+    Option("guard_clip", None, "gradient-spike guard: clip the gradient's norm to this (the double-pendulum claims: "
+           "100; default: none)", lambda v: v is None or (real(v) and v > 0), "a number > 0", kind=float),
+    Option("guard_skip", None, "gradient-spike guard: skip a step whose gradient norm is at least this many times "
+           "the recent median (the claims: 10; default: none)", lambda v: v is None or (real(v) and v > 0),
+           "a number > 0", kind=float),
     Option("delan_eps", 0.01, "DeLaN: epsilon of M = L L^T + eps I", lambda v: real(v) and v >= 0,
            "a finite number >= 0", kind=float),
     Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", real, "a finite number", kind=float),
@@ -152,6 +164,10 @@ def check(values: dict) -> None:
             v = values[o.name]
             shown = ",".join(map(str, v)) if o.name == "hidden" and isinstance(v, tuple) else v
             raise ValueError(f"{o.cli}: {shown!r} is not valid; expected {o.expected}")
+    keep, restarts = values.get("restart_keep"), values.get("restarts")
+    if keep is not None and (restarts is None or keep >= restarts):
+        raise ValueError(f"--restart-keep: {keep!r} needs --restarts above it (the restarts that go on after the "
+                         f"first half)")
     system = values.get("system")
     if system is not None:
         import systems

@@ -34,7 +34,7 @@ from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
 from replication.fit import trajectories, userdata
 from replication.run.units import Unit, run_unit
-from replication.training.protocol import Data, Protocol
+from replication.training.protocol import Data, Guard, Protocol, Scouting
 from replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
@@ -98,8 +98,12 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     n_train = prep.counts["train"]
     data = Data(recipe=prep.reference, n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)))  # the file's split
     schedule = OneCycle(lr=o.lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
-    protocol = Protocol(data=data, task=task, steps=o.steps, batch=min(o.batch, n_train), loss=o.loss, l2=o.weight_decay,
-                        schedule=schedule, dtype=dtype, log_every=max(1, o.steps // 100))
+    batch = min(o.batch, n_train)
+    scouting = Scouting(count=o.restarts, steps=o.restart_steps or max(o.steps // 8, 2), batch=batch, schedule=schedule,
+                        keep=o.restart_keep) if o.restarts else None
+    guard = Guard(clip=o.guard_clip, skip=o.guard_skip) if (o.guard_clip or o.guard_skip) else None
+    protocol = Protocol(data=data, task=task, steps=o.steps, batch=batch, loss=o.loss, l2=o.weight_decay,
+                        schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=max(1, o.steps // 100))
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
