@@ -17,9 +17,10 @@ import pandas as pd
 from reports.document import NOT_RUN, Para, Section, Table
 from reports.fmt import cell, num, stat, summarise
 from reports.load import Results
-from reports.tables import published_cell, published_entry
+from reports.tables import published_cell, published_entry, verdict_text
 
-REASON_CHARS = 240
+REASON_CHARS = 120
+FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}
 
 
 def _metric_of(u, name: str):
@@ -29,31 +30,59 @@ def _metric_of(u, name: str):
     return u.metric(name)
 
 
-def _reproduced(res: Results, claim: dict, model: str, metric: str) -> str:
-    parts = []
-    for fw in res.frameworks:
-        us = [u for u in res.usable(claim["id"]) if u.model == model and u.framework == fw]
-        vals = [_metric_of(u, metric) for u in us]
-        s = summarise(vals)
-        n_inf = sum(v is not None and v == float("inf") for v in vals)
-        text = "inf" if n_inf == len(vals) and vals else (stat(**s) if s["n"] else NOT_RUN)
-        if n_inf and n_inf < len(vals):
-            text = f"inf ({n_inf} of {len(vals)} seeds diverged; finite: {stat(**s)})"
-        parts.append(f"{fw} {text}")
-    return "; ".join(parts) if parts else NOT_RUN
+def _reproduced(res: Results, claim: dict, model: str, metric: str, fw: str) -> str:
+    us = [u for u in res.usable(claim["id"]) if u.model == model and u.framework == fw]
+    vals = [_metric_of(u, metric) for u in us]
+    s = summarise(vals)
+    n_inf = sum(v is not None and v == float("inf") for v in vals)
+    text = "inf" if n_inf == len(vals) and vals else (stat(**s) if s["n"] else NOT_RUN)
+    if n_inf and n_inf < len(vals):
+        text = f"inf ({n_inf} of {len(vals)} seeds diverged; finite: {stat(**s)})"
+    return text
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= REASON_CHARS else text[: REASON_CHARS - 1] + "…"
 
 
 def _reason(v: dict | None) -> str:
-    """The claim's own reason, then the first undecided or failed part's reason in its first framework."""
+    """The claim's own reason, in its first sentence (the parts' reasons in full: `reasons_table`)."""
     if not v:
         return "no verdict"
-    parts = v.get("parts") or []
-    first = next((p for p in parts if not p.get("check") and p.get("verdict") != "reproduced"), None)
-    text = str(v.get("reason") or "").split(". ", 1)[0]
-    if first and first.get("reason"):
-        fw, why = next(iter(first["reason"].items()))
-        text += f". {first['name']} ({fw}): {why}"
-    return text if len(text) <= REASON_CHARS else text[: REASON_CHARS - 1] + "…"
+    return _short(str(v.get("reason") or "").split(". ", 1)[0])
+
+
+def reasons_table(res: Results) -> pd.DataFrame | None:
+    """Every part not reproduced, per framework, with its reason in full (the scorecard's reasons are short)."""
+    rows = []
+    for claim in res.claims:
+        for p in (res.verdicts.get(claim["id"]) or {}).get("parts") or []:
+            if p.get("verdict") == "reproduced":
+                continue
+            for fw, why in (p.get("reason") or {}).items():
+                rows.append({"#": cell(claim.get("number"), "–"), "claim": claim["id"], "part": cell(p.get("name")),
+                             "framework": fw, "verdict": cell(p.get("verdict")), "reason": cell(why)})
+    return pd.DataFrame(rows) if rows else None
+
+
+def all_parts_table(res: Results, kind: str = "claim") -> pd.DataFrame | None:
+    """Every part of every claim of `kind`: its verdict and the interval it read per framework."""
+    rows = []
+    for claim in res.claims:
+        if _kind(res, claim) != kind:
+            continue
+        for p in (res.verdicts.get(claim["id"]) or {}).get("parts") or []:
+            ivs = p.get("interval") or {}
+            row = {"#": cell(claim.get("number"), "–"), "claim": claim["id"],
+                   "part": cell(p.get("name")) + (" [check]" if p.get("check") else ""),
+                   "verdict": cell(p.get("verdict")) + (f" ({p['flag']})" if p.get("flag") else ""),
+                   "interval of": cell(next(iter(ivs.values())).get("what") if ivs else None, "–")}
+            for fw in res.frameworks:
+                iv = ivs.get(fw)
+                row[FRAMEWORK_NAMES.get(fw, fw)] = (f"{num(iv.get('point'))} [{num(iv.get('lo'))}, {num(iv.get('hi'))}]"
+                                                    if iv else "–")
+            rows.append(row)
+    return pd.DataFrame(rows) if rows else None
 
 
 def interval_text(p: dict) -> str:
@@ -79,6 +108,8 @@ def _kind(res: Results, claim: dict) -> str:
 
 
 def scorecard_table(res: Results, kind: str = "claim") -> pd.DataFrame:
+    """One row per claim of `kind`: what it says and where, its verdict, its key model's number per framework
+    beside the published one, and the reason in short."""
     rows = []
     for claim in res.claims:
         if _kind(res, claim) != kind:
@@ -87,15 +118,14 @@ def scorecard_table(res: Results, kind: str = "claim") -> pd.DataFrame:
         key = claim.get("key") or next(iter(claim.get("models") or []), "")
         p = published_entry(claim, key)
         metric = (p or {}).get("metric") or claim.get("metric") or ""
-        published = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
-        v = res.verdicts.get(cid)
-        parts = (v or {}).get("parts") or []
-        rows.append({"#": cell(claim.get("number"), "–"), "claim": cid,
-                     "verdict": cell((v or {}).get("verdict"), NOT_RUN),
-                     "key number": f"{key} {metric}: {_reproduced(res, claim, key, metric)}" if key else NOT_RUN,
-                     "published": published, "why": _reason(v),
-                     "parts": "; ".join(part_text(x) + (" [check]" if x.get("check") else "") for x in parts)
-                     or NOT_RUN})
+        row = {"#": cell(claim.get("number"), "–"), "claim": cid, "says": cell(claim.get("title"), "untitled"),
+               "paper": f"{cell(claim.get('paper'), '?')} {cell(claim.get('section'), '')}".strip(),
+               "verdict": verdict_text(res, claim), "key number": f"{key} {metric}" if key else NOT_RUN}
+        for fw in res.frameworks:
+            row[FRAMEWORK_NAMES.get(fw, fw)] = _reproduced(res, claim, key, metric, fw) if key else NOT_RUN
+        row["published"] = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
+        row["why"] = _reason(res.verdicts.get(cid))
+        rows.append(row)
     return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN], "verdict": [NOT_RUN]})
 
 
@@ -180,6 +210,15 @@ def scorecard_section(res: Results) -> Section:
     checks = scorecard_table(res, "check")
     if "#" in checks.columns:
         s.add(Table("Checks", checks, ["claims.json", "units/*/*/*/seed*/result.json"]))
+    for kind, title in (("claim", "Parts of the paper claims"), ("check", "Parts of the checks")):
+        parts = all_parts_table(res, kind)
+        if parts is not None:
+            s.add(Table(title, parts, ["summary/verdicts.json", "units/*/*/*/seed*/result.json"],
+                        note="Each part is decided per framework on the interval shown (point [low, high] over "
+                             "seeds or seed pairs)."))
+    why = reasons_table(res)
+    if why is not None:
+        s.add(Table("Reasons in full (parts not reproduced)", why, ["summary/verdicts.json"]))
     variants = variants_table(res)
     if variants is not None:
         s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],

@@ -18,7 +18,7 @@ from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results
 from reports.scorecard import competence_table, parts_table
-from reports.tables import claim_table, metrics_table, problem_units_table, status_table, summary_table
+from reports.tables import claim_table, metrics_table, problem_units_table, status_table
 from reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
@@ -36,9 +36,8 @@ def summary_sections(res: Results) -> list[Section]:
     s.add(Para(f"{len(res.claims)} claims catalogued; {len(res.units)} units found, {n_ok} usable "
                f"(status ok, checksums verified). Reproduced values are mean ± sample std over seeds "
                f"(n = seeds) of each claim's metric; numbers and verdicts are both recomputed from the "
-               f"unit files."))
-    s.add(Table("Claims: published against reproduced", summary_table(res),
-                ["claims.json", "units/*/*/*/seed*/result.json", "summary/verdicts.json"]))
+               f"unit files. The scorecard shows each claim's key model; every model's numbers are in the "
+               f"claim's own section."))
     st = Section("Run status", level=2)
     st.add(Table("Units per claim and framework", status_table(res), ["units/*/*/*/seed*/result.json"]))
     bad = problem_units_table(res)

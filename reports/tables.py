@@ -83,36 +83,6 @@ def verdict_text(res: Results, claim: dict) -> str:
     return text
 
 
-def profile_text(res: Results, claim: dict) -> str:
-    profiles = sorted({str(u.result.get("profile")) for u in res.usable(claim["id"]) if u.result.get("profile")})
-    return ", ".join(profiles) if profiles else NOT_RUN
-
-
-def summary_table(res: Results) -> pd.DataFrame:
-    """One row per claim: paper, section, published, reproduced per framework, verdict, profile."""
-    frameworks = res.frameworks or ["any framework"]
-    rows = []
-    for claim in res.claims:
-        vals = values(res.claim_units(claim["id"]), claim.get("metric"))
-        row = {
-            "#": cell(claim.get("number"), "–"),
-            "claim": claim["id"],
-            "paper": cell(claim.get("paper"), "unknown"),
-            "section": cell(claim.get("section"), "unknown"),
-            "metric": cell(claim.get("metric"), "unknown"),
-            "published": "\n".join(f"{m}: {published_cell(claim, m, [u for u in res.usable(claim['id']) if u.model == m])}"
-                                   for m in (claim.get("published") or {})) or "none published",
-        }
-        for fw in frameworks:
-            per = vals.get(fw, {})
-            models = [m for m in claim_models(res, claim) if m in per]
-            row[f"reproduced ({fw})"] = "\n".join(f"{m}: {stat(**per[m])}" for m in models) or NOT_RUN
-        row["verdict"] = verdict_text(res, claim)
-        row["profile"] = profile_text(res, claim)
-        rows.append(row)
-    return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN], "verdict": [NOT_RUN]})
-
-
 def claim_table(res: Results, claim: dict) -> pd.DataFrame:
     """Rows: models; columns: published value and the claim metric per framework (mean ± std (n))."""
     vals = values(res.claim_units(claim["id"]), claim.get("metric"))

@@ -26,19 +26,22 @@ def table_rows(md: str, title: str) -> dict[str, list[str]]:
     return {r[1].strip(): [c.strip() for c in r] for r in rows}
 
 
-def summary_rows(md: str) -> dict[str, list[str]]:
-    return table_rows(md, "Claims: published against reproduced")
+def claim_rows(md: str) -> dict[str, list[str]]:
+    """The scorecard's and the checks' rows: #, claim, says, paper, verdict, key number, JAX, PyTorch,
+    published, why."""
+    return {**table_rows(md, "Scorecard"), **table_rows(md, "Checks")}
 
 
 def test_markdown_has_every_claim_row_and_not_run(built):
     md = built["markdown"].read_text()
-    rows = summary_rows(md)
+    rows = claim_rows(md)
     assert set(rows) == {c[0] for c in CLAIMS}
-    assert all(rows[NOT_RUN_CLAIM][i] == "not run" for i in (6, 7, 8, 9))
+    assert all(rows[NOT_RUN_CLAIM][i] == "not run" for i in (4, 6, 7))
     # recomputed from the unit files: dp_loss's models pass their bar (null recorded) and agree;
     # dp_energy's rollouts record no divergence count, so its LNN cannot pass its rollout bar
-    assert rows["dp_loss"][8] == "reproduced; 1 corrupt unit excluded"
-    assert rows["dp_energy"][8] == "inconclusive"
+    assert rows["dp_loss"][4] == "reproduced; 1 corrupt unit excluded"
+    assert rows["dp_energy"][4] == "inconclusive"
+    assert "Claims: published against reproduced" not in md   # folded into the scorecard
     assert "summary/verdicts.json disagrees with the unit files for" in md
     for line in md.splitlines():
         if line.startswith("|"):
@@ -54,8 +57,8 @@ def test_corrupt_unit_is_listed_and_excluded(built):
     rel = "units/{}/{}/{}/seed{}".format(*CORRUPT)
     assert f"| {rel} | corrupt | result.json checksum mismatch |" in md
     assert "999" not in md
-    torch_cell = summary_rows(md)["dp_loss"][7]
-    assert "lnn:" in torch_cell and "(n=2)" in torch_cell.split("<br>")[0]
+    torch_cell = claim_rows(md)["dp_loss"][7]
+    assert torch_cell.endswith("(n=2)") and claim_rows(md)["dp_loss"][5] == "lnn heldout_l1"
 
 
 def test_figures_written_and_referenced(built):
@@ -93,9 +96,9 @@ def test_claims_only_reads_not_run_everywhere(tmp_path):
     res = tmp_path / "res"
     write_json(res / "claims.json", {"schema": 1, "claims": [claim_record(c) for c in CLAIMS]})
     paths = build_report(res, tmp_path / "out", pdf=False)
-    rows = summary_rows(paths["markdown"].read_text())
+    rows = claim_rows(paths["markdown"].read_text())
     assert set(rows) == {c[0] for c in CLAIMS}
-    assert all(r[-1] == "not run" and r[-2] == "not run" for r in rows.values())
+    assert all(r[4] == "not run" for r in rows.values())
     assert paths["figures"] == []
 
 
@@ -138,10 +141,15 @@ def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
     assert set(rows) | set(checks) == {c[0] for c in CLAIMS} and not set(rows) & set(checks)
     assert "appendix_b" in checks and "dp_loss" in rows      # a check is kept apart from the paper claims
     assert re.search(r"Paper claims: (\d+ [a-z ]+, )*\d+ reproduced", md) and "Checks (implementation and numerics): " in md
-    assert rows["dp_loss"][2] == "reproduced" and rows["dp_energy"][2] == "inconclusive"
-    assert rows["dp_loss"][6].startswith("similar held-out loss: reproduced (lnn/baseline: jax ")
-    assert re.fullmatch(r"lnn heldout_l1: jax 0\.0\d+ ± \S+ \(n=2\); torch 0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][3])
-    assert "below the competence bar" in rows["dp_energy"][5]
+    assert rows["dp_loss"][4].startswith("reproduced") and rows["dp_energy"][4] == "inconclusive"
+    assert rows["dp_loss"][3].startswith("LNN") and rows["dp_loss"][2]   # the paper's section and what it says
+    assert re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][6]) and re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][7])
+    assert len(rows["dp_energy"][9]) <= 120
+    parts = table_rows(md, "Parts of the paper claims")
+    assert parts["dp_loss"][2] == "similar held-out loss" and parts["dp_loss"][3] == "reproduced"
+    assert re.fullmatch(r"\S+ \[\S+, \S+\]", parts["dp_loss"][5])   # JAX: point [low, high]
+    full = table_rows(md, "Reasons in full (parts not reproduced)")
+    assert "below the competence bar" in full["dp_energy"][5]
 
 
 def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(results_dir, tmp_path):
@@ -155,7 +163,7 @@ def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(results_
     shutil.rmtree(res / "units" / "dp_loss" / "jax" / "baseline")
     shutil.rmtree(res / "units" / "dp_loss" / "torch" / "baseline")
     md = build_report(res, tmp_path / "out", pdf=False)["markdown"].read_text()
-    assert scorecard_rows(md)["dp_loss"][2] == "not run"       # the stored verdict said "reproduced"
+    assert scorecard_rows(md)["dp_loss"][4].startswith("not run")   # the stored verdict said "reproduced"
     assert "This run is unfinished: 4 planned unit(s) have no result" in md
     assert "| units/dp_loss/jax/baseline/seed0 | missing |" in md
     assert "No failed, corrupt or missing units" not in md
