@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 from dataclasses import dataclass
 
 from replication.training.protocol_parts import (
@@ -86,8 +87,7 @@ class Protocol:
             check(integer(getattr(self, name)) and getattr(self, name) >= 1,
                   f"protocol {name} must be a positive integer, got {getattr(self, name)!r}")
             object.__setattr__(self, name, int(getattr(self, name)))
-        check(real(self.l2) and self.l2 == self.l2 and abs(self.l2) != float("inf"),
-              f"protocol l2 must be a finite number, got {self.l2!r}")
+        check(real(self.l2) and math.isfinite(self.l2), f"protocol l2 must be a finite number, got {self.l2!r}")
         object.__setattr__(self, "l2", float(self.l2))
         n_train = self.data.n_train
         check(self.batch <= n_train, f"batch {self.batch} exceeds the training pool n_train={n_train}")
