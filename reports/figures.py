@@ -14,6 +14,7 @@ returns False (writing nothing) when the units lack the data it needs. Inputs:
 from __future__ import annotations
 
 import io
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -122,10 +123,12 @@ def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative ene
         label = f"{model} ({fw}, {len(seeds)} seed{'s' * (len(seeds) > 1)}" + (f"; {bad} of {n} rollouts diverged"
                                                                               if bad else "") + ")"
         after = slice(1, None)   # the start is exact by construction: no point on a log axis
-        ax.plot(t[after], np.nanmedian(stack, axis=0)[after], label=label, **kw)
+        with warnings.catch_warnings():   # a time at which every rollout of every seed diverged: NaN, no point
+            warnings.simplefilter("ignore", RuntimeWarning)
+            mid, lo, hi = np.nanmedian(stack, axis=0), np.nanmin(stack, 0), np.nanmax(stack, 0)
+        ax.plot(t[after], mid[after], label=label, **kw)
         if len(seeds) > 1:
-            ax.fill_between(t[after], np.nanmin(stack, 0)[after], np.nanmax(stack, 0)[after], color=kw["color"],
-                            alpha=0.15, lw=0)
+            ax.fill_between(t[after], lo[after], hi[after], color=kw["color"], alpha=0.15, lw=0)
     ax.set_yscale("log")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel(f"|{scale_label}| (–)")

@@ -34,3 +34,9 @@ def test_a_blow_up_is_counted_not_averaged(tmp_path, monkeypatch):
     assert seen["scale"] == "log" and seen["top"] < 1
     assert any("1 of 4 rollouts diverged" in x for x in seen["labels"] if x.startswith("baseline"))
     assert not any("diverged" in x for x in seen["labels"] if x.startswith("lnn"))
+
+
+def test_a_model_whose_every_rollout_diverged_is_named_not_drawn(tmp_path):
+    t = np.linspace(0, 10, 11)
+    units = [_unit(tmp_path, "lnn", 0, [1e-3 * t]), _unit(tmp_path, "baseline", 0, [np.where(t > 0, np.inf, 0.0)] * 2)]
+    assert F.energy_drift(units, tmp_path / "e.png")
