@@ -2,27 +2,20 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
+from replication.renamed import renamed
 from replication.training.device import HELP as DEVICE_HELP
 
-
-def _heldout_states(args) -> int:
-    """--heldout-states, or its old spelling --heldout (read, with a deprecation notice)."""
-    if args.heldout_old is None:
-        return args.heldout_states
-    if args.heldout_states != 4096:
-        raise ValueError("--heldout: give it once, as --heldout-states")
-    print("lagbench: train-target --heldout is deprecated; use --heldout-states", file=sys.stderr)
-    return args.heldout_old
+HELDOUT_STATES = 4096
 
 
 def cmd_train_target(args):
     from replication.fit.options import widths
     from speedstudy.train_target_run import check_names, run_study
 
-    heldout = _heldout_states(args)
+    heldout = renamed("train-target", args.heldout_states, args.heldout_old, HELDOUT_STATES, "--heldout-states", "--heldout",
+                      "in `fit`, --holdout-fraction is a fraction of the rows")
     if heldout < 1 or args.seed < 0:
         raise ValueError(f"--heldout-states takes an integer >= 1 and --seed one >= 0; got {heldout} and {args.seed}")
     names = [x.strip() for x in args.protocols.split(",") if x.strip()] if args.protocols else None
@@ -53,7 +46,7 @@ def add_train_target(sub) -> None:
     s.add_argument("--budget", type=float, default=5e5, help="training samples per protocol (default 5e5; the "
                                                              "issue's target is 3e7)")
     s.add_argument("--hidden", default="64,64,64", help="MLP widths (default 64,64,64; the paper's 600,600,600)")
-    s.add_argument("--heldout-states", type=int, default=4096, help="held-out states, >= 1 (default 4096)")
+    s.add_argument("--heldout-states", type=int, default=HELDOUT_STATES, help="held-out states, >= 1 (default 4096)")
     # the old spelling: in `fit`, --holdout-fraction is a fraction of the rows
     s.add_argument("--heldout", dest="heldout_old", type=int, help=argparse.SUPPRESS)
     s.add_argument("--protocols", help="comma-separated: original_scaled, variant, restarts, restarts_fast, "

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from replication.claims.base import PROFILES
 from replication.fit import options as fit_options
+from replication.renamed import renamed
 from replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
@@ -101,16 +102,11 @@ def cmd_fit(args):
 
 
 def _fitted_folder(args) -> str:
-    """--fitted, or its old spelling --model (read, with a deprecation notice)."""
-    if args.fitted_old is not None:
-        if args.fitted is not None:
-            raise ValueError("--model: give the fitted models once, as --fitted")
-        print("lagbench: evaluate --model is deprecated; use --fitted (in `fit`, --model is the model kind)",
-              file=sys.stderr)
-        return args.fitted_old
-    if args.fitted is None:
+    """--fitted, or its old spelling --model."""
+    fitted = renamed("evaluate", args.fitted, args.fitted_old, None, "--fitted", "--model", "in `fit`, --model is the model kind")
+    if fitted is None:
         raise ValueError("--fitted: required; give a fit's unit folder or a `lagbench fit` results folder")
-    return args.fitted
+    return fitted
 
 
 def cmd_predict(args):

@@ -10,7 +10,6 @@ keywords of `fit` from parsed flags (a flag's text read by the option's `parse`)
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -18,6 +17,7 @@ from types import SimpleNamespace
 from models import ACTIVATIONS
 from replication.fit.rows import HELDOUT, SPLITS
 from replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
+from replication.renamed import renamed
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
 FRAMEWORKS = ("jax", "torch")
@@ -197,11 +197,7 @@ def from_args(args) -> dict:
     out = {}
     for o in OPTIONS:
         v = getattr(args, o.cli[2:].replace("-", "_"))
-        old = getattr(args, "old_" + o.name, None) if o.old else None
-        if old is not None:
-            if v != (o.text if o.parse is not None else o.default):
-                raise ValueError(f"{o.old}: give it once, as {o.cli}")
-            print(f"lagbench: {o.old} is deprecated; use {o.cli}", file=sys.stderr)
-            v = old
+        if o.old:
+            v = renamed("fit", v, getattr(args, "old_" + o.name), o.text if o.parse is not None else o.default, o.cli, o.old)
         out[o.name] = o.parse(v) if o.parse is not None else v
     return out
