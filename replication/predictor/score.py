@@ -92,7 +92,8 @@ def setup(system: str, profile: str = "quick") -> Setup:
 def score(function, system: str, profile: str = "quick", out=None, label: str | None = None, name: str = "") -> dict:
     """The predictor's record (see the module's doc); `name` is how errors name it (its module:function)."""
     s = setup(system, profile)
-    label = label or getattr(function, "__name__", "predictor")
+    named = getattr(function, "__name__", "")
+    label = label or (named if named.isidentifier() else "predictor")   # a lambda's "<lambda>" names no folder
     if not label.replace("_", "").replace("-", "").isalnum():
         raise ValueError(f"--label {label}: use letters, digits, - and _ only (it names a folder)")
     folder = R.output_folder(out) / "predict" / system / label if out is not None else None

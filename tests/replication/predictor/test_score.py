@@ -48,7 +48,9 @@ def test_a_diverging_predictor_is_valid_for_no_time(scored):
 
 def test_a_system_without_chaos_has_no_lyapunov_time():
     s = systems.get("spring")
-    m = score(lambda q, qd: s.acceleration(q, qd, backend="numpy"), "spring", "smoke", label="exact")["metrics"]
+    d = score(lambda q, qd: s.acceleration(q, qd, backend="numpy"), "spring", "smoke")   # unnamed: "predictor"
+    m = d["metrics"]
+    assert d["model"] == "predictor"
     assert m["heldout_l1"] == 0.0 and np.isnan(m["lyapunov_time_s"]) and m["vpt_s"] == m["chaos_floor_vpt_s"]
 
 
