@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from reports import sections_registration
 from reports.document import NOT_RUN, Para, Section, Table
 from reports.fmt import cell, num, stat, summarise
 from reports.load import Results
@@ -140,18 +141,6 @@ def variants_table(res: Results) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
-def registration_table(res: Results) -> pd.DataFrame | None:
-    """Per claim: the hash of what decides it under this profile, and the registration it matches."""
-    rows = []
-    for claim in res.claims:
-        r = (res.verdicts.get(claim["id"]) or {}).get("preregistration")
-        if r:
-            rows.append({"claim": claim["id"], "protocol hash": r["protocol_hash"],
-                         "registered": f"yes, frozen {r['frozen']}" if r["registered"] else "NO: changed since",
-                         "tuned on": cell(r.get("tuned_on")), "registrations": r["registrations"]})
-    return pd.DataFrame(rows) if rows else None
-
-
 def made_by(res: Results) -> str:
     """Which run this is: profile, split, commit, hardware and date, from run.json."""
     run = res.run or {}
@@ -178,9 +167,9 @@ def headline(res: Results) -> str:
 SPLIT_TEXT = {
     "test": "Decided on the test split: training seeds from 1000 on, and a held-out draw, rollout initial "
             "conditions and sampled states from generator seeds that no trial, study or protocol choice has "
-            "read (replication/run/splits.py). The protocols were frozen before this run; they were tuned "
-            "by hand on the development split (seeds from 0, the development draws), with more trials for "
-            "some models than for others (docs/decisions/, docs/lab/).",
+            "read (replication/run/splits.py). The protocols were frozen before this run and chosen on the "
+            "development split (seeds from 0, the development draws): by `lagbench tune` where the registered "
+            "protocols table says so, else by hand (docs/decisions/, docs/lab/).",
     "dev": "Development split (seeds from 0, the development draws): the data the protocols were tuned on. "
            "These numbers are for development; verdicts of record come from the test split (`lagbench run`, "
            "its default).",
@@ -224,14 +213,7 @@ def scorecard_section(res: Results) -> Section:
         s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
                     note="A variant is a model with a departure from the paper standing in for the paper's model; "
                          "the claim is judged again with it, on this line only. A variant never decides a claim."))
-    registered = registration_table(res)
-    if registered is not None:
-        s.add(Table("Registered protocols", registered, ["replication/claims/registrations.json"],
-                    note="What decides each claim under this profile (its models' specs and protocols, the "
-                         "evaluation, the seeds, the bars and the rules) is hashed and registered before a "
-                         "test-split run; a change after one is a new dated registration, never a silent edit. "
-                         "The protocols were tuned by hand on the development split, with unequal effort "
-                         "between models; `lagbench tune` searches every model alike, but has not chosen these protocols."))
+    sections_registration.add_to(s, res)
     flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
     s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
                "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else

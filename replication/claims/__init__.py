@@ -1,4 +1,7 @@
-"""The ten claims of the SPEC, by id, in the SPEC's order, then the hard-case claims (11: precision)."""
+"""The ten claims of the SPEC, by id, in the SPEC's order, then the hard-case claims (11: precision).
+
+`CLAIMS` holds each claim as it runs: its models with the protocols `lagbench tune` chose where a choice is
+adopted (`tuned.py`); `untuned(id)` the claim as its file writes it, the base every tuning searches around."""
 from replication.claims import (
     activation_study,
     appendix_b,
@@ -10,13 +13,15 @@ from replication.claims import (
     init_study,
     precision,
     rel_coords,
+    tuned,
     wave_lgn,
 )
 from replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
 
 _ALL = (dp_loss, dp_energy, rel_coords, wave_lgn, appendix_b, init_study, activation_study, delan_table1,
         delan_arm, hnn_energy, precision)
-CLAIMS = {m.CLAIM.id: m.CLAIM for m in sorted(_ALL, key=lambda m: m.CLAIM.number)}
+_WRITTEN = {m.CLAIM.id: m.CLAIM for m in sorted(_ALL, key=lambda m: m.CLAIM.number)}
+CLAIMS = {cid: tuned.apply(c) for cid, c in _WRITTEN.items()}
 
 
 def get(claim_id: str) -> Claim:
@@ -25,4 +30,9 @@ def get(claim_id: str) -> Claim:
     return CLAIMS[claim_id]
 
 
-__all__ = ["CLAIMS", "PROFILES", "VERDICTS", "Claim", "ModelEntry", "get"]
+def untuned(claim_id: str) -> Claim:
+    get(claim_id)
+    return _WRITTEN[claim_id]
+
+
+__all__ = ["CLAIMS", "PROFILES", "VERDICTS", "Claim", "ModelEntry", "get", "untuned"]

@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication import results as R
-from replication.claims import CLAIMS, registration
+from replication.claims import CLAIMS, registration, tuned
 from replication.claims.bars import competence
 from replication.claims.parts import claim_verdict, combine_frameworks
 from replication.claims.rules import Outcome, Stat
@@ -173,7 +173,9 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
              "by_framework": {}, "parts": [], "variants": [], "flags": [], "values": {}, "competence": {},
              "failed_units": {}}
     if profile is not None:
-        entry["preregistration"] = registration.status(claim, profile)
+        tuning = tuned.tuning(claim, profile)
+        entry["preregistration"] = {**registration.status(claim, profile), "tuning": tuning,
+                                    "equal_tuning": tuned.equal(tuning)}
     if not len(sub):
         return entry
     entry["seeds"] = sorted({int(s) for s in sub["seed"]})
@@ -219,7 +221,7 @@ def write_summary(out, profile: str, split: str = "dev") -> dict:
     """summary/units.csv and summary/verdicts.json of the units of `split` in `out`."""
     df = of_split(collect_units(out), split)
     R.write_csv(Path(out) / "summary" / "units.csv", df)
-    judged = judge_all(df, profile)
+    judged = [{**v, "split": split} for v in judge_all(df, profile)]
     verdicts = {"schema": R.SCHEMA, "profile": profile, "split": split, "headline": headline(judged),
                 "claims": judged}
     return R.write_json(Path(out) / "summary" / "verdicts.json", verdicts)

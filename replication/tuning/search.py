@@ -11,12 +11,11 @@ combinations drawn without replacement (generator `seed`); the same list for eve
 """
 from __future__ import annotations
 
-import dataclasses
 import itertools
 
 import numpy as np
 
-from replication.claims.base import PROFILES, per_profile
+from replication.claims.tuned import with_knobs
 
 KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
 REGISTERED = {"lr": 1.0, "width": 1.0}
@@ -32,12 +31,6 @@ def configs(n: int, seed: int = 0) -> list[dict]:
 
 
 def apply(entry, base, profile: str, knobs: dict):
-    """`entry` (a claims.base.ModelEntry) with the knob values applied to its protocol and widths."""
-    p = entry.protocol(base, profile)
-    change = {"schedule.lr": p.schedule.lr * knobs["lr"]}
-    if p.scouting:
-        change["scouting.schedule.lr"] = p.scouting.schedule.lr * knobs["lr"]
-    common = {k: v for k, v in entry.overrides.items() if k not in PROFILES}
-    per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
-    hidden = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))
-    return dataclasses.replace(entry, overrides={**common, profile: {**per, **change}}, hidden=hidden)
+    """`entry` (a claims.base.ModelEntry) with the knob values applied to its protocol and widths under
+    `profile` (its other profiles unchanged): the same function applies an adopted choice."""
+    return with_knobs(entry, base, profile, knobs)

@@ -8,8 +8,8 @@ claim's metric (lower is better), averaged over seeds and frameworks. The units 
 OUT/config<k>/units/...; the ledger to OUT/ledger.json and OUT/ledger.csv: per model and configuration
 its knob values and score, and per model the configurations tried, the chosen one (the lowest score)
 and the split they were scored on ("dev").
-What it does not do: change a claim. A claim's protocol is what `replication/claims/<claim>.py` says and
-its registration freezes; a tuning result reaches it only by an edit and a new registration.
+What it does not do: change a claim. A ledger's choices reach the claim only when adopted
+(`python -m replication.tuning.adopt OUT/ledger.json`) and registered (a new dated line).
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication import results as R
-from replication.claims import get as get_claim
+from replication.claims import untuned
 from replication.run import splits
 from replication.run.executor import run_units
 from replication.run.units import Unit
@@ -36,7 +36,7 @@ def score_metric(result: dict, claim) -> float | None:
 @R.writes
 def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int = 1, frameworks=("jax",),
          out="results/tune", progress: bool = True) -> dict:
-    claim = get_claim(claim_id)
+    claim = untuned(claim_id)   # the search is around the claim as written, never around an adopted choice
     if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     grid = search.configs(n_configs)

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from replication.claims import get
+from replication.claims import get, untuned
 from replication.claims.registration import protocol_hash
 from replication.cli import main
 from replication.run import splits
@@ -23,7 +23,7 @@ def test_configs_start_from_the_registered_setting_and_are_distinct():
 
 
 def test_apply_changes_only_the_knobs():
-    claim = get("dp_loss")
+    claim = untuned("dp_loss")
     entry = claim.entry("lnn")
     base = claim.protocol("quick")
     p0 = entry.protocol(base, "quick")
@@ -35,6 +35,9 @@ def test_apply_changes_only_the_knobs():
     assert p.scouting.schedule.lr == pytest.approx(3 * p0.scouting.schedule.lr)
     assert other.widths("quick") == tuple(w // 2 for w in entry.widths("quick"))
     assert p.replace(**{"schedule.lr": p0.schedule.lr, "scouting.schedule.lr": p0.scouting.schedule.lr}) == p0   # the budget and everything else as registered
+    for q in ("smoke", "full", "paper"):   # the other profiles as registered
+        assert other.widths(q) == entry.widths(q)
+        assert other.protocol(claim.protocol(q), q) == entry.protocol(claim.protocol(q), q)
 
 
 def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path, monkeypatch):

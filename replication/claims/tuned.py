@@ -1,0 +1,84 @@
+"""Protocols chosen by `lagbench tune`: a claim's models with the knob values its adopted search chose.
+
+`tuned.json` (beside this file): {claim id: {profile: record}}, a record being {"ledger_hash" (the
+`canonical_hash` of the adopted ledger.json), "split" ("dev", the only split a choice may read), "seeds",
+"frameworks", "configs" (configurations tried per model), "search" (the knobs and their values), "adopted"
+(the date), "models": {label: {"knobs", "configs_tried", "score"}}}. Written by
+`python -m replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
+
+`with_knobs(entry, base, profile, knobs) -> ModelEntry`: the entry with the knob values applied under
+`profile` only (peak rate, the scouting round's with it, as a multiple of the entry's own; every hidden
+width as a multiple): the tuning search's configurations and an adopted choice are both this.
+`apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile.
+A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices, so that their
+trainings stay one. Models and profiles without a record keep their registered (hand-chosen) setting.
+`tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
+configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+from functools import lru_cache
+from pathlib import Path
+
+from replication.claims.base import PROFILES, per_profile
+
+FILE = Path(__file__).with_name("tuned.json")
+# claim -> (the claim whose tuning it takes, {its label: that claim's label}); the claims share trainings
+SHARED = {"dp_energy": ("dp_loss", {}),
+          "precision": ("dp_loss", {f"{m}_{d}": m for m in ("lnn", "baseline") for d in ("f32", "f64")})}
+
+
+def with_knobs(entry, base, profile: str, knobs: dict):
+    p = entry.protocol(base, profile)
+    change = {"schedule.lr": p.schedule.lr * knobs["lr"]}
+    if p.scouting:
+        change["scouting.schedule.lr"] = p.scouting.schedule.lr * knobs["lr"]
+    per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
+    hidden = {q: entry.widths(q) for q in PROFILES}
+    hidden[profile] = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))
+    return dataclasses.replace(entry, overrides={**entry.overrides, profile: {**per, **change}}, hidden=hidden)
+
+
+@lru_cache(maxsize=1)
+def records() -> dict:
+    return json.loads(FILE.read_text()) if FILE.is_file() else {}
+
+
+def _record(claim_id: str, profile: str) -> tuple[dict | None, dict]:
+    """The adopted record that serves the claim under the profile, and the label map into it."""
+    source, names = SHARED.get(claim_id, (claim_id, {}))
+    return records().get(source, {}).get(profile), names
+
+
+def apply(claim):
+    models = list(claim.models)
+    for profile in PROFILES:
+        rec, names = _record(claim.id, profile)
+        if rec is None:
+            continue
+        base = claim.protocol(profile) if per_profile(claim.protocols, profile) is not None else None
+        for i, m in enumerate(models):
+            chosen = rec["models"].get(names.get(m.label, m.label))
+            if base is not None and chosen and m.train and m.runs_in(profile):
+                models[i] = with_knobs(m, base, profile, chosen["knobs"])
+    return dataclasses.replace(claim, models=tuple(models))
+
+
+def tuning(claim, profile: str) -> dict:
+    rec, names = _record(claim.id, profile)
+    out = {}
+    for m in claim.models:
+        if not (m.train and m.runs_in(profile)):
+            continue
+        chosen = (rec or {}).get("models", {}).get(names.get(m.label, m.label))
+        out[m.label] = ({"configs_tried": chosen["configs_tried"], "scored_on": rec["split"], "knobs": chosen["knobs"],
+                         "seeds": rec["seeds"], "ledger_hash": rec["ledger_hash"]} if chosen else
+                        {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": [], "ledger_hash": None})
+    return out
+
+
+def equal(tuning_: dict) -> bool:
+    """Whether every trained model got the same number of configurations."""
+    return len({t["configs_tried"] for t in tuning_.values()}) <= 1

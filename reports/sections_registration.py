@@ -1,0 +1,81 @@
+"""The registration and tuning of each claim's protocol, from verdicts.json's `preregistration`.
+
+`registration_table(res)`: per claim, the hash of what decides it under the run's profile, the
+registration line it matches and how its models were tuned (`tuning_text`).
+`tuning_table(res)`: per claim and trained model, the configurations its protocol was chosen among by
+`lagbench tune`, the split they were scored on and the choice (knobs as multiples of the registered
+setting); a model chosen among fewer configurations than a rival of its claim is flagged.
+`add_to(section, res)`: both tables, with their notes.
+"""
+from __future__ import annotations
+
+import pandas as pd
+
+from reports.document import Section, Table
+from reports.fmt import cell
+from reports.load import Results
+
+
+def _prereg(res: Results, claim: dict) -> dict:
+    return (res.verdicts.get(claim["id"]) or {}).get("preregistration") or {}
+
+
+def tuning_text(tuning: dict) -> str:
+    if not tuning:
+        return "-"
+    tried = {t["configs_tried"] for t in tuning.values()}
+    if tried == {0}:
+        return "by hand, no search"
+    if len(tried) == 1:
+        split = next(iter(tuning.values()))["scored_on"]
+        return f"lagbench tune: {tried.pop()} configurations per model ({split})"
+    return "UNEQUAL: " + ", ".join(f"{m} {t['configs_tried']}" for m, t in tuning.items())
+
+
+def registration_table(res: Results) -> pd.DataFrame | None:
+    rows = []
+    for claim in res.claims:
+        r = _prereg(res, claim)
+        if r:
+            rows.append({"claim": claim["id"], "protocol hash": r["protocol_hash"],
+                         "registered": f"yes, frozen {r['frozen']}" if r["registered"] else "NO: changed since",
+                         "registrations": r["registrations"], "tuning": tuning_text(r.get("tuning") or {})})
+    return pd.DataFrame(rows) if rows else None
+
+
+def _knobs(k: dict | None) -> str:
+    return "registered setting (by hand)" if not k else ", ".join(f"{n} x{v:.3g}" for n, v in k.items())
+
+
+def tuning_table(res: Results) -> pd.DataFrame | None:
+    rows = []
+    for claim in res.claims:
+        tuning = _prereg(res, claim).get("tuning") or {}
+        most = max((t["configs_tried"] for t in tuning.values()), default=0)
+        if not most:
+            continue
+        for model, t in tuning.items():
+            rows.append({"claim": claim["id"], "model": model, "configurations": t["configs_tried"],
+                         "scored on": cell(t["scored_on"]), "dev seeds": ", ".join(map(str, t["seeds"])) or "-",
+                         "chosen": _knobs(t["knobs"]),
+                         "flag": "LESS TUNING than a rival" if t["configs_tried"] < most else ""})
+    return pd.DataFrame(rows) if rows else None
+
+
+def add_to(s: Section, res: Results) -> None:
+    registered = registration_table(res)
+    if registered is not None:
+        s.add(Table("Registered protocols", registered, ["replication/claims/registrations.json",
+                                                         "replication/claims/tuned.json"],
+                    note="What decides each claim under this profile (its models' specs and protocols, the "
+                         "evaluation, the seeds, the bars and the rules) is hashed and registered before a "
+                         "test-split run; a change after one is a new dated registration, never a silent edit. "
+                         "'tuning' says how the models' protocols were chosen: by `lagbench tune` (the same "
+                         "configurations for every model, scored on the development split) or by hand."))
+    ledger = tuning_table(res)
+    if ledger is not None:
+        s.add(Table("Tuning ledger", ledger, ["replication/claims/tuned.json", "docs/lab/tuning/*/ledger.json"],
+                    note="Per model of a tuned claim: how many configurations of the declared search (peak rate "
+                         "x 1/3, 1, 3; hidden widths x 1/2, 1, 2; the registered setting among them) it was "
+                         "chosen among, on which split and seeds, and the choice as multiples of the registered "
+                         "setting. Claims not listed were tuned by hand."))

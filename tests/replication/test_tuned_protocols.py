@@ -1,0 +1,121 @@
+"""Adopted tuning (`replication.claims.tuned`, `replication.tuning.adopt`): a `lagbench tune` ledger's
+choices become the claim's protocol under its profile only when every model was searched alike on the
+development split; claims that share trainings take the same choice; verdicts and the report say how
+each model's protocol was chosen and flag a model tuned less than its rivals."""
+import json
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from replication.claims import CLAIMS, get, tuned, untuned
+from replication.training.protocol import canonical_hash
+from replication.tuning import adopt
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _ledger(claim_id="hnn_energy", profile="quick", split="dev", tried=4, knobs=None, drop=()):
+    claim = untuned(claim_id)
+    labels = [m.label for m in claim.models if m.train and m.runs_in(profile) and m.label not in drop]
+    knobs = knobs or {"lr": 1 / 3, "width": 2.0}
+    return {"claim": claim_id, "profile": profile, "split": split, "search": {"lr": [1 / 3, 1, 3], "width": [0.5, 1, 2]},
+            "seeds": [0], "frameworks": ["jax"],
+            "models": {x: {"configs_tried": tried if i else 4, "scored_on": split, "chosen": 1, "chosen_knobs": knobs,
+                           "scores": {"0": 2.0, "1": 1.0}} for i, x in enumerate(labels)}}
+
+
+@pytest.fixture
+def record_file(tmp_path, monkeypatch):
+    monkeypatch.setattr(tuned, "FILE", tmp_path / "tuned.json")
+    tuned.records.cache_clear()
+    yield tmp_path
+    tuned.records.cache_clear()
+
+
+def _write(tmp_path, ledger) -> Path:
+    f = tmp_path / f"ledger_{len(list(tmp_path.iterdir()))}.json"
+    f.write_text(json.dumps(ledger))
+    return f
+
+
+def test_adopt_applies_the_choice_under_its_profile_only(record_file):
+    rec = adopt.adopt(_write(record_file, _ledger()), today="2026-01-01")
+    assert rec["split"] == "dev" and rec["configs"] == 4 and rec["adopted"] == "2026-01-01"
+    claim = tuned.apply(untuned("hnn_energy"))
+    written = untuned("hnn_energy")
+    for m, w in zip(claim.models, written.models, strict=True):
+        assert m.widths("quick") == tuple(2 * x for x in w.widths("quick"))
+        assert m.protocol(claim.protocol("quick"), "quick").schedule.lr == pytest.approx(
+            w.protocol(written.protocol("quick"), "quick").schedule.lr / 3)
+        for q in ("smoke", "full", "paper"):
+            assert m.widths(q) == w.widths(q) and m.protocol(claim.protocol(q), q) == w.protocol(written.protocol(q), q)
+    t = tuned.tuning(claim, "quick")
+    assert all(x["configs_tried"] == 4 and x["scored_on"] == "dev" for x in t.values()) and tuned.equal(t)
+    assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuned.tuning(claim, "full").values())
+
+
+@pytest.mark.parametrize("ledger, says", [
+    (_ledger(split="test"), "development split"),
+    (_ledger(tried=2), "unequal"),
+    (_ledger(drop=("baseline_spring",)), "baseline_spring"),
+    ({"models": {}}, "not a ledger"),
+])
+def test_adopt_refuses_a_ledger_that_is_not_an_equal_dev_search(record_file, ledger, says, capsys):
+    f = _write(record_file, ledger)
+    with pytest.raises(ValueError, match=says):
+        adopt.adopt(f)
+    assert not tuned.FILE.exists()
+    with pytest.raises(SystemExit) as e:
+        adopt.main([str(f)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and says in err
+
+
+def test_claims_that_share_trainings_take_the_same_choice(record_file):
+    adopt.adopt(_write(record_file, _ledger("dp_loss", profile="smoke", knobs={"lr": 3.0, "width": 0.5})))
+    loss, energy, precision = (tuned.apply(untuned(c)) for c in ("dp_loss", "dp_energy", "precision"))
+    for label, same in (("lnn", energy.entry("lnn")), ("baseline", energy.entry("baseline")),
+                        ("baseline", precision.entry("baseline_f32"))):
+        a = loss.entry(label)
+        assert a.widths("smoke") == same.widths("smoke") == tuple(w // 2 for w in untuned("dp_loss").entry(label).widths("smoke"))
+        pa, pb = a.protocol(loss.protocol("smoke"), "smoke"), same.protocol(precision.protocol("smoke"), "smoke")
+        assert pa.schedule == pb.schedule and pa.scouting == pb.scouting
+
+
+def test_every_adopted_choice_is_its_committed_ledgers():
+    """Each record of tuned.json names the ledger it came from by hash; that ledger is committed under
+    docs/lab/tuning/<claim>/ and chose exactly those knobs, on the development split, for every model alike."""
+    for claim_id, per in tuned.records().items():
+        for profile, rec in per.items():
+            ledger = json.loads((ROOT / "docs" / "lab" / "tuning" / claim_id / "ledger.json").read_text())
+            assert canonical_hash(ledger, 16) == rec["ledger_hash"] and ledger["profile"] == profile
+            assert ledger["split"] == rec["split"] == "dev"
+            for label, m in rec["models"].items():
+                assert ledger["models"][label]["chosen_knobs"] == m["knobs"]
+            assert tuned.equal(tuned.tuning(get(claim_id), profile))
+
+
+def test_the_running_claims_are_the_written_ones_with_the_adopted_knobs():
+    for claim_id, claim in CLAIMS.items():
+        assert claim == tuned.apply(untuned(claim_id))
+
+
+def test_report_flags_a_model_tuned_less_than_its_rivals():
+    from reports import sections_registration as sr
+
+    def prereg(tuning):
+        return {"protocol_hash": "x", "registered": True, "frozen": "2026-01-01", "registrations": 1, "tuning": tuning}
+    t = {"configs_tried": 4, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0]}
+    hand = {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": []}
+    res = SimpleNamespace(claims=[{"id": "a"}, {"id": "b"}, {"id": "c"}],
+                          verdicts={"a": {"preregistration": prereg({"lnn": t, "baseline": hand})},
+                                    "b": {"preregistration": prereg({"hnn": t, "baseline": t})},
+                                    "c": {"preregistration": prereg({"lgn": hand})}})
+    reg = sr.registration_table(res).set_index("claim")["tuning"]
+    assert reg["a"].startswith("UNEQUAL") and "4 configurations per model (dev)" in reg["b"] and reg["c"] == "by hand, no search"
+    ledger = sr.tuning_table(res)
+    flagged = ledger[ledger["flag"] != ""]
+    assert list(zip(flagged["claim"], flagged["model"], strict=True)) == [("a", "baseline")]
+    assert set(ledger["claim"]) == {"a", "b"}
