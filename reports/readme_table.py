@@ -61,10 +61,18 @@ def _seeds(claims: list[dict], by_id: dict) -> str:
     return f"seeds from {first}: {usual} a model" + (f" ({rest})" if rest else "")
 
 
+def _seed_rule(claims: list[dict], profile) -> str:
+    """The seed rule of the first paper claim that reads each seed as a replication (claims.json), if recorded."""
+    rule = next((c["seed_rule"].get(profile) for c in claims if c.get("kind", "claim") == "claim"
+                 and not c.get("pooled") and (c.get("seed_rule") or {}).get(profile)), None)
+    return f" Seeds: {rule}." if rule else ""
+
+
 def table(claims: list[dict], verdicts: dict) -> str:
     by_id = {v["id"]: v for v in verdicts.get("claims") or []}
     split = verdicts.get("split", "dev")
-    lines = [f"Profile `{verdicts.get('profile')}`, {split} split; {_seeds(claims, by_id)}.", "",
+    profile = verdicts.get("profile")
+    lines = [f"Profile `{profile}`, {split} split; {_seeds(claims, by_id)}.{_seed_rule(claims, profile)}", "",
              "| # | claim | paper | verdict | parts | key number (seed mean) | published |",
              "|---|---|---|---|---|---|---|"]
     ordered = sorted(claims, key=lambda c: (c.get("kind", "claim") != "claim", c.get("number", 0)))

@@ -1,7 +1,7 @@
 """The registration and tuning of each claim's protocol, from verdicts.json's `preregistration`.
 
 `registration_table(res)`: per claim, the hash of what decides it under the run's profile, the
-registration line it matches and how its models were tuned (`tuning_text`).
+registration line it matches, how its models were tuned (`tuning_text`) and its seed count's rule.
 `tuning_table(res)`: per claim and trained model, the configurations its protocol was chosen among by
 `lagbench tune`, the split they were scored on and the choice (knobs as multiples of the registered
 setting); a model chosen among fewer configurations than a rival of its claim is flagged.
@@ -34,12 +34,14 @@ def tuning_text(tuning: dict) -> str:
 
 def registration_table(res: Results) -> pd.DataFrame | None:
     rows = []
+    profile = (res.run or {}).get("profile") or res.verdict_profile
     for claim in res.claims:
         r = _prereg(res, claim)
         if r:
             rows.append({"claim": claim["id"], "protocol hash": r["protocol_hash"],
                          "registered": f"yes, frozen {r['frozen']}" if r["registered"] else "NO: changed since",
-                         "registrations": r["registrations"], "tuning": tuning_text(r.get("tuning") or {})})
+                         "registrations": r["registrations"], "tuning": tuning_text(r.get("tuning") or {}),
+                         "seeds (rule)": cell((claim.get("seed_rule") or {}).get(profile))})
     return pd.DataFrame(rows) if rows else None
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from replication.claims import seed_rule
 from replication.claims.parts import Part, Variant
 from replication.claims.rules import VERDICTS
 from replication.training.protocol import Protocol
@@ -118,6 +119,7 @@ class Claim:
                 "kind": self.kind, "verdict_rule": self.verdict_rule, "bars": [b.describe() for b in self.bars],
                 "parts": [p.describe() for p in self.parts], "variants": [v.describe() for v in self.variants],
                 "key": self.key_model, "seeds": dict(self.seeds), "pooled": self.pooled,
+                "seed_rule": {p: seed_rule.describe(self, p) for p in PROFILES},
                 "protocol": {p: pr.to_dict() for p, pr in self.protocols.items()}}
 
     @property

@@ -39,5 +39,5 @@ CLAIM = Claim(
                 for s in ("spring", "pendulum")),
     bars=(Bar(tuple(m.label for m in MODELS), "heldout_l1"),
           Bar(("hnn_spring", "hnn_pendulum"), None, max_diverged=0)),
-    eval_config=EVAL, seeds={"smoke": 1, "quick": 3, "full": 3, "paper": 3},
+    eval_config=EVAL, seeds={"smoke": 1, "quick": 3, "full": 5, "paper": 5},
 )

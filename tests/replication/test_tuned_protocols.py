@@ -109,7 +109,7 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
         return {"protocol_hash": "x", "registered": True, "frozen": "2026-01-01", "registrations": 1, "tuning": tuning}
     t = {"configs_tried": 4, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0]}
     hand = {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": []}
-    res = SimpleNamespace(claims=[{"id": "a"}, {"id": "b"}, {"id": "c"}],
+    res = SimpleNamespace(claims=[{"id": "a"}, {"id": "b"}, {"id": "c"}], run={"profile": "quick"}, verdict_profile="quick",
                           verdicts={"a": {"preregistration": prereg({"lnn": t, "baseline": hand})},
                                     "b": {"preregistration": prereg({"hnn": t, "baseline": t})},
                                     "c": {"preregistration": prereg({"lgn": hand})}})

@@ -1,8 +1,8 @@
 """The claim records themselves: kinds, parts and variants name real models, a pooled claim's seed counts
-follow its stated power rule, and a variant differs from the paper's model only in its departure."""
+follow its stated power rule, every claim its seed rule, and a variant differs from the paper's model only in its departure."""
 import pytest
 
-from replication.claims import CLAIMS, PROFILES
+from replication.claims import CLAIMS, PROFILES, seed_rule
 from replication.claims.base import Claim
 from replication.claims.stats import seeds_needed
 
@@ -20,6 +20,28 @@ def test_pooled_seed_counts_can_reach_the_level_in_every_deciding_profile(cid):
     for profile in PROFILES:
         if profile != "smoke":
             assert claim.n_seeds(profile) >= seeds_needed(0.05, rivals), (profile, claim.n_seeds(profile))
+
+
+@pytest.mark.parametrize("cid", list(CLAIMS))
+def test_every_claim_runs_the_seeds_its_stated_rule_requires(cid):
+    """The seed rule (`seed_rule`), fixed before a test run: profiles of record give a seed range that covers
+    a model's median with at least 90 % probability (5 seeds); pooled claims meet their power rule."""
+    claim = CLAIMS[cid]
+    for profile in PROFILES:
+        assert claim.n_seeds(profile) >= seed_rule.required(claim, profile), (profile, claim.n_seeds(profile))
+        assert f"{claim.n_seeds(profile)} seed" in seed_rule.describe(claim, profile)
+
+
+def test_median_coverage_of_a_seed_range():
+    """1 - 2^(1-n), checked against a simulation: the range of n draws of a skewed distribution covers its median."""
+    import numpy as np
+
+    rng = np.random.default_rng(0)
+    for n in (2, 3, 5):
+        x = rng.lognormal(size=(200_000, n))
+        covered = np.mean((x.min(1) <= 1.0) & (x.max(1) >= 1.0))   # the lognormal's median is 1
+        assert covered == pytest.approx(seed_rule.median_coverage(n), abs=0.005)
+    assert seed_rule.RECORD_SEEDS == 5 and seed_rule.median_coverage(3) == 0.75
 
 
 @pytest.mark.parametrize("cid", [c.id for c in CLAIMS.values() if c.variants])
