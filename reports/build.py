@@ -15,42 +15,50 @@ from pathlib import Path
 
 from replication.results import writes
 from reports import output
-from reports.document import Figure, Section, tables_and_figures
+from reports.document import Figure, Para, Section, tables_and_figures
 from reports.environment import environment_sections, sources_sections
 from reports.findings import findings_sections
 from reports.load import load_results
 from reports.markdown import render_markdown
 from reports.pdf import write_pdf
-from reports.scorecard import scorecard_section
-from reports.sections_claims import metrics_appendix, summary_sections, theme_sections
+from reports.scorecard import scorecard_appendix, scorecard_section
+from reports.sections_claims import claim_details, metrics_appendix, summary_sections, theme_sections
 from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
 from reports.sections_predict import predict_sections
-from reports.sections_speed import speed_sections
+from reports.sections_speed import speed_appendix, speed_sections
 from reports.sections_stiff import stiff_sections
 from reports.systems_table import systems_sections
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
 
-def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
+APPENDIX = ("What the body's numbers rest on: every part with its interval, the reasons in full, the "
+            "registrations and the tuning ledger, the run's status, each claim's competence and rollout tables, each unit's speed "
+            "against error, the findings (paper against original code), the cross-framework comparison, the velocity-Hessian health, the stiff-solver study, the results "
+            "by system, the environment, every recorded metric and the source files of every table and figure.")
+
+
+def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
+    """The report's body (the scorecard, a page per claim with its figures, speed against error) and its
+    appendix (everything else), as two lists of sections."""
     res = load_results(results_dir)
     mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
     if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
         sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
-        return sections + sources_sections(res, sections)
-    sections = [scorecard_section(res)] + summary_sections(res)
-    sections += theme_sections(res, out_dir)
-    sections += speed_sections(res, out_dir)
-    sections += frameworks_sections(res)
-    sections += hessian_sections(res)
-    sections += stiff_sections(res)
-    sections += findings_sections(res)
-    sections += systems_sections(results_dir) + mine
-    sections += environment_sections(res, now)
-    sections += metrics_appendix(res)
-    return sections + sources_sections(res, sections)
+        return sections, sources_sections(res, sections)
+    body = [scorecard_section(res)] + theme_sections(res, out_dir) + speed_sections(res, out_dir)
+    appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]
+    appendix += summary_sections(res) + claim_details(res) + speed_appendix(res, out_dir)
+    appendix += findings_sections(res) + frameworks_sections(res) + hessian_sections(res) + stiff_sections(res)
+    appendix += systems_sections(results_dir) + mine + environment_sections(res, now) + metrics_appendix(res)
+    return body, appendix + sources_sections(res, body + appendix)
+
+
+def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
+    body, appendix = body_and_appendix(results_dir, out_dir, now)
+    return body + appendix
 
 
 @writes

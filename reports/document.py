@@ -45,9 +45,14 @@ class Figure:
 
 @dataclass
 class Section:
+    """``page``: in the PDF, the section starts a page (a claim's page); ``appendix``: the section opens the
+    appendix (the PDF starts a page and numbers the sections from it A, B, ...)."""
+
     title: str
     blocks: list = field(default_factory=list)
     level: int = 1
+    page: bool = False
+    appendix: bool = False
 
     def add(self, *blocks) -> Section:
         self.blocks.extend(b for b in blocks if b is not None)

@@ -18,16 +18,17 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 def figure_width(path: Path) -> str:
-    """70 % of the text width for single-panel figures, full width for wide multi-panel ones."""
+    """55 % of the text width for single-panel figures (a claim's page holds its tables and figures), full
+    width for wide multi-panel ones."""
     try:
         with open(path, "rb") as f:
             head = f.read(24)
         w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
     except OSError:
-        return "70%"
+        return "55%"
     if not head.startswith(PNG_SIGNATURE) or h == 0:
-        return "70%"
-    return "100%" if w / h > 2.4 else "70%"
+        return "55%"
+    return "100%" if w / h > 2.4 else "55%"
 
 
 PREAMBLE = """#set document(title: {title})
@@ -73,6 +74,10 @@ def render_typst(title: str, sections: list[Section], root: Path = Path(".")) ->
            f"#align(center, text(size: 18pt, weight: \"bold\", {lit(title)}))\n",
            "#outline(depth: 1)\n"]
     for s in sections:
+        if s.appendix:
+            out.append('#pagebreak(weak: true)\n#counter(heading).update(0)\n#set heading(numbering: "A.1")\n')
+        elif s.page:
+            out.append("#pagebreak(weak: true)\n")
         out.append(f"#heading(level: {s.level}, {lit(s.title)})\n")
         for b in s.blocks:
             if isinstance(b, Para):

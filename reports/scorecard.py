@@ -199,6 +199,23 @@ def scorecard_section(res: Results) -> Section:
     checks = scorecard_table(res, "check")
     if "#" in checks.columns:
         s.add(Table("Checks", checks, ["claims.json", "units/*/*/*/seed*/result.json"]))
+    variants = variants_table(res)
+    if variants is not None:
+        s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
+                    note="A variant is a model with a departure from the paper standing in for the paper's model; "
+                         "the claim is judged again with it, on this line only. A variant never decides a claim."))
+    s.add(Para(sections_registration.summary(res)))
+    flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
+    s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
+               "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else
+               "No part has frameworks that disagree."))
+    return s
+
+
+def scorecard_appendix(res: Results) -> Section:
+    """The appendix's scorecard tables: every part with its interval, the reasons in full, the registration
+    and tuning of each claim's protocol."""
+    s = Section("Parts, reasons and registrations")
     for kind, title in (("claim", "Parts of the paper claims"), ("check", "Parts of the checks")):
         parts = all_parts_table(res, kind)
         if parts is not None:
@@ -208,16 +225,7 @@ def scorecard_section(res: Results) -> Section:
     why = reasons_table(res)
     if why is not None:
         s.add(Table("Reasons in full (parts not reproduced)", why, ["summary/verdicts.json"]))
-    variants = variants_table(res)
-    if variants is not None:
-        s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
-                    note="A variant is a model with a departure from the paper standing in for the paper's model; "
-                         "the claim is judged again with it, on this line only. A variant never decides a claim."))
     sections_registration.add_to(s, res)
-    flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
-    s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
-               "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else
-               "No part has frameworks that disagree."))
     return s
 
 

@@ -1,7 +1,8 @@
 """Summary, run-status and per-claim sections (grouped by :mod:`reports.themes`), with their figures.
 
-``summary_sections(res)`` and ``theme_sections(res, out_dir)`` return ``list[Section]``; figures are
-written under ``out_dir/figures/`` as ``<claim>_<kind>.png`` only when their data exist.
+``summary_sections(res)``, ``theme_sections(res, out_dir)`` (a page per claim) and ``claim_details(res)``
+(the appendix's tables behind the claims' pages) return ``list[Section]``; figures are written under
+``out_dir/figures/`` as ``<claim>_<kind>.png`` only when their data exist.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from reports.tables import claim_table, metrics_table, problem_units_table, stat
 from reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
+REASON_CHARS = 400   # a verdict's reason on a claim's page
 
 
 def slug(text: str) -> str:
@@ -73,18 +75,27 @@ def _rollout_table(units) -> pd.DataFrame | None:
     return pd.DataFrame(rows)
 
 
+def _brief(text: str, limit: int = REASON_CHARS) -> str:
+    """A reason cut at a word for the claim's page; the parts table beside it and the appendix give it in full."""
+    if len(text) <= limit:
+        return text
+    return text[:limit].rsplit(" ", 1)[0] + " … (in full: appendix, 'Reasons in full')"
+
+
 def _trainings(units) -> tuple:
     """What identifies a claim's trainings: claims sharing them (the double pendulum's 1 and 2) share this."""
     return tuple(sorted((u.framework, u.model, u.seed, u.result.get("final_train_loss")) for u in units))
 
 
 def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None) -> Section:
-    """The claim's section; `drawn` maps the trainings whose work-precision figure is already in the report to
-    its claim, so a figure of the same trainings is drawn once."""
+    """The claim's page: what it says and where, its verdict and parts, the decisive numbers against the
+    published ones, then the figures that answer it. `drawn` maps the trainings whose work-precision figure is
+    already in the report to its claim, so a figure of the same trainings is drawn once. The competence and
+    rollout tables are the claim's details in the appendix (`claim_details`)."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
-    s = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}", level=2)
+    s = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}", level=2, page=True)
     s.add(Para(f"{cell(claim.get('title'), 'untitled')} — {cell(claim.get('paper'), 'paper unknown')} "
                f"{cell(claim.get('section'), '')}. System: {cell(claim.get('system'), 'unknown')}. "
                f"Metric: {cell(claim.get('metric'), 'unknown')} ({cell(claim.get('metric_label'), 'no label')}). "
@@ -93,26 +104,20 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     v = res.verdicts.get(cid)
     if v is not None:
         kind = "check (not counted among the paper claims)" if v.get("kind") == "check" else "paper claim"
-        s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {cell(v.get('reason'), '')}"))
+        s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {_brief(cell(v.get('reason'), ''))}"))
         for var in v.get("variants") or []:
             s.add(Para(f"Variant: {cell(var.get('name'))} ({cell(var.get('departure'))}): {cell(var.get('verdict'))}, "
-                       f"{cell(var.get('reason'), '')}. It does not decide the claim."))
+                       f"{_brief(cell(var.get('reason'), ''))}. It does not decide the claim."))
     pt = parts_table(res, claim)
     if pt is not None:
         s.add(Table(f"{cid}: parts per framework", pt, [src + "result.json"],
                     note="Each part is decided on the interval shown; the last column gives the part's verdict "
                          "with the suite's own threshold (a factor, a band, a fraction, a level) halved and doubled."))
-    ct = competence_table(res, claim)
-    if ct is not None:
-        s.add(Table(f"{cid}: competence bars per model and framework", ct, [src + "result.json"]))
     if not units:
         s.add(Para(f"Result: {NOT_RUN} (no usable unit for this claim)."))
         return s
     s.add(Table(f"{cid}: {claim.get('metric', 'metric')} per model and framework", claim_table(res, claim),
                 ["claims.json", src + "result.json"]))
-    rt = _rollout_table(units)
-    if rt is not None:
-        s.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
     figs = [
         ("energy", F.energy_drift, "|Energy error| over time against truth, log axis (as LNN Fig. 4; line: median "
                                   "over seeds of each seed's median over its rollouts, band: seed range; diverged "
@@ -144,6 +149,28 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     return s
 
 
+def claim_details(res: Results) -> list[Section]:
+    """The appendix's tables behind each claim's page: competence bars per model and framework, and the
+    rollout metrics (mean over trajectories and seeds)."""
+    out = []
+    for claim in res.claims:
+        cid = claim["id"]
+        src = RESULT_FILES.format(claim=cid)
+        d = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}, details", level=2)
+        ct = competence_table(res, claim)
+        if ct is not None:
+            d.add(Table(f"{cid}: competence bars per model and framework", ct, [src + "result.json"]))
+        rt = _rollout_table(res.usable(cid)) if res.usable(cid) else None
+        if rt is not None:
+            d.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
+        if d.blocks:
+            out.append(d)
+    if not out:
+        return []
+    return [Section("Claim details").add(Para("The competence bars of every model and framework, and the rollout "
+                                               "metrics, behind each claim's page.")), *out]
+
+
 def metrics_appendix(res: Results) -> list[Section]:
     """Every metric each claim's units recorded (mean ± std over seeds): the dump behind the claims' tables."""
     s = Section("Appendix: all recorded metrics")
@@ -166,5 +193,8 @@ def theme_sections(res: Results, out_dir: Path) -> list[Section]:
         if not claims:
             s.add(Para(f"Result: {NOT_RUN} (no claim of this kind in claims.json)."))
         out.append(s)
-        out.extend(claim_section(res, c, out_dir, drawn) for c in claims)
+        pages = [claim_section(res, c, out_dir, drawn) for c in claims]
+        if pages:
+            pages[0].page = False   # the theme's first claim follows its heading on the same page
+        out.extend(pages)
     return out

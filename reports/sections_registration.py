@@ -5,7 +5,7 @@ registration line it matches, how its models were tuned (`tuning_text`) and its 
 `tuning_table(res)`: per claim and trained model, the configurations its protocol was chosen among by
 `lagbench tune`, the split they were scored on and the choice (knobs as multiples of the registered
 setting); a model chosen among fewer configurations than a rival of its claim is flagged.
-`add_to(section, res)`: both tables, with their notes.
+`add_to(section, res)`: both tables, with their notes; `summary(res)`: one paragraph of both for the scorecard.
 """
 from __future__ import annotations
 
@@ -62,6 +62,26 @@ def tuning_table(res: Results) -> pd.DataFrame | None:
                          "chosen": _knobs(t["knobs"]),
                          "flag": "LESS TUNING than a rival" if t["configs_tried"] < most else ""})
     return pd.DataFrame(rows) if rows else None
+
+
+def summary(res: Results) -> str:
+    """How the claims' protocols were chosen and registered, in one paragraph (the tables are in the appendix)."""
+    by = {}
+    unregistered = []
+    for claim in res.claims:
+        r = _prereg(res, claim)
+        if r:
+            by.setdefault(tuning_text(r.get("tuning") or {}), []).append(str(claim.get("number", claim["id"])))
+            if not r["registered"]:
+                unregistered.append(claim["id"])
+    if not by:
+        return "Protocols: no registration is recorded for this run."
+    text = "; ".join(f"claim{'s' if len(ns) > 1 else ''} {', '.join(ns)}: {how}" for how, ns in by.items())
+    return (f"How each claim's protocol was chosen: {text}. "
+            + (f"NOT REGISTERED (changed since their registration): {', '.join(unregistered)}. " if unregistered
+               else "Every protocol matches its registration. ")
+            + "The registrations, the tuning ledger and the seed rule per claim: appendix, 'Parts, reasons and "
+              "registrations'.")
 
 
 def add_to(s: Section, res: Results) -> None:

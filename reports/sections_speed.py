@@ -36,8 +36,9 @@ def _bench_table(df: pd.DataFrame, missing: str | None = None) -> pd.DataFrame:
                          for c in head.columns}).astype(str)
 
 
-def speed_sections(res: Results, out_dir: Path) -> list[Section]:
-    s = Section("Speed against error")
+def speed_appendix(res: Results, out_dir: Path) -> list[Section]:
+    """Every unit's training throughput (or time) against its claim's metric, a figure per claim."""
+    s = Section("Speed against error per unit")
     s.add(Para("Each point is one unit (claim x framework x model x seed): training throughput (or training "
                "time) against the claim's metric; colour per model, marker per framework. Lower error and "
                "higher throughput are better."))
@@ -51,6 +52,13 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                          [f"units/{claim['id']}/<framework>/<model>/seed<k>/result.json"]))
     if not any_fig:
         s.add(Para(f"Units with throughput and error: {NOT_RUN}."))
+    return [s]
+
+
+def speed_sections(res: Results, out_dir: Path) -> list[Section]:
+    s = Section("Speed against error")
+    s.add(Para("Each claim's page shows its work-precision figure (held-out loss against training samples and "
+               "time); every unit's throughput against its claim's metric is in the appendix."))
     cheap = cheapest_table(res)
     if cheap is not None:
         s.add(Table(f"Cheapest model within {TOLERANCE:g}x of the best error, per claim", cheap,

@@ -1,0 +1,45 @@
+"""The report a reader gets through: a body of the scorecard, a page per claim (its verdict, parts, decisive
+numbers and figures) and speed against error, with every dump, table of counters and study in the appendix."""
+from result_fixtures import CLAIMS, NOT_RUN_CLAIM
+
+from reports.build import TITLE, body_and_appendix
+from reports.document import Figure, Table
+from reports.pdf import page_count, write_pdf
+
+DUMPS = ("competence bars", "rollout metrics", "all recorded metrics", "Reasons in full", "Parts of the paper claims",
+         "Registered protocols", "Tuning ledger", "Units per claim")
+
+
+def test_every_claim_has_a_page_with_its_numbers_and_a_figure_and_the_dumps_are_in_the_appendix(results_dir, tmp_path):
+    body, appendix = body_and_appendix(results_dir, tmp_path)
+    pages = {s.title.split(": ", 1)[1]: s for s in body if s.title.startswith("Claim ")}
+    assert set(pages) == {c[0] for c in CLAIMS}
+    for cid, page in pages.items():
+        tables = [b.title for b in page.blocks if isinstance(b, Table)]
+        assert f"{cid}: parts per framework" in tables or cid == NOT_RUN_CLAIM
+        if cid != NOT_RUN_CLAIM:
+            assert any("per model and framework" in t for t in tables), cid   # the decisive numbers
+            assert any(isinstance(b, Figure) for b in page.blocks) or cid == "appendix_b", cid
+    # each claim starts a page, except the first of a theme, which follows its theme's heading
+    for before, s in zip(body, body[1:], strict=False):
+        if s.title.startswith("Claim "):
+            assert s.page == (before.title.startswith("Claim ")), s.title
+    body_tables = [b.title for s in body for b in s.blocks if isinstance(b, Table)]
+    assert not [t for t in body_tables if any(d in t for d in DUMPS)]
+    app_tables = [b.title for s in appendix for b in s.blocks if isinstance(b, Table)]
+    for d in ("competence bars", "all recorded metrics", "Parts of the paper claims", "Units per claim"):
+        assert any(d in t for t in app_tables), d
+    assert appendix[0].appendix and not any(s.appendix for s in body + appendix[1:])
+    titles = [s.title for s in appendix]
+    assert {"Cross-framework agreement", "Environment", "Findings: paper against original code"} <= set(titles)
+
+
+def test_the_body_is_short_and_the_appendix_starts_a_page(results_dir, tmp_path):
+    body, appendix = body_and_appendix(results_dir, tmp_path)
+    _, pdf = write_pdf(TITLE, body, tmp_path)
+    n_body = page_count(pdf)
+    assert n_body <= 20
+    _, pdf = write_pdf(TITLE, body + appendix, tmp_path)
+    assert page_count(pdf) > n_body
+    typ = (tmp_path / "REPORT.typ").read_text()
+    assert typ.index('#set heading(numbering: "A.1")') < typ.index('"Appendix"')
