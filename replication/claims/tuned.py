@@ -11,7 +11,7 @@
 width as a multiple): the tuning search's configurations and an adopted choice are both this.
 `apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile.
 A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices, so that their
-trainings stay one. Models and profiles without a record keep their registered (hand-chosen) setting.
+trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models and profiles without a record keep their registered (hand-chosen) setting.
 `tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
 configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
 """
@@ -52,6 +52,13 @@ def _record(claim_id: str, profile: str) -> tuple[dict | None, dict]:
     return records().get(source, {}).get(profile), names
 
 
+def _chosen(claim, rec: dict | None, names: dict, label: str) -> dict | None:
+    """The record's choice for a model: a variant (a departure from the paper) takes its paper model's, so
+    that the departure is all that tells them apart."""
+    paper = {variant: p for v in claim.variants for p, variant in v.replaces}.get(label, label)
+    return (rec or {}).get("models", {}).get(names.get(paper, paper))
+
+
 def apply(claim):
     models = list(claim.models)
     for profile in PROFILES:
@@ -60,7 +67,7 @@ def apply(claim):
             continue
         base = claim.protocol(profile) if per_profile(claim.protocols, profile) is not None else None
         for i, m in enumerate(models):
-            chosen = rec["models"].get(names.get(m.label, m.label))
+            chosen = _chosen(claim, rec, names, m.label)
             if base is not None and chosen and m.train and m.runs_in(profile):
                 models[i] = with_knobs(m, base, profile, chosen["knobs"])
     return dataclasses.replace(claim, models=tuple(models))
@@ -72,7 +79,7 @@ def tuning(claim, profile: str) -> dict:
     for m in claim.models:
         if not (m.train and m.runs_in(profile)):
             continue
-        chosen = (rec or {}).get("models", {}).get(names.get(m.label, m.label))
+        chosen = _chosen(claim, rec, names, m.label)
         out[m.label] = ({"configs_tried": chosen["configs_tried"], "scored_on": rec["split"], "knobs": chosen["knobs"],
                          "seeds": rec["seeds"], "ledger_hash": rec["ledger_hash"]} if chosen else
                         {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": [], "ledger_hash": None})
