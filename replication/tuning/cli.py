@@ -23,7 +23,8 @@ def add_command(sub) -> None:
                        "restarts and input scaling as registered) on the development seeds and draws, score each "
                        "by its development held-out error, and write OUT/ledger.json and OUT/ledger.csv "
                        "(configurations tried and chosen per model). It never reads the test split and never "
-                       "changes a claim.")
+                       "changes a claim: a ledger's choices become the claim's protocol when adopted "
+                       "(python -m replication.tuning.adopt OUT/ledger.json) and registered.")
     s.add_argument("--claim", required=True, help="a claim id (see `lagbench list`)")
     s.add_argument("--profile", default="quick", choices=PROFILES, help="the budget to tune at (default: quick)")
     s.add_argument("--configs", type=int, default=4,
