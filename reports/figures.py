@@ -101,10 +101,12 @@ def _energy_per_seed(u: Unit):
     return t, curve, len(per), len(bad)
 
 
-def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative energy error") -> bool:
-    """|energy error| against time on a log axis, as the LNN paper's Fig. 4: per model and framework the median
+def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative energy error",
+                 published: dict | None = None) -> bool:
+    """|energy error| against time on a log axis, as the LNN paper's Fig. 2(b): per model and framework the median
     over seeds of each seed's median over its rollouts, the band from the lowest to the highest seed; a rollout
-    whose error ever exceeds `DIVERGED` is left out of the curves and counted in the legend."""
+    whose error ever exceeds `DIVERGED` is left out of the curves and counted in the legend. `published`:
+    {model: (value, its conditions)}, each a dotted line in the model's colour."""
     curves = {}
     for key, group in _groups(units).items():
         seeds = [c for c in (_energy_per_seed(u) for u in group) if c is not None]
@@ -129,6 +131,9 @@ def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative ene
         ax.plot(t[after], mid[after], label=label, **kw)
         if len(seeds) > 1:
             ax.fill_between(t[after], lo[after], hi[after], color=kw["color"], alpha=0.15, lw=0)
+    for model, (value, where) in (published or {}).items():
+        if model in models and value > 0:
+            ax.axhline(value, color=colour(models[model]), ls=":", lw=1.2, label=f"published {model}: {value:.2g} ({where})")
     ax.set_yscale("log")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel(f"|{scale_label}| (–)")

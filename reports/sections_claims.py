@@ -24,6 +24,10 @@ from reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
 REASON_CHARS = 400   # a verdict's reason on a claim's page
+# the paper figure a claim's figure recreates (the LNN paper's numbering, shared/seeds): same quantity and axes
+PAPER_FIGURES = {("dp_energy", "energy"): "LNN Fig. 2(b) (energy of the double pendulum over a long time)",
+                 ("dp_energy", "trajectory"): "LNN Fig. 2(a) (the double pendulum over a short time)",
+                 ("wave_lgn", "spacetime"): "LNN Fig. 4 (the wave equation learned by a Lagrangian graph network)"}
 
 
 def slug(text: str) -> str:
@@ -75,6 +79,17 @@ def _rollout_table(units) -> pd.DataFrame | None:
     return pd.DataFrame(rows)
 
 
+def _published_energy(claim: dict) -> dict:
+    """The published energy errors of a claim's models, with the conditions they were measured under."""
+    out = {}
+    for model, p in (claim.get("published") or {}).items():
+        if str(p.get("metric", "")).startswith("energy_err") and isinstance(p.get("value"), int | float):
+            cond = ", ".join(f"{k} {v:g}" if isinstance(v, int | float) else f"{k} {v}"
+                             for k, v in (p.get("conditions") or {}).items())
+            out[model] = (float(p["value"]), f"{p.get('kind', 'published')}" + (f"; {cond}" if cond else ""))
+    return out
+
+
 def _brief(text: str, limit: int = REASON_CHARS) -> str:
     """A reason cut at a word for the claim's page; the parts table beside it and the appendix give it in full."""
     if len(text) <= limit:
@@ -119,9 +134,10 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     s.add(Table(f"{cid}: {claim.get('metric', 'metric')} per model and framework", claim_table(res, claim),
                 ["claims.json", src + "result.json"]))
     figs = [
-        ("energy", F.energy_drift, "|Energy error| over time against truth, log axis (as LNN Fig. 4; line: median "
-                                  "over seeds of each seed's median over its rollouts, band: seed range; diverged "
-                                  "rollouts counted in the legend, not in the line)", "timeseries.csv"),
+        ("energy", lambda us, p: F.energy_drift(us, p, published=_published_energy(claim)),
+         "|Energy error| over time against truth, log axis (line: median over seeds of each seed's median over its "
+         "rollouts, band: seed range; diverged rollouts counted in the legend, not in the line; dotted: a published "
+         "value, under the conditions its legend names)", "timeseries.csv"),
         ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
         ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
         ("decomposition", F.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
@@ -132,7 +148,8 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     for kind, fn, caption, file in figs:
         rel = f"figures/{slug(cid)}_{kind}.png"
         if fn(units, out_dir / rel):
-            s.add(Figure(rel, f"{cid}: {caption}.", [src + file]))
+            paper = PAPER_FIGURES.get((cid, kind))
+            s.add(Figure(rel, f"{cid}: {caption}." + (f" It stands for {paper}." if paper else ""), [src + file]))
     drawn = {} if drawn is None else drawn
     key = _trainings(units)
     if key in drawn:

@@ -1,4 +1,4 @@
-"""Claim 2 (LNN §5, Fig. 4): the LNN conserves energy far better than the baseline.
+"""Claim 2 (LNN §5, Fig. 2(b)): the LNN conserves energy far better than the baseline.
 
 Same trained models as claim 1 (the training cache shares them); the metric is the original one:
 |E_pred(T) - E_true(T)| / 29.4 at the final time, averaged over initial conditions near rest, a
@@ -13,7 +13,7 @@ from replication.claims.rules import better_by
 
 _PAPER_HORIZON = (("n_ics", 40), ("t_end", 100.0))
 CLAIM = Claim(
-    id="dp_energy", number=2, paper="LNN", section="§5, Fig. 4",
+    id="dp_energy", number=2, paper="LNN", section="§5, Fig. 2(b)",
     title="LNN conserves energy far better than the baseline on the double pendulum",
     system="double_pendulum", models=dp.MODELS, protocols=dp.PROTOCOLS, evaluate="energy_rollout",
     metric="energy_err_final",

@@ -28,7 +28,7 @@ CLAIMS = [
     # id, number, paper, section, system, models, metric, published
     ("dp_loss", 1, "LNN", "§5", "double_pendulum", ["lnn", "baseline"], "heldout_l1",
      {"lnn": 0.073, "baseline": 0.074}),
-    ("dp_energy", 2, "LNN", "§5 / Fig. 4", "double_pendulum", ["lnn", "baseline"], "energy_err_final",
+    ("dp_energy", 2, "LNN", "§5 / Fig. 2(b)", "double_pendulum", ["lnn", "baseline"], "energy_err_final",
      {"lnn": 0.0043, "baseline": 0.0736}),
     ("rel_coords", 3, "LNN", "§5 / Fig. 5", "relativistic", ["hnn_qqdot", "hnn_qp", "lnn"], "heldout_l1",
      {"hnn_qqdot": 0.41, "hnn_qp": 2.4e-4, "lnn": 7.9e-4}),

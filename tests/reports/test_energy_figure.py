@@ -1,4 +1,4 @@
-"""The energy figure (`reports.figures.energy_drift`, LNN Fig. 4's axes): |error| on a log axis, medians over
+"""The energy figure (`reports.figures.energy_drift`, LNN Fig. 2(b)'s axes): |error| on a log axis, medians over
 rollouts and seeds, a diverged rollout counted in the legend and kept out of the line."""
 import numpy as np
 import pandas as pd
@@ -40,3 +40,20 @@ def test_a_model_whose_every_rollout_diverged_is_named_not_drawn(tmp_path):
     t = np.linspace(0, 10, 11)
     units = [_unit(tmp_path, "lnn", 0, [1e-3 * t]), _unit(tmp_path, "baseline", 0, [np.where(t > 0, np.inf, 0.0)] * 2)]
     assert F.energy_drift(units, tmp_path / "e.png")
+
+
+def test_a_published_value_is_marked_with_its_conditions_for_models_drawn_only(tmp_path, monkeypatch):
+    t = np.linspace(0, 10, 11)
+    units = [_unit(tmp_path, "lnn", 0, [1e-3 * t])]
+    seen = {}
+    real = F.save
+
+    def keep(fig, path):
+        seen.update({ln.get_label(): ln.get_ydata() for ln in fig.axes[0].get_lines()})
+        return real(fig, path)
+    monkeypatch.setattr(F, "save", keep)
+    assert F.energy_drift(units, tmp_path / "e.png", published={"lnn": (0.0043, "final time; t_end 100"),
+                                                                 "baseline": (0.074, "final time")})
+    marked = [k for k in seen if k.startswith("published")]
+    assert marked == ["published lnn: 0.0043 (final time; t_end 100)"]
+    assert np.allclose(seen[marked[0]], 0.0043)
