@@ -11,7 +11,8 @@
 width as a multiple): the tuning search's configurations and an adopted choice are both this.
 `apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile.
 A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices, so that their
-trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models and profiles without a record keep their registered (hand-chosen) setting.
+trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models
+and profiles without a record keep their registered (hand-chosen) setting.
 `tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
 configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
 """
