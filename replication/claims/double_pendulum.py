@@ -7,7 +7,9 @@ per-sample L1, batch 512, Adam with the cosine one-cycle, l2 1e-6/512; 300 epoch
 The recorded runs were continuations (peak lr 1e-5 / 4e-5); from scratch the `paper` profile uses the
 code's commented peak 1e-3 for both. `quick` trains both models with restarts over initialisations and the
 gradient-spike guard (not in the original code; see PROTOCOLS) at 3 x 64, so that both have learned
-before they are compared.
+before they are compared. These are the claims as written, the setting every tuning searches around; under
+`quick` both models run with what `lagbench tune` chose for them (3 x 128 at these rates:
+`replication/claims/tuned.json`, `docs/lab/tuning/dp_loss/`).
 """
 from replication.claims.bars import Bar
 from replication.claims.base import ModelEntry
