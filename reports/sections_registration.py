@@ -22,7 +22,7 @@ def _prereg(res: Results, claim: dict) -> dict:
 
 def tuning_text(tuning: dict) -> str:
     if not tuning:
-        return "-"
+        return "no trained model"
     tried = {t["configs_tried"] for t in tuning.values()}
     if tried == {0}:
         return "by hand, no search"

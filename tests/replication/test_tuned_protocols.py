@@ -119,3 +119,19 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
     flagged = ledger[ledger["flag"] != ""]
     assert list(zip(flagged["claim"], flagged["model"], strict=True)) == [("a", "baseline")]
     assert set(ledger["claim"]) == {"a", "b"}
+
+
+def test_the_scorecard_says_in_one_paragraph_how_each_claim_was_chosen():
+    from reports import sections_registration as sr
+
+    t = {"configs_tried": 4, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0]}
+    hand = {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": []}
+    pre = {"protocol_hash": "x", "registered": True, "frozen": "2026-01-01", "registrations": 1}
+    res = SimpleNamespace(claims=[{"id": "a", "number": 1}, {"id": "b", "number": 2}, {"id": "c", "number": 5}],
+                          verdicts={"a": {"preregistration": {**pre, "tuning": {"lnn": t, "baseline": t}}},
+                                    "b": {"preregistration": {**pre, "tuning": {"lnn": hand}, "registered": False}},
+                                    "c": {"preregistration": {**pre, "tuning": {}}}})
+    text = sr.summary(res)
+    assert "claim 1: lagbench tune: 4 configurations per model (dev)" in text
+    assert "claim 2: by hand, no search" in text and "claim 5: no trained model" in text
+    assert "NOT REGISTERED (changed since their registration): b" in text
