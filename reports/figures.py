@@ -57,6 +57,20 @@ def style_index(values: list[str]) -> dict[str, int]:
     return {v: i for i, v in enumerate(dict.fromkeys(values))}
 
 
+# one colour per model kind across the report (a label's kind is its part before the first "_")
+KIND_COLOURS = {"baseline": "C0", "lnn": "C1", "hnn": "C2", "delan": "C3", "lgn": "C4", "ff": "C5"}
+
+
+def model_colours(labels: list[str]) -> dict[str, str]:
+    """A colour per model: its kind's (`KIND_COLOURS`) when the figure's models are of different kinds, so a
+    kind keeps its colour from figure to figure; by order where two share a kind (an ablation, a data sweep)."""
+    labels = list(dict.fromkeys(labels))
+    kinds = [x.split("_", 1)[0] for x in labels]
+    if len(set(kinds)) == len(kinds) and all(k in KIND_COLOURS for k in kinds):
+        return {x: KIND_COLOURS[k] for x, k in zip(labels, kinds, strict=True)}
+    return {x: colour(i) for i, x in enumerate(labels)}
+
+
 def log_if_spread(ax, values, axis: str = "y", decades: float = 1.5) -> None:
     arr = np.asarray(values, dtype=float)
     arr = arr[np.isfinite(arr)]
@@ -115,13 +129,13 @@ def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative ene
     if not curves:
         return False
     fig, (ax,) = new_figure()
-    models = style_index([k[0] for k in curves])
+    models = model_colours([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
     for (model, fw), seeds in curves.items():
         t = seeds[0][0]
         stack = np.vstack([np.interp(t, c[0], c[1]) if c[0].size > 1 else c[1] for c in seeds])
         n, bad = sum(c[2] for c in seeds), sum(c[3] for c in seeds)
-        kw = {"color": colour(models[model]), "ls": LINESTYLES[fws[fw] % 4]}
+        kw = {"color": models[model], "ls": LINESTYLES[fws[fw] % 4]}
         label = f"{model} ({fw}, {len(seeds)} seed{'s' * (len(seeds) > 1)}" + (f"; {bad} of {n} rollouts diverged"
                                                                               if bad else "") + ")"
         after = slice(1, None)   # the start is exact by construction: no point on a log axis
@@ -133,7 +147,7 @@ def energy_drift(units: list[Unit], path: Path, scale_label: str = "relative ene
             ax.fill_between(t[after], lo[after], hi[after], color=kw["color"], alpha=0.15, lw=0)
     for model, (value, where) in (published or {}).items():
         if model in models and value > 0:
-            ax.axhline(value, color=colour(models[model]), ls=":", lw=1.2, label=f"published {model}: {value:.2g} ({where})")
+            ax.axhline(value, color=models[model], ls=":", lw=1.2, label=f"published {model}: {value:.2g} ({where})")
     ax.set_yscale("log")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel(f"|{scale_label}| (–)")
@@ -166,7 +180,7 @@ def trajectory(units: list[Unit], path: Path) -> bool:
     ref = next(iter(found.values()))
     dof = min(first_traj(ref["q_true"]).shape[1], 4)
     fig, axes = new_figure(ncols=dof, width=3.3 * dof)
-    models = style_index([k[0] for k in found])
+    models = model_colours([k[0] for k in found])
     fws = style_index([k[1] for k in found])
     for j, ax in enumerate(axes):
         t = np.asarray(ref["t"], dtype=float)
@@ -174,7 +188,7 @@ def trajectory(units: list[Unit], path: Path) -> bool:
         for (model, fw), arr in found.items():
             tt = np.asarray(arr["t"], dtype=float)
             qp = first_traj(arr["q_pred"])
-            ax.plot(tt[: len(qp)], qp[: len(tt), j], color=colour(models[model]),
+            ax.plot(tt[: len(qp)], qp[: len(tt), j], color=models[model],
                     ls=LINESTYLES[fws[fw] % 4], lw=1, label=f"{model} ({fw})")
         ax.set_xlabel("time t (s)")
         ax.set_ylabel(f"q{j + 1} (rad or m)")
@@ -251,14 +265,14 @@ def training_curves(units: list[Unit], path: Path) -> bool:
     if not curves:
         return False
     fig, (ax,) = new_figure(height=3.8)
-    models = style_index([k[0] for k in curves])
+    models = model_colours([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
     allv = []
     for (model, fw), logs in curves.items():
         idx = logs[0].index
         stack = np.vstack([s.reindex(idx).to_numpy(dtype=float) for s in logs])
         allv.extend(stack.ravel())
-        ax.plot(idx.to_numpy(), np.nanmean(stack, 0), color=colour(models[model]),
+        ax.plot(idx.to_numpy(), np.nanmean(stack, 0), color=models[model],
                 ls=LINESTYLES[fws[fw] % 4], label=f"{model} ({fw})")
     log_if_spread(ax, allv, decades=1.0)
     ax.set_xlabel("training step")

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.ticker import NullFormatter
 
-from reports.figures import LINESTYLES, _groups, colour, new_figure, save, style_index
+from reports.figures import LINESTYLES, _groups, model_colours, new_figure, save, style_index
 from reports.load import Unit
 
 COLUMNS = {"samples", "train_s", "heldout_loss"}
@@ -44,7 +44,7 @@ def work_precision(units: list[Unit], path: Path) -> bool:
     if not curves:
         return False
     fig, axes = new_figure(ncols=2, width=9.0, height=3.6)
-    models = style_index([k[0] for k in curves])
+    models = model_colours([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
     for ax, x, label in ((axes[0], "samples", "training samples"), (axes[1], "train_s", "training time (s)")):
         xs = []
@@ -53,7 +53,7 @@ def work_precision(units: list[Unit], path: Path) -> bool:
             if not len(d):
                 continue
             xs.extend(d[x])
-            c = colour(models[model])
+            c = models[model]
             ax.plot(d[x], d["mean"], color=c, ls=LINESTYLES[fws[fw] % 4], label=f"{model} ({fw})")
             ax.fill_between(d[x], d["lo"], d["hi"], color=c, alpha=0.15, lw=0)
         ax.set_xscale("log")

@@ -18,7 +18,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from reports.figures import MARKERS, colour, log_if_spread, new_figure, save, style_index, ticks_at
+from reports.figures import (
+    MARKERS,
+    colour,
+    log_if_spread,
+    model_colours,
+    new_figure,
+    save,
+    style_index,
+    ticks_at,
+)
 from reports.load import Unit
 
 SIZE_METRIC = re.compile(r"^(?P<base>.+)_n(?P<n>\d+)$")
@@ -49,12 +58,12 @@ def speed_error(units: list[Unit], metric: str, path: Path) -> bool:
     label = pts[0][1][0]
     pts = [p for p in pts if p[1][0] == label]
     fig, (ax,) = new_figure(height=3.6)
-    models = style_index([u.model for u, _, _ in pts])
+    models = model_colours([u.model for u, _, _ in pts])
     fws = style_index([u.framework for u, _, _ in pts])
     seen = set()
     for u, (_, x), y in pts:
         key = (u.model, u.framework)
-        ax.scatter(x, y, color=colour(models[u.model]), marker=MARKERS[fws[u.framework] % 6], s=30,
+        ax.scatter(x, y, color=models[u.model], marker=MARKERS[fws[u.framework] % 6], s=30,
                    label=f"{u.model} ({u.framework})" if key not in seen else None)
         seen.add(key)
     log_if_spread(ax, [x for _, (_, x), _ in pts], axis="x", decades=1.0)
@@ -171,12 +180,12 @@ def data_efficiency(units: list[Unit], path: Path, metric: str | None) -> bool:
     fig, axes = new_figure(ncols=len(bases), width=3.6 * len(bases), height=3.4)
     for ax, base in zip(axes, bases, strict=True):
         rows = pd.DataFrame(found[base], columns=["model", "framework", "n", "value"])
-        models = style_index(list(rows["model"]))
+        models = model_colours(list(rows["model"]))
         fws = style_index(list(rows["framework"]))
         for (model, fw), g in rows.groupby(["model", "framework"], sort=True):
             s = g.groupby("n")["value"].agg(["mean", "min", "max"])
             ax.errorbar(s.index, s["mean"], yerr=[s["mean"] - s["min"], s["max"] - s["mean"]],
-                        color=colour(models[model]), marker=MARKERS[fws[fw] % 6], capsize=2,
+                        color=models[model], marker=MARKERS[fws[fw] % 6], capsize=2,
                         label=f"{model} ({fw})")
         ax.set_xscale("log")
         ticks_at(ax, rows["n"])

@@ -43,3 +43,15 @@ def test_the_body_is_short_and_the_appendix_starts_a_page(results_dir, tmp_path)
     assert page_count(pdf) > n_body
     typ = (tmp_path / "REPORT.typ").read_text()
     assert typ.index('#set heading(numbering: "A.1")') < typ.index('"Appendix"')
+
+
+def test_a_model_kind_keeps_its_colour_from_figure_to_figure():
+    from reports.figures import model_colours
+
+    a = model_colours(["lnn", "baseline"])
+    b = model_colours(["baseline_spring", "hnn_spring"])
+    c = model_colours(["delan_relativistic", "lnn_relativistic"])
+    assert a["lnn"] == c["lnn_relativistic"] and a["baseline"] == b["baseline_spring"]
+    assert len(set(a.values())) == 2 and len(set(b.values())) == 2
+    ablation = model_colours(["lnn_act-softplus", "lnn_act-relu", "lnn_act-tanh"])   # one kind: by order
+    assert len(set(ablation.values())) == 3
