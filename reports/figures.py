@@ -41,8 +41,36 @@ def new_figure(ncols: int = 1, nrows: int = 1, width: float = 6.4, height: float
     return fig, list(axes.ravel())
 
 
+LINEAR_DECADES = 3.0   # a linear axis over positive values spanning more decades than this is drawn on a log axis
+
+
+def _values(ax, axis: str) -> np.ndarray:
+    """The finite values an axes plots along ``axis`` (lines and scatter points)."""
+    k = 0 if axis == "x" else 1
+    parts = [np.asarray(ln.get_xdata() if k == 0 else ln.get_ydata(), dtype=float).ravel() for ln in ax.get_lines()]
+    parts += [np.asarray(c.get_offsets(), dtype=float).reshape(-1, 2)[:, k] for c in ax.collections
+              if hasattr(c, "get_offsets") and len(c.get_offsets())]
+    v = np.concatenate(parts) if parts else np.zeros(0)
+    return v[np.isfinite(v)]
+
+
+def linear_span(ax, axis: str = "y") -> float:
+    """Decades spanned by the positive values on a linear axis (0 for a log axis or values of both signs)."""
+    if (ax.get_yscale() if axis == "y" else ax.get_xscale()) != "linear" or ax.images:
+        return 0.0
+    v = _values(ax, axis)
+    v = v[v != 0]
+    return float(np.log10(v.max() / v.min())) if v.size and (v > 0).all() else 0.0
+
+
 def save(fig: Figure, path: Path) -> bool:
-    """Render to memory, then replace ``path`` atomically (never writing through a symlink there)."""
+    """Render to memory, then replace ``path`` atomically (never writing through a symlink there). A linear
+    axis whose positive values span more than `LINEAR_DECADES` becomes a log axis first (one outlier must not
+    flatten every other curve)."""
+    for ax in fig.axes:
+        for axis in ("x", "y"):
+            if linear_span(ax, axis) > LINEAR_DECADES:
+                (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI)
     write(path, buf.getvalue())

@@ -83,7 +83,7 @@ def _published_energy(claim: dict) -> dict:
     """The published energy errors of a claim's models, with the conditions they were measured under."""
     out = {}
     for model, p in (claim.get("published") or {}).items():
-        if str(p.get("metric", "")).startswith("energy_err") and isinstance(p.get("value"), int | float):
+        if isinstance(p, dict) and str(p.get("metric", "")).startswith("energy_err") and isinstance(p.get("value"), int | float):
             cond = ", ".join(f"{k} {v:g}" if isinstance(v, int | float) else f"{k} {v}"
                              for k, v in (p.get("conditions") or {}).items())
             out[model] = (float(p["value"]), f"{p.get('kind', 'published')}" + (f"; {cond}" if cond else ""))

@@ -55,3 +55,33 @@ def test_a_model_kind_keeps_its_colour_from_figure_to_figure():
     assert len(set(a.values())) == 2 and len(set(b.values())) == 2
     ablation = model_colours(["lnn_act-softplus", "lnn_act-relu", "lnn_act-tanh"])   # one kind: by order
     assert len(set(ablation.values())) == 3
+
+
+def test_no_figure_keeps_a_linear_axis_over_more_than_three_decades(results_dir, tmp_path, monkeypatch):
+    import numpy as np
+
+    from reports import figures as F
+    from reports.build import build_sections
+
+    fig, (ax,) = F.new_figure()
+    ax.plot([0, 1, 2], [1e-3, 1.0, 1e2])
+    F.save(fig, tmp_path / "x.png")
+    assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"   # x spans 0-2 (a zero is no decade)
+    fig, (ax,) = F.new_figure()
+    ax.plot([0, 1], [-1e3, 1e-2])   # both signs: stays linear
+    F.save(fig, tmp_path / "y.png")
+    assert ax.get_yscale() == "linear"
+
+    spans = []
+    real = F.save
+
+    def check(fig, path):
+        out = real(fig, path)
+        spans.extend(F.linear_span(a, axis) for a in fig.axes for axis in ("x", "y"))
+        return out
+    from reports import figures_precision, figures_speed
+
+    for module in (F, figures_precision, figures_speed):
+        monkeypatch.setattr(module, "save", check)
+    build_sections(results_dir, tmp_path / "report")
+    assert spans and max(spans) <= F.LINEAR_DECADES and np.isfinite(spans).all()
