@@ -6,8 +6,7 @@ returns False (writing nothing) when the units lack the data it needs. Inputs:
   log axis, medians over rollouts and seeds, diverged rollouts counted apart.
 - ``trajectory``: ``arrays.npz`` keys ``t`` (T,), ``q_true`` and ``q_pred`` ((T, n) or (n_traj, T, n)).
 - ``wave_spacetime``: ``arrays.npz`` keys ``x`` (n,), ``t`` (T,), ``field_true``/``field_pred`` (T, n).
-- ``delan_decomposition``: ``arrays.npz`` pairs ``M_true/M_pred``, ``c_true/c_pred``, ``g_true/g_pred``
-  (and ``tau_true/tau_pred``) of any matching shapes; drawn as predicted-vs-true parity plots.
+- ``delan_decomposition`` and ``torque_traces`` are in :mod:`reports.figures_delan`.
 - ``training_curves``: ``train_log.csv`` (step, loss) averaged over seeds per model and framework.
 """
 
@@ -243,40 +242,6 @@ def wave_spacetime(units: list[Unit], path: Path) -> bool:
         ax.set_xlabel("position x (m)")
         ax.set_ylabel("time t (s)")
         fig.colorbar(im, ax=ax, label="displacement u (m)")
-    return save(fig, path)
-
-
-DECOMPOSITION = [("M", r"inertia $M(q)$"), ("c", r"Coriolis/centrifugal $c(q, \dot q)$"),
-                 ("g", r"gravity $g(q)$"), ("tau", r"torque $\tau$")]
-
-
-def delan_decomposition(units: list[Unit], path: Path) -> bool:
-    found = {}
-    for key, group in _groups(units).items():
-        for u in group:
-            arr = u.arrays() or {}
-            terms = [(k, name) for k, name in DECOMPOSITION if f"{k}_true" in arr and f"{k}_pred" in arr]
-            if terms:
-                found[key] = (arr, terms)
-                break
-    if not found:
-        return False
-    terms = list(dict.fromkeys(t for _, ts in found.values() for t in ts))
-    fig, axes = new_figure(ncols=len(terms), width=3.2 * len(terms), height=3.2)
-    for ax, (k, name) in zip(axes, terms, strict=True):
-        lo, hi = np.inf, -np.inf
-        for i, ((model, fw), (arr, _)) in enumerate(found.items()):
-            if f"{k}_true" not in arr:
-                continue
-            a = np.asarray(arr[f"{k}_true"], float).ravel()
-            b = np.asarray(arr[f"{k}_pred"], float).ravel()
-            ax.scatter(a, b, s=4, alpha=0.5, color=colour(i), marker=MARKERS[i % 6], label=f"{model} ({fw})")
-            lo, hi = min(lo, np.nanmin(a)), max(hi, np.nanmax(a))
-        ax.plot([lo, hi], [lo, hi], color="k", lw=0.8, label="pred = true")
-        ax.set_title(name, fontsize=9)
-        ax.set_xlabel("true (SI units)")
-        ax.set_ylabel("predicted (SI units)")
-    axes[0].legend(fontsize=7)
     return save(fig, path)
 
 

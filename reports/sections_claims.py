@@ -13,6 +13,7 @@ from pathlib import Path
 import pandas as pd
 
 from reports import figures as F
+from reports import figures_delan as FD
 from reports import figures_precision as FP
 from reports import figures_speed as FS
 from reports.document import NOT_RUN, Figure, Para, Section, Table
@@ -140,7 +141,9 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
          "value, under the conditions its legend names)", "timeseries.csv"),
         ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
         ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
-        ("decomposition", F.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
+        ("torques", FD.torque_traces, "Torque per joint on the unseen trajectories: truth against each model "
+                                      "trained on the full data set (first seed)", "arrays.npz"),
+        ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
                                                  "(predicted against true)", "arrays.npz"),
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
          "Data efficiency: error against training samples (bars: seed range)", "result.json"),

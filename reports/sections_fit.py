@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from reports import figures as F
+from reports import figures_delan as FD
 from reports.document import Figure, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results, protocol_of
@@ -201,7 +202,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
              "arrays.npz"),
             ("energy", lambda us, p: F.energy_drift(us, p, "true energy error / mean kinetic energy"),
              "True energy along each rollout against along the data", "timeseries.csv"),
-            ("decomposition", F.delan_decomposition, "DeLaN's inertia, Coriolis and gravity terms against the "
+            ("decomposition", FD.delan_decomposition, "DeLaN's inertia, Coriolis and gravity terms against the "
                                                      "system's", "arrays.npz"),
             ("training", F.training_curves, "Training curves", "train_log.csv")]
     for kind, fn, caption, file in figs:

@@ -96,8 +96,9 @@ def arrays_for(cid, rng) -> dict[str, np.ndarray]:
     if cid == "delan_arm":
         m = rng.standard_normal((30, 2, 2))
         c, g = rng.standard_normal((30, 2)), rng.standard_normal((30, 2))
+        tau = np.stack([np.sin(t[:30]), np.cos(t[:30])], -1)
         return {"M_true": m, "M_pred": m + 0.05 * rng.standard_normal(m.shape), "c_true": c,
-                "c_pred": c * 1.02, "g_true": g, "g_pred": g * 0.98}
+                "c_pred": c * 1.02, "g_true": g, "g_pred": g * 0.98, "tau_true": tau, "tau_pred": tau * 1.01}
     return {}
 
 

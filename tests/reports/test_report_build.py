@@ -65,7 +65,7 @@ def test_figures_written_and_referenced(built):
     figs = built["figures"]
     names = {p.name for p in figs}
     for name in ("dp_energy_energy.png", "dp_energy_trajectory.png", "wave_lgn_spacetime.png",
-                 "delan_arm_decomposition.png", "delan_arm_data_efficiency.png", "init_study_training.png",
+                 "delan_arm_decomposition.png", "delan_arm_torques.png", "delan_arm_data_efficiency.png", "init_study_training.png",
                  "dp_loss_speed_error.png", "bench_inference.png", "bench_scaling.png"):
         assert name in names
     md = built["markdown"].read_text()

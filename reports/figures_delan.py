@@ -1,0 +1,77 @@
+"""The DeLaN paper's figures recreated from a claim's arrays: the torque decomposition (inertial,
+Coriolis/centrifugal, gravity: predicted against true) and the torque traces per joint on trajectories
+the models never saw, truth against each model."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from reports.figures import LINESTYLES, MARKERS, _groups, model_colours, new_figure, save, style_index
+from reports.load import Unit
+
+DECOMPOSITION = [("M", r"inertia $M(q)$"), ("c", r"Coriolis/centrifugal $c(q, \dot q)$"),
+                 ("g", r"gravity $g(q)$"), ("tau", r"torque $\tau$")]
+
+
+def delan_decomposition(units: list[Unit], path: Path) -> bool:
+    found = {}
+    for key, group in _groups(units).items():
+        for u in group:
+            arr = u.arrays() or {}
+            terms = [(k, name) for k, name in DECOMPOSITION if f"{k}_true" in arr and f"{k}_pred" in arr]
+            if terms:
+                found[key] = (arr, terms)
+                break
+    if not found:
+        return False
+    terms = list(dict.fromkeys(t for _, ts in found.values() for t in ts))
+    fig, axes = new_figure(ncols=len(terms), width=3.2 * len(terms), height=3.2)
+    colours = model_colours([m for m, _ in found])
+    for ax, (k, name) in zip(axes, terms, strict=True):
+        lo, hi = np.inf, -np.inf
+        for i, ((model, fw), (arr, _)) in enumerate(found.items()):
+            if f"{k}_true" not in arr:
+                continue
+            a = np.asarray(arr[f"{k}_true"], float).ravel()
+            b = np.asarray(arr[f"{k}_pred"], float).ravel()
+            ax.scatter(a, b, s=4, alpha=0.5, color=colours[model], marker=MARKERS[i % 6], label=f"{model} ({fw})")
+            lo, hi = min(lo, np.nanmin(a)), max(hi, np.nanmax(a))
+        ax.plot([lo, hi], [lo, hi], color="k", lw=0.8, label="pred = true")
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("true (SI units)")
+        ax.set_ylabel("predicted (SI units)")
+    axes[0].legend(fontsize=7)
+    return save(fig, path)
+
+
+def torque_traces(units: list[Unit], path: Path) -> bool:
+    """Torque per joint against the sample index of the unseen trajectories: the truth and each model trained
+    on the full data set (the data-size sweep's models, `*_n<k>`, left out), first seed of each framework."""
+    found = {}
+    for (model, fw), group in _groups(units).items():
+        if "_n" in model:
+            continue
+        for u in sorted(group, key=lambda u: str(u.seed)):
+            arr = u.arrays() or {}
+            if "tau_true" in arr and "tau_pred" in arr:
+                found[(model, fw)] = arr
+                break
+    if not found:
+        return False
+    ref = np.asarray(next(iter(found.values()))["tau_true"], float)
+    ref = ref[:, None] if ref.ndim == 1 else ref
+    fig, axes = new_figure(ncols=ref.shape[1], width=3.6 * ref.shape[1], height=3.2)
+    models = model_colours([k[0] for k in found])
+    fws = style_index([k[1] for k in found])
+    for j, ax in enumerate(axes):
+        ax.plot(ref[:, j], color="k", lw=2, alpha=0.5, label="truth")
+        for (model, fw), arr in found.items():
+            pred = np.asarray(arr["tau_pred"], float)
+            pred = pred[:, None] if pred.ndim == 1 else pred
+            ax.plot(pred[:, j], color=models[model], ls=LINESTYLES[fws[fw] % 4], lw=1, label=f"{model} ({fw})")
+        ax.set_xlabel("sample of the unseen trajectories")
+        ax.set_ylabel(f"torque joint {j + 1} (N m)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Inverse dynamics on unseen trajectories: torque per joint")
+    return save(fig, path)
