@@ -73,16 +73,27 @@ def cmd_fit(args):
     rollouts = RolloutBars(args.quiet, f"lagbench fit {args.model}")
 
     def on_log(row):
-        if not bars:
+        step = min(int(row["step"]) + 1, args.steps)
+        if not bars or step < bars[-1].n:   # a new training (--tune fits one per configuration)
             bars.append(tqdm(total=args.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet))
-        bar = bars[0]
+        bar = bars[-1]
         bar.set_postfix_str(f"training {LOSS_NAMES[args.loss]} {row['loss']:.4g}", refresh=False)
-        bar.update(min(int(row["step"]) + 1, bar.total) - bar.n)
+        bar.update(step - bar.n)
         if bar.n >= bar.total:   # closed now, so that its time is the training's, not the evaluation's too
             bar.close()
 
     try:
-        d = fit(args.data, out=args.out, on_log=on_log, on_progress=rollouts, **fit_options.from_args(args))
+        if args.tune:
+            from replication.fit.tune import tune_fit
+
+            d, ledger = tune_fit(args.data, out=args.out, n_configs=args.tune, on_log=on_log, on_progress=rollouts,
+                                 **fit_options.from_args(args))
+            scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in ledger["scores"].items())
+            print(f"tune: chose configuration {ledger['chosen']} of {len(ledger['configs'])} "
+                  f"(--lr {ledger['options']['lr']:.4g} --hidden {','.join(map(str, ledger['options']['hidden']))}; "
+                  f"held-out {scores}), ledger in {Path(args.out) / 'tune'}")
+        else:
+            d = fit(args.data, out=args.out, on_log=on_log, on_progress=rollouts, **fit_options.from_args(args))
     finally:
         for bar in bars:
             bar.close()
@@ -190,6 +201,11 @@ def add_commands(sub) -> None:
     s.add_argument("--strict", action="store_true", help="exit with status 1 when the model is not clearly better "
                    "than the null predictor (at most half its error on the reported set)")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
+    s.add_argument("--tune", type=int, default=0, metavar="N",
+                   help="choose --lr and --hidden by the suite's declared search first: N configurations (the given "
+                   "options, then peak rate x 1/3, 1, 3 and widths x 1/2, 1, 2), each fitted to the training rows and "
+                   "scored on the held-out rows (never the test file); the best is fitted again into OUT "
+                   "(ledger in OUT/tune/; default: 0, no search)")
     s.set_defaults(func=cmd_fit)
     _show_defaults(s)
 

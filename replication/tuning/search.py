@@ -12,6 +12,7 @@ combinations drawn without replacement (generator `seed`); the same list for eve
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from replication.claims.tuned import with_knobs
 
 KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
 REGISTERED = {"lr": 1.0, "width": 1.0}
+SIZE = math.prod(len(v) for v in KNOBS.values())   # the search's combinations
 
 
 def configs(n: int, seed: int = 0) -> list[dict]:
