@@ -23,6 +23,7 @@ from reports.markdown import render_markdown
 from reports.pdf import write_pdf
 from reports.scorecard import scorecard_appendix, scorecard_section
 from reports.sections_claims import claim_details, metrics_appendix, summary_sections, theme_sections
+from reports.sections_control import control_sections
 from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
@@ -41,14 +42,16 @@ APPENDIX = ("What the body's numbers rest on: every part with its interval, the 
 
 
 def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
-    """The report's body (the scorecard, a page per claim with its figures, speed against error) and its
+    """The report's body (the scorecard, a page per claim with its figures, the closed-loop control study,
+    speed against error) and its
     appendix (everything else), as two lists of sections."""
     res = load_results(results_dir)
     mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
     if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
         sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
         return sections, sources_sections(res, sections)
-    body = [scorecard_section(res)] + theme_sections(res, out_dir) + speed_sections(res, out_dir)
+    body = [scorecard_section(res)] + theme_sections(res, out_dir) + control_sections(res, out_dir)
+    body += speed_sections(res, out_dir)
     appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]
     appendix += summary_sections(res) + claim_details(res) + speed_appendix(res, out_dir)
     appendix += findings_sections(res) + frameworks_sections(res) + hessian_sections(res) + stiff_sections(res)

@@ -9,7 +9,9 @@
 `with_knobs(entry, base, profile, knobs) -> ModelEntry`: the entry with the knob values applied under
 `profile` only (peak rate, the scouting round's with it, as a multiple of the entry's own; every hidden
 width as a multiple): the tuning search's configurations and an adopted choice are both this.
-`apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile.
+`apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile, and
+under a profile the claim is silent about (a model that runs there exactly as under quick: `full` for most
+claims), quick's choice, the search having run at that profile's budget too.
 A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices, so that their
 trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models
 and profiles without a record keep their registered (hand-chosen) setting.
@@ -60,26 +62,53 @@ def _chosen(claim, rec: dict | None, names: dict, label: str) -> dict | None:
     return (rec or {}).get("models", {}).get(names.get(paper, paper))
 
 
+def _same_as_quick(claim, entry, profile: str) -> bool:
+    """Whether the entry runs under `profile` exactly as under quick (a claim silent about the profile): then
+    quick's adopted search is one at this profile's budget too, and its choice serves it."""
+    if profile == "quick" or not (entry.runs_in(profile) and entry.runs_in("quick")):
+        return False
+    if per_profile(claim.protocols, profile) is None or per_profile(claim.protocols, "quick") is None:
+        return False
+    return (entry.widths(profile) == entry.widths("quick") and entry.spec_fields(profile) == entry.spec_fields("quick")
+            and entry.protocol(claim.protocol(profile), profile) == entry.protocol(claim.protocol("quick"), "quick"))
+
+
+def _serving(claim, entry, profile: str) -> tuple[dict | None, dict]:
+    """The adopted record that serves the entry under the profile (its own, else quick's where the entry runs
+    as under quick), and the label map into it."""
+    rec, names = _record(claim.id, profile)
+    if rec is None and _same_as_quick(claim, entry, profile):
+        rec, names = _record(claim.id, "quick")
+    return rec, names
+
+
 def apply(claim):
     models = list(claim.models)
     for profile in PROFILES:
-        rec, names = _record(claim.id, profile)
-        if rec is None:
+        if per_profile(claim.protocols, profile) is None:
             continue
-        base = claim.protocol(profile) if per_profile(claim.protocols, profile) is not None else None
+        base = claim.protocol(profile)
         for i, m in enumerate(models):
+            rec, names = _serving(claim, claim.models[i], profile)   # judged on the claim as written
             chosen = _chosen(claim, rec, names, m.label)
-            if base is not None and chosen and m.train and m.runs_in(profile):
+            if chosen and m.train and m.runs_in(profile):
                 models[i] = with_knobs(m, base, profile, chosen["knobs"])
     return dataclasses.replace(claim, models=tuple(models))
 
 
 def tuning(claim, profile: str) -> dict:
-    rec, names = _record(claim.id, profile)
+    from replication.claims import untuned
+
+    try:
+        written = untuned(claim.id)   # whether a profile runs as quick is judged on the claim as written
+    except KeyError:
+        written = claim
     out = {}
     for m in claim.models:
         if not (m.train and m.runs_in(profile)):
             continue
+        entry = next((w for w in written.models if w.label == m.label), m)
+        rec, names = _serving(written, entry, profile)
         chosen = _chosen(claim, rec, names, m.label)
         out[m.label] = ({"configs_tried": chosen["configs_tried"], "scored_on": rec["split"], "knobs": chosen["knobs"],
                          "seeds": rec["seeds"], "ledger_hash": rec["ledger_hash"]} if chosen else

@@ -48,11 +48,23 @@ def test_adopt_applies_the_choice_under_its_profile_only(record_file):
         assert m.widths("quick") == tuple(2 * x for x in w.widths("quick"))
         assert m.protocol(claim.protocol("quick"), "quick").schedule.lr == pytest.approx(
             w.protocol(written.protocol("quick"), "quick").schedule.lr / 3)
-        for q in ("smoke", "full", "paper"):
+        for q in ("smoke", "paper"):
             assert m.widths(q) == w.widths(q) and m.protocol(claim.protocol(q), q) == w.protocol(written.protocol(q), q)
+        # full: claim 10 is silent about it (its models run there as under quick), so quick's choice serves it
+        assert m.widths("full") == m.widths("quick")
+        assert m.protocol(claim.protocol("full"), "full") == m.protocol(claim.protocol("quick"), "quick")
     t = tuned.tuning(claim, "quick")
     assert all(x["configs_tried"] == 4 and x["scored_on"] == "dev" for x in t.values()) and tuned.equal(t)
-    assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuned.tuning(claim, "full").values())
+    assert tuned.tuning(claim, "full") == t
+    assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuned.tuning(claim, "paper").values())
+
+
+def test_a_profile_that_runs_otherwise_than_quick_keeps_its_own_setting(record_file):
+    adopt.adopt(_write(record_file, _ledger("dp_loss", knobs={"lr": 3.0, "width": 2.0})))
+    claim, written = tuned.apply(untuned("dp_loss")), untuned("dp_loss")
+    assert claim.entry("lnn").widths("quick") != written.entry("lnn").widths("quick")
+    assert claim.entry("lnn").widths("full") == written.entry("lnn").widths("full")   # full trains longer
+    assert all(x["configs_tried"] == 0 for x in tuned.tuning(claim, "full").values())
 
 
 @pytest.mark.parametrize("ledger, says", [

@@ -1,0 +1,152 @@
+"""Closed-loop tracking control of the two-link arm with a learned inverse model (the DeLaN paper's experiment).
+
+Computed-torque control: tau = tau_hat(q_d, qdot_d, qddot_d) + KP (q_d - q) + KD (qdot_d - qdot), at
+`RATE` Hz with the torque held over each control period (zero-order hold). The plant is the SymPy ground
+truth (`systems.get("two_link_arm")`, forward dynamics under the torque) integrated by RK4 with `SUBSTEPS`
+steps per period in float64, independent of the controller. A batch of reference trajectories is tracked
+side by side from the reference's own initial state; a trajectory whose state leaves `DIVERGED` is marked
+diverged and scores no error.
+
+References the models never trained on: the "test" family of `systems.arm_data` (other shapes, higher
+frequencies) and the training family played twice as fast ("train_x2": q_d(2t), so velocities x 2 and
+accelerations x 4). Controllers: each learned inverse model of claim 9 trained on the full data set
+(`delan`, `ff`; every framework and seed in the results folder), the true inverse dynamics (the best a
+model can give) and PD alone (tau_hat = 0, the null controller). Gains are fixed and declared (`KP`,
+`KD`), low enough that the feed-forward term has to do most of the work, as in the paper.
+
+`track(inverse, refs, ...) -> dict` simulates one controller; `control_study(results, ...) -> DataFrame`
+runs every controller on every family; `write_study(results, folder)` (`lagbench control`, into
+RESULTS/control) writes FOLDER/tracking.csv (one row per controller, framework, seed and family: tracking
+MSE per joint and overall, torque effort, diverged count, ratio to PD alone) and FOLDER/traces.npz (the
+first reference of each family and each controller's first-seed response) for the report.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+RATE = 500.0             # control ticks per second
+SUBSTEPS = 4             # plant RK4 steps per control period
+KP = np.array([20.0, 20.0])
+KD = 2.0 * np.sqrt(KP)   # critically damped for a unit inertia
+DURATION = 4.0           # seconds per reference
+N_REFS = 8
+SEED = 2000              # the references' generator seed: no training or held-out draw of claim 9 uses it
+DIVERGED = 1e3
+MODELS = ("delan", "ff")
+
+
+def references(family: str, n: int = N_REFS, duration: float = DURATION, rate: float = RATE, seed: int = SEED):
+    """q_d, qdot_d, qddot_d (n, T, 2) at the control ticks, and t (T,)."""
+    from systems.arm_data import arm_dataset
+
+    fast = family == "train_x2"
+    k = 2.0 if fast else 1.0
+    base = "train" if fast else family
+    n_t = int(round(duration * rate)) + 1
+    d = arm_dataset(base, n_traj=n, n_points=n_t, seed=seed, duration=k * duration, cache=False)
+    return {"t": d["t"] / k, "q": d["q"], "qdot": d["qdot"] * k, "qddot": d["qddot"] * k * k}
+
+
+def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=KP, kd=KD) -> dict:
+    """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, 2)
+    float64 arrays, or None for PD alone. Returns q, tau (B, T, 2) and a diverged mask (B,)."""
+    import systems
+
+    plant = systems.get("two_link_arm")
+    qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
+    b, n_t, dof = qd.shape
+    q, v = qd[:, 0].copy(), vd[:, 0].copy()
+    h = 1.0 / rate / substeps
+    qs, taus = np.zeros((b, n_t, dof)), np.zeros((b, n_t, dof))
+    bad = np.zeros(b, bool)
+
+    def f(q_, v_, tau):
+        return v_, plant.acceleration(q_, v_, tau=tau)
+
+    for i in range(n_t):
+        qs[:, i] = q
+        ff = np.zeros((b, dof)) if inverse is None else np.asarray(inverse(qd[:, i], vd[:, i], ad[:, i]), float)
+        tau = ff + kp * (qd[:, i] - q) + kd * (vd[:, i] - v)
+        tau[bad] = 0.0
+        taus[:, i] = tau
+        if i == n_t - 1:
+            break
+        with np.errstate(over="ignore", invalid="ignore"):   # a diverging state is caught below
+            for _ in range(substeps):   # RK4 under the held torque
+                k1 = f(q, v, tau)
+                k2 = f(q + 0.5 * h * k1[0], v + 0.5 * h * k1[1], tau)
+                k3 = f(q + 0.5 * h * k2[0], v + 0.5 * h * k2[1], tau)
+                k4 = f(q + h * k3[0], v + h * k3[1], tau)
+                q = q + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+                v = v + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+            now = ~np.isfinite(q).all(-1) | ~np.isfinite(v).all(-1) | (np.abs(np.c_[q, v]) > DIVERGED).any(-1)
+        bad |= now
+        q[bad], v[bad] = qd[bad, i + 1], vd[bad, i + 1]   # parked on the reference; scored as diverged
+    return {"q": qs, "tau": taus, "diverged": bad}
+
+
+def scores(sim: dict, refs: dict) -> dict:
+    ok = ~sim["diverged"]
+    err = (sim["q"] - refs["q"])[ok]
+    out = {"n_refs": int(len(ok)), "n_diverged": int((~ok).sum())}
+    if ok.any():
+        for j in range(err.shape[-1]):
+            out[f"track_mse_joint{j}"] = float(np.mean(err[..., j] ** 2))
+        out["track_mse"] = float(np.mean(np.sum(err ** 2, -1)))
+        out["torque_effort"] = float(np.mean(np.sum(sim["tau"][ok] ** 2, -1)))
+    return out
+
+
+def _learned(results) -> list:
+    """(model, framework, seed, Fitted) for every usable full-data claim-9 unit in the results folder."""
+    from pathlib import Path
+
+    from replication.fit.load import load_fitted
+
+    out = []
+    for model in MODELS:
+        for folder in sorted(Path(results).glob(f"units/delan_arm/*/{model}/seed*")):
+            if (folder / "result.json").is_file() and (folder / "checkpoint.npz").is_file():
+                try:
+                    out.append((model, folder.parent.parent.name, folder.name.removeprefix("seed"), load_fitted(folder)))
+                except ValueError:
+                    continue   # a failed or damaged unit: no controller
+    return out
+
+
+def control_study(results, families=("test", "train_x2"), n_refs: int = N_REFS, duration: float = DURATION,
+                  progress=None) -> tuple[pd.DataFrame, dict]:
+    import systems
+
+    plant = systems.get("two_link_arm")
+    controllers = [("exact", "numpy", "-", lambda q, v, a: plant.inverse_dynamics(q, v, a)), ("pd", "numpy", "-", None)]
+    controllers += [(m, fw, seed, fitted.inverse_dynamics) for m, fw, seed, fitted in _learned(results)]
+    rows, traces = [], {}
+    for family in families:
+        refs = references(family, n_refs, duration)
+        traces[f"{family}__t"], traces[f"{family}__q_ref"] = refs["t"], refs["q"][0]
+        for name, fw, seed, inverse in controllers:
+            sim = track(inverse, refs)
+            rows.append({"family": family, "controller": name, "framework": fw, "seed": seed, **scores(sim, refs)})
+            key = f"{family}__{name}__{fw}"
+            if key + "__q" not in traces:
+                traces[key + "__q"], traces[key + "__tau"] = sim["q"][0], sim["tau"][0]
+            if progress:
+                progress(f"{family} {name} {fw} {seed}")
+    df = pd.DataFrame(rows)
+    pd_mse = df[df["controller"] == "pd"].set_index("family")["track_mse"]
+    df["ratio_to_pd"] = df["track_mse"] / df["family"].map(pd_mse)
+    return df, traces
+
+
+def write_study(results, folder, **kw) -> pd.DataFrame:
+    from pathlib import Path
+
+    from replication import results as R
+
+    folder = Path(folder)
+    df, traces = control_study(results, **kw)
+    R.write_csv(folder / "tracking.csv", df)
+    R.write_npz(folder / "traces.npz", traces)
+    return df
