@@ -147,3 +147,24 @@ def test_the_scorecard_says_in_one_paragraph_how_each_claim_was_chosen():
     assert "claim 1: lagbench tune: 4 configurations per model (dev)" in text
     assert "claim 2: by hand, no search" in text and "claim 5: no trained model" in text
     assert "NOT REGISTERED (changed since their registration): b" in text
+
+
+def test_every_data_file_the_package_reads_ships_in_it():
+    """A JSON file beside the code (registrations, adopted tuning) is package data: a wheel without it would
+    run other protocols than the repository's."""
+    import tomllib
+
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
+    for f in ROOT.glob("replication/**/*.json"):
+        package = ".".join(f.parent.relative_to(ROOT).parts)
+        assert f.name in data.get(package, []), f"{f.relative_to(ROOT)} is not package data in pyproject.toml"
+
+
+def test_a_missing_adopted_tuning_file_is_an_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(tuned, "FILE", tmp_path / "absent.json")
+    tuned.records.cache_clear()
+    try:
+        with pytest.raises(RuntimeError, match="missing"):
+            tuned.records()
+    finally:
+        tuned.records.cache_clear()
