@@ -33,6 +33,11 @@ SHARED = {"dp_energy": ("dp_loss", {}),
           "precision": ("dp_loss", {f"{m}_{d}": m for m in ("lnn", "baseline") for d in ("f32", "f64")})}
 
 
+def scaled_widths(widths, factor: float) -> tuple:
+    """Every hidden width times the width knob, rounded, at least 1."""
+    return tuple(max(1, int(round(w * factor))) for w in widths)
+
+
 def with_knobs(entry, base, profile: str, knobs: dict):
     p = entry.protocol(base, profile)
     change = {"schedule.lr": p.schedule.lr * knobs["lr"]}
@@ -40,7 +45,7 @@ def with_knobs(entry, base, profile: str, knobs: dict):
         change["scouting.schedule.lr"] = p.scouting.schedule.lr * knobs["lr"]
     per = dict(per_profile({k: v for k, v in entry.overrides.items() if k in PROFILES}, profile, {}))
     hidden = {q: entry.widths(q) for q in PROFILES}
-    hidden[profile] = tuple(max(1, int(round(w * knobs["width"]))) for w in entry.widths(profile))
+    hidden[profile] = scaled_widths(entry.widths(profile), knobs["width"])
     return dataclasses.replace(entry, overrides={**entry.overrides, profile: {**per, **change}}, hidden=hidden)
 
 

@@ -41,7 +41,7 @@ def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progre
     rows = []
     for k, knobs in enumerate(grid):
         chosen = {**options, "lr": o.lr * knobs["lr"], "test": None,
-                  "hidden": tuple(max(1, int(round(w * knobs["width"]))) for w in o.hidden)}
+                  "hidden": search.scaled_widths(o.hidden, knobs["width"])}
         record = fit(data, out=out / "tune" / f"config{k}", on_log=on_log, on_progress=on_progress, **chosen)
         rows.append({"config": k, **{f"knob_{n}": v for n, v in knobs.items()}, "lr": chosen["lr"],
                      "hidden": ",".join(map(str, chosen["hidden"])), "metric": record.get("metric"),

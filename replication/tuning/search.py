@@ -16,7 +16,9 @@ import math
 
 import numpy as np
 
-from replication.claims.tuned import with_knobs
+from replication.claims.tuned import scaled_widths, with_knobs
+
+__all__ = ["KNOBS", "REGISTERED", "SIZE", "apply", "configs", "scaled_widths"]
 
 KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
 REGISTERED = {"lr": 1.0, "width": 1.0}
