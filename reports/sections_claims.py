@@ -14,6 +14,7 @@ import pandas as pd
 
 from reports import figures as F
 from reports import figures_delan as FD
+from reports import figures_paper as FL
 from reports import figures_precision as FP
 from reports import figures_speed as FS
 from reports.document import NOT_RUN, Figure, Para, Section, Table
@@ -28,7 +29,15 @@ REASON_CHARS = 400   # a verdict's reason on a claim's page
 # the paper figure a claim's figure recreates (the LNN paper's numbering, shared/seeds): same quantity and axes
 PAPER_FIGURES = {("dp_energy", "energy"): "LNN Fig. 2(b) (energy of the double pendulum over a long time)",
                  ("dp_energy", "trajectory"): "LNN Fig. 2(a) (the double pendulum over a short time)",
-                 ("wave_lgn", "spacetime"): "LNN Fig. 4 (the wave equation learned by a Lagrangian graph network)"}
+                 ("rel_coords", "panels"): "LNN Fig. 3 (a)-(c) (the relativistic particle: HNN on non-canonical "
+                                           "coordinates, HNN on canonical ones, LNN; trajectories over t in [0, 1])",
+                 ("wave_lgn", "spacetime"): "LNN Fig. 4 (the wave equation learned by a Lagrangian graph network)",
+                 ("wave_lgn", "wave_energy"): "LNN Fig. 4's statement that the graph network almost exactly conserves "
+                                              "the energy integrated across the material",
+                 ("hnn_energy", "energy"): "HNN Fig. 2's total-energy column (mass-spring, pendulum), drawn as the "
+                                           "error against the truth's energy",
+                 ("hnn_energy", "trajectory"): "HNN Fig. 2's first column (predicted trajectories), drawn against "
+                                               "time rather than in phase space"}
 
 
 def slug(text: str) -> str:
@@ -91,6 +100,13 @@ def _published_energy(claim: dict) -> dict:
     return out
 
 
+def _paper_models(claim: dict) -> list[str]:
+    """The models the claim's parts read (the paper's models), in the parts' order; its models where it has
+    no parts."""
+    read = [m for part in claim.get("parts") or [] for m in part.get("reads") or []]
+    return list(dict.fromkeys(read or claim.get("models") or []))
+
+
 def _brief(text: str, limit: int = REASON_CHARS) -> str:
     """A reason cut at a word for the claim's page; the parts table beside it and the appendix give it in full."""
     if len(text) <= limit:
@@ -139,8 +155,13 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
          "|Energy error| over time against truth, log axis (line: median over seeds of each seed's median over its "
          "rollouts, band: seed range; diverged rollouts counted in the legend, not in the line; dotted: a published "
          "value, under the conditions its legend names)", "timeseries.csv"),
+        ("panels", lambda us, p: FL.model_panels(us, p, _paper_models(claim)),
+         "Velocity over time from three held-out initial states, one panel per paper model (first seed): truth "
+         "(grey) against the model (dashed)", "arrays.npz"),
         ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
         ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
+        ("wave_energy", FL.wave_energy, "Total energy of the pulse over time (line: median over seeds, band: seed "
+                                        "range) and its error against the truth's, log axis", "timeseries.csv"),
         ("torques", FD.torque_traces, "Torque per joint on the unseen trajectories: truth against each model "
                                       "trained on the full data set (first seed)", "arrays.npz"),
         ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
@@ -148,9 +169,13 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
          "Data efficiency: error against training samples (bars: seed range)", "result.json"),
     ]
+    done = set()
     for kind, fn, caption, file in figs:
         rel = f"figures/{slug(cid)}_{kind}.png"
+        if kind == "trajectory" and "panels" in done:   # the per-model panels show the same rollouts
+            continue
         if fn(units, out_dir / rel):
+            done.add(kind)
             paper = PAPER_FIGURES.get((cid, kind))
             s.add(Figure(rel, f"{cid}: {caption}." + (f" It stands for {paper}." if paper else ""), [src + file]))
     drawn = {} if drawn is None else drawn

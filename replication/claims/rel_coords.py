@@ -67,13 +67,17 @@ PROTOCOLS = {
 PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, data=PROTOCOLS["quick"].data.replace(n_heldout=100_000),
                                                log_every=500, tracking=Tracking(every=2000))
 
+# rollouts for the trajectory figure (LNN Fig. 3: the original plots t in [0, 1] at 50 points); no verdict reads them
+TRAJECTORIES = {"n_ics": 3, "t_end": 1.0, "n_t": 50, "dt": 0.005}
+EVAL = {p: TRAJECTORIES for p in ("smoke", "quick", "full", "paper")}
+
 BUDGET = "the original's 4 x 500 LNN left its plateau after 5.8e7 samples"
 
 
 CLAIM = Claim(
     id="rel_coords", number=3, paper="LNN", section="§5, special relativity",
     title="HNN fails on non-canonical (q, qdot); HNN on (q, p) and LNN on (q, qdot) succeed",
-    system="relativistic", models=MODELS, protocols=PROTOCOLS, evaluate="heldout",
+    system="relativistic", models=MODELS, protocols=PROTOCOLS, evaluate="heldout_trajectories", eval_config=EVAL,
     metric="heldout_l1_qddot", metric_label="held-out (1+gamma)-weighted L1 of q-double-dot",
     published={
         "lnn": Published(7.86e-4, "training loss", _SRC + "LNN, epoch 99", metric="final_train_loss"),

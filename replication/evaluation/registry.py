@@ -8,6 +8,7 @@ from replication.evaluation.exact import eval_exact_lagrangian
 from replication.evaluation.pace import eval_pace
 from replication.evaluation.precision import eval_precision
 from replication.evaluation.routines import eval_energy_rollout, eval_heldout
+from replication.evaluation.short_rollout import eval_heldout_trajectories
 from replication.evaluation.wave import eval_wave
 from replication.fit.evaluate import eval_fit
 
@@ -15,6 +16,7 @@ from replication.fit.evaluate import eval_fit
 # 3: valid prediction time, the chaos floor's from a 1e-8 perturbation and the Lyapunov time (energy rollouts)
 EVALUATION_VERSION = 3
 
-EVALUATIONS = {"heldout": eval_heldout, "pace": eval_pace, "energy_rollout": eval_energy_rollout, "wave": eval_wave,
+EVALUATIONS = {"heldout": eval_heldout, "heldout_trajectories": eval_heldout_trajectories, "pace": eval_pace,
+               "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,
                "precision": eval_precision, "fit": eval_fit}

@@ -80,6 +80,16 @@ def pdot_to_qddot(protocol, q, qdot, pdot):
     return s.acceleration(q, qdot) + np.linalg.solve(s.velocity_hessian(q, qdot), gap)[..., 0]
 
 
+def qddot_of_prediction(p, batch, pred):
+    """q-double-dot from a model's prediction of `batch`'s target, as the verdicts read it: the prediction
+    itself for an acceleration model, the y-rate of an HNN on (q, qdot), the pdot of an HNN on (q, p) mapped
+    through dp/dqdot; None for an inverse model (it predicts torques)."""
+    if p.task == "hamiltonian":
+        ydot = pred[:, batch["q"].shape[-1]:]
+        return ydot if p.data.coords == "qqdot" else pdot_to_qddot(p, batch["q"], _qdot(batch, p), ydot)
+    return pred if p.task == "acceleration" else None
+
+
 def eval_heldout(ctx) -> Evaluation:
     p, m = ctx.protocol, ctx.model
     batch = heldout_of(ctx)
@@ -89,14 +99,7 @@ def eval_heldout(ctx) -> Evaluation:
     null = null_errors(batch["target"], w)
     out = Evaluation(metrics={"heldout_l1": e["l1"], "heldout_mse": e["mse"],
                               "null_heldout_l1": null["l1"], "null_heldout_mse": null["mse"]})
-    if p.task == "hamiltonian":
-        d = batch["q"].shape[-1]
-        ydot = pred[:, d:]
-        qdd = ydot if p.data.coords == "qqdot" else pdot_to_qddot(p, batch["q"], _qdot(batch, p), ydot)
-    elif p.task == "acceleration":
-        qdd = pred
-    else:
-        qdd = None
+    qdd = qddot_of_prediction(p, batch, pred)
     if qdd is not None:
         out.metrics["heldout_l1_qddot"] = heldout_errors(qdd, batch["qddot"], w)["l1"]
         out.metrics["null_heldout_l1_qddot"] = null_errors(batch["qddot"], w)["l1"]

@@ -93,6 +93,10 @@ def arrays_for(cid, rng) -> dict[str, np.ndarray]:
         x = np.linspace(0.0, 1.0, 20)
         f = np.exp(-((x[None, :] - 0.5 - 0.03 * t[:, None]) % 1.0 - 0.0) ** 2 / 0.01)
         return {"x": x, "t": t, "field_true": f, "field_pred": f + 0.01 * rng.standard_normal(f.shape)}
+    if cid == "rel_coords":
+        v = np.tanh(np.linspace(0.2, 0.9, 3)[:, None] + 0.5 * t[None, :])[..., None]
+        return {"t": t, "q_true": np.cumsum(v, 1) * 0.2, "q_pred": np.cumsum(v, 1) * 0.2, "qdot_true": v,
+                "qdot_pred": v + 0.01 * rng.standard_normal(v.shape)}
     if cid == "delan_arm":
         m = rng.standard_normal((30, 2, 2))
         c, g = rng.standard_normal((30, 2)), rng.standard_normal((30, 2))
@@ -113,6 +117,9 @@ def write_unit(root: Path, cid: str, fw: str, model: str, seed: int, rng) -> dic
         t = np.linspace(0, 10, 20)
         rows = [(traj, ti, "energy_err", 1e-4 * (1 + traj) * (1 + ti) * (3 if "baseline" in model else 1))
                 for traj in range(2) for ti in t]
+        if cid == "wave_lgn":   # the pulse's total energy, truth and model
+            rows = [(0, ti, q, 0.45 * (1 + (1e-3 * ti * rng.random() if q == "energy_pred" else 0)))
+                    for ti in t for q in ("energy_true", "energy_pred")]
         pd.DataFrame(rows, columns=["traj", "t", "quantity", "value"]).to_csv(udir / "timeseries.csv", index=False)
         pd.DataFrame({"traj": [0, 1], "energy_err_final": [1e-3, 2e-3], "state_err_gm": [0.1, 0.2]}).to_csv(
             udir / "rollouts.csv", index=False)

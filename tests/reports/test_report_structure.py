@@ -34,6 +34,19 @@ def test_every_claim_has_a_page_with_its_numbers_and_a_figure_and_the_dumps_are_
     assert {"Cross-framework agreement", "Environment", "Findings: paper against original code"} <= set(titles)
 
 
+def test_the_papers_figures_are_recreated_with_the_figure_each_stands_for(results_dir, tmp_path):
+    body, _ = body_and_appendix(results_dir, tmp_path)
+    captions = {s.title.split(": ", 1)[1]: [b.caption for b in s.blocks if isinstance(b, Figure)]
+                for s in body if s.title.startswith("Claim ")}
+    for cid, figure in (("dp_energy", "LNN Fig. 2(b)"), ("dp_energy", "LNN Fig. 2(a)"), ("rel_coords", "LNN Fig. 3"),
+                        ("wave_lgn", "LNN Fig. 4 ("), ("wave_lgn", "energy integrated across the material"),
+                        ("hnn_energy", "HNN Fig. 2's total-energy column")):
+        assert any(figure in c for c in captions[cid]), (cid, figure)
+    # the relativistic rollouts are drawn once, as the paper's per-model panels
+    assert not any("Trajectory: truth against each model" in c for c in captions["rel_coords"])
+    assert (tmp_path / "figures" / "rel_coords_panels.png").stat().st_size > 0
+
+
 def test_the_body_is_short_and_the_appendix_starts_a_page(results_dir, tmp_path):
     body, appendix = body_and_appendix(results_dir, tmp_path)
     _, pdf = write_pdf(TITLE, body, tmp_path)
