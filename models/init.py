@@ -50,6 +50,10 @@ def _draw(rng, scheme: str, role: str, index: int, fan_in: int, fan_out: int):
 
 def init_params(spec: ModelSpec, seed: int = 0) -> dict:
     """Fresh parameters in the `models.params` layout, dtype spec.dtype. Same seed, same numbers."""
+    if spec.kind == "user":
+        from models import user
+
+        return user.init_params(spec, seed)
     rng = np.random.default_rng(seed)
     out = {}
     for index, (prefix, fan_in, fan_out, role) in enumerate(layer_table(spec)):

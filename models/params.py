@@ -34,7 +34,11 @@ def layer_table(spec: ModelSpec) -> list:
 
 
 def param_shapes(spec: ModelSpec) -> dict:
-    """{key: shape} of the layout, in drawing order."""
+    """{key: shape} of the layout, in drawing order (a user's model: its module's parameters, `models.user`)."""
+    if spec.kind == "user":
+        from models import user
+
+        return user.param_shapes(spec)
     out = {}
     for prefix, fan_in, fan_out, _ in layer_table(spec):
         out[f"{prefix}.weight"] = (fan_out, fan_in)

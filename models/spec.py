@@ -56,6 +56,9 @@ CAPABILITIES = {
                         extra_inputs=False, scalar_output=False),
     "lgn": Capability("LGN", ("acceleration",), True, {"banded": "aot", "dense": "traced"},
                       formulations=("fast", "banded", "dense", "paper"), extra_inputs=False),
+    # a user's PyTorch module (`lagbench run --add-model`): q-double-dot from (q, qdot), built by its factory
+    "user": Capability("UserModel", ("acceleration",), False, {"-": "none"}, extra_inputs=False,
+                       scalar_output=False),
 }
 KINDS = tuple(CAPABILITIES)
 INITS = ("cranmer2020", "pytorch_default", "xavier", "kaiming")
@@ -87,6 +90,9 @@ class ModelSpec:
     lorentz_factor: lnn, hnn: the MLP also sees gamma_k = (1 - qdot_k^2)^(-1/2) of every velocity component
         (the speed of light c = 1), after qdot; a kinematic feature of a speed-limited system, differentiated
         through like qdot. Left out of `to_dict` while False, so older specs keep their training keys.
+    factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
+        the torch.nn.Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
+        module is a new spec and never reuses a cached training (`models.user`). Left out while None.
     """
 
     kind: str
@@ -104,6 +110,8 @@ class ModelSpec:
     delan_diag_offset: float = 2.0
     lgn_radius: int = 1
     lorentz_factor: bool = False
+    factory: str | None = None
+    factory_source: str | None = None
 
     def __post_init__(self):
         _choices("kind", self.kind, KINDS)
@@ -135,6 +143,8 @@ class ModelSpec:
             raise ValueError(f"lorentz_factor must be True or False, got {self.lorentz_factor!r}")
         if self.lorentz_factor and self.kind not in LORENTZ_KINDS:
             raise ValueError(f"lorentz_factor is for kinds {', '.join(LORENTZ_KINDS)}, not {self.kind!r}")
+        if (self.kind == "user") != (self.factory is not None):
+            raise ValueError("kind 'user' needs a factory (module:function), and only it takes one")
         if not self.delan_eps >= 0:
             raise ValueError(f"delan_eps must be >= 0, got {self.delan_eps!r}")
         if self.input_scale is not None:
@@ -160,6 +170,9 @@ class ModelSpec:
         d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
         if not self.lorentz_factor:
             del d["lorentz_factor"]
+        for k in ("factory", "factory_source"):
+            if d[k] is None:
+                del d[k]
         return d
 
     @classmethod

@@ -56,7 +56,7 @@ def cmd_run(args):
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
-                  dry_run=args.dry_run, split=args.split)
+                  dry_run=args.dry_run, split=args.split, add_models=args.add_model)
     if summary.get("dry_run"):
         return 0
     for c in summary["claims"]:
@@ -170,6 +170,9 @@ def build_parser():
     s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
                    "list`)")
     s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
+    s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module, "
+                   "factory(dof) -> forward(q, qdot) = q-double-dot, trained in every claim it fits beside the "
+                   "paper's models (PyTorch; repeatable; see the README's 'Compare your own model')")
     s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
     s.add_argument("--split", default="test", choices=("test", "dev"), help="test: seeds 1000.. and held-out "
                    "data and initial conditions no protocol choice has seen, where verdicts are decided; dev: "

@@ -3,7 +3,7 @@
   against the model (``arrays.npz`` keys t, qdot_true, qdot_pred (n, T, d)): the relativistic particle's Fig. 3.
 - ``wave_energy``: the wave's total energy over time, truth against each model, and the model's error
   relative to the truth's energy on a log axis (``timeseries.csv`` quantities energy_true, energy_pred):
-  the energy statement of Fig. 4.
+  the energy statement of Fig. 4. Diverged seeds are counted, not drawn.
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reports.figures import LINESTYLES, _first_with, _groups, model_colours, new_figure, save, style_index
+from reports.figures import DIVERGED, LINESTYLES, _first_with, _groups, model_colours, new_figure, save, style_index
 from reports.load import Unit
 
 
@@ -57,12 +57,14 @@ def _energies(u: Unit):
 
 def wave_energy(units: list[Unit], path: Path) -> bool:
     """Left: total energy over time, the truth (first unit's) and each model and framework (median over seeds,
-    band: seed range). Right: |E_model - E_true| / E_true(0) on a log axis."""
-    curves = {}
+    band: seed range). Right: |E_model - E_true| / E_true(0) on a log axis. A seed whose relative error ever
+    exceeds `DIVERGED` (or is not finite) has diverged: it is counted in the legend, not drawn."""
+    curves, diverged = {}, {}
     for key, group in _groups(units).items():
         got = [e for e in (_energies(u) for u in group) if e is not None]
-        if got:
-            curves[key] = got
+        kept = [e for e in got if np.all(np.abs(e[2] - e[1]) <= DIVERGED * abs(e[1][0]))]
+        if kept:
+            curves[key], diverged[key] = kept, len(got) - len(kept)
     if not curves:
         return False
     fig, (ax, ax_err) = new_figure(ncols=2, width=10, height=3.4, gap=1.1)
@@ -75,7 +77,8 @@ def wave_energy(units: list[Unit], path: Path) -> bool:
         pred = np.vstack([np.interp(t, g[0], g[2]) for g in got])
         err = np.vstack([np.abs(np.interp(t, g[0], g[2]) - np.interp(t, g[0], g[1])) / abs(g[1][0]) for g in got])
         kw = {"color": colours[m], "ls": LINESTYLES[fws[fw] % 4]}
-        label = f"{m} ({fw}, {len(got)} seed{'s' * (len(got) > 1)})"
+        n_div = diverged[(m, fw)]
+        label = f"{m} ({fw}, {len(got)} seed{'s' * (len(got) > 1)}" + (f"; {n_div} more diverged" if n_div else "") + ")"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             ax.plot(t, np.nanmedian(pred, 0), label=label, **kw)

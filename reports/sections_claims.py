@@ -161,7 +161,8 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
         ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
         ("wave_energy", FL.wave_energy, "Total energy of the pulse over time (line: median over seeds, band: seed "
-                                        "range) and its error against the truth's, log axis", "timeseries.csv"),
+                                        "range; diverged seeds counted in the legend, not drawn) and its error "
+                                        "against the truth's, log axis", "timeseries.csv"),
         ("torques", FD.torque_traces, "Torque per joint on the unseen trajectories: truth against each model "
                                       "trained on the full data set (first seed)", "arrays.npz"),
         ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "

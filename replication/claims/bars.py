@@ -81,3 +81,13 @@ def competence(bars, v: dict) -> tuple[bool, list[str], dict]:
             fails = [w for _, (p, w) in res.items() if not p]
             why.append(("none of them passed: " if bar.need == "any" else "") + "; ".join(fails))
     return ok, why, per
+
+
+def added_competence(bars, v: dict, known) -> dict:
+    """{label: (passed, why)} for the models of ``v`` that are not the claim's (``known``): a user's model
+    (`lagbench run --add-model`), held to the claim's first bar's metric, fraction and rollout limit. No part
+    reads it: it says how the model fares, never what the claim's verdict is."""
+    if not bars:
+        return {}
+    b = bars[0]
+    return {x: Bar((x,), b.metric, b.fraction, b.max_diverged).check(x, v[x]) for x in v if x not in known}

@@ -24,7 +24,7 @@ import pandas as pd
 
 from replication import results as R
 from replication.claims import CLAIMS, registration, tuned
-from replication.claims.bars import competence
+from replication.claims.bars import added_competence, competence
 from replication.claims.parts import claim_verdict, combine_frameworks
 from replication.claims.rules import Outcome, Stat
 
@@ -114,6 +114,7 @@ def _framework(claim, s: pd.DataFrame, labels) -> tuple[dict, dict, dict, int]:
               for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
     v = model_stats(ok)
     _, _, per = competence(claim.bars, v)
+    per.update(added_competence(claim.bars, v, {m.label for m in claim.models}))
     return {p.name: _decide_part(p, v, per, failed) for p in _active(claim, labels)}, per, v, len(bad)
 
 

@@ -97,17 +97,19 @@ def cost(chain) -> float:
 
 
 def ref(u) -> tuple:
-    """What names a unit across processes (a claim's rules are closures: they do not pickle)."""
-    return u.claim.id, u.entry.label, u.framework, u.seed, u.profile
+    """What names a unit across processes (a claim's rules are closures: they do not pickle); a user's model
+    (`replication.run.added_models`) is not in its claim's list, so its entry travels with it."""
+    user = u.entry if u.entry.spec.get("kind") == "user" else None
+    return u.claim.id, u.entry.label, u.framework, u.seed, u.profile, user
 
 
 def unit_of(r):
     from replication.claims import get as get_claim
     from replication.run.units import Unit
 
-    claim_id, label, framework, seed, profile = r
+    claim_id, label, framework, seed, profile, user = r
     claim = get_claim(claim_id)
-    return Unit(claim, next(e for e in claim.models if e.label == label), framework, seed, profile)
+    return Unit(claim, user or next(e for e in claim.models if e.label == label), framework, seed, profile)
 
 
 def run_chain(refs, out):

@@ -22,6 +22,7 @@ from replication.claims import get as get_claim
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
+from replication.run import added_models
 from replication.run import environment as env
 from replication.run import splits
 from replication.run.estimate import describe, estimate
@@ -41,8 +42,9 @@ def _once(option: str, values) -> None:
 
 
 def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None,
-         split: str = "dev") -> list:
-    """The units of a run; a ValueError naming the option if any is invalid or nothing would run."""
+         split: str = "dev", added=()) -> list:
+    """The units of a run; a ValueError naming the option if any is invalid or nothing would run. `added`:
+    a user's models (`replication.run.added_models.Added`), each entering the claims it fits, in PyTorch."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
     splits.get(split)
@@ -59,7 +61,11 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer from 1 to "
                          f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
-    labels = sorted({e.label for c in chosen for e in c.models})
+    extra = {c.id: [e for a in added for e in added_models.entries(c, a, profile)] for c in chosen}
+    if added and "torch" not in frameworks:
+        raise ValueError("--add-model: a user's model is a torch.nn.Module and runs in PyTorch; add torch to "
+                         "--frameworks")
+    labels = sorted({e.label for c in chosen for e in (*c.models, *extra[c.id])})
     unknown = sorted(set(models or ()) - set(labels))
     if unknown:
         raise ValueError(f"--models: unknown {', '.join(unknown)} for the chosen claims; valid: {', '.join(labels)}")
@@ -68,10 +74,10 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         n = claim.n_seeds(profile)
         if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
             n = seeds if max(claim.seeds.values()) > 1 else 1
-        for entry in claim.models:
+        for entry in (*claim.models, *extra[claim.id]):
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
-            for fw in frameworks:
+            for fw in (("torch",) if entry.spec.get("kind") == "user" else frameworks):
                 for seed in splits.get(split).seeds(n):
                     units.append(Unit(claim, entry, fw, seed, profile))
     if not units:
@@ -174,11 +180,14 @@ def executor_of(executor, jobs, address):
 
 @R.writes
 def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
-        progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT) -> dict:
+        progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT,
+        add_models=()) -> dict:
+    """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`)."""
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
-    units = plan(profile, claims, frameworks, seeds, models, split)
+    added = added_models.parse(add_models, {e.label for c in CLAIMS.values() for e in c.models})
+    units = plan(profile, claims, frameworks, seeds, models, split, added)
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
         if todo:
@@ -192,6 +201,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "split": split, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
+                "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source} for a in added],
                 # the units this run plans: the report names any that have no result (an unfinished run)
                 "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}

@@ -1,0 +1,73 @@
+"""A user's model in the suite's claims: `lagbench run --add-model NAME=module:factory` (`models.user`).
+
+`parse(values) -> [Added]`: each "NAME=module:factory" (or "NAME=path/file.py:factory"), the factory
+imported and the file that defines it hashed; a ValueError naming the option and the value otherwise.
+`entries(claim, added, profile) -> [ModelEntry]`: the model's entries in `claim`. It enters a claim whose
+evaluation scores q-double-dot (held-out error, energy rollouts), once per system the claim's paper models
+run on: it stands in for the first model the claim's parts read that trains on q-double-dot from (q, qdot)
+alone, on that model's data and with its protocol and budget (the claim's tuned protocol where it has
+one). Its label is NAME, or NAME_<system> where the claim has several systems. It runs in PyTorch only, is
+judged by the same bars and tables, and no part or verdict reads it: an extra model beside the claim.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from replication.claims.base import ModelEntry
+
+SCORES_QDDOT = ("heldout", "energy_rollout", "heldout_trajectories")   # evaluations a q-double-dot model fits
+NAME = re.compile(r"[A-Za-z][A-Za-z0-9-]{0,31}")
+
+
+@dataclass(frozen=True)
+class Added:
+    name: str
+    ref: str
+    source: str   # sha256 (16 hex) of the file that defines the factory
+
+
+def parse(values, suite_labels=()) -> list[Added]:
+    from models.user import factory_source
+
+    out = []
+    for v in values or ():
+        name, sep, ref = str(v).partition("=")
+        if not sep or not NAME.fullmatch(name) or not ref:
+            raise ValueError(f"--add-model {v}: give NAME=module:factory, NAME a letter then letters, digits "
+                             f"or '-' (at most 32)")
+        if name in suite_labels or name in {a.name for a in out}:
+            raise ValueError(f"--add-model {v}: the name {name!r} is taken; choose another")
+        out.append(Added(name, ref, factory_source(ref)))
+    return out
+
+
+def _stand_in(claim, entry, profile) -> bool:
+    p = entry.protocol(claim.protocol(profile), profile)
+    fields = entry.spec_fields(profile)
+    return (entry.train and entry.runs_in(profile) and p.task == "acceleration" and not fields.get("extra_inputs")
+            and fields.get("kind") != "lgn")
+
+
+def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
+    if claim.evaluate not in SCORES_QDDOT:
+        return []
+    read = list(dict.fromkeys(m for part in claim.parts for m in part.reads))
+    by_recipe = {}
+    for label in read:
+        entry = claim.entry(label)
+        if _stand_in(claim, entry, profile):
+            recipe = entry.protocol(claim.protocol(profile), profile).data.recipe
+            by_recipe.setdefault(recipe, entry)
+    several = len(by_recipe) > 1
+    out = []
+    for recipe, template in by_recipe.items():
+        label = f"{added.name}_{recipe.removesuffix('_iid')}" if several else added.name
+        out.append(ModelEntry(label, {"kind": "user", "factory": added.ref, "factory_source": added.source},
+                              hidden=(1,), overrides=template.overrides, profiles=template.profiles))
+    return out
+
+
+def describe(entry: ModelEntry) -> dict:
+    return {"label": entry.label, **{k: entry.spec[k] for k in ("factory", "factory_source")}}
+
