@@ -13,9 +13,8 @@ import hashlib
 import inspect
 
 
-
 def _factory(ref: str):
-    from replication.user_functions import import_function   # the one importer of a user's code
+    from replication.user_functions import import_function  # the one importer of a user's code
 
     return import_function(ref, "--add-model")
 

@@ -12,7 +12,16 @@ from pathlib import Path
 
 import numpy as np
 
-from reports.figures import DIVERGED, LINESTYLES, _first_with, _groups, model_colours, new_figure, save, style_index
+from reports.figures import (
+    DIVERGED,
+    LINESTYLES,
+    _first_with,
+    _groups,
+    model_colours,
+    new_figure,
+    save,
+    style_index,
+)
 from reports.load import Unit
 
 

@@ -22,9 +22,8 @@ from replication.claims import get as get_claim
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
-from replication.run import added_models
+from replication.run import added_models, splits
 from replication.run import environment as env
-from replication.run import splits
 from replication.run.estimate import describe, estimate
 from replication.run.executor import run_units
 from replication.run.units import Unit
