@@ -22,8 +22,8 @@ def _factory(ref: str):
 def factory_source(ref: str) -> str:
     fn = _factory(ref)
     try:
-        path = inspect.getsourcefile(fn)
-        data = open(path, "rb").read()
+        with open(inspect.getsourcefile(fn), "rb") as f:
+            data = f.read()
     except (TypeError, OSError) as e:
         raise ValueError(f"--add-model {ref}: cannot read the file that defines it ({e})") from None
     return hashlib.sha256(data).hexdigest()[:16]
