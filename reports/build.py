@@ -50,10 +50,11 @@ def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None 
     if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
         sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
         return sections, sources_sections(res, sections)
-    body = [scorecard_section(res)] + theme_sections(res, out_dir) + control_sections(res, out_dir)
+    moved: dict = {}   # figures a claim's page sends to its details in the appendix
+    body = [scorecard_section(res)] + theme_sections(res, out_dir, moved) + control_sections(res, out_dir)
     body += speed_sections(res, out_dir)
     appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]
-    appendix += summary_sections(res) + claim_details(res) + speed_appendix(res, out_dir)
+    appendix += summary_sections(res) + claim_details(res, moved) + speed_appendix(res, out_dir)
     appendix += findings_sections(res) + frameworks_sections(res) + hessian_sections(res) + stiff_sections(res)
     appendix += systems_sections(results_dir) + mine + environment_sections(res, now) + metrics_appendix(res)
     return body, appendix + sources_sections(res, body + appendix)

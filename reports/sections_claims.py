@@ -119,11 +119,13 @@ def _trainings(units) -> tuple:
     return tuple(sorted((u.framework, u.model, u.seed, u.result.get("final_train_loss")) for u in units))
 
 
-def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None) -> Section:
+def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None,
+                  details: dict | None = None) -> Section:
     """The claim's page: what it says and where, its verdict and parts, the decisive numbers against the
     published ones, then the figures that answer it. `drawn` maps the trainings whose work-precision figure is
     already in the report to its claim, so a figure of the same trainings is drawn once. The competence and
-    rollout tables are the claim's details in the appendix (`claim_details`)."""
+    rollout tables are the claim's details in the appendix (`claim_details`); so are its training curves
+    where no work-precision figure stands in for them, when `details` ({claim: [Figure]}) collects them."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
@@ -191,13 +193,18 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
                           f"time (line: mean over seeds, band: seed range).", [src + "train_log.csv"]))
     elif F.training_curves(units, out_dir / (rel := f"figures/{slug(cid)}_training.png")):
         drawn[key] = cid
-        s.add(Figure(rel, f"{cid}: Training curves (mean over seeds).", [src + "train_log.csv"]))
+        fig = Figure(rel, f"{cid}: Training curves (mean over seeds).", [src + "train_log.csv"])
+        if details is None:
+            s.add(fig)
+        else:
+            details.setdefault(cid, []).append(fig)
+            s.add(Para("Training curves: in the appendix, with the claim's details."))
     return s
 
 
-def claim_details(res: Results) -> list[Section]:
+def claim_details(res: Results, figures: dict | None = None) -> list[Section]:
     """The appendix's tables behind each claim's page: competence bars per model and framework, and the
-    rollout metrics (mean over trajectories and seeds)."""
+    rollout metrics (mean over trajectories and seeds); `figures` {claim: [Figure]} moved off its page."""
     out = []
     for claim in res.claims:
         cid = claim["id"]
@@ -209,6 +216,8 @@ def claim_details(res: Results) -> list[Section]:
         rt = _rollout_table(res.usable(cid)) if res.usable(cid) else None
         if rt is not None:
             d.add(Table(f"{cid}: rollout metrics (mean over trajectories and seeds)", rt, [src + "rollouts.csv"]))
+        for fig in (figures or {}).get(cid, []):
+            d.add(fig)
         if d.blocks:
             out.append(d)
     if not out:
@@ -228,7 +237,7 @@ def metrics_appendix(res: Results) -> list[Section]:
     return [s] if s.blocks else []
 
 
-def theme_sections(res: Results, out_dir: Path) -> list[Section]:
+def theme_sections(res: Results, out_dir: Path, details: dict | None = None) -> list[Section]:
     groups = assign(res.claims)
     out, drawn = [], {}
     for key, title, blurb, _ in THEMES:
@@ -239,7 +248,7 @@ def theme_sections(res: Results, out_dir: Path) -> list[Section]:
         if not claims:
             s.add(Para(f"Result: {NOT_RUN} (no claim of this kind in claims.json)."))
         out.append(s)
-        pages = [claim_section(res, c, out_dir, drawn) for c in claims]
+        pages = [claim_section(res, c, out_dir, drawn, details) for c in claims]
         if pages:
             pages[0].page = False   # the theme's first claim follows its heading on the same page
         out.extend(pages)
