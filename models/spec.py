@@ -56,11 +56,16 @@ CAPABILITIES = {
                         extra_inputs=False, scalar_output=False),
     "lgn": Capability("LGN", ("acceleration",), True, {"banded": "aot", "dense": "traced"},
                       formulations=("fast", "banded", "dense", "paper"), extra_inputs=False),
-    # a user's PyTorch module (`lagbench run --add-model`): q-double-dot from (q, qdot), built by its factory
-    "user": Capability("UserModel", ("acceleration",), False, {"-": "none"}, extra_inputs=False,
-                       scalar_output=False),
 }
 KINDS = tuple(CAPABILITIES)
+# a user's PyTorch module (`lagbench run --add-model`, `models.user`): q-double-dot from (q, qdot), built by its
+# factory; a kind of the spec, not of the suite (no mirror, no parity: `KINDS` leaves it out)
+USER_KIND = "user"
+USER_CAPABILITY = Capability("UserModel", ("acceleration",), False, {}, extra_inputs=False, scalar_output=False)
+
+
+def capability(kind: str) -> Capability:
+    return USER_CAPABILITY if kind == USER_KIND else CAPABILITIES[kind]
 INITS = ("cranmer2020", "pytorch_default", "xavier", "kaiming")
 FORMULATIONS = ("fast", "paper", "dense", "banded")
 DTYPES = ("float32", "float64")
@@ -114,12 +119,12 @@ class ModelSpec:
     factory_source: str | None = None
 
     def __post_init__(self):
-        _choices("kind", self.kind, KINDS)
+        _choices("kind", self.kind, (*KINDS, USER_KIND))
         _choices("activation", self.activation, ACTIVATIONS)
         _choices("init", self.init, INITS)
         _choices("dtype", self.dtype, DTYPES)
         _choices("formulation", self.formulation, FORMULATIONS)
-        cap = CAPABILITIES[self.kind]
+        cap = capability(self.kind)
         if cap.formulations:
             _choices(f"formulation for kind {self.kind!r}", self.formulation, cap.formulations)
         if isinstance(self.dof, bool) or not isinstance(self.dof, int) or self.dof < 1:
@@ -143,7 +148,7 @@ class ModelSpec:
             raise ValueError(f"lorentz_factor must be True or False, got {self.lorentz_factor!r}")
         if self.lorentz_factor and self.kind not in LORENTZ_KINDS:
             raise ValueError(f"lorentz_factor is for kinds {', '.join(LORENTZ_KINDS)}, not {self.kind!r}")
-        if (self.kind == "user") != (self.factory is not None):
+        if (self.kind == USER_KIND) != (self.factory is not None):
             raise ValueError("kind 'user' needs a factory (module:function), and only it takes one")
         if not self.delan_eps >= 0:
             raise ValueError(f"delan_eps must be >= 0, got {self.delan_eps!r}")
@@ -161,7 +166,7 @@ class ModelSpec:
         if self.kind == "lgn":
             return (2 * (2 * self.lgn_radius + 1), *self.hidden, 1)
         n_in = (3 if self.lorentz_factor else 2) * self.dof + self.extra_inputs
-        n_out = 1 if CAPABILITIES[self.kind].scalar_output else (self.n_out or self.dof)
+        n_out = 1 if capability(self.kind).scalar_output else (self.n_out or self.dof)
         return (n_in, *self.hidden, n_out)
 
     def to_dict(self) -> dict:

@@ -125,7 +125,8 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     published ones, then the figures that answer it. `drawn` maps the trainings whose work-precision figure is
     already in the report to its claim, so a figure of the same trainings is drawn once. The competence and
     rollout tables are the claim's details in the appendix (`claim_details`); so are its training curves
-    where no work-precision figure stands in for them, when `details` ({claim: [Figure]}) collects them."""
+    where no work-precision figure stands in for them and the page has another figure, when `details`
+    ({claim: [Figure]}) collects them."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
@@ -194,7 +195,7 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     elif F.training_curves(units, out_dir / (rel := f"figures/{slug(cid)}_training.png")):
         drawn[key] = cid
         fig = Figure(rel, f"{cid}: Training curves (mean over seeds).", [src + "train_log.csv"])
-        if details is None:
+        if details is None or not done:   # the page's only figure stays on it
             s.add(fig)
         else:
             details.setdefault(cid, []).append(fig)

@@ -11,17 +11,24 @@ import jax.numpy as jnp
 import numpy as np
 
 from models.params import check_params
-from models.spec import CAPABILITIES, ModelSpec
+from models.spec import CAPABILITIES, USER_KIND, ModelSpec
 
 CLASSES = {kind: getattr(importlib.import_module(f"models.jax.{kind}"), cap.model_class)
            for kind, cap in CAPABILITIES.items()}
+
+
+def model_class(kind: str):
+    """CLASSES[kind], or a user's model (`models.user`), imported when one is built."""
+    if kind == USER_KIND:
+        return importlib.import_module("models.jax.user").UserModel
+    return CLASSES[kind]
 
 
 def build(spec: ModelSpec, params: dict):
     """An equinox Module of class CLASSES[spec.kind] holding params cast to spec.dtype."""
     check_params(spec, params)
     arrays = {k: jnp.asarray(np.asarray(v), dtype=spec.dtype) for k, v in params.items()}
-    return CLASSES[spec.kind](arrays, spec)
+    return model_class(spec.kind)(arrays, spec)
 
 
 def to_params(model) -> dict:

@@ -13,16 +13,23 @@ import importlib
 import numpy as np
 
 from models.params import check_params
-from models.spec import CAPABILITIES, ModelSpec
+from models.spec import CAPABILITIES, USER_KIND, ModelSpec
 
 CLASSES = {kind: getattr(importlib.import_module(f"models.torch.{kind}"), cap.model_class)
            for kind, cap in CAPABILITIES.items()}
 
 
+def model_class(kind: str):
+    """CLASSES[kind], or a user's model (`models.user`), imported when one is built."""
+    if kind == USER_KIND:
+        return importlib.import_module("models.torch.user").UserModel
+    return CLASSES[kind]
+
+
 def build(spec: ModelSpec, params: dict):
     """An nn.Module of class CLASSES[spec.kind] whose parameters are params cast to spec.dtype."""
     check_params(spec, params)
-    return CLASSES[spec.kind](spec, params)
+    return model_class(spec.kind)(spec, params)
 
 
 def to_params(model) -> dict:
@@ -32,17 +39,17 @@ def to_params(model) -> dict:
 
 def stacks(spec: ModelSpec) -> bool:
     """Whether spec's model takes stacked members (`build_stacked`)."""
-    return CLASSES[spec.kind].stacks(spec)
+    return model_class(spec.kind).stacks(spec)
 
 
 def compiles(spec: ModelSpec) -> bool:
     """Whether a training loss of spec's model may run under torch.compile (`Model.compiles`)."""
-    return CLASSES[spec.kind].compiles(spec)
+    return model_class(spec.kind).compiles(spec)
 
 
 def build_stacked(spec: ModelSpec, params_list: list[dict]):
     """One nn.Module holding K = len(params_list) models of spec, each parameter stacked on a leading axis."""
-    cls = CLASSES[spec.kind]
+    cls = model_class(spec.kind)
     if not cls.stacks(spec):
         raise ValueError(f"a {spec.kind} model with this spec does not take stacked members")
     for params in params_list:
