@@ -1,5 +1,6 @@
 """A user's model (`lagbench run --add-model NAME=module:factory`): the factory, called as factory(dof),
-returns a torch.nn.Module whose forward(q, qdot) maps (N, dof) tensors to q-double-dot (N, dof).
+returns a torch.nn.Module whose forward(q, qdot) maps (N, dof) tensors to q-double-dot (N, dof), or, if the
+module says `returns = "lagrangian"`, to a scalar Lagrangian per sample (`returns`).
 
 `factory_source(ref)`: the sha256 (16 hex digits) of the file that defines the factory (a spec field, so
 an edited module never reuses a cached training). `make_module(spec)`: a fresh module of spec's factory
@@ -50,6 +51,28 @@ def init_params(spec, seed: int) -> dict:
         torch.manual_seed(seed)
         module = make_module(spec)
     return {k: v.detach().cpu().numpy().astype(spec.dtype) for k, v in module.named_parameters()}
+
+
+RETURNS = ("acceleration", "lagrangian")
+
+
+def returns(module) -> str:
+    """What forward(q, qdot) gives: the module's class attribute `returns`, "acceleration" (q-double-dot, the
+    default) or "lagrangian" (a scalar L per sample, turned into q-double-dot by the suite's Euler-Lagrange)."""
+    r = getattr(module, "returns", "acceleration")
+    if r not in RETURNS:
+        raise ValueError(f"--add-model: {type(module).__name__}.returns is {r!r}; valid: {', '.join(RETURNS)}")
+    return r
+
+
+def scalar(spec, out, like):
+    """A Lagrangian's output (N,) or (N, 1) as (N,)."""
+    if out.shape[-1:] == (1,) and out.ndim == like.ndim:
+        out = out[..., 0]
+    if tuple(out.shape) != tuple(like.shape[:-1]):
+        raise ValueError(f"--add-model {spec.factory}: a Lagrangian's forward(q, qdot) returned shape "
+                         f"{tuple(out.shape)}, expected {tuple(like.shape[:-1])} (one scalar per sample)")
+    return out
 
 
 def check_output(spec, out, like) -> None:

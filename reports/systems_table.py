@@ -20,7 +20,7 @@ from reports.load import load_results, protocol_of
 from reports.sections_predict import predictor_results
 
 METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
-           "lyapunov_time_s", "torque_mse_test")
+           "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test")
 
 
 def _params(unit) -> float:

@@ -1,7 +1,8 @@
 """A user's PyTorch module as a suite model (`models.user`): its parameters are the suite's parameter dict
 (`models.torch.base.Model`), and q-double-dot is the user's forward(q, qdot) run on them with
-torch.func.functional_call, so training, checkpoints, members (torch.func.vmap) and evaluation treat it
-like any other kind."""
+torch.func.functional_call (or, for a module that declares `returns = "lagrangian"`, the suite's
+Euler-Lagrange step of the scalar it returns), so training, checkpoints, members (torch.func.vmap) and
+evaluation treat it like any other kind."""
 from __future__ import annotations
 
 import torch
@@ -9,6 +10,7 @@ from torch.func import functional_call
 
 from models import user
 from models.torch.base import Model
+from models.torch.lnn import euler_lagrange
 
 
 class UserModel(Model):
@@ -16,9 +18,14 @@ class UserModel(Model):
         super().__init__(spec, params, members)
         object.__setattr__(self, "_net", user.make_module(spec))   # held apart: its parameters are self's
 
+    def _forward(self, q, qdot):
+        return functional_call(self._net, dict(self.named_parameters()), (q, qdot))
+
     def acceleration(self, q, qdot, extra=None):
         self._check_state(q, qdot, extra)
-        out = functional_call(self._net, dict(self.named_parameters()), (q, qdot))
+        if user.returns(self._net) == "lagrangian":   # L(q, qdot) (...,): the suite's Euler-Lagrange step
+            return euler_lagrange(lambda a, b: user.scalar(self.spec, self._forward(a, b), a), q, qdot)
+        out = self._forward(q, qdot)
         user.check_output(self.spec, out, q)
         return out
 

@@ -24,7 +24,13 @@ from replication.evaluation.metrics import (
     null_errors,
 )
 from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
-from replication.evaluation.valid_time import PERTURBATION, valid_times
+from replication.evaluation.valid_time import (
+    PERTURBATION,
+    VPT_NRMSE,
+    normalised_rmse,
+    valid_time,
+    valid_times,
+)
 from replication.run.splits import DEV
 from replication.training import data as datamod
 from replication.training.objective import predict
@@ -145,6 +151,16 @@ def _floor(name, params, cfg_items):
     return systems.trajectories.integrate(s, q[:, 0] + PERTURBATION, qd[:, 0], t)
 
 
+@lru_cache(maxsize=8)
+def _float32_truth(name, params, cfg_items):
+    """The exact equations of motion through the suite's RK4 in float32 (state, step and equations), from the
+    truth's initial states at the evaluation's dt: what a perfect model rolled out in float32 gives."""
+    s, t, q, qd, _, _ = _truth(name, params, cfg_items)
+    accel = lambda a, b: s.acceleration(a, b, backend="numpy").astype(np.float32)  # noqa: E731
+    y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
+    return rollout(lagrangian_field(accel, s.dof), y0, t, dict(cfg_items)["dt"], dtype=np.float32)
+
+
 def _model_rollout(ctx, s, q0, qd0, t):
     p, m, d = ctx.protocol, ctx.model, s.dof
     if p.task == "hamiltonian" and p.data.coords == "qp":
@@ -178,6 +194,10 @@ def eval_energy_rollout(ctx) -> Evaluation:
     out.metrics["chaos_floor_gmean_err"] = float(np.mean(geometric_mean_over_time(floor)))
     vpt, vpt_columns = valid_times(t, z_pred, z_true, np.concatenate(_floor(*truth_key(ctx)), -1))
     out.metrics.update(vpt)
+    if cfg.get("float32_truth"):   # the second floor: the exact model rolled out in float32
+        with np.errstate(all="ignore"):
+            err32 = normalised_rmse(_float32_truth(*truth_key(ctx)), z_true)
+        out.metrics["float32_truth_vpt_s"] = float(np.median(valid_time(err32, t, VPT_NRMSE)))
     idx = np.unique(np.linspace(0, t.size - 1, min(t.size, 200)).astype(int))
     rows = []
     for b in range(q.shape[0]):

@@ -1,7 +1,8 @@
 """A user's model in the suite's claims: `lagbench run --add-model NAME=module:factory` (`models.user`).
 
-`parse(values) -> [Added]`: each "NAME=module:factory" (or "NAME=path/file.py:factory"), the factory
-imported and the file that defines it hashed; a ValueError naming the option and the value otherwise.
+`parse(values) -> [Added]`: each "NAME=module:factory" (or "NAME=path/file.py:factory"), or a bare NAME that
+an installed package declares in the entry point group `lagbench.models` (NAME = "module:factory"), the
+factory imported and the file that defines it hashed; a ValueError naming the option and the value otherwise.
 `entries(claim, added, profile) -> [ModelEntry]`: the model's entries in `claim`. It enters a claim whose
 evaluation scores q-double-dot (held-out error, energy rollouts), once per system the claim's paper models
 run on: it stands in for the first model the claim's parts read that trains on q-double-dot from (q, qdot)
@@ -33,13 +34,33 @@ def parse(values, suite_labels=()) -> list[Added]:
     out = []
     for v in values or ():
         name, sep, ref = str(v).partition("=")
-        if not sep or not NAME.fullmatch(name) or not ref:
+        if not sep and NAME.fullmatch(name):
+            ref = installed(name)
+        elif not sep or not ref:
+            ref = ""
+        if not NAME.fullmatch(name) or not ref:
             raise ValueError(f"--add-model {v}: give NAME=module:factory, NAME a letter then letters, digits "
                              f"or '-' (at most 32)")
         if name in suite_labels or name in {a.name for a in out}:
             raise ValueError(f"--add-model {v}: the name {name!r} is taken; choose another")
         out.append(Added(name, ref, factory_source(ref)))
     return out
+
+
+GROUP = "lagbench.models"
+
+
+def installed(name: str) -> str:
+    """The "module:factory" an installed package declares for `name` in the entry point group GROUP."""
+    from importlib.metadata import entry_points
+
+    found = [ep.value for ep in entry_points(group=GROUP) if ep.name == name]
+    if not found:
+        names = sorted({ep.name for ep in entry_points(group=GROUP)})
+        raise ValueError(f"--add-model {name}: no installed package declares it in the entry point group {GROUP} "
+                         f"({'installed: ' + ', '.join(names) if names else 'none installed'}); or give "
+                         f"NAME=module:factory")
+    return found[0]
 
 
 def _stand_in(claim, entry, profile) -> bool:

@@ -31,6 +31,8 @@ def test_the_exact_acceleration_scores_at_the_chaos_floor(scored):
     assert m["heldout_l1"] == 0.0 and m["null_heldout_l1"] > 10
     # the suite's RK4 (dt 0.01) against the truth's tight dopri8: valid for most of what a 1e-8 perturbation allows
     assert 0.5 * m["chaos_floor_vpt_s"] <= m["vpt_s"] <= m["chaos_floor_vpt_s"] + 1e-9
+    # the second floor, the exact model in float32 through the same RK4: no later than the 1e-8 floor
+    assert 0.5 * m["chaos_floor_vpt_s"] <= m["float32_truth_vpt_s"] <= m["chaos_floor_vpt_s"] + 1e-9
     assert 0.3 < m["lyapunov_time_s"] < 3 and m["vpt_lyapunov"] > 5
     assert m["energy_err_final"] < 1e-3 and m["n_diverged"] == 0
 

@@ -3,6 +3,7 @@ enters and with what, what it is refused with, and that an edited model file is 
 import numpy as np
 import pytest
 
+import systems
 from models import ModelSpec, init_params
 from replication.claims import CLAIMS
 from replication.claims.bars import Bar, added_competence
@@ -64,7 +65,7 @@ def test_it_runs_in_pytorch_alone(model_file):
 
 
 @pytest.mark.parametrize("value, message", [
-    ("mine", "give NAME=module:factory"), ("1st={f}:make", "give NAME=module:factory"),
+    ("mine", "no installed package declares it"), ("mine=", "give NAME=module:factory"), ("1st={f}:make", "give NAME=module:factory"),
     ("lnn={f}:make", "is taken"), ("mine={f}:nothing", "cannot import"), ("mine=no_such_module:make", "cannot import"),
 ])
 def test_a_bad_option_is_one_clear_error(model_file, value, message):
@@ -101,3 +102,58 @@ def test_the_added_model_is_held_to_the_claims_first_bar():
          "mine": {"heldout_l1": Stat.of([40.0]), "null_heldout_l1": Stat.of([50.0])}}
     per = added_competence(bars, v, {"lnn"})
     assert set(per) == {"mine"} and per["mine"][0] is False and "40 > 0.1 x null 50" in per["mine"][1]
+
+
+def test_an_installed_package_declares_its_model_by_entry_point(model_file, monkeypatch):
+    import importlib.metadata
+    from importlib.metadata import EntryPoint
+
+    monkeypatch.syspath_prepend(str(model_file.parent))
+    eps = [EntryPoint("theirs", "user_net:make", added_models.GROUP)]
+    monkeypatch.setattr(importlib.metadata, "entry_points", lambda group=None: [e for e in eps if e.group == group])
+    (a,) = added_models.parse(["theirs"])
+    assert (a.name, a.ref) == ("theirs", "user_net:make") and len(a.source) == 16
+    with pytest.raises(ValueError, match="installed: theirs"):
+        added_models.parse(["other"])
+
+
+LAGRANGIAN = '''import torch
+
+
+class L(torch.nn.Module):
+    returns = "lagrangian"
+
+    def __init__(self, dof):
+        super().__init__()
+        self.k = torch.nn.Parameter(torch.tensor([2.0]))
+
+    def forward(self, q, qdot):
+        return 0.5 * (qdot ** 2).sum(-1) - 0.5 * self.k * (q ** 2).sum(-1)
+
+
+def make(dof):
+    return L(dof)
+'''
+
+
+def test_a_lagrangian_module_goes_through_the_suites_euler_lagrange_step_and_trains_with_scouts(tmp_path):
+    """L = |qdot|^2 / 2 - k |q|^2 / 2 gives qddot = -k q; it trains under a protocol with restarts over
+    initialisations (the scouts train as members under torch.func.vmap) and learns the harmonic chain's k."""
+    from replication.training.protocol import Data, Protocol, Scouting
+    from replication.training.schedules import OneCycle
+    from replication.training.train import run_training
+
+    path = tmp_path / "user_lagrangian.py"
+    path.write_text(LAGRANGIAN, encoding="utf-8")
+    (a,) = added_models.parse([f"lag={path}:make"])
+    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
+    m = adapter("torch", spec, init_params(spec, 0))
+    q, qd = np.random.default_rng(0).normal(size=(5, 1)), np.ones((5, 1))
+    np.testing.assert_allclose(m.acceleration(q, qd, None), -2.0 * q, atol=1e-12)
+    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64), steps=150, batch=32, loss="mse",
+                 schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64",
+                 scouting=Scouting(count=2, steps=20, batch=32, schedule=OneCycle(lr=3e-2, start=0.3)))
+    out = run_training("torch", spec, p, seed=0)
+    assert out.failure is None
+    k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
+    assert abs(float(out.params["k"][0]) - k_true) < 0.05 * k_true
