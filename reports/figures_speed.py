@@ -189,7 +189,8 @@ def data_efficiency(units: list[Unit], path: Path, metric: str | None) -> bool:
                         label=f"{model} ({fw})")
         ax.set_xscale("log")
         ticks_at(ax, rows["n"])
-        log_if_spread(ax, rows["value"], decades=1.0)
+        if (rows["value"] > 0).all():   # log-log, as DeLaN's and every data-efficiency curve is read
+            ax.set_yscale("log")
         ax.set_xlabel("training samples N")
         ax.set_ylabel(base.replace("_", " "))
         ax.legend(fontsize=7)

@@ -171,7 +171,7 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
                                                  "(predicted against true)", "arrays.npz"),
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
-         "Data efficiency: error against training samples (bars: seed range)", "result.json"),
+         "Data efficiency: error against training samples, log-log (bars: seed range)", "result.json"),
     ]
     done = set()
     for kind, fn, caption, file in figs:

@@ -3,7 +3,7 @@ its seeds) and predictors scored by `lagbench evaluate --predict`.
 
 ``systems_table(root) -> DataFrame``: columns system, source ("claim" or "predictor"), claim, model,
 framework, seeds, params (the checkpoint's numbers), train_samples and train_time_s (medians over seeds), and
-for each of ``METRICS`` its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
+for each of ``METRICS`` (errors, valid times against the chaos and float32 floors, rollout µs per step) its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
 NaN where the claim's evaluation does not compute it). `lagbench table` writes it to
 ``summary/systems.csv`` and prints a table per system; the report shows it (``systems_sections``).
 """
@@ -20,7 +20,7 @@ from reports.load import load_results, protocol_of
 from reports.sections_predict import predictor_results
 
 METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
-           "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test")
+           "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test", "rollout_us_per_step")
 
 
 def _params(unit) -> float:
@@ -73,6 +73,7 @@ def shown(df: pd.DataFrame) -> pd.DataFrame:
     out = df[["source", "claim", "model", "framework", "seeds"]].copy()
     out["params"] = [num(v) for v in df["params"]]
     out["train samples"] = [num(v) for v in df["train_samples"]]
+    out["train time (s)"] = [num(v) for v in df["train_time_s"]]
     for m in METRICS:
         if df[m].notna().any():
             out[m] = [num(a) if not (a == a) or n == 1 or lo == hi else f"{num(a)} [{num(lo)}, {num(hi)}]"

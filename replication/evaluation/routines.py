@@ -8,6 +8,7 @@ are judged by the same code; ground truth comes from `systems` in float64.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -23,7 +24,7 @@ from replication.evaluation.metrics import (
     heldout_errors,
     null_errors,
 )
-from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
+from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout, steps
 from replication.evaluation.valid_time import (
     PERTURBATION,
     VPT_NRMSE,
@@ -183,7 +184,13 @@ def eval_energy_rollout(ctx) -> Evaluation:
     out = eval_heldout(ctx)
     cfg = ctx.cfg
     s, t, q, qd, qc, qdc = _truth(*truth_key(ctx))
+    t0 = time.perf_counter()
     qp, qdp = _model_rollout(ctx, s, q[:, 0], qd[:, 0], t)
+    # wall-clock microseconds per RK4 step of one trajectory (the rollout batched over its initial conditions,
+    # the model called from NumPy in its own framework; beside other workers on a shared CPU: a guide, the
+    # speed study times inference properly)
+    n_steps = sum(steps(b - a, cfg["dt"], "split", np.float64)[0] for a, b in zip(t[:-1], t[1:], strict=True))
+    out.metrics["rollout_us_per_step"] = 1e6 * (time.perf_counter() - t0) / max(n_steps * q.shape[0], 1)
     with np.errstate(over="ignore", invalid="ignore"):   # a diverged rollout's energy is inf or nan: counted as such
         E_true, E_pred = s.energy(q, qd, backend="numpy"), s.energy(qp, qdp, backend="numpy")
     out.metrics.update(energy_errors(E_pred, E_true, cfg["energy_scale"]))
