@@ -1,17 +1,22 @@
 """A user's model (`lagbench run --add-model NAME=module:factory`): the factory, called as factory(dof),
 returns a torch.nn.Module whose forward(q, qdot) maps (N, dof) tensors to q-double-dot (N, dof), or, if the
-module says `returns = "lagrangian"`, to a scalar Lagrangian per sample (`returns`).
+module says `returns = "lagrangian"`, to a scalar Lagrangian per sample (`returns`); a factory that takes a
+`key`, factory(dof, key), returns an equinox Module called as module(q, qdot) the same way, and trains in
+JAX (`framework_of`).
 
 `factory_source(ref)`: the sha256 (16 hex digits) of the file that defines the factory (a spec field, so
-an edited module never reuses a cached training). `make_module(spec)`: a fresh module of spec's factory
-in spec.dtype. `param_shapes(spec)`: {name: shape} of its parameters (the layout `models.params` checks
-against). `init_params(spec, seed)`: its initial parameters as NumPy arrays, the factory called under
-torch.manual_seed(seed) (same seed, same numbers). Imported only when a user names a model.
+an edited module never reuses a cached training). `make_module(spec, seed)`: a fresh module of spec's
+factory. `param_shapes(spec)`: {name: shape} of its parameters (the layout `models.params` checks against).
+`init_params(spec, seed)`: its initial parameters as NumPy arrays, the factory called under
+torch.manual_seed(seed) or with jax.random.PRNGKey(seed) (same seed, same numbers). Imported only when a
+user names a model.
 """
 from __future__ import annotations
 
 import hashlib
 import inspect
+
+import numpy as np
 
 
 def _factory(ref: str):
@@ -30,21 +35,52 @@ def factory_source(ref: str) -> str:
     return hashlib.sha256(data).hexdigest()[:16]
 
 
-def make_module(spec):
+def framework_of(ref: str) -> str:
+    """"jax" for a factory that takes a `key` (an equinox module's PRNG key), else "torch"."""
+    return "jax" if "key" in inspect.signature(_factory(ref)).parameters else "torch"
+
+
+def make_module(spec, seed: int = 0):
+    """A fresh module of spec's factory: PyTorch's in spec.dtype (under the caller's torch seed), equinox's
+    from jax.random.PRNGKey(seed)."""
+    fn = _factory(spec.factory)
+    if framework_of(spec.factory) == "jax":
+        import equinox as eqx
+        import jax
+
+        module = fn(spec.dof, key=jax.random.PRNGKey(seed))
+        if not isinstance(module, eqx.Module):
+            raise ValueError(f"--add-model {spec.factory}: the factory takes a key but returned "
+                             f"{type(module).__name__}, not an equinox Module")
+        return module
     import torch
 
-    module = _factory(spec.factory)(spec.dof)
+    module = fn(spec.dof)
     if not isinstance(module, torch.nn.Module):
         raise ValueError(f"--add-model {spec.factory}: the factory returned {type(module).__name__}, not a "
-                         f"torch.nn.Module")
+                         f"torch.nn.Module (an equinox factory takes a key: factory(dof, key))")
     return module.to(getattr(torch, spec.dtype))
 
 
+def _named_arrays(spec, module) -> dict:
+    """{name: array} of the module's parameters: PyTorch's named_parameters, equinox's inexact array leaves
+    by their tree path."""
+    if framework_of(spec.factory) == "jax":
+        import equinox as eqx
+        import jax
+
+        arrays = eqx.filter(module, eqx.is_inexact_array)
+        return {jax.tree_util.keystr(path): leaf for path, leaf in jax.tree_util.tree_flatten_with_path(arrays)[0]}
+    return dict(module.named_parameters())
+
+
 def param_shapes(spec) -> dict:
-    return {k: tuple(v.shape) for k, v in make_module(spec).named_parameters()}
+    return {k: tuple(v.shape) for k, v in _named_arrays(spec, make_module(spec)).items()}
 
 
 def init_params(spec, seed: int) -> dict:
+    if framework_of(spec.factory) == "jax":
+        return {k: np.asarray(v).astype(spec.dtype) for k, v in _named_arrays(spec, make_module(spec, seed)).items()}
     import torch
 
     with torch.random.fork_rng():

@@ -170,9 +170,9 @@ def build_parser():
     s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
                    "list`)")
     s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
-    s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module, "
-                   "factory(dof) -> forward(q, qdot) = q-double-dot, trained in every claim it fits beside the "
-                   "paper's models (PyTorch; repeatable; see the README's 'Compare your own model')")
+    s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module "
+                   "(factory(dof)) or equinox Module (factory(dof, key)) mapping (q, qdot) to q-double-dot, trained "
+                   "in every claim it fits beside the paper's models (repeatable; README 'Compare your own model')")
     s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
     s.add_argument("--split", default="test", choices=("test", "dev"), help="test: seeds 1000.. and held-out "
                    "data and initial conditions no protocol choice has seen, where verdicts are decided; dev: "

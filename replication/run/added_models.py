@@ -7,8 +7,9 @@ factory imported and the file that defines it hashed; a ValueError naming the op
 evaluation scores q-double-dot (held-out error, energy rollouts), once per system the claim's paper models
 run on: it stands in for the first model the claim's parts read that trains on q-double-dot from (q, qdot)
 alone, on that model's data and with its protocol and budget (the claim's tuned protocol where it has
-one). Its label is NAME, or NAME_<system> where the claim has several systems. It runs in PyTorch only, is
-judged by the same bars and tables, and no part or verdict reads it: an extra model beside the claim.
+one). Its label is NAME, or NAME_<system> where the claim has several systems. It runs in its own framework
+(PyTorch for a torch.nn.Module, JAX for an equinox Module), is judged by the claim's bar and tables, and no
+part or verdict reads it: an extra model beside the claim.
 """
 from __future__ import annotations
 
@@ -25,11 +26,12 @@ NAME = re.compile(r"[A-Za-z][A-Za-z0-9-]{0,31}")
 class Added:
     name: str
     ref: str
-    source: str   # sha256 (16 hex) of the file that defines the factory
+    source: str      # sha256 (16 hex) of the file that defines the factory
+    framework: str   # "torch" (a torch.nn.Module) or "jax" (an equinox Module: the factory takes a key)
 
 
 def parse(values, suite_labels=()) -> list[Added]:
-    from models.user import factory_source
+    from models.user import factory_source, framework_of
 
     out = []
     for v in values or ():
@@ -43,7 +45,7 @@ def parse(values, suite_labels=()) -> list[Added]:
                              f"or '-' (at most 32)")
         if name in suite_labels or name in {a.name for a in out}:
             raise ValueError(f"--add-model {v}: the name {name!r} is taken; choose another")
-        out.append(Added(name, ref, factory_source(ref)))
+        out.append(Added(name, ref, factory_source(ref), framework_of(ref)))
     return out
 
 
@@ -89,6 +91,8 @@ def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
     return out
 
 
-def describe(entry: ModelEntry) -> dict:
-    return {"label": entry.label, **{k: entry.spec[k] for k in ("factory", "factory_source")}}
+def framework(entry: ModelEntry) -> str:
+    """The framework a user's entry runs in."""
+    from models.user import framework_of
 
+    return framework_of(entry.spec["factory"])

@@ -43,7 +43,8 @@ def _once(option: str, values) -> None:
 def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None,
          split: str = "dev", added=()) -> list:
     """The units of a run; a ValueError naming the option if any is invalid or nothing would run. `added`:
-    a user's models (`replication.run.added_models.Added`), each entering the claims it fits, in PyTorch."""
+    a user's models (`replication.run.added_models.Added`), each entering the claims it fits, in its own
+    framework."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
     splits.get(split)
@@ -61,9 +62,10 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
                          f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
     extra = {c.id: [e for a in added for e in added_models.entries(c, a, profile)] for c in chosen}
-    if added and "torch" not in frameworks:
-        raise ValueError("--add-model: a user's model is a torch.nn.Module and runs in PyTorch; add torch to "
-                         "--frameworks")
+    for a in added:
+        if a.framework not in frameworks:
+            raise ValueError(f"--add-model {a.name}: it runs in {a.framework} (its own framework: PyTorch for a "
+                             f"torch.nn.Module, JAX for an equinox Module); add {a.framework} to --frameworks")
     labels = sorted({e.label for c in chosen for e in (*c.models, *extra[c.id])})
     unknown = sorted(set(models or ()) - set(labels))
     if unknown:
@@ -76,7 +78,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         for entry in (*claim.models, *extra[claim.id]):
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
-            for fw in (("torch",) if entry.spec.get("kind") == "user" else frameworks):
+            for fw in ((added_models.framework(entry),) if entry.spec.get("kind") == "user" else frameworks):
                 for seed in splits.get(split).seeds(n):
                     units.append(Unit(claim, entry, fw, seed, profile))
     if not units:
@@ -200,7 +202,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "split": split, "frameworks": list(frameworks), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
-                "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source} for a in added],
+                "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source,
+                                  "framework": a.framework} for a in added],
                 # the units this run plans: the report names any that have no result (an unfinished run)
                 "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}

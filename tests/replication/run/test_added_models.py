@@ -60,7 +60,7 @@ def test_it_runs_in_pytorch_alone(model_file):
     units = plan("smoke", claims=["dp_loss"], frameworks=("jax", "torch"), added=[a])
     assert {u.framework for u in units if u.entry.label == "mine"} == {"torch"}
     assert {u.framework for u in units if u.entry.label == "lnn"} == {"jax", "torch"}
-    with pytest.raises(ValueError, match="runs in PyTorch"):
+    with pytest.raises(ValueError, match="runs in torch"):
         plan("smoke", claims=["dp_loss"], frameworks=("jax",), added=[a])
 
 
@@ -157,3 +157,47 @@ def test_a_lagrangian_module_goes_through_the_suites_euler_lagrange_step_and_tra
     assert out.failure is None
     k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
     assert abs(float(out.params["k"][0]) - k_true) < 0.05 * k_true
+
+
+EQX_LAGRANGIAN = '''import equinox as eqx
+import jax.numpy as jnp
+
+
+class L(eqx.Module):
+    returns = "lagrangian"
+    k: jnp.ndarray
+
+    def __init__(self, dof, key):
+        self.k = jnp.array([2.0])
+
+    def __call__(self, q, qdot):
+        return 0.5 * (qdot ** 2).sum(-1) - 0.5 * self.k[0] * (q ** 2).sum(-1)
+
+
+def make(dof, key):
+    return L(dof, key)
+'''
+
+
+def test_an_equinox_module_trains_in_jax_with_scouts_through_the_suites_euler_lagrange_step(tmp_path):
+    from replication.training.protocol import Data, Protocol, Scouting
+    from replication.training.schedules import OneCycle
+    from replication.training.train import run_training
+
+    path = tmp_path / "user_eqx.py"
+    path.write_text(EQX_LAGRANGIAN, encoding="utf-8")
+    (a,) = added_models.parse([f"eqx={path}:make"])
+    assert a.framework == "jax"
+    units = plan("smoke", claims=["dp_loss"], frameworks=("jax", "torch"), added=[a])
+    assert {u.framework for u in units if u.entry.label == "eqx"} == {"jax"}
+    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
+    assert set(init_params(spec, 0)) == {".k"}
+    m = adapter("jax", spec, init_params(spec, 0))
+    q, qd = np.random.default_rng(0).normal(size=(5, 1)), np.ones((5, 1))
+    np.testing.assert_allclose(m.acceleration(q, qd, None), -2.0 * q, atol=1e-12)
+    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64), steps=150, batch=32, loss="mse",
+                 schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64",
+                 scouting=Scouting(count=2, steps=20, batch=32, schedule=OneCycle(lr=3e-2, start=0.3)))
+    out = run_training("jax", spec, p, seed=0)
+    k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
+    assert out.failure is None and abs(float(out.params[".k"][0]) - k_true) < 0.05 * k_true
