@@ -20,7 +20,7 @@ from models.jax.lnn import euler_lagrange
 def skeleton(spec):
     """(parameter names in leaf order, the arrays' treedef, the module's non-array part) of spec's factory."""
     module = user.make_module(spec)
-    if not hasattr(module, "__call__"):
+    if not callable(module):
         raise ValueError(f"--add-model {spec.factory}: the equinox module is not callable as module(q, qdot)")
     arrays, static = eqx.partition(module, eqx.is_inexact_array)
     paths, treedef = jax.tree_util.tree_flatten_with_path(arrays)
