@@ -48,6 +48,9 @@ def _draw(rng, scheme: str, role: str, index: int, fan_in: int, fan_out: int):
     raise ValueError(f"unknown init {scheme!r}")
 
 
+DISSIPATION_INIT = 0.01   # the Rayleigh coefficients' start, b = softplus(raw): small, so training sets them
+
+
 def init_params(spec: ModelSpec, seed: int = 0) -> dict:
     """Fresh parameters in the `models.params` layout, dtype spec.dtype. Same seed, same numbers."""
     if spec.kind == "user":
@@ -60,4 +63,6 @@ def init_params(spec: ModelSpec, seed: int = 0) -> dict:
         w, b = _draw(rng, spec.init, role, index, fan_in, fan_out)
         out[f"{prefix}.weight"] = w.astype(spec.dtype)
         out[f"{prefix}.bias"] = b.astype(spec.dtype)
+    if spec.dissipation:   # not drawn: every coordinate starts at b = DISSIPATION_INIT
+        out["dissipation.raw"] = np.full(spec.dof, np.log(np.expm1(DISSIPATION_INIT)), dtype=spec.dtype)
     return out

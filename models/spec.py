@@ -95,6 +95,12 @@ class ModelSpec:
     lorentz_factor: lnn, hnn: the MLP also sees gamma_k = (1 - qdot_k^2)^(-1/2) of every velocity component
         (the speed of light c = 1), after qdot; a kinematic feature of a speed-limited system, differentiated
         through like qdot. Left out of `to_dict` while False, so older specs keep their training keys.
+    dissipation: lnn (fast formulation): a learned Rayleigh dissipation D = 1/2 sum_k b_k qdot_k^2 with
+        b_k = softplus(raw_k) >= 0 (parameter "dissipation.raw", (dof,)), entering the Euler-Lagrange equation
+        as -s dD/dqdot = -s b * qdot, s = sign(trace of the velocity Hessian): linear viscous friction per
+        coordinate. A Lagrangian learned from accelerations is fixed only up to a factor, of either sign; s
+        orients the force against the learned energy s E, so the friction the data see, b / |factor|, is never
+        negative. Left out of `to_dict` while False.
     factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
         the torch.nn.Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
         module is a new spec and never reuses a cached training (`models.user`). Left out while None.
@@ -115,6 +121,7 @@ class ModelSpec:
     delan_diag_offset: float = 2.0
     lgn_radius: int = 1
     lorentz_factor: bool = False
+    dissipation: bool = False
     factory: str | None = None
     factory_source: str | None = None
 
@@ -148,6 +155,11 @@ class ModelSpec:
             raise ValueError(f"lorentz_factor must be True or False, got {self.lorentz_factor!r}")
         if self.lorentz_factor and self.kind not in LORENTZ_KINDS:
             raise ValueError(f"lorentz_factor is for kinds {', '.join(LORENTZ_KINDS)}, not {self.kind!r}")
+        if not isinstance(self.dissipation, bool):
+            raise ValueError(f"dissipation must be True or False, got {self.dissipation!r}")
+        if self.dissipation and (self.kind != "lnn" or self.formulation != "fast"):
+            raise ValueError(f"dissipation is for kind 'lnn' in the fast formulation, not {self.kind!r} "
+                             f"({self.formulation})")
         if (self.kind == USER_KIND) != (self.factory is not None):
             raise ValueError("kind 'user' needs a factory (module:function), and only it takes one")
         if not self.delan_eps >= 0:
@@ -173,8 +185,9 @@ class ModelSpec:
         d = dataclasses.asdict(self)
         d["hidden"] = list(self.hidden)
         d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
-        if not self.lorentz_factor:
-            del d["lorentz_factor"]
+        for k in ("lorentz_factor", "dissipation"):
+            if not d[k]:
+                del d[k]
         for k in ("factory", "factory_source"):
             if d[k] is None:
                 del d[k]

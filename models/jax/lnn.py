@@ -174,7 +174,11 @@ class LNN(Model):
         if self.spec.formulation != "fast":
             return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
         d = q.shape[-1]
-        x, n_bad = solve_with_fallback(*self._blocked_terms(q, qdot, extra))
+        hess, rhs = self._blocked_terms(q, qdot, extra)
+        if self.spec.dissipation:   # Rayleigh D = 1/2 sum b qdot^2 against L's orientation: -sign(tr H) b qdot
+            side = jnp.sign(jnp.trace(hess, axis1=-2, axis2=-1))[:, None]
+            rhs = rhs - side * jax.nn.softplus(self.params["dissipation.raw"]) * _flat(qdot, d)
+        x, n_bad = solve_with_fallback(hess, rhs)
         return x.reshape(*q.shape[:-1], d), n_bad
 
     def acceleration(self, q, qdot, extra=None):

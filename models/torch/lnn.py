@@ -226,7 +226,12 @@ class LNN(Model):
         if self.spec.formulation != "fast":
             return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
         d = q.shape[-1]
-        return _solved(*self._fast_terms(self._rows(q, d), self._rows(qdot, d), self._rows(extra)), q.shape[:-1])
+        hess, rhs = self._fast_terms(self._rows(q, d), self._rows(qdot, d), self._rows(extra))
+        if self.spec.dissipation:   # Rayleigh D = 1/2 sum b qdot^2 against L's orientation: -sign(tr H) b qdot
+            b = torch.nn.functional.softplus(self.params["dissipation.raw"])
+            side = torch.sign(torch.diagonal(hess, dim1=-2, dim2=-1).sum(-1, keepdim=True))
+            rhs = rhs - side * (b if self.members is None else b[:, None, :]) * self._rows(qdot, d)
+        return _solved(hess, rhs, q.shape[:-1])
 
     def acceleration(self, q, qdot, extra=None):
         """qddot (..., dof)."""

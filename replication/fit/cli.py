@@ -34,7 +34,7 @@ def cmd_simulate(args):
     if path.suffix != ".csv":
         raise ValueError(f"--out {path}: give a .csv file name")
     df = simulate(args.system, args.trajectories, args.duration, args.rate, args.noise, args.seed, args.velocities,
-                  args.dropped, args.decimals)
+                  args.dropped, args.decimals, settings=args.set)
     write_csv(path, df)
     print(f"{args.trajectories} trajectories of {args.system}, {len(df)} rows, written to {path}")
 
@@ -182,6 +182,8 @@ def add_commands(sub) -> None:
     s.add_argument("--decimals", type=int, help="round the written times to this many decimals, as a real log "
                    "(default: full precision)")
     s.add_argument("--seed", type=int, default=0, help="seed of the initial states and the noise")
+    s.add_argument("--set", action="append", metavar="NAME=VALUE", help="a system parameter or option, e.g. "
+                   "friction=0.2 (viscous friction of the pendulums and the arm; repeatable; `lagbench list`)")
     s.add_argument("--out", required=True, help="the .csv file to write")
     s.set_defaults(func=cmd_simulate)
     _show_defaults(s)

@@ -26,6 +26,8 @@ energy     (no torques) the model's own energy along its rollout (`Fitted.energy
            E(q, qdot) - E(q, 0) over S's states (energy offsets cancel). With a system: its energy along the
            rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
+dissipation (an LNN with spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; with a system,
+           S_dissipation_coefficient_<k> = b_k / c in the system's units, c = S_dissipation_scale (`_dissipation`).
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
            of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig. Trained on
            accelerations, a Lagrangian is fixed only up to a constant factor: the terms are then compared at
@@ -228,6 +230,22 @@ def _decomposition(f: Fitted, r, name, system, out: Evaluation):
             out.arrays[f"{k}_true"], out.arrays[f"{k}_pred"] = true[k], pred[k]
 
 
+def _dissipation(f: Fitted, r, name, system, out: Evaluation):
+    """A dissipative LNN's Rayleigh coefficients b = softplus(raw) (the Lagrangian's own scale), and with a
+    system the coefficients in the system's units: a Lagrangian learned from accelerations is fixed only up to
+    a factor c (of either sign), its velocity Hessian H = c M, so the friction the data obey is b / |c|, c the
+    least-squares factor of H against the system's mass matrix M over S's states (S_dissipation_scale)."""
+    b = np.log1p(np.exp(np.asarray(f.params["dissipation.raw"], np.float64)))
+    out.metrics.update({f"dissipation_b{k}": float(v) for k, v in enumerate(b)})
+    if system is None:
+        return
+    q, qd = r["q"][:KEEP], r["qdot"][:KEEP]
+    h, m = np.asarray(f.model.velocity_hessian(q, qd), np.float64), system.mass_matrix(q)
+    c = float(np.sum(h * m) / np.sum(m * m))
+    out.metrics[f"{name}_dissipation_scale"] = c
+    out.metrics.update({f"{name}_dissipation_coefficient_{k}": float(v / abs(c)) for k, v in enumerate(b)})
+
+
 def eval_fit(ctx) -> Evaluation:
     import systems
 
@@ -262,6 +280,8 @@ def eval_fit(ctx) -> Evaluation:
             out.counters[f"{name}_rollouts"] = f"not run: {why}"
         if f.spec.kind == "delan":
             _decomposition(f, r, name, system, out)
+        if f.spec.dissipation:
+            _dissipation(f, r, name, system, out)
     if one:
         out.tables["one_step.csv"] = pd.DataFrame(one)
     if roll:

@@ -8,7 +8,8 @@ float64 by diffrax at tight tolerances (`systems.trajectories.integrate`), sampl
 seconds from t = 0 to `duration`; independent Gaussian noise of standard deviation `noise` (in the
 units of q, and of qdot) is then added to every sample. As a real recording: `dropped`, the share of
 samples (never a trajectory's first or last) left out at random, as a logger that drops frames; `decimals`,
-the times rounded to that many decimals when written. A ValueError names a bad option.
+the times rounded to that many decimals when written. `settings`: "NAME=VALUE" system parameters or options
+(`--set friction=0.2`: viscous friction). A ValueError names a bad option.
 """
 from __future__ import annotations
 
@@ -41,13 +42,31 @@ def check_options(system, trajectories, duration, rate, noise, seed, dropped=0.0
             raise ValueError(f"{option}: {value!r} is not valid; expected {valid}")
 
 
+def parse_settings(settings) -> dict:
+    """{name: float or int} from "NAME=VALUE" strings (`--set`); a ValueError names a malformed one."""
+    out = {}
+    for item in settings or ():
+        name, sep, value = str(item).partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = None
+        if not sep or not name.isidentifier() or number is None or not math.isfinite(number):
+            raise ValueError(f"--set {item}: give NAME=VALUE with a finite number, e.g. friction=0.2")
+        out[name] = int(number) if number.is_integer() and "." not in value and "e" not in value.lower() else number
+    return out
+
+
 def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0.0, seed=0,
-             velocities=False, dropped=0.0, decimals=None) -> pd.DataFrame:
+             velocities=False, dropped=0.0, decimals=None, settings=()) -> pd.DataFrame:
     import systems
     import systems.trajectories
 
     check_options(system, trajectories, duration, rate, noise, seed, dropped, decimals)
-    s = systems.get(system)
+    try:
+        s = systems.get(system, **parse_settings(settings))
+    except (TypeError, KeyError) as e:
+        raise ValueError(f"--set: {e}; see the system's parameters with `lagbench list`") from None
     rng = np.random.default_rng(seed)
     st = s.sample_states(trajectories, rng)
     t = np.arange(int(math.floor(duration * rate + 1e-9)) + 1) / rate

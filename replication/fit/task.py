@@ -158,6 +158,8 @@ def _model_spec(o, prep, task: str) -> dict:
             "init": "cranmer2020" if o.model == "lnn" else "xavier"}
     if o.model == "delan":
         spec.update(delan_eps=float(o.delan_eps), delan_diag_offset=float(o.delan_offset))
+    if o.dissipation:
+        spec["dissipation"] = True
     if task == "inverse_dynamics" and o.model == "baseline":
         spec["extra_inputs"] = prep.dof
     if o.input_scale is not None:

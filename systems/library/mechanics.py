@@ -79,14 +79,15 @@ def build_double_pendulum() -> Definition:
     q, v = coordinates(["theta1", "theta2"])
     p = {k: param(k, 1.0) for k in ("m1", "m2", "l1", "l2")}
     p["g"] = param("g", 9.8)
-    m1, m2, l1, l2, g = (p[k][0] for k in ("m1", "m2", "l1", "l2", "g"))
+    p["friction"] = param("friction", 0.0, "nonnegative")   # viscous, on each absolute angle: -friction * qdot
+    m1, m2, l1, l2, g, b = (p[k][0] for k in ("m1", "m2", "l1", "l2", "g", "friction"))
     # angle from the downward vertical = polar angle theta - pi/2
     links = [(l1, q[0] - sp.pi / 2), (l2, q[1] - sp.pi / 2)]
     points = [links[:1], links]
     t = planar_kinetic(points, [m1, m2], q, v)
     y1, y2 = (planar_position(p)[1] for p in points)
     lag = t - (m1 * g * y1 + m2 * g * y2)
-    return Definition("double_pendulum", q, v, lag, p, _double_pendulum_sampler,
+    return Definition("double_pendulum", q, v, lag, p, _double_pendulum_sampler, forces=(-b * v[0], -b * v[1]),
                       description="double pendulum, absolute angles from the downward vertical")
 
 

@@ -171,3 +171,45 @@ def test_pinv_solve_by_svd_matches_pinv():
     want, got = pinv_solve(h, rhs), pinv_solve(h, rhs, by_svd=True)
     np.testing.assert_allclose(got.numpy(), want.numpy(), rtol=1e-9, atol=1e-9)
     assert torch.isnan(got[3]).all() and (got[2] == 0).all()
+
+
+@pytest.mark.parametrize("orientation", [1.0, -1.0])
+@pytest.mark.parametrize("fw", ["jax", "torch"])
+def test_dissipation_removes_energy_at_the_rate_of_its_rayleigh_function(fw, orientation):
+    """With D = 1/2 sum b qdot^2 the learned energy E = qdot . dL/dqdot - L, oriented by s = sign(tr H), changes
+    at d(sE)/dt = -sum b qdot^2 along the model's own motion (the model's Hessian and gradients,
+    finite-differenced along that motion), and the acceleration is the conservative one less H^-1 s b qdot."""
+    from models import ModelSpec, init_params
+
+    def _np(x):
+        return x.detach().numpy() if hasattr(x, "detach") else np.asarray(x)
+
+    spec = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64", dissipation=True)
+    params = init_params(spec, seed=2)
+    params["dissipation.raw"] = np.array([0.4, -0.7])
+    for k in ("mlp.2.weight", "mlp.2.bias"):   # the same Lagrangian, or its negative: both fit the same data
+        params[k] = orientation * params[k]
+    b = np.log1p(np.exp(params["dissipation.raw"]))
+    conservative = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64")
+    build, conv = (models.jax.build, jnp.asarray) if fw == "jax" else (models.torch.build, torch.tensor)
+    m = build(spec, {k: conv(v) for k, v in params.items()})
+    m0 = build(conservative, {k: conv(v) for k, v in params.items() if k != "dissipation.raw"})
+    rng = np.random.default_rng(0)
+    q, qd = rng.normal(size=(6, 2)), rng.normal(size=(6, 2))
+    qdd = _np(m.acceleration(conv(q), conv(qd)))
+    hess = _np(m0.velocity_hessian(conv(q), conv(qd)))
+    side = np.sign(np.trace(hess, axis1=-2, axis2=-1))[:, None]   # the force opposes the learned energy side * E
+    expected = _np(m0.acceleration(conv(q), conv(qd))) - np.linalg.solve(hess, (side * b * qd)[..., None])[..., 0]
+    assert_rel(qdd, expected, "float64", "dissipative acceleration")
+
+    def energy(q_, qd_):
+        lag = _np(m0.lagrangian(conv(q_), conv(qd_)))
+        h = 1e-4   # qdot . dL/dqdot by central differences along qdot (L is O(10): wider steps, less rounding)
+        lp, lm = (_np(m0.lagrangian(conv(q_), conv(qd_ * (1 + s * h)))) for s in (1, -1))
+        return (lp - lm) / (2 * h) - lag
+    dt = 1e-5   # qddot reaches 60 here: the central difference along the motion errs by O(dt^2 qddot^2)
+    rate = (energy(q + dt * qd, qd + dt * qdd) - energy(q - dt * qd, qd - dt * qdd)) / (2 * dt)
+    fine = np.linalg.cond(hess) < 100   # where the finite differences are accurate (not near a singular H)
+    assert fine.sum() >= 4
+    assert np.all(side[fine] == orientation)
+    np.testing.assert_allclose((side[:, 0] * rate)[fine], -np.sum(b * qd * qd, -1)[fine], rtol=1e-4, atol=1e-6)

@@ -18,6 +18,7 @@ CASES = {
                            input_scale=(0.5, 2.0, 1.5, 0.3, 1.0, 1.0)),
     "lnn_lorentz": dict(kind="lnn", dof=2, activation="softplus", extra_inputs=1, lorentz_factor=True),
     "lnn_relu2_dof3": dict(kind="lnn", dof=3, activation="relu2"),
+    "lnn_dissipation": dict(kind="lnn", dof=2, dissipation=True),
     "lnn_relu_falls_back": dict(kind="lnn", dof=2, activation="relu"),
     "baseline": dict(kind="baseline", dof=2, extra_inputs=1, angle_wrap=True),
 }
