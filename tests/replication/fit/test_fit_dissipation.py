@@ -1,0 +1,44 @@
+"""The dissipative fit of docs/fit.md ('Friction: a dissipative fit'), run as written from its own text: on a
+pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction and rolls
+out better than the conservative LNN, which cannot lose energy, and than the baseline."""
+import json
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from replication.cli import main
+
+DOC = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
+MARKER = "<!-- dissipative example: tests/replication/fit/test_fit_dissipation.py runs this block -->"
+
+
+@pytest.fixture(scope="module")
+def metrics(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("friction")
+    text = DOC.read_text(encoding="utf-8")
+    block = re.search(r"```bash\n(.*?)```", text[text.index(MARKER):], re.S).group(1)
+    commands = [shlex.split(ln)[1:] for ln in block.splitlines() if ln.startswith("lagbench ")]
+    assert [c[0] for c in commands] == ["simulate", "simulate", "fit", "fit", "fit"]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(folder)
+        for args in commands:
+            assert main([*args, "--quiet"] if args[0] == "fit" else args) == 0, args
+    return {p.parts[-7]: json.loads(p.read_text())["metrics"]
+            for p in folder.glob("results/friction_*/units/fit/*/*/seed0/result.json")}
+
+
+def test_the_dissipative_lnn_recovers_the_friction(metrics):
+    m = metrics["friction_lnn_dissipative"]
+    assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
+    assert "test_dissipation_coefficient_0" not in metrics["friction_lnn"]
+
+
+def test_it_rolls_out_better_than_the_conservative_lnn_and_the_baseline(metrics):
+    d, lnn, base = metrics["friction_lnn_dissipative"], metrics["friction_lnn"], metrics["friction_baseline"]
+    assert d["test_rollout_gmean_err"] < 0.5 * lnn["test_rollout_gmean_err"]
+    assert d["test_rollout_gmean_err"] < base["test_rollout_gmean_err"]
+    assert d["test_l1"] < 0.1 * d["null_test_l1"]
+    # the conservative LNN keeps the energy the pendulum loses
+    assert lnn["test_energy_err_final"] > 5 * d["test_energy_err_final"]
