@@ -6,7 +6,7 @@ Keys (weights are (out, in), as torch.nn.Linear; biases (out,)):
   delan adds:  "delan_lower.weight" (dof*(dof-1)/2, hidden[-1]), "delan_lower.bias"  (absent if dof == 1)
                "delan_diag.weight"  (dof, hidden[-1]),            "delan_diag.bias"
                "delan_potential.weight" (1, hidden[-1]),          "delan_potential.bias"
-  lnn with spec.dissipation adds "dissipation.raw" (dof,): the Rayleigh coefficients b = softplus(raw).
+  lnn, hnn, delan with spec.dissipation add "dissipation.raw" (dof,): the Rayleigh coefficients b = softplus(raw).
 The order of `layer_table(spec)` is the order in which `models.init` draws them.
 """
 from __future__ import annotations

@@ -71,6 +71,7 @@ FORMULATIONS = ("fast", "paper", "dense", "banded")
 DTYPES = ("float32", "float64")
 
 
+DISSIPATIVE_KINDS = ("lnn", "hnn", "delan")   # kinds that may learn a Rayleigh dissipation (`ModelSpec.dissipation`)
 LORENTZ_KINDS = ("lnn", "hnn")   # kinds whose MLP may take the Lorentz factor of qdot (`ModelSpec.lorentz_factor`)
 
 
@@ -100,7 +101,9 @@ class ModelSpec:
         as -s dD/dqdot = -s b * qdot, s = sign(trace of the velocity Hessian): linear viscous friction per
         coordinate. A Lagrangian learned from accelerations is fixed only up to a factor, of either sign; s
         orients the force against the learned energy s E, so the friction the data see, b / |factor|, is never
-        negative. Left out of `to_dict` while False.
+        negative. hnn: ydot = -dH/dx - b * dH/dy (the force on the momentum, xdot = dH/dy the velocity);
+        delan: tau = M qddot + c + g + b * qdot (M is positive definite: no orientation to fix). Left out of
+        `to_dict` while False.
     factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
         the torch.nn.Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
         module is a new spec and never reuses a cached training (`models.user`). Left out while None.
@@ -157,9 +160,9 @@ class ModelSpec:
             raise ValueError(f"lorentz_factor is for kinds {', '.join(LORENTZ_KINDS)}, not {self.kind!r}")
         if not isinstance(self.dissipation, bool):
             raise ValueError(f"dissipation must be True or False, got {self.dissipation!r}")
-        if self.dissipation and (self.kind != "lnn" or self.formulation != "fast"):
-            raise ValueError(f"dissipation is for kind 'lnn' in the fast formulation, not {self.kind!r} "
-                             f"({self.formulation})")
+        if self.dissipation and (self.kind not in DISSIPATIVE_KINDS or (self.kind == "lnn" and self.formulation != "fast")):
+            raise ValueError(f"dissipation is for kinds {', '.join(DISSIPATIVE_KINDS)} (the LNN in its fast "
+                             f"formulation), not {self.kind!r} ({self.formulation})")
         if (self.kind == USER_KIND) != (self.factory is not None):
             raise ValueError("kind 'user' needs a factory (module:function), and only it takes one")
         if not self.delan_eps >= 0:

@@ -13,6 +13,7 @@ Shapes: q, qdot, qddot, tau (..., dof); M (..., dof, dof); V, L (...,).
 from __future__ import annotations
 
 import equinox as eqx
+import jax
 import jax.numpy as jnp
 
 from models.jax.base import Model
@@ -100,7 +101,13 @@ class DeLaN(Model):
         self._check_state(q, qdot)
         self._check("qddot", qddot, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
-        return _mv(m, qddot) + c + g
+        return _mv(m, qddot) + c + g + self._friction(qdot)
+
+    def _friction(self, qdot):
+        """The Rayleigh force's torque b * qdot (spec.dissipation), else 0."""
+        if not self.spec.dissipation:
+            return 0.0
+        return jax.nn.softplus(self.params["dissipation.raw"]) * qdot
 
     @eqx.filter_jit
     def acceleration(self, q, qdot, extra=None):
@@ -109,7 +116,7 @@ class DeLaN(Model):
         tau = jnp.zeros_like(q) if extra is None else extra
         self._check("tau (extra)", tau, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
-        return jnp.linalg.solve(m, (tau - c - g)[..., None])[..., 0]
+        return jnp.linalg.solve(m, (tau - c - g - self._friction(qdot))[..., None])[..., 0]
 
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration (..., dof), 0): M is positive definite, no fallback."""

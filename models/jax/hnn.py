@@ -30,4 +30,6 @@ class HNN(Model):
         """(xdot, ydot) = (dH/dy, -dH/dx), each (..., dof)."""
         self._check_state(x, y, extra)
         dh_dx, dh_dy = jax.grad(lambda a, b: jnp.sum(self._hamiltonian(a, b, extra)), argnums=(0, 1))(x, y)
+        if self.spec.dissipation:   # Rayleigh D = 1/2 sum b xdot^2: the momentum loses b * dH/dy
+            return dh_dy, -dh_dx - jax.nn.softplus(self.params["dissipation.raw"]) * dh_dy
         return dh_dy, -dh_dx

@@ -145,7 +145,13 @@ class DeLaN(Model):
         self._check_state(q, qdot)
         self._check("qddot", qddot, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
-        return _mv(m, qddot) + c + g
+        return _mv(m, qddot) + c + g + self._friction(qdot)
+
+    def _friction(self, qdot):
+        """The Rayleigh force's torque b * qdot (spec.dissipation), else 0."""
+        if not self.spec.dissipation:
+            return 0.0
+        return torch.nn.functional.softplus(self.params["dissipation.raw"]) * qdot
 
     def acceleration(self, q, qdot, extra=None):
         """Forward model qddot = M^-1 (tau - c - g) (..., dof), tau = extra (zero if None)."""
@@ -154,7 +160,7 @@ class DeLaN(Model):
         self._check("tau (extra)", tau, self.spec.dof, like=q)
         m, c, g = self._dynamics(q, qdot)
         solve = pick(_linalg_solve, exporting=spd_solve_unrolled if self.spec.dof <= 8 else None)
-        return solve(m, tau - c - g)
+        return solve(m, tau - c - g - self._friction(qdot))
 
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration (..., dof), 0): M is positive definite, no fallback."""

@@ -38,4 +38,6 @@ class HNN(Model):
         dh_dy = g[..., d:2 * d]
         if spec.lorentz_factor:   # y also enters as gamma(y), slot 2d + k
             dh_dy = dh_dy + g[..., 2 * d:3 * d] * lorentz_slopes(y)[0]
+        if spec.dissipation:   # Rayleigh D = 1/2 sum b xdot^2: the momentum loses b * dH/dy
+            return dh_dy, -g[..., :d] - torch.nn.functional.softplus(self.params["dissipation.raw"]) * dh_dy
         return dh_dy, -g[..., :d]

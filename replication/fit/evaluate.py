@@ -26,8 +26,8 @@ energy     (no torques) the model's own energy along its rollout (`Fitted.energy
            E(q, qdot) - E(q, 0) over S's states (energy offsets cancel). With a system: its energy along the
            rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
-dissipation (an LNN with spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; with a system,
-           S_dissipation_coefficient_<k> = b_k / c in the system's units, c = S_dissipation_scale (`_dissipation`).
+dissipation (spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; an LNN's with a system, and a
+           DeLaN's fitted to torques, S_dissipation_coefficient_<k> in the system's units (`_dissipation`).
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
            of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig. Trained on
            accelerations, a Lagrangian is fixed only up to a constant factor: the terms are then compared at
@@ -237,7 +237,9 @@ def _dissipation(f: Fitted, r, name, system, out: Evaluation):
     least-squares factor of H against the system's mass matrix M over S's states (S_dissipation_scale)."""
     b = np.log1p(np.exp(np.asarray(f.params["dissipation.raw"], np.float64)))
     out.metrics.update({f"dissipation_b{k}": float(v) for k, v in enumerate(b)})
-    if system is None:
+    if f.spec.kind == "delan" and f.task == "inverse_dynamics":   # fitted to torques: b is in their units
+        out.metrics.update({f"{name}_dissipation_coefficient_{k}": float(v) for k, v in enumerate(b)})
+    if system is None or f.spec.kind != "lnn":   # an HNN's b is per unit of its momentum, qdot as it trained
         return
     q, qd = r["q"][:KEEP], r["qdot"][:KEEP]
     h, m = np.asarray(f.model.velocity_hessian(q, qd), np.float64), system.mass_matrix(q)

@@ -131,8 +131,9 @@ OPTIONS = (
            "a finite number >= 0", kind=float),
     Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", real, "a finite number", kind=float),
     Option("angle_wrap", False, "input feature: wrap q to [-pi, pi) before the MLP", switch=True),
-    Option("dissipation", False, "lnn: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: viscous "
-           "friction per coordinate) beside the Lagrangian, for data that lose energy", switch=True),
+    Option("dissipation", False, "lnn, hnn, delan: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: "
+           "viscous friction per coordinate) beside the Lagrangian or Hamiltonian, for data that lose energy",
+           switch=True),
     Option("input_scale", None, "input feature: multipliers of the MLP inputs [q, qdot(, qddot)]: none, auto (1 / "
            "standard deviation over the training rows) or numbers such as 1,1,0.3,0.3",
            lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(real(x) and x > 0 for x in v)),
@@ -170,9 +171,9 @@ def check(values: dict) -> None:
     if keep is not None and (restarts is None or keep >= restarts):
         raise ValueError(f"--restart-keep: {keep!r} needs --restarts above it (the restarts that go on after the "
                          f"first half)")
-    if values.get("dissipation") and values.get("model") not in (None, "lnn"):
-        raise ValueError(f"--dissipation: for --model lnn (a Lagrangian with a Rayleigh function), not "
-                         f"{values.get('model')}")
+    if values.get("dissipation") and values.get("model") == "baseline":
+        raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
+                         "function); the baseline's q-double-dot is free-form already")
     system = values.get("system")
     if system is not None:
         import systems

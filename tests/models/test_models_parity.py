@@ -27,6 +27,8 @@ CASES = [
     ("hnn", {"activation": "tanh"}),
     ("hnn", {"extra_inputs": 1, "angle_wrap": True, "input_scale": (0.5, 2.0, 1.5, 0.1, 2.0)}),
     ("delan", {"init": "xavier"}),
+    ("delan", {"init": "xavier", "dissipation": True}),
+    ("hnn", {"activation": "tanh", "dissipation": True}),
     ("lgn", {"formulation": "banded", "dof": 7}),
     ("lgn", {"formulation": "dense", "dof": 7}),
 ]
