@@ -183,7 +183,8 @@ def add_commands(sub) -> None:
                    "(default: full precision)")
     s.add_argument("--seed", type=int, default=0, help="seed of the initial states and the noise")
     s.add_argument("--set", action="append", metavar="NAME=VALUE", help="a system parameter or option, e.g. "
-                   "friction=0.2 (viscous friction of the pendulums and the arm; repeatable; `lagbench list`)")
+                   "friction=0.2 (viscous friction of the pendulums and the arm; repeatable; an unknown name "
+                   "lists the system's parameters)")
     s.add_argument("--out", required=True, help="the .csv file to write")
     s.set_defaults(func=cmd_simulate)
     _show_defaults(s)

@@ -66,7 +66,7 @@ def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0
     try:
         s = systems.get(system, **parse_settings(settings))
     except (TypeError, KeyError) as e:
-        raise ValueError(f"--set: {e}; see the system's parameters with `lagbench list`") from None
+        raise ValueError(f"--set: {e}") from None
     rng = np.random.default_rng(seed)
     st = s.sample_states(trajectories, rng)
     t = np.arange(int(math.floor(duration * rate + 1e-9)) + 1) / rate
