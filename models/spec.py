@@ -61,7 +61,8 @@ KINDS = tuple(CAPABILITIES)
 # a user's PyTorch module (`lagbench run --add-model`, `models.user`): q-double-dot from (q, qdot), built by its
 # factory; a kind of the spec, not of the suite (no mirror, no parity: `KINDS` leaves it out)
 USER_KIND = "user"
-USER_CAPABILITY = Capability("UserModel", ("acceleration",), False, {}, extra_inputs=False, scalar_output=False)
+USER_CAPABILITY = Capability("UserModel", ("acceleration", "hamiltonian"), False, {}, extra_inputs=False,
+                             scalar_output=False)
 
 
 def capability(kind: str) -> Capability:

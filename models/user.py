@@ -89,16 +89,24 @@ def init_params(spec, seed: int) -> dict:
     return {k: v.detach().cpu().numpy().astype(spec.dtype) for k, v in module.named_parameters()}
 
 
-RETURNS = ("acceleration", "lagrangian")
+RETURNS = ("acceleration", "lagrangian", "hamiltonian")
 
 
 def returns(module) -> str:
     """What forward(q, qdot) gives: the module's class attribute `returns`, "acceleration" (q-double-dot, the
-    default) or "lagrangian" (a scalar L per sample, turned into q-double-dot by the suite's Euler-Lagrange)."""
+    default), "lagrangian" (a scalar L per sample, turned into q-double-dot by the suite's Euler-Lagrange) or
+    "hamiltonian" (a scalar H(q, p) per sample: Hamilton's equations, trained where the paper's HNN is)."""
     r = getattr(module, "returns", "acceleration")
     if r not in RETURNS:
         raise ValueError(f"--add-model: {type(module).__name__}.returns is {r!r}; valid: {', '.join(RETURNS)}")
     return r
+
+
+def returns_of(ref: str) -> str:
+    """`returns` of the module the factory `ref` builds (built once, for one coordinate)."""
+    from models.spec import ModelSpec
+
+    return returns(make_module(ModelSpec(kind="user", dof=1, factory=ref, factory_source="-")))
 
 
 def scalar(spec, out, like):

@@ -88,8 +88,10 @@ def claim_table(res: Results, claim: dict) -> pd.DataFrame:
     vals = values(res.claim_units(claim["id"]), claim.get("metric"))
     rows = []
     for model in claim_models(res, claim):
-        row = {"model": model,
-               "published": published_cell(claim, model, [u for u in res.usable(claim["id"]) if u.model == model])}
+        units = [u for u in res.usable(claim["id"]) if u.model == model]
+        added = any((u.result.get("model_spec") or {}).get("kind") == "user" for u in units)
+        row = {"model": f"{model} (added: --add-model; no verdict reads it)" if added else model,
+               "published": published_cell(claim, model, units)}
         for fw in res.frameworks or ["any framework"]:
             per = vals.get(fw, {}).get(model)
             row[fw] = stat(**per) if per else NOT_RUN

@@ -2,7 +2,8 @@
 dict (`models.jax.base.Model`, keyed by tree path), put back into the module's skeleton (`eqx.combine`) at
 every call, so training, members, checkpoints and evaluation treat it like any other kind. A module that
 declares `returns = "lagrangian"` gives a scalar L per sample, turned into q-double-dot by the suite's
-Euler-Lagrange step (`models.jax.lnn.euler_lagrange`)."""
+Euler-Lagrange step (`models.jax.lnn.euler_lagrange`); `returns = "hamiltonian"` a scalar H(q, p), whose
+time derivative is Hamilton's equations."""
 from __future__ import annotations
 
 from functools import lru_cache
@@ -44,3 +45,13 @@ class UserModel(Model):
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration, 0): no fallback exists."""
         return self.acceleration(q, qdot, extra), jnp.zeros((), dtype=jnp.int64)
+
+    def time_derivative(self, x, y, extra=None):
+        """A Hamiltonian module's (xdot, ydot) = (dH/dy, -dH/dx), H = module(x, y) (...,): Hamilton's equations."""
+        self._check_state(x, y, extra)
+        module = self._module()
+        if user.returns(module) != "hamiltonian":
+            raise ValueError(f"--add-model {self.spec.factory}: time_derivative is for a module that returns a "
+                             f"Hamiltonian (returns = 'hamiltonian')")
+        dh_dx, dh_dy = jax.grad(lambda a, b: jnp.sum(user.scalar(self.spec, module(a, b), a)), argnums=(0, 1))(x, y)
+        return dh_dy, -dh_dx

@@ -1,12 +1,12 @@
 """A user's PyTorch module as a suite model (`models.user`): its parameters are the suite's parameter dict
 (`models.torch.base.Model`), and q-double-dot is the user's forward(q, qdot) run on them with
 torch.func.functional_call (or, for a module that declares `returns = "lagrangian"`, the suite's
-Euler-Lagrange step of the scalar it returns), so training, checkpoints, members (torch.func.vmap) and
+Euler-Lagrange step of the scalar it returns; `returns = "hamiltonian"`, Hamilton's equations), so training, checkpoints, members (torch.func.vmap) and
 evaluation treat it like any other kind."""
 from __future__ import annotations
 
 import torch
-from torch.func import functional_call
+from torch.func import functional_call, grad
 
 from models import user
 from models.torch.base import Model
@@ -32,3 +32,12 @@ class UserModel(Model):
     def acceleration_info(self, q, qdot, extra=None):
         """(acceleration, 0): no fallback exists."""
         return self.acceleration(q, qdot, extra), torch.zeros((), dtype=torch.int64, device=q.device)
+
+    def time_derivative(self, x, y, extra=None):
+        """A Hamiltonian module's (xdot, ydot) = (dH/dy, -dH/dx), H = forward(x, y) (...,): Hamilton's equations."""
+        self._check_state(x, y, extra)
+        if user.returns(self._net) != "hamiltonian":
+            raise ValueError(f"--add-model {self.spec.factory}: time_derivative is for a module that returns a "
+                             f"Hamiltonian (returns = 'hamiltonian')")
+        dh_dx, dh_dy = grad(lambda a, b: user.scalar(self.spec, self._forward(a, b), a).sum(), argnums=(0, 1))(x, y)
+        return dh_dy, -dh_dx

@@ -6,7 +6,7 @@ factory imported and the file that defines it hashed; a ValueError naming the op
 `entries(claim, added, profile) -> [ModelEntry]`: the model's entries in `claim`. It enters a claim whose
 evaluation scores q-double-dot (held-out error, energy rollouts), once per system the claim's paper models
 run on: it stands in for the first model the claim's parts read that trains on q-double-dot from (q, qdot)
-alone, on that model's data and with its protocol and budget (the claim's tuned protocol where it has
+alone (a Hamiltonian module: on the time derivative of (q, p), where the paper's HNN does), on that model's data and with its protocol and budget (the claim's tuned protocol where it has
 one). Its label is NAME, or NAME_<system> where the claim has several systems. It runs in its own framework
 (PyTorch for a torch.nn.Module, JAX for an equinox Module), is judged by the claim's bar and tables, and no
 part or verdict reads it: an extra model beside the claim.
@@ -28,10 +28,11 @@ class Added:
     ref: str
     source: str      # sha256 (16 hex) of the file that defines the factory
     framework: str   # "torch" (a torch.nn.Module) or "jax" (an equinox Module: the factory takes a key)
+    returns: str = "acceleration"   # or "lagrangian", "hamiltonian" (`models.user.returns`)
 
 
 def parse(values, suite_labels=()) -> list[Added]:
-    from models.user import factory_source, framework_of
+    from models.user import factory_source, framework_of, returns_of
 
     out = []
     for v in values or ():
@@ -45,7 +46,7 @@ def parse(values, suite_labels=()) -> list[Added]:
                              f"or '-' (at most 32)")
         if name in suite_labels or name in {a.name for a in out}:
             raise ValueError(f"--add-model {v}: the name {name!r} is taken; choose another")
-        out.append(Added(name, ref, factory_source(ref), framework_of(ref)))
+        out.append(Added(name, ref, factory_source(ref), framework_of(ref), returns_of(ref)))
     return out
 
 
@@ -65,10 +66,10 @@ def installed(name: str) -> str:
     return found[0]
 
 
-def _stand_in(claim, entry, profile) -> bool:
+def _stand_in(claim, entry, profile, task: str) -> bool:
     p = entry.protocol(claim.protocol(profile), profile)
     fields = entry.spec_fields(profile)
-    return (entry.train and entry.runs_in(profile) and p.task == "acceleration" and not fields.get("extra_inputs")
+    return (entry.train and entry.runs_in(profile) and p.task == task and not fields.get("extra_inputs")
             and fields.get("kind") != "lgn")
 
 
@@ -79,7 +80,7 @@ def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
     by_recipe = {}
     for label in read:
         entry = claim.entry(label)
-        if _stand_in(claim, entry, profile):
+        if _stand_in(claim, entry, profile, "hamiltonian" if added.returns == "hamiltonian" else "acceleration"):
             recipe = entry.protocol(claim.protocol(profile), profile).data.recipe
             by_recipe.setdefault(recipe, entry)
     several = len(by_recipe) > 1

@@ -201,3 +201,50 @@ def test_an_equinox_module_trains_in_jax_with_scouts_through_the_suites_euler_la
     out = run_training("jax", spec, p, seed=0)
     k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
     assert out.failure is None and abs(float(out.params[".k"][0]) - k_true) < 0.05 * k_true
+
+
+HAMILTONIAN = '''import torch
+
+
+class H(torch.nn.Module):
+    returns = "hamiltonian"
+
+    def __init__(self, dof):
+        super().__init__()
+        self.k = torch.nn.Parameter(torch.tensor([2.0]))
+
+    def forward(self, q, p):
+        return 0.5 * (p ** 2).sum(-1) + 0.5 * self.k * (q ** 2).sum(-1)
+
+
+def make(dof):
+    return H(dof)
+'''
+
+
+def test_a_hamiltonian_module_stands_in_for_the_hnn_and_goes_through_hamiltons_equations(tmp_path):
+    from replication.training.protocol import Data, Protocol
+    from replication.training.schedules import OneCycle
+    from replication.training.train import run_training
+
+    path = tmp_path / "user_hamiltonian.py"
+    path.write_text(HAMILTONIAN, encoding="utf-8")
+    (a,) = added_models.parse([f"ham={path}:make"])
+    assert a.returns == "hamiltonian"
+    hnn = CLAIMS["hnn_energy"]
+    entries = added_models.entries(hnn, a, "quick")
+    assert sorted(e.label for e in entries) == ["ham_pendulum", "ham_spring"]
+    for e in entries:   # on the HNN's data and task, not the baseline's
+        assert e.protocol(hnn.protocol("quick"), "quick").task == "hamiltonian"
+    assert added_models.entries(CLAIMS["dp_loss"], a, "quick") == []   # no HNN there
+    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
+    m = adapter("torch", spec, init_params(spec, 0))
+    x, y = np.random.default_rng(0).normal(size=(2, 5, 1))
+    xdot, ydot = m.time_derivative(x, y, None)
+    np.testing.assert_allclose(xdot, y, atol=1e-12)
+    np.testing.assert_allclose(ydot, -2.0 * x, atol=1e-12)
+    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64, coords="qp"), task="hamiltonian", steps=150,
+                 batch=32, loss="mse", schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64")
+    out = run_training("torch", spec, p, seed=0)
+    k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
+    assert out.failure is None and abs(float(out.params["k"][0]) - k_true) < 0.05 * k_true
