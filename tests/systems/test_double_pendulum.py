@@ -28,7 +28,7 @@ def test_non_default_parameters_match_closed_form():
 
 def test_structure_and_defaults():
     s = systems.get("double_pendulum")
-    assert s.params == {"m1": 1.0, "m2": 1.0, "l1": 1.0, "l2": 1.0, "g": 9.8}
+    assert s.params == {"m1": 1.0, "m2": 1.0, "l1": 1.0, "l2": 1.0, "g": 9.8, "friction": 0.0}
     assert s.structure == {"quadratic_kinetic": True, "separable": False,
                            "local_coupling": False, "actuated": False}
     # the LNN energy scale 29.4 = m1 g l1 + m2 g (l1 + l2) is the potential of the upright state
@@ -46,3 +46,15 @@ def test_momentum_rate_is_the_time_derivative_of_momentum():
     p = s.canonical_momentum(q, qdot)
     fd = (p[:, 2] - p[:, 0]) / 2e-4
     np.testing.assert_allclose(fd, s.canonical_momentum_rate(q[:, 1], qdot[:, 1]), rtol=1e-6, atol=1e-6)
+
+
+def test_friction_is_a_viscous_force_on_each_angle():
+    """With friction b: M qddot = (the frictionless right-hand side) - b qdot, against the closed form."""
+    b = 0.4
+    s = systems.get("double_pendulum", friction=b)
+    st = s.sample_states(5, 3)
+    q, qd = st["q"], st["qdot"]
+    c = np.cos(q[:, 0] - q[:, 1])   # m = l = 1, absolute angles: M = [[2, cos(q1 - q2)], [cos(q1 - q2), 1]]
+    m = np.stack([np.stack([2 + 0 * c, c], -1), np.stack([c, 1 + 0 * c], -1)], -2)
+    expected = closed_form.double_pendulum_acceleration(q, qd) - np.linalg.solve(m, b * qd[..., None])[..., 0]
+    np.testing.assert_allclose(s.acceleration(q, qd, backend="numpy"), expected, rtol=1e-10, atol=1e-12)

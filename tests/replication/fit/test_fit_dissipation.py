@@ -42,3 +42,16 @@ def test_it_rolls_out_better_than_the_conservative_lnn_and_the_baseline(metrics)
     assert d["test_l1"] < 0.1 * d["null_test_l1"]
     # the conservative LNN keeps the energy the pendulum loses
     assert lnn["test_energy_err_final"] > 5 * d["test_energy_err_final"]
+
+
+def test_a_starved_fit_reports_no_friction(tmp_path, monkeypatch):
+    """Five steps: the model learned nothing, and its b / |c| (which can land anywhere) is not reported."""
+    monkeypatch.chdir(tmp_path)
+    for args in (["simulate", "--system", "pendulum", "--set", "friction=0.3", "--trajectories", "4", "--out", "d.csv"],
+                 ["fit", "--data", "d.csv", "--model", "lnn", "--dissipation", "--system", "pendulum", "--steps", "5",
+                  "--hidden", "16,16", "--out", "r", "--quiet"]):
+        assert main(args) == 0
+    d = json.loads(next(tmp_path.glob("r/units/fit/*/lnn/seed0/result.json")).read_text())
+    assert not any(k.startswith("heldout_dissipation_coefficient") for k in d["metrics"])
+    assert d["counters"]["heldout_dissipation_coefficient"] == ("not estimated: the model is not clearly better "
+                                                                "than the null predictor")
