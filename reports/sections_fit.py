@@ -34,7 +34,10 @@ ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"
                    ("energy_err_max", "true energy error, max over time"),
                    ("mass_matrix_rel_err", "DeLaN M relative error"), ("coriolis_rel_err", "DeLaN c relative error"),
                    ("gravity_rel_err", "DeLaN g relative error"),
-                   ("decomposition_scale", "DeLaN: factor to the system's L (accelerations fix L up to one)")]
+                   ("decomposition_scale", "DeLaN: factor to the system's L (accelerations fix L up to one)"),
+                   *((f"dissipation_coefficient_{k}", f"friction q{k} in the system's units (--dissipation)")
+                     for k in range(4)),
+                   ("dissipation_hessian_residual", "--dissipation: learned velocity Hessian against c M, residual")]
 
 
 def is_fit_results(res: Results) -> bool:
