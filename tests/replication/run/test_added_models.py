@@ -117,48 +117,25 @@ def test_an_installed_package_declares_its_model_by_entry_point(model_file, monk
         added_models.parse(["other"])
 
 
-LAGRANGIAN = '''import torch
+TORCH_SCALAR = '''import torch
 
 
-class L(torch.nn.Module):
-    returns = "lagrangian"
+class S(torch.nn.Module):
+    returns = "{returns}"
 
     def __init__(self, dof):
         super().__init__()
         self.k = torch.nn.Parameter(torch.tensor([2.0]))
 
-    def forward(self, q, qdot):
-        return 0.5 * (qdot ** 2).sum(-1) - 0.5 * self.k * (q ** 2).sum(-1)
+    def forward(self, q, v):
+        return 0.5 * (v ** 2).sum(-1) {sign} 0.5 * self.k * (q ** 2).sum(-1)
 
 
 def make(dof):
-    return L(dof)
+    return S(dof)
 '''
-
-
-def test_a_lagrangian_module_goes_through_the_suites_euler_lagrange_step_and_trains_with_scouts(tmp_path):
-    """L = |qdot|^2 / 2 - k |q|^2 / 2 gives qddot = -k q; it trains under a protocol with restarts over
-    initialisations (the scouts train as members under torch.func.vmap) and learns the harmonic chain's k."""
-    from replication.training.protocol import Data, Protocol, Scouting
-    from replication.training.schedules import OneCycle
-    from replication.training.train import run_training
-
-    path = tmp_path / "user_lagrangian.py"
-    path.write_text(LAGRANGIAN, encoding="utf-8")
-    (a,) = added_models.parse([f"lag={path}:make"])
-    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
-    m = adapter("torch", spec, init_params(spec, 0))
-    q, qd = np.random.default_rng(0).normal(size=(5, 1)), np.ones((5, 1))
-    np.testing.assert_allclose(m.acceleration(q, qd, None), -2.0 * q, atol=1e-12)
-    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64), steps=150, batch=32, loss="mse",
-                 schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64",
-                 scouting=Scouting(count=2, steps=20, batch=32, schedule=OneCycle(lr=3e-2, start=0.3)))
-    out = run_training("torch", spec, p, seed=0)
-    assert out.failure is None
-    k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
-    assert abs(float(out.params["k"][0]) - k_true) < 0.05 * k_true
-
-
+LAGRANGIAN = TORCH_SCALAR.format(returns="lagrangian", sign="-")   # L = |qdot|^2 / 2 - k |q|^2 / 2
+HAMILTONIAN = TORCH_SCALAR.format(returns="hamiltonian", sign="+")   # H = |p|^2 / 2 + k |q|^2 / 2
 EQX_LAGRANGIAN = '''import equinox as eqx
 import jax.numpy as jnp
 
@@ -179,57 +156,45 @@ def make(dof, key):
 '''
 
 
-def test_an_equinox_module_trains_in_jax_with_scouts_through_the_suites_euler_lagrange_step(tmp_path):
+def _added(tmp_path, text, name):
+    path = tmp_path / f"user_{name}.py"
+    path.write_text(text, encoding="utf-8")
+    (a,) = added_models.parse([f"{name}={path}:make"])
+    return a, ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
+
+
+def _learns_the_springs_k(framework, spec, key, **protocol):
+    """Trained on the spring (k = 1) with restarts over initialisations (the scouts train as members), the
+    module's k (2 at the start) comes within 5 % of the spring's."""
     from replication.training.protocol import Data, Protocol, Scouting
     from replication.training.schedules import OneCycle
     from replication.training.train import run_training
 
-    path = tmp_path / "user_eqx.py"
-    path.write_text(EQX_LAGRANGIAN, encoding="utf-8")
-    (a,) = added_models.parse([f"eqx={path}:make"])
-    assert a.framework == "jax"
-    units = plan("smoke", claims=["dp_loss"], frameworks=("jax", "torch"), added=[a])
-    assert {u.framework for u in units if u.entry.label == "eqx"} == {"jax"}
-    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
-    assert set(init_params(spec, 0)) == {".k"}
-    m = adapter("jax", spec, init_params(spec, 0))
-    q, qd = np.random.default_rng(0).normal(size=(5, 1)), np.ones((5, 1))
-    np.testing.assert_allclose(m.acceleration(q, qd, None), -2.0 * q, atol=1e-12)
-    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64), steps=150, batch=32, loss="mse",
+    coords = {"coords": "qp"} if protocol.get("task") == "hamiltonian" else {}
+    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64, **coords), steps=150, batch=32, loss="mse",
                  schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64",
-                 scouting=Scouting(count=2, steps=20, batch=32, schedule=OneCycle(lr=3e-2, start=0.3)))
-    out = run_training("jax", spec, p, seed=0)
+                 scouting=Scouting(count=2, steps=20, batch=32, schedule=OneCycle(lr=3e-2, start=0.3)), **protocol)
+    out = run_training(framework, spec, p, seed=0)
     k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
-    assert out.failure is None and abs(float(out.params[".k"][0]) - k_true) < 0.05 * k_true
+    assert out.failure is None and abs(float(out.params[key][0]) - k_true) < 0.05 * k_true
 
 
-HAMILTONIAN = '''import torch
-
-
-class H(torch.nn.Module):
-    returns = "hamiltonian"
-
-    def __init__(self, dof):
-        super().__init__()
-        self.k = torch.nn.Parameter(torch.tensor([2.0]))
-
-    def forward(self, q, p):
-        return 0.5 * (p ** 2).sum(-1) + 0.5 * self.k * (q ** 2).sum(-1)
-
-
-def make(dof):
-    return H(dof)
-'''
+@pytest.mark.parametrize("framework, text, key", [("torch", LAGRANGIAN, "k"), ("jax", EQX_LAGRANGIAN, ".k")])
+def test_a_lagrangian_module_trains_in_its_framework_through_the_suites_euler_lagrange_step(tmp_path, framework,
+                                                                                           text, key):
+    """L = |qdot|^2 / 2 - k |q|^2 / 2 gives qddot = -k q; a torch module trains in PyTorch, an equinox one in JAX."""
+    a, spec = _added(tmp_path, text, "lag")
+    assert a.framework == framework and set(init_params(spec, 0)) == {key}
+    units = plan("smoke", claims=["dp_loss"], frameworks=("jax", "torch"), added=[a])
+    assert {u.framework for u in units if u.entry.label == "lag"} == {framework}
+    q, qd = np.random.default_rng(0).normal(size=(5, 1)), np.ones((5, 1))
+    np.testing.assert_allclose(adapter(framework, spec, init_params(spec, 0)).acceleration(q, qd, None), -2.0 * q,
+                               atol=1e-12)
+    _learns_the_springs_k(framework, spec, key)
 
 
 def test_a_hamiltonian_module_stands_in_for_the_hnn_and_goes_through_hamiltons_equations(tmp_path):
-    from replication.training.protocol import Data, Protocol
-    from replication.training.schedules import OneCycle
-    from replication.training.train import run_training
-
-    path = tmp_path / "user_hamiltonian.py"
-    path.write_text(HAMILTONIAN, encoding="utf-8")
-    (a,) = added_models.parse([f"ham={path}:make"])
+    a, spec = _added(tmp_path, HAMILTONIAN, "ham")
     assert a.returns == "hamiltonian"
     hnn = CLAIMS["hnn_energy"]
     entries = added_models.entries(hnn, a, "quick")
@@ -237,14 +202,8 @@ def test_a_hamiltonian_module_stands_in_for_the_hnn_and_goes_through_hamiltons_e
     for e in entries:   # on the HNN's data and task, not the baseline's
         assert e.protocol(hnn.protocol("quick"), "quick").task == "hamiltonian"
     assert added_models.entries(CLAIMS["dp_loss"], a, "quick") == []   # no HNN there
-    spec = ModelSpec(kind="user", dof=1, factory=a.ref, factory_source=a.source, dtype="float64")
-    m = adapter("torch", spec, init_params(spec, 0))
     x, y = np.random.default_rng(0).normal(size=(2, 5, 1))
-    xdot, ydot = m.time_derivative(x, y, None)
+    xdot, ydot = adapter("torch", spec, init_params(spec, 0)).time_derivative(x, y, None)
     np.testing.assert_allclose(xdot, y, atol=1e-12)
     np.testing.assert_allclose(ydot, -2.0 * x, atol=1e-12)
-    p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64, coords="qp"), task="hamiltonian", steps=150,
-                 batch=32, loss="mse", schedule=OneCycle(lr=3e-2, start=0.3), log_every=50, dtype="float64")
-    out = run_training("torch", spec, p, seed=0)
-    k_true = -float(systems.get("spring").acceleration(np.ones((1, 1)), np.zeros((1, 1)))[0, 0])
-    assert out.failure is None and abs(float(out.params["k"][0]) - k_true) < 0.05 * k_true
+    _learns_the_springs_k("torch", spec, "k", task="hamiltonian")
