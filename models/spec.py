@@ -58,8 +58,8 @@ CAPABILITIES = {
                       formulations=("fast", "banded", "dense", "paper"), extra_inputs=False),
 }
 KINDS = tuple(CAPABILITIES)
-# a user's PyTorch module (`lagbench run --add-model`, `models.user`): q-double-dot from (q, qdot), built by its
-# factory; a kind of the spec, not of the suite (no mirror, no parity: `KINDS` leaves it out)
+# a user's torch.nn.Module or equinox Module (`lagbench run --add-model`, `models.user`), built by its factory;
+# a kind of the spec, not of the suite (one framework, no parity: `KINDS` leaves it out)
 USER_KIND = "user"
 USER_CAPABILITY = Capability("UserModel", ("acceleration", "hamiltonian"), False, {}, extra_inputs=False,
                              scalar_output=False)
@@ -106,7 +106,7 @@ class ModelSpec:
         delan: tau = M qddot + c + g + b * qdot (M is positive definite: no orientation to fix). Left out of
         `to_dict` while False.
     factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
-        the torch.nn.Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
+        the torch.nn.Module or equinox Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
         module is a new spec and never reuses a cached training (`models.user`). Left out while None.
     """
 

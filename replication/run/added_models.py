@@ -16,6 +16,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from models.spec import USER_KIND
 from replication.claims.base import ModelEntry
 
 SCORES_QDDOT = ("heldout", "energy_rollout", "heldout_trajectories")   # evaluations a q-double-dot model fits
@@ -87,7 +88,7 @@ def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
     out = []
     for recipe, template in by_recipe.items():
         label = f"{added.name}_{recipe.removesuffix('_iid')}" if several else added.name
-        out.append(ModelEntry(label, {"kind": "user", "factory": added.ref, "factory_source": added.source},
+        out.append(ModelEntry(label, {"kind": USER_KIND, "factory": added.ref, "factory_source": added.source},
                               hidden=(1,), overrides=template.overrides, profiles=template.profiles))
     return out
 

@@ -19,6 +19,7 @@ import gc
 import logging
 import sys
 
+from models.spec import USER_KIND
 from replication import results as R
 
 log = logging.getLogger("lagbench")
@@ -99,7 +100,7 @@ def cost(chain) -> float:
 def ref(u) -> tuple:
     """What names a unit across processes (a claim's rules are closures: they do not pickle); a user's model
     (`replication.run.added_models`) is not in its claim's list, so its entry travels with it."""
-    user = u.entry if u.entry.spec.get("kind") == "user" else None
+    user = u.entry if u.entry.spec.get("kind") == USER_KIND else None
     return u.claim.id, u.entry.label, u.framework, u.seed, u.profile, user
 
 

@@ -16,6 +16,7 @@ import logging
 import time
 from pathlib import Path
 
+from models.spec import USER_KIND
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
@@ -78,7 +79,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
         for entry in (*claim.models, *extra[claim.id]):
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
-            for fw in ((added_models.framework(entry),) if entry.spec.get("kind") == "user" else frameworks):
+            for fw in ((added_models.framework(entry),) if entry.spec.get("kind") == USER_KIND else frameworks):
                 for seed in splits.get(split).seeds(n):
                     units.append(Unit(claim, entry, fw, seed, profile))
     if not units:
