@@ -88,6 +88,38 @@ def _competence_para(units) -> Para | None:
     return Para("Not clearly better than the null predictor (at most half its error): " + "; ".join(flagged) + ".")
 
 
+RECOMMEND_WITHIN = 2.0   # the recommendation: the fewest parameters among the fits within this x the best rollout error
+
+
+def _learned(u) -> bool:
+    """Whether the fit is clearly better than the null predictor on the set it reports (test, else held-out)."""
+    from replication.fit.competence import competence
+
+    m, loss = u.result.get("metrics") or {}, (u.result.get("protocol") or {}).get("loss", "l1")
+    c = next((c for c in (competence(m, f"{s}_{loss}") for s in ("test", "heldout")) if c is not None), None)
+    return bool(c and c["learned"])
+
+
+def _recommendation_para(units) -> Para | None:
+    """The fit to use on this data: among the fits that learned, the one with the fewest parameters whose
+    rollout error (test file, else held-out) is within RECOMMEND_WITHIN x the best; None with fewer than two."""
+    from reports.systems_table import params_of
+
+    cands = []
+    for u in units:
+        err = u.metric("test_rollout_gmean_err")
+        err = u.metric("heldout_rollout_gmean_err") if err is None else err
+        if u.claim == "fit" and err is not None and np.isfinite(err) and _learned(u):
+            cands.append((err, params_of(u), _name(u)))
+    if len(cands) < 2:
+        return None
+    best = min(cands)
+    pick = min((c for c in cands if c[0] <= RECOMMEND_WITHIN * best[0]), key=lambda c: (c[1], c[0]))
+    return Para(f"Recommended on this data: {pick[2]} (rollout error {num(pick[0])}, {num(pick[1])} parameters), the "
+                f"fewest parameters among the fits within {RECOMMEND_WITHIN:g} x the best rollout error ({best[2]}: "
+                f"{num(best[0])}); fits not clearly better than the null predictor are left out.")
+
+
 def _one_step_table(units) -> pd.DataFrame | None:
     frames = []
     for u in units:
@@ -186,7 +218,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
         s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))
     if not units:
         return [s]
-    s.add(_data_para(units), _competence_para(units))
+    s.add(_data_para(units), _competence_para(units), _recommendation_para(units))
     s.add(Table("The models side by side", _models_table(units), [SRC.format(claim="*") + "result.json"]))
     out = [s]
     e = Section("Errors", level=2)

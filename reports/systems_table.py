@@ -23,7 +23,8 @@ METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_fin
            "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test", "rollout_us_per_step")
 
 
-def _params(unit) -> float:
+def params_of(unit) -> float:
+    """The number of parameters in the unit's checkpoint (NaN if it has none)."""
     path = unit.path / "checkpoint.npz"
     if not path.is_file():
         return np.nan
@@ -51,7 +52,7 @@ def systems_table(root) -> pd.DataFrame:
     rows = []
     for (system, claim, model, fw), units in sorted(groups.items()):
         r = {"system": system, "source": "claim", "claim": claim, "model": model, "framework": fw,
-             "seeds": len(units), "params": _params(units[0]),
+             "seeds": len(units), "params": params_of(units[0]),
              "train_samples": _spread([u.result.get("train_time_s", 0) * (u.result.get("train_samples_per_s") or 0)
                                        for u in units])[""],
              "train_time_s": _spread([u.result.get("train_time_s") for u in units])[""]}

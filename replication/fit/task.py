@@ -114,7 +114,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         cfg["horizon"] = float(o.horizon)
     if tprep is not None:  # the user's test file and its rows, for the report
         cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
-    entry = ModelEntry(o.model, _model_spec(o, prep, task), hidden=o.hidden)
+    # a dissipative fit has its own folder beside the conservative one of the same kind: the two compare
+    entry = ModelEntry(o.model + ("_dissipative" if o.dissipation else ""), _model_spec(o, prep, task), hidden=o.hidden)
     unit = Unit(FitSource(protocol, cfg), entry, o.framework, o.seed, "quick")
     from replication.run.runner import is_current
 
