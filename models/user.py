@@ -35,16 +35,20 @@ def factory_source(ref: str) -> str:
     return hashlib.sha256(data).hexdigest()[:16]
 
 
+def _framework(fn) -> str:
+    return "jax" if "key" in inspect.signature(fn).parameters else "torch"
+
+
 def framework_of(ref: str) -> str:
     """"jax" for a factory that takes a `key` (an equinox module's PRNG key), else "torch"."""
-    return "jax" if "key" in inspect.signature(_factory(ref)).parameters else "torch"
+    return _framework(_factory(ref))
 
 
 def make_module(spec, seed: int = 0):
     """A fresh module of spec's factory: PyTorch's in spec.dtype (under the caller's torch seed), equinox's
     from jax.random.PRNGKey(seed)."""
-    fn = _factory(spec.factory)
-    if framework_of(spec.factory) == "jax":
+    fn = _factory(spec.factory)   # imported once: a file named by its path runs on each import
+    if _framework(fn) == "jax":
         import equinox as eqx
         import jax
 
@@ -62,31 +66,32 @@ def make_module(spec, seed: int = 0):
     return module.to(getattr(torch, spec.dtype))
 
 
-def _named_arrays(spec, module) -> dict:
+def _named_arrays(module) -> dict:
     """{name: array} of the module's parameters: PyTorch's named_parameters, equinox's inexact array leaves
     by their tree path."""
-    if framework_of(spec.factory) == "jax":
-        import equinox as eqx
-        import jax
+    import torch
 
-        arrays = eqx.filter(module, eqx.is_inexact_array)
-        return {jax.tree_util.keystr(path): leaf for path, leaf in jax.tree_util.tree_flatten_with_path(arrays)[0]}
-    return dict(module.named_parameters())
+    if isinstance(module, torch.nn.Module):
+        return {k: v.detach() for k, v in module.named_parameters()}
+    import equinox as eqx
+    import jax
+
+    arrays = eqx.filter(module, eqx.is_inexact_array)
+    return {jax.tree_util.keystr(path): leaf for path, leaf in jax.tree_util.tree_flatten_with_path(arrays)[0]}
 
 
 def param_shapes(spec) -> dict:
-    return {k: tuple(v.shape) for k, v in _named_arrays(spec, make_module(spec)).items()}
+    return {k: tuple(v.shape) for k, v in _named_arrays(make_module(spec)).items()}
 
 
 def init_params(spec, seed: int) -> dict:
-    if framework_of(spec.factory) == "jax":
-        return {k: np.asarray(v).astype(spec.dtype) for k, v in _named_arrays(spec, make_module(spec, seed)).items()}
     import torch
 
-    with torch.random.fork_rng():
+    with torch.random.fork_rng():   # a torch factory draws under the seed; an equinox one from its key
         torch.manual_seed(seed)
-        module = make_module(spec)
-    return {k: v.detach().cpu().numpy().astype(spec.dtype) for k, v in module.named_parameters()}
+        module = make_module(spec, seed)
+    return {k: np.asarray(v.cpu() if hasattr(v, "cpu") else v).astype(spec.dtype)
+            for k, v in _named_arrays(module).items()}
 
 
 RETURNS = ("acceleration", "lagrangian", "hamiltonian")
@@ -104,9 +109,9 @@ def returns(module) -> str:
 
 def returns_of(ref: str) -> str:
     """`returns` of the module the factory `ref` builds (built once, for one coordinate)."""
-    from models.spec import ModelSpec
+    from models.spec import USER_KIND, ModelSpec
 
-    return returns(make_module(ModelSpec(kind="user", dof=1, factory=ref, factory_source="-")))
+    return returns(make_module(ModelSpec(kind=USER_KIND, dof=1, factory=ref, factory_source="-")))
 
 
 def scalar(spec, out, like):
@@ -124,5 +129,3 @@ def check_output(spec, out, like) -> None:
         raise ValueError(f"--add-model {spec.factory}: forward(q, qdot) returned shape {tuple(out.shape)}, "
                          f"expected {tuple(like.shape)} (q-double-dot, one per coordinate)")
 
-
-__all__ = ["factory_source", "make_module", "param_shapes", "init_params", "check_output"]

@@ -18,8 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from replication.evaluation.rollout import lagrangian_field, rollout
-from replication.evaluation.routines import _truth, eval_energy_rollout, truth_key
+from replication.evaluation.routines import _truth, eval_energy_rollout, truth_key, truth_rk4
 
 
 @lru_cache(maxsize=8)
@@ -29,8 +28,7 @@ def truth_drift_in_dtype(name, params, cfg_items, dtype: str):
     s, t, q, qd, _, _ = _truth(name, params, cfg_items)
     y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
     if cfg.get("truth_integrator", "dopri5") == "rk4":
-        accel = lambda q, qd: s.acceleration(q, qd).astype(dtype)  # noqa: E731
-        ys = rollout(lagrangian_field(accel, s.dof), y0, t, cfg["dt"], dtype=dtype, step="dt")
+        ys = truth_rk4(name, params, cfg_items, dtype, step="dt")
     else:
         ys = _dopri5_in_dtype(s, y0, t, cfg, dtype)
     e = s.energy(ys[..., :s.dof], ys[..., s.dof:])

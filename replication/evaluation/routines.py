@@ -152,14 +152,19 @@ def _floor(name, params, cfg_items):
     return systems.trajectories.integrate(s, q[:, 0] + PERTURBATION, qd[:, 0], t)
 
 
+def truth_rk4(name, params, cfg_items, dtype: str, step: str = "split"):
+    """The exact equations of motion through the suite's RK4 in `dtype` (state, step and equations), from the
+    truth's initial states at the evaluation's dt (step rule `step`): what a perfect model rolled out in that
+    dtype gives. Not cached: its callers cache what they derive from it."""
+    s, t, q, qd, _, _ = _truth(name, params, cfg_items)
+    accel = lambda a, b: s.acceleration(a, b, backend="numpy").astype(dtype)  # noqa: E731
+    y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
+    return rollout(lagrangian_field(accel, s.dof), y0, t, dict(cfg_items)["dt"], dtype=dtype, step=step)
+
+
 @lru_cache(maxsize=8)
 def _float32_truth(name, params, cfg_items):
-    """The exact equations of motion through the suite's RK4 in float32 (state, step and equations), from the
-    truth's initial states at the evaluation's dt: what a perfect model rolled out in float32 gives."""
-    s, t, q, qd, _, _ = _truth(name, params, cfg_items)
-    accel = lambda a, b: s.acceleration(a, b, backend="numpy").astype(np.float32)  # noqa: E731
-    y0 = np.concatenate([q[:, 0], qd[:, 0]], -1)
-    return rollout(lagrangian_field(accel, s.dof), y0, t, dict(cfg_items)["dt"], dtype=np.float32)
+    return truth_rk4(name, params, cfg_items, "float32")
 
 
 def _model_rollout(ctx, s, q0, qd0, t):

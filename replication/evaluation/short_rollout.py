@@ -22,8 +22,7 @@ def _states(ctx, s):
     cfg = ctx.cfg
     rng = np.random.default_rng(cfg.get("ic_seed", 0) + ctx.split.draw_offset)
     st = s.sample_states(cfg["n_ics"], rng)
-    fixed = dict(ctx.protocol.data.system_params)
-    names = sorted(k for k in st if k not in ("q", "qdot") and k not in fixed)
+    names = datamod.sample_inputs(st, ctx.protocol.data.system_params)
     return st["q"], st["qdot"], names, [np.asarray(st[k], float).reshape(len(st["q"]), -1) for k in names]
 
 

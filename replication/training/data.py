@@ -80,13 +80,19 @@ def arm_trajectories(n: int) -> int:
     return max(min(ARM_MIN_TRAJECTORIES, n // 2), n // ARM_POINTS, 1)
 
 
+def sample_inputs(states: dict, system_params) -> list:
+    """The per-sample system inputs of drawn `states` (e.g. the relativistic field g) that `system_params`
+    does not fix, in the order the models see them as extra inputs."""
+    fixed = dict(system_params)
+    return sorted(k for k in states if k not in ("q", "qdot") and k not in fixed)
+
+
 def recipe_iid(protocol, n, rng):
     """i.i.d. states from the system's declared distribution, exact targets."""
     name = protocol.data.recipe.removesuffix("_iid")
     params = tuple(sorted(protocol.data.system_params))
     s, st = _states(name, params, n, rng)
-    fixed = dict(params)
-    kw = {k: v for k, v in st.items() if k not in ("q", "qdot") and k not in fixed}
+    kw = {k: st[k] for k in sample_inputs(st, params)}
     st = {k: v for k, v in st.items() if k in ("q", "qdot") or k in kw}
     qddot = s.acceleration(st["q"], st["qdot"], backend="numpy", **kw)
     extra = np.stack([kw[k] for k in sorted(kw)], -1) if kw else None
