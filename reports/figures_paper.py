@@ -84,7 +84,7 @@ def wave_energy(units: list[Unit], path: Path) -> bool:
     for (m, fw), got in curves.items():
         t = got[0][0]
         pred = np.vstack([np.interp(t, g[0], g[2]) for g in got])
-        err = np.vstack([np.abs(np.interp(t, g[0], g[2]) - np.interp(t, g[0], g[1])) / abs(g[1][0]) for g in got])
+        err = np.abs(pred - np.vstack([np.interp(t, g[0], g[1]) for g in got])) / np.array([[abs(g[1][0])] for g in got])
         kw = {"color": colours[m], "ls": LINESTYLES[fws[fw] % 4]}
         n_div = diverged[(m, fw)]
         label = f"{m} ({fw}, {len(got)} seed{'s' * (len(got) > 1)}" + (f"; {n_div} more diverged" if n_div else "") + ")"

@@ -69,35 +69,26 @@ def _models_table(units) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _competence(u) -> dict | None:
+    """`replication.fit.competence.competence` of the unit on the set it reports: the test file's, else held-out."""
+    from replication.fit.competence import competence
+
+    m, loss = u.result.get("metrics") or {}, (u.result.get("protocol") or {}).get("loss", "l1")
+    return next((c for c in (competence(m, f"{s}_{loss}") for s in ("test", "heldout")) if c is not None), None)
+
+
 def _competence_para(units) -> Para | None:
     """The fits and evaluations not clearly better than the null predictor on the set they report, named."""
-    from replication.fit.competence import competence, describe
+    from replication.fit.competence import describe
 
-    flagged = []
-    for u in units:
-        m = u.result.get("metrics") or {}
-        loss = (u.result.get("protocol") or {}).get("loss", "l1")
-        for metric in (f"test_{loss}", f"heldout_{loss}"):   # the set the fit reports: the test file's, else held-out
-            c = competence(m, metric)
-            if c is not None:
-                if not c["learned"]:
-                    flagged.append(f"{_name(u)} ({u.claim}), {metric}: {describe(c)}")
-                break
+    flagged = [f"{_name(u)} ({u.claim}), {c['metric']}: {describe(c)}" for u in units
+               if (c := _competence(u)) is not None and not c["learned"]]
     if not flagged:
         return None
     return Para("Not clearly better than the null predictor (at most half its error): " + "; ".join(flagged) + ".")
 
 
 RECOMMEND_WITHIN = 2.0   # the recommendation: the fewest parameters among the fits within this x the best rollout error
-
-
-def _learned(u) -> bool:
-    """Whether the fit is clearly better than the null predictor on the set it reports (test, else held-out)."""
-    from replication.fit.competence import competence
-
-    m, loss = u.result.get("metrics") or {}, (u.result.get("protocol") or {}).get("loss", "l1")
-    c = next((c for c in (competence(m, f"{s}_{loss}") for s in ("test", "heldout")) if c is not None), None)
-    return bool(c and c["learned"])
 
 
 def _recommendation_para(units) -> Para | None:
@@ -109,7 +100,7 @@ def _recommendation_para(units) -> Para | None:
     for u in units:
         err = u.metric("test_rollout_gmean_err")
         err = u.metric("heldout_rollout_gmean_err") if err is None else err
-        if u.claim == "fit" and err is not None and np.isfinite(err) and _learned(u):
+        if u.claim == "fit" and err is not None and np.isfinite(err) and (_competence(u) or {}).get("learned"):
             cands.append((err, params_of(u), _name(u)))
     if len(cands) < 2:
         return None
