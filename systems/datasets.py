@@ -9,7 +9,8 @@
   rtol=1e-12, atol=1e-12, **system_kwargs)``: initial states from the distribution integrated
   with ``systems.trajectories.integrate``. Returns "t" (T,), "q", "qdot", "qddot" (B, T, dof),
   "energy" (B, T) and per-sample parameters (B,).
-- ``arm_dataset`` (re-exported from ``systems.arm_data``): the two-link arm's torque datasets.
+- ``arm_dataset`` (re-exported from ``systems.arm_data``): the arms' torque datasets (two_link_arm,
+  four_joint_arm).
 
 Every dataset is written once to ``$LAGBENCH_CACHE/datasets/`` as .npz, keyed by a hash of
 everything that defines it (kind, system, options, parameters, seed, sizes, the Lagrangian's

@@ -13,7 +13,7 @@ import functools
 import inspect
 
 from systems.definition import Definition
-from systems.library import arm, magnetic, mechanics, relativistic, stiff, wave
+from systems.library import arm, arm4, magnetic, mechanics, relativistic, stiff, wave
 from systems.system import System
 
 _BUILDERS = {
@@ -27,6 +27,7 @@ _BUILDERS = {
     "charged_magnetic": magnetic.build_charged_magnetic,
     "wave": wave.build_wave,
     "two_link_arm": arm.build_two_link_arm,
+    "four_joint_arm": arm4.build_four_joint_arm,
     "stiff_chain": stiff.build_stiff_chain,
 }
 

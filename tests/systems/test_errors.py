@@ -11,7 +11,7 @@ import systems
 def test_names_are_the_spec_table():
     assert systems.names() == sorted(["free_fall", "pendulum", "spring", "double_pendulum", "relativistic",
                                       "relativistic_standard", "charged_magnetic", "wave", "two_link_arm",
-                                      "pendulum_chain", "stiff_chain"])
+                                      "four_joint_arm", "pendulum_chain", "stiff_chain"])
 
 
 def test_unknown_name_lists_valid_names():
