@@ -1,16 +1,18 @@
 """The framework-neutral model spec: one frozen dataclass both frameworks build from.
 
 `ModelSpec(kind, dof, hidden, activation, init, dtype, extra_inputs, formulation, n_out,
-angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius, lorentz_factor)` is validated on creation
-(unknown names and bad sizes raise ValueError listing what is valid) and round-trips through
-`to_dict()` / `from_dict()` (plain JSON types).
+angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius, lorentz_factor, dissipation, periodic)` is
+validated on creation (unknown names and bad sizes raise ValueError listing what is valid) and round-trips
+through `to_dict()` / `from_dict()` (plain JSON types).
 
-Per kind, the MLP input width and output width (see `mlp_sizes`):
-  baseline: [q, qdot, extra]            (2*dof + extra_inputs) -> n_out (default dof)
-  lnn, hnn: [q, qdot, extra] / [x, y, extra]  (2*dof + extra_inputs) -> 1; with lorentz_factor
-            [q, qdot, gamma(qdot), extra]   (3*dof + extra_inputs) -> 1
-  delan:    q (dof) -> hidden[-1], trunk only (every layer activated); heads in `models.params`
+Per kind, the MLP input width and output width (see `mlp_sizes`); x = input_scale * the features:
+  baseline: [q, qdot, extra]            (2*dof + p + extra_inputs) -> n_out (default dof)
+  lnn, hnn: [q, qdot, extra] / [x, y, extra]  (2*dof + p + extra_inputs) -> 1; with lorentz_factor
+            [q, qdot, gamma(qdot), extra]   (3*dof + p + extra_inputs) -> 1
+  delan:    q (dof + p) -> hidden[-1], trunk only (every layer activated); heads in `models.params`
   lgn:      [q_nb, qdot_nb] of one node's 2r+1 neighbours (2*(2r+1)) -> 1
+p = len(periodic): the q part (q, or x for the hnn) has each coordinate k in order, as q_k or, for k in
+`periodic`, as the pair (cos q_k, sin q_k); e.g. dof 2, periodic (0,): [cos q_0, sin q_0, q_1] (dof + p wide).
 Formulations: lnn "fast" | "paper"; lgn "banded" (alias "fast") | "dense" | "paper";
 other kinds ignore it.
 `CAPABILITIES[kind]` (`Capability`): the one table of kinds (class name, tasks, formulations, how PyTorch
@@ -74,6 +76,7 @@ DTYPES = ("float32", "float64")
 
 DISSIPATIVE_KINDS = ("lnn", "hnn", "delan")   # kinds that may learn a Rayleigh dissipation (`ModelSpec.dissipation`)
 LORENTZ_KINDS = ("lnn", "hnn")   # kinds whose MLP may take the Lorentz factor of qdot (`ModelSpec.lorentz_factor`)
+PERIODIC_KINDS = ("baseline", "lnn", "hnn", "delan")   # kinds whose MLP may see angles as cos, sin (`ModelSpec.periodic`)
 
 
 def _choices(what: str, value, valid) -> None:
@@ -90,7 +93,7 @@ class ModelSpec:
     extra_inputs: extra MLP inputs not differentiated (e.g. the relativistic field g, or tau/qddot
         for a baseline), shape (..., extra_inputs).
     n_out: baseline output width (default dof); must be None or 1 for lnn/hnn/lgn; unused by delan.
-    angle_wrap: wrap q to [-pi, pi) before the MLP.
+    angle_wrap: wrap q to [-pi, pi) before the MLP (discontinuous at the wrap; `periodic` is smooth).
     input_scale: per-feature multipliers of the MLP input vector (length = MLP input width).
     delan_eps: epsilon of M = L L^T + eps I. delan_diag_offset: diag(L) = softplus(raw + offset).
     lgn_radius: neighbours on each side of a node in the density MLP.
@@ -105,6 +108,9 @@ class ModelSpec:
         negative. hnn: ydot = -dH/dx - b * dH/dy (the force on the momentum, xdot = dH/dy the velocity);
         delan: tau = M qddot + c + g + b * qdot (M is positive definite: no orientation to fix). Left out of
         `to_dict` while False.
+    periodic: baseline, lnn, hnn, delan: the indices (sorted, unique, in [0, dof)) of the coordinates of q the
+        MLP sees as the pair (cos q_k, sin q_k) instead of q_k (angles recorded unwrapped): the model is exactly
+        2 pi periodic in them; the others stay linear. Not with angle_wrap. Left out of `to_dict` while empty.
     factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
         the torch.nn.Module or equinox Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
         module is a new spec and never reuses a cached training (`models.user`). Left out while None.
@@ -126,6 +132,7 @@ class ModelSpec:
     lgn_radius: int = 1
     lorentz_factor: bool = False
     dissipation: bool = False
+    periodic: tuple = ()
     factory: str | None = None
     factory_source: str | None = None
 
@@ -164,6 +171,7 @@ class ModelSpec:
         if self.dissipation and (self.kind not in DISSIPATIVE_KINDS or (self.kind == "lnn" and self.formulation != "fast")):
             raise ValueError(f"dissipation is for kinds {', '.join(DISSIPATIVE_KINDS)} (the LNN in its fast "
                              f"formulation), not {self.kind!r} ({self.formulation})")
+        self._check_periodic()
         if (self.kind == USER_KIND) != (self.factory is not None):
             raise ValueError("kind 'user' needs a factory (module:function), and only it takes one")
         if not self.delan_eps >= 0:
@@ -175,13 +183,30 @@ class ModelSpec:
                                  f"got {len(scale)}")
             object.__setattr__(self, "input_scale", scale)
 
+    def _check_periodic(self):
+        periodic = self.periodic
+        if not isinstance(periodic, (list, tuple)) or any(
+                isinstance(k, bool) or not isinstance(k, int) or not 0 <= k < self.dof for k in periodic):
+            raise ValueError(f"periodic must be indices of q's coordinates, ints in [0, {self.dof}), got {periodic!r}")
+        if list(periodic) != sorted(set(periodic)):
+            raise ValueError(f"periodic indices must be unique and sorted, got {tuple(periodic)}")
+        object.__setattr__(self, "periodic", tuple(periodic))
+        if periodic and self.kind not in PERIODIC_KINDS:
+            raise ValueError(f"periodic is for kinds {', '.join(PERIODIC_KINDS)}, not {self.kind!r}")
+        if periodic and self.angle_wrap:
+            raise ValueError("periodic and angle_wrap exclude each other: cos and sin are periodic already")
+
+    def q_width(self) -> int:
+        """Width of the MLP's q part: dof, plus one for each periodic coordinate (its cos and sin)."""
+        return self.dof + len(self.periodic)
+
     def mlp_sizes(self) -> tuple:
         """Layer widths of the (trunk) MLP, input first: e.g. (4, 600, 600, 600, 1)."""
         if self.kind == "delan":
-            return (self.dof, *self.hidden)
+            return (self.q_width(), *self.hidden)
         if self.kind == "lgn":
             return (2 * (2 * self.lgn_radius + 1), *self.hidden, 1)
-        n_in = (3 if self.lorentz_factor else 2) * self.dof + self.extra_inputs
+        n_in = self.q_width() + (2 if self.lorentz_factor else 1) * self.dof + self.extra_inputs
         n_out = 1 if capability(self.kind).scalar_output else (self.n_out or self.dof)
         return (n_in, *self.hidden, n_out)
 
@@ -189,7 +214,8 @@ class ModelSpec:
         d = dataclasses.asdict(self)
         d["hidden"] = list(self.hidden)
         d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
-        for k in ("lorentz_factor", "dissipation"):
+        d["periodic"] = list(self.periodic)
+        for k in ("lorentz_factor", "dissipation", "periodic"):
             if not d[k]:
                 del d[k]
         for k in ("factory", "factory_source"):
@@ -203,4 +229,6 @@ class ModelSpec:
         d["hidden"] = tuple(d.get("hidden", cls.hidden))
         if d.get("input_scale") is not None:
             d["input_scale"] = tuple(d["input_scale"])
+        if "periodic" in d:
+            d["periodic"] = tuple(d["periodic"])
         return cls(**d)

@@ -1,8 +1,9 @@
 """Deep Lagrangian Network (JAX): L = 1/2 qdot^T M(q) qdot - V(q), M = Lc Lc^T + eps I.
 
-A shared trunk h = MLP(q) (every layer activated) feeds three linear heads: "delan_lower" (the strictly
-lower entries of Lc, np.tril_indices order), "delan_diag" (diag(Lc) = softplus(raw + delan_diag_offset)
-> 0) and "delan_potential" (V). M is symmetric positive definite by construction (eps >= 0, diag > 0).
+A shared trunk h = MLP(f(q)) (every layer activated; f the q part, `models.jax.mlp.q_features`: q, or
+cos and sin of the periodic coordinates) feeds three linear heads: "delan_lower" (the strictly lower entries
+of Lc, np.tril_indices order), "delan_diag" (diag(Lc) = softplus(raw + delan_diag_offset) > 0) and
+"delan_potential" (V). M is symmetric positive definite by construction (eps >= 0, diag > 0).
 Derivatives from ONE forward-mode pass along the d unit tangents of q (dh/dq_k propagated forward, as
 the DeLaN paper does; `models.torch.delan` mirrors it line for line; activation slopes by an elementwise jvp):
   dLc_k = dLc/dq_k, Ldot = sum_k qdot_k dLc_k, u = Lc^T qdot, w_k = dLc_k^T qdot,
@@ -17,7 +18,7 @@ import jax
 import jax.numpy as jnp
 
 from models.jax.base import Model
-from models.jax.mlp import ACT, act_and_slope, input_scale, linear, mlp, mlp_input, wrap_angles
+from models.jax.mlp import ACT, act_and_slope, input_scale, linear, mlp, mlp_input, q_features, q_features_jvp
 from models.params import n_layers, tril_selection
 
 
@@ -34,7 +35,7 @@ class DeLaN(Model):
     def _heads(self, q):
         """(Lc (..., d, d), V (...,)) from the trunk on q."""
         spec, d = self.spec, self.spec.dof
-        h = mlp(self.params, mlp_input(spec, [wrap_angles(spec, q)]), spec, final_linear=False)
+        h = mlp(self.params, mlp_input(spec, [q_features(spec, q)]), spec, final_linear=False)
         diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
         return _lower(jnp.concatenate(parts, axis=-1), d), linear(self.params, "delan_potential", h)[..., 0]
@@ -44,11 +45,17 @@ class DeLaN(Model):
 
     def _heads_tangents(self, q):
         """(Lc (..., d, d), dLc (..., d_k, d, d) = dLc/dq_k, V (...,), dV/dq (..., d)): the trunk with
-        its d forward tangents (x = scale * wrap(q), so dx/dq_k = scale_k e_k; wrapping has slope 1)."""
+        its d forward tangents (x = scale * f(q), so dx/dq_k = scale_k e_k, wrapping has slope 1; with periodic
+        coordinates row k is scale * (df/dq_k), -sin q_k and cos q_k in the slots of k's pair: per sample)."""
         spec, d, p = self.spec, self.spec.dof, self.params
-        x = mlp_input(spec, [wrap_angles(spec, q)])
-        scale = input_scale(spec, d, q.dtype)
-        h, dh = x, jnp.broadcast_to(jnp.diag(scale), (*q.shape[:-1], d, d))
+        x = mlp_input(spec, [q_features(spec, q)])
+        scale = input_scale(spec, spec.q_width(), q.dtype)
+        if spec.periodic:
+            eye = jnp.broadcast_to(jnp.eye(d, dtype=q.dtype), (*q.shape[:-1], d, d))
+            dh = q_features_jvp(spec, q[..., None, :], eye) * scale
+        else:
+            dh = jnp.broadcast_to(jnp.diag(scale), (*q.shape[:-1], d, d))
+        h = x
         for i in range(n_layers(spec)):
             h, s1 = act_and_slope(spec.activation, linear(p, f"mlp.{i}", h))
             dh = s1[..., None, :] * (dh @ p[f"mlp.{i}.weight"].T)

@@ -1,7 +1,8 @@
 """The Hamiltonian neural network (jax): H = MLP([x, y, extra]); (xdot, ydot) = (dH/dy, -dH/dx).
 
 x, y (..., dof) are canonical (q, p), or deliberately non-canonical (q, qdot) to replicate the failure;
-extra (..., extra_inputs) or None is fed to the MLP but not differentiated. angle_wrap wraps x.
+extra (..., extra_inputs) or None is fed to the MLP but not differentiated. x enters as the q part
+(`models.jax.mlp.q_features`: wrapped with angle_wrap, cos and sin of the periodic coordinates).
 """
 from __future__ import annotations
 
@@ -10,13 +11,13 @@ import jax
 import jax.numpy as jnp
 
 from models.jax.base import Model
-from models.jax.mlp import mlp, mlp_input, wrap_angles
+from models.jax.mlp import mlp, mlp_input, q_features
 from models.lorentz import velocity_parts
 
 
 class HNN(Model):
     def _hamiltonian(self, x, y, extra=None):
-        z = mlp_input(self.spec, [wrap_angles(self.spec, x), *velocity_parts(self.spec, y), *self._parts(extra)])
+        z = mlp_input(self.spec, [q_features(self.spec, x), *velocity_parts(self.spec, y), *self._parts(extra)])
         return mlp(self.params, z, self.spec)[..., 0]
 
     @eqx.filter_jit

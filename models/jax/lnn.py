@@ -28,7 +28,7 @@ from jax import lax
 
 from models.jax.base import Model
 from models.jax.blocking import in_row_blocks
-from models.jax.mlp import input_scale, mlp, mlp_input, wrap_angles
+from models.jax.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
 from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
 from models.lorentz import lorentz_slopes, velocity_parts
 from models.numerics import pinv_rtol, rcond_min
@@ -114,38 +114,41 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
 
 
 class LNN(Model):
-    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None.
+    """L = MLP([f(q), qdot, extra]) (f: `q_features`); q, qdot (..., dof), extra (..., extra_inputs) or None.
 
     The fast formulation and velocity_hessian differentiate the model's own MLP by hand
     (`models.jax.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, fewer FLOPs
     (XLA's forward-over-reverse also pushes the d + 1 tangents back through the network)."""
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
+        x = mlp_input(self.spec, [q_features(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
-        MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
-        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term. With the
-        Lorentz factor, x = scale * [wrap(q), qdot, gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k)
-        in slot 2d + k, and H gains the curvature of the feature itself, diag(df/dx_(2d+k) s_g[k] gamma'')."""
+        MLP input x = scale * [f(q), qdot, extra], f the q part (`q_features`, p = q_width - d slots wider with
+        periodic coordinates; extra is not differentiated): tangents s_qd[k] e_(p+d+k) give the Hessian columns,
+        s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has
+        no qdot in it: H needs none of its curvature). With the Lorentz factor, x = scale * [f(q), qdot,
+        gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k) in the gamma slot k, and H gains the
+        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma'')."""
         spec, (n, d) = self.spec, q.shape
-        x = mlp_input(spec, [wrap_angles(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
+        x = mlp_input(spec, [q_features(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype)
-        s_q, s_qd = scale[:d], scale[d:2 * d]
+        nq = spec.q_width()
+        s_q, s_qd, s_g = scale[:nq], scale[nq:nq + d], scale[nq + d:nq + 2 * d]
         tangents = jnp.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
-        tangents = tangents.at[:, :d, d:2 * d].set(jnp.diag(s_qd))
-        tangents = tangents.at[:, d, :d].set(qdot * s_q)
+        tangents = tangents.at[:, :d, nq:nq + d].set(jnp.diag(s_qd))
+        tangents = tangents.at[:, d, :nq].set(q_features_jvp(spec, q, qdot) * s_q)
         if spec.lorentz_factor:
             slope, curve = lorentz_slopes(qdot)
-            s_g, k = scale[2 * d:3 * d], jnp.arange(d)
-            tangents = tangents.at[:, k, 2 * d + k].set(slope * s_g)
+            k = jnp.arange(d)
+            tangents = tangents.at[:, k, nq + d + k].set(slope * s_g)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=d)
         hess = gram[:, :d, :d]
         if spec.lorentz_factor:
-            hess = hess + jnp.eye(d, dtype=x.dtype) * (g[:, 2 * d:3 * d] * s_g * curve)[:, None, :]
-        return hess, g[:, :d] * s_q - gram[:, :d, d]
+            hess = hess + jnp.eye(d, dtype=x.dtype) * (g[:, nq + d:nq + 2 * d] * s_g * curve)[:, None, :]
+        return hess, q_features_vjp(spec, q, g[:, :nq] * s_q) - gram[:, :d, d]
 
     def _blocked_terms(self, q, qdot, extra):
         """`_fast_terms` on the flattened batch, in cache-sized row blocks (`models.jax.blocking`)."""

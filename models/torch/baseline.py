@@ -1,5 +1,6 @@
-"""The feed-forward baseline (torch): qddot = MLP([q, qdot, extra]) (the LNN paper's baseline), or any
-direct map such as the DeLaN comparison's inverse model tau = MLP([q, qdot, qddot = extra]).
+"""The feed-forward baseline (torch): qddot = MLP([f(q), qdot, extra]) (the LNN paper's baseline), or any
+direct map such as the DeLaN comparison's inverse model tau = MLP([f(q), qdot, qddot = extra]); f is the q part
+(`models.torch.mlp.q_features`: q, wrapped with angle_wrap, cos and sin of the periodic coordinates).
 
 q, qdot (..., dof), extra (..., extra_inputs) or None -> (..., n_out), n_out = dof by default.
 """
@@ -8,7 +9,7 @@ from __future__ import annotations
 import torch
 
 from models.torch.base import Model
-from models.torch.mlp import mlp, mlp_input, wrap_angles
+from models.torch.mlp import mlp, mlp_input, q_features
 
 
 class Baseline(Model):
@@ -26,7 +27,7 @@ class Baseline(Model):
     def acceleration(self, q, qdot, extra=None):
         """MLP output (..., n_out)."""
         self._check_state(q, qdot, extra)
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q), qdot, *self._parts(extra)])
+        x = mlp_input(self.spec, [q_features(self.spec, q), qdot, *self._parts(extra)])
         return mlp(self.params, x, self.spec)
 
     def acceleration_info(self, q, qdot, extra=None):

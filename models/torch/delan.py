@@ -1,8 +1,9 @@
 """Deep Lagrangian Network (PyTorch): L = 1/2 qdot^T M(q) qdot - V(q), M = Lc Lc^T + eps I.
 
-A shared trunk h = MLP(q) (every layer activated) feeds three linear heads: "delan_lower" (the strictly
-lower entries of Lc, np.tril_indices order), "delan_diag" (diag(Lc) = softplus(raw + delan_diag_offset)
-> 0) and "delan_potential" (V). M is symmetric positive definite by construction (eps >= 0, diag > 0).
+A shared trunk h = MLP(f(q)) (every layer activated; f the q part, `models.torch.mlp.q_features`: q, or
+cos and sin of the periodic coordinates) feeds three linear heads: "delan_lower" (the strictly lower entries
+of Lc, np.tril_indices order), "delan_diag" (diag(Lc) = softplus(raw + delan_diag_offset) > 0) and
+"delan_potential" (V). M is symmetric positive definite by construction (eps >= 0, diag > 0).
 Derivatives in closed form from ONE forward pass carrying d tangents (dh/dq_k, k = 1..d, the layer
 Jacobians propagated forward as the DeLaN paper does), no autograd graph of its own:
   dLc_k = dLc/dq_k, Ldot = sum_k qdot_k dLc_k, u = Lc^T qdot, w_k = dLc_k^T qdot,
@@ -21,7 +22,7 @@ from torch.nn.functional import linear as _lin
 from models.params import n_layers, tril_selection
 from models.torch.base import Model
 from models.torch.export_paths import pick
-from models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, wrap_angles
+from models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, q_features, q_features_jvp
 from models.torch.mlp_derivatives import ACT_DERIVS
 
 
@@ -68,29 +69,36 @@ class DeLaN(Model):
     def __init__(self, spec, params):
         """Per-call constants are built once, as non-persistent buffers (a tensor built from NumPy costs
         more than the small products; buffers, unlike a module-level cache, are also what torch.export
-        captures): "tril" the (d(d+1)/2, d*d) assembly matrix S^T, "eye" I_d, "dx" diag(input scale),
-        the tangents dx/dq_k."""
+        captures): "tril" the (d(d+1)/2, d*d) assembly matrix S^T, "eye" I_d, "scale" the input scale and,
+        without periodic coordinates, "dx" = diag(scale), the tangents dx/dq_k (with them they vary per sample)."""
         super().__init__(spec, params)
         d, dtype = spec.dof, getattr(torch, spec.dtype)
-        scale = input_scale(spec, d, dtype)
+        scale = input_scale(spec, spec.q_width(), dtype)
         self.register_buffer("tril", torch.tensor(tril_selection(d).T, dtype=dtype), persistent=False)
         self.register_buffer("eye", torch.eye(d, dtype=dtype), persistent=False)
-        self.register_buffer("dx", torch.diag(scale), persistent=False)
+        self.register_buffer("scale", scale, persistent=False)
+        if not spec.periodic:
+            self.register_buffer("dx", torch.diag(scale), persistent=False)
 
     def _heads(self, q):
         """(Lc (..., d, d), V (...,)) from the trunk on q (no derivatives)."""
         spec, d = self.spec, self.spec.dof
-        h = mlp(self.params, mlp_input(spec, [wrap_angles(spec, q)]), spec, final_linear=False)
+        h = mlp(self.params, mlp_input(spec, [q_features(spec, q)]), spec, final_linear=False)
         diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
         return _lower(torch.cat(parts, dim=-1), self.tril, d), linear(self.params, "delan_potential", h)[..., 0]
 
     def _heads_tangents(self, q):
         """(Lc (..., d, d), dLc (..., d_k, d, d) = dLc/dq_k, V (...,), dV/dq (..., d)): the trunk with
-        its d forward tangents (x = scale * wrap(q), so dx/dq_k = scale_k e_k; wrapping has slope 1)."""
+        its d forward tangents (x = scale * f(q), so dx/dq_k = scale_k e_k, wrapping has slope 1; with periodic
+        coordinates row k is scale * (df/dq_k), -sin q_k and cos q_k in the slots of k's pair: per sample)."""
         spec, d, p = self.spec, self.spec.dof, self.params
-        x = mlp_input(spec, [wrap_angles(spec, q)])
-        h, dh = x, self.dx.expand(*q.shape[:-1], d, d)
+        x = mlp_input(spec, [q_features(spec, q)])
+        if spec.periodic:
+            dh = q_features_jvp(spec, q[..., None, :], self.eye.expand(*q.shape[:-1], d, d)) * self.scale
+        else:
+            dh = self.dx.expand(*q.shape[:-1], d, d)
+        h = x
         derivs = ACT_DERIVS[spec.activation]
         for i in range(n_layers(spec)):
             a = linear(p, f"mlp.{i}", h)

@@ -19,7 +19,7 @@ from models.lorentz import lorentz_slopes, velocity_parts
 from models.numerics import pinv_rtol, rcond_min
 from models.torch.base import Model
 from models.torch.export_paths import pick, replace_bad_rows
-from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
+from models.torch.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
 from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
@@ -166,7 +166,7 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
 
 
 class LNN(Model):
-    """L = MLP([q, qdot, extra]); q, qdot (..., dof), extra (..., extra_inputs) or None.
+    """L = MLP([f(q), qdot, extra]) (f: `q_features`); q, qdot (..., dof), extra (..., extra_inputs) or None.
 
     The fast formulation and velocity_hessian differentiate the model's own MLP by hand
     (`models.torch.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, faster."""
@@ -177,35 +177,39 @@ class LNN(Model):
         return spec.formulation == "fast"
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [wrap_angles(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
+        x = mlp_input(self.spec, [q_features(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
         return mlp(self.params, x, self.spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
-        MLP input x = scale * [wrap(q), qdot, extra] (wrap has derivative 1; extra is not differentiated):
-        tangents s_qd[k] e_(d+k) give the Hessian columns, s_q * qdot in the q slots the mixed term. With the
-        Lorentz factor, x = scale * [wrap(q), qdot, gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k)
-        in slot 2d + k, and H gains the curvature of the feature itself, diag(df/dx_(2d+k) s_g[k] gamma'')."""
+        MLP input x = scale * [f(q), qdot, extra], f the q part (`q_features`, p = q_width - d slots wider with
+        periodic coordinates; extra is not differentiated): tangents s_qd[k] e_(p+d+k) give the Hessian columns,
+        s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has
+        no qdot in it: H needs none of its curvature). With the Lorentz factor, x = scale * [f(q), qdot,
+        gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k) in the gamma slot k, and H gains the
+        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma'')."""
         spec, lead, d = self.spec, q.shape[:-1], q.shape[-1]   # lead: (B,), or (K, B) for stacked members
-        x = mlp_input(spec, [wrap_angles(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
+        x = mlp_input(spec, [q_features(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
-        s_q, s_qd = scale[:d], scale[d:2 * d]
+        nq = spec.q_width()
+        s_q, s_qd, s_g = scale[:nq], scale[nq:nq + d], scale[nq + d:nq + 2 * d]
         width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
-        used = 3 * d if spec.lorentz_factor else 2 * d
+        used = nq + (2 * d if spec.lorentz_factor else d)
         zeros = torch.zeros((d, width - used), dtype=x.dtype, device=x.device)
-        rows = torch.cat([torch.zeros((d, d), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1).expand(*lead, d, 2 * d)
+        rows = torch.cat([torch.zeros((d, nq), dtype=x.dtype, device=x.device), torch.diag(s_qd)], -1)
+        rows = rows.expand(*lead, d, nq + d)
         if spec.lorentz_factor:
             slope, curve = lorentz_slopes(qdot)
-            s_g = scale[2 * d:3 * d]
             rows = torch.cat([rows, torch.diag_embed(slope * s_g)], -1)
         rows = torch.cat([rows, zeros.expand(*lead, d, width - used)], -1)
-        mixed = torch.cat([qdot * s_q, torch.zeros((*lead, width - d), dtype=x.dtype, device=x.device)], -1)
+        mixed = torch.cat([q_features_jvp(spec, q, qdot) * s_q,
+                           torch.zeros((*lead, width - nq), dtype=x.dtype, device=x.device)], -1)
         tangents = torch.cat([rows, mixed.unsqueeze(-2)], -2)
         g, gram = input_grad_and_tangent_hessian(self.params, x, tangents, spec, rows=d)
         hess = gram[..., :d, :d]
         if spec.lorentz_factor:
-            hess = hess + torch.diag_embed(g[..., 2 * d:3 * d] * s_g * curve)
-        return hess, g[..., :d] * s_q - gram[..., :d, d]
+            hess = hess + torch.diag_embed(g[..., nq + d:nq + 2 * d] * s_g * curve)
+        return hess, q_features_vjp(spec, q, g[..., :nq] * s_q) - gram[..., :d, d]
 
     def lagrangian(self, q, qdot, extra=None):
         """L (...,)."""

@@ -3,6 +3,10 @@
 mlp(params, x, spec, prefix="mlp", final_linear=True): x (..., n_in) -> (..., n_out) with the layers
 "{prefix}.{i}.weight" (out, in) / ".bias" (out,), activation after every layer but the last (after every
 layer too when final_linear=False). Mirrors `models.jax.mlp`.
+The MLP's q part (`ModelSpec.periodic`, `angle_wrap`): q_features(spec, q) (..., d) -> (..., spec.q_width()),
+each coordinate k in order as q_k (wrapped with angle_wrap) or, for k in spec.periodic, (cos q_k, sin q_k);
+for the hand-written chain rules its tangent q_features_jvp(spec, q, v) = (dq_features/dq) v (..., q_width)
+and its transpose q_features_vjp(spec, q, g) = (dq_features/dq)^T g (..., d); q and v broadcast.
 """
 from __future__ import annotations
 
@@ -91,6 +95,45 @@ def wrap_angles(spec, q):
     if not spec.angle_wrap:
         return q
     return torch.remainder(q + math.pi, 2 * math.pi) - math.pi
+
+
+def q_features(spec, q):
+    """q (..., d) -> the MLP's q part (..., d + len(spec.periodic)); see the module docstring."""
+    if not spec.periodic:
+        return wrap_angles(spec, q)
+    cols = []
+    for k in range(q.shape[-1]):
+        qk = q[..., k:k + 1]
+        cols += [torch.cos(qk), torch.sin(qk)] if k in spec.periodic else [qk]
+    return torch.cat(cols, dim=-1)
+
+
+def q_features_jvp(spec, q, v):
+    """(dq_features/dq) v (..., d + len(spec.periodic)) for q, v (..., d) (wrapping has slope 1)."""
+    if not spec.periodic:
+        return v
+    v = v.expand(torch.broadcast_shapes(q.shape, v.shape))
+    cols = []
+    for k in range(q.shape[-1]):
+        qk, vk = q[..., k:k + 1], v[..., k:k + 1]
+        cols += [-torch.sin(qk) * vk, torch.cos(qk) * vk] if k in spec.periodic else [vk]
+    return torch.cat(cols, dim=-1)
+
+
+def q_features_vjp(spec, q, g):
+    """(dq_features/dq)^T g (..., d) for q (..., d), g (..., d + len(spec.periodic)) on the q part's slots."""
+    if not spec.periodic:
+        return g
+    cols, i = [], 0
+    for k in range(q.shape[-1]):
+        if k in spec.periodic:
+            qk = q[..., k:k + 1]
+            cols.append(torch.cos(qk) * g[..., i + 1:i + 2] - torch.sin(qk) * g[..., i:i + 1])
+            i += 2
+        else:
+            cols.append(g[..., i:i + 1])
+            i += 1
+    return torch.cat(cols, dim=-1)
 
 
 def input_scale(spec, n: int, dtype, device=None):

@@ -1,5 +1,6 @@
 """JAX against PyTorch on identical parameters: outputs and the gradients of the L1 training loss with
-respect to every parameter, to TOL[dtype] relative (float64 1e-10, float32 dtype-appropriate)."""
+respect to every parameter, to TOL[dtype] relative (float64 1e-10, float32 dtype-appropriate); every kind
+that takes periodic angle features has a row with them."""
 import jax
 import jax.numpy as jnp
 import pytest
@@ -31,8 +32,16 @@ CASES = [
     ("hnn", {"activation": "tanh", "dissipation": True}),
     ("lgn", {"formulation": "banded", "dof": 7}),
     ("lgn", {"formulation": "dense", "dof": 7}),
+    # angles as cos and sin (`ModelSpec.periodic`)
+    ("lnn", {"formulation": "fast", "periodic": (0,)}),
+    ("lnn", {"formulation": "paper", "periodic": (0, 1)}),
+    ("lnn", {"formulation": "fast", "periodic": (1,), "extra_inputs": 1, "dissipation": True,
+             "input_scale": (0.5, 2.0, 1.5, 0.3, 1.1, 2.0)}),
+    ("hnn", {"periodic": (0, 1), "extra_inputs": 1, "input_scale": (0.5, 2.0, 1.5, 0.7, 0.3, 1.1, 2.0)}),
+    ("delan", {"init": "xavier", "periodic": (1,)}),
+    ("baseline", {"periodic": (0,), "extra_inputs": 2}),
 ]
-FLOAT32 = [0, 2, 4, 6, 8]
+FLOAT32 = [0, 2, 4, 6, 8, 13, 16]
 
 
 def _check(kind, kw, dtype):

@@ -21,6 +21,9 @@ CASES = {
     "lnn_dissipation": dict(kind="lnn", dof=2, dissipation=True),
     "lnn_relu_falls_back": dict(kind="lnn", dof=2, activation="relu"),
     "baseline": dict(kind="baseline", dof=2, extra_inputs=1, angle_wrap=True),
+    "lnn_periodic": dict(kind="lnn", dof=3, periodic=(0, 2), extra_inputs=1, lorentz_factor=True,
+                         input_scale=(0.5, 2.0, 1.5, 0.7, 1.3, 0.3, 1.1, 0.9, 0.02, 0.05, 0.01, 0.1)),
+    "baseline_periodic": dict(kind="baseline", dof=2, periodic=(1,)),
 }
 
 
