@@ -65,19 +65,27 @@ class RolloutBars:
 def cmd_fit(args):
     from tqdm.auto import tqdm
 
-    from replication.fit.task import LOSS_NAMES, fit
+    from replication.fit import kind_defaults
+    from replication.fit.task import LOSS_NAMES, fit, resolved
     from replication.training import device
 
     device.apply(args.device, (args.framework,))   # before anything is written
+    given = fit_options.from_args(args)
+    o, task = resolved(args.data, given)   # a refused option: one line, nothing written
+    if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
+        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task)} where not given "
+              f"({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
+              f"{f', {o.restarts} restarts' if o.restarts else ''}{', spike guard' if o.guard_clip or o.guard_skip else ''})",
+              file=sys.stderr)
     bars = []  # made at the first log row, so that a refused option prints one line and nothing else
     rollouts = RolloutBars(args.quiet, f"lagbench fit {args.model}")
 
     def on_log(row):
-        step = min(int(row["step"]) + 1, args.steps)
+        step = min(int(row["step"]) + 1, o.steps)
         if not bars or step < bars[-1].n:   # a new training (--tune fits one per configuration)
-            bars.append(tqdm(total=args.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet))
+            bars.append(tqdm(total=o.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet))
         bar = bars[-1]
-        bar.set_postfix_str(f"training {LOSS_NAMES[args.loss]} {row['loss']:.4g}", refresh=False)
+        bar.set_postfix_str(f"training {LOSS_NAMES[o.loss]} {row['loss']:.4g}", refresh=False)
         bar.update(step - bar.n)
         if bar.n >= bar.total:   # closed now, so that its time is the training's, not the evaluation's too
             bar.close()
@@ -107,7 +115,8 @@ def cmd_fit(args):
     again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
     value = d.get("final_train_loss") if d["metric"] == "final_train_loss" else d["metrics"].get(d["metric"])
     c = competence(d["metrics"], d["metric"])
-    print(f"{'ok' if c is None or c['learned'] else 'done'}: {d['metric_label']} {value:.6g}"
+    shown = "none (not finite)" if value is None else f"{value:.6g}"
+    print(f"{'ok' if c is None or c['learned'] else 'done'}: {d['metric_label']} {shown}"
           f"{f' ({describe(c)})' if c else ''}, written to {folder}{again}")
     return 1 if args.strict and c is not None and not c["learned"] else 0
 

@@ -25,6 +25,15 @@ LOSSES = ("l1", "mse")
 SCHEDULES = ("onecycle", "constant")
 
 
+class _ByKind:
+    """The default of an option that the model kind sets (`replication.fit.kind_defaults`)."""
+
+    def __repr__(self):
+        return "the model kind's default"
+
+
+BY_KIND = _ByKind()
+KIND = " (default: the model kind's, from the suite's protocols; see docs/fit.md)"
 HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (longer trajectories are rolled "
                 "out and scored to there)")
 
@@ -99,45 +108,58 @@ OPTIONS = (
     Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
     Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
     Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),
-    Option("steps", 2000, "optimiser steps, >= 1", count(1), "an integer >= 1", kind=int),
-    Option("batch", 256, "batch size, >= 1; at most the training rows", count(1), "an integer >= 1", kind=int),
-    Option("hidden", (128, 128), "comma-separated MLP widths",
+    Option("steps", BY_KIND, "optimiser steps, >= 1" + KIND, count(1), "an integer >= 1", kind=int),
+    Option("batch", BY_KIND, "batch size, >= 1; at most the training rows" + KIND, count(1), "an integer >= 1", kind=int),
+    Option("hidden", BY_KIND, "comma-separated MLP widths" + KIND,
            lambda v: len(v) > 0 and all(count(1)(h) for h in v), "comma-separated layer widths >= 1 such as 128,128",
-           parse=widths, text="128,128"),
-    Option("activation", "softplus", "softplus | relu | relu2 | relu3 | tanh | sigmoid", one_of(ACTIVATIONS),
+           parse=widths),
+    Option("activation", BY_KIND, "softplus | relu | relu2 | relu3 | tanh | sigmoid" + KIND, one_of(ACTIVATIONS),
            f"one of {', '.join(ACTIVATIONS)}"),
-    Option("lr", 1e-3, "peak learning rate, > 0", lambda v: real(v) and v > 0, "a finite number > 0", kind=float),
-    Option("schedule", "onecycle", "onecycle | constant", one_of(SCHEDULES), f"one of {', '.join(SCHEDULES)}"),
-    Option("lr_min_ratio", 1e-4, "one-cycle: final rate as a fraction of --lr", lambda v: real(v) and 0 < v <= 1,
-           "a fraction in (0, 1]", flag="--lr-final", kind=float),
-    Option("weight_decay", 0.0, "L2 penalty: coefficient of sum(theta^2) added to the loss",
+    Option("lr", BY_KIND, "peak learning rate, > 0" + KIND, lambda v: real(v) and v > 0, "a finite number > 0",
+           kind=float),
+    Option("schedule", BY_KIND, "onecycle | constant" + KIND, one_of(SCHEDULES), f"one of {', '.join(SCHEDULES)}"),
+    Option("lr_start", BY_KIND, "one-cycle: the phase the cycle starts at, in [0, 1) (0.5 is the peak; the rate "
+           "there is --lr x (1 - cos(2 pi phase)) / 2)" + KIND, lambda v: real(v) and 0 <= v < 1, "a number in [0, 1)",
+           kind=float),
+    Option("lr_min_ratio", BY_KIND, "one-cycle: final rate as a fraction of --lr" + KIND,
+           lambda v: real(v) and 0 < v <= 1, "a fraction in (0, 1]", flag="--lr-final", kind=float),
+    Option("weight_decay", BY_KIND, "L2 penalty: coefficient of sum(theta^2) added to the loss" + KIND,
            lambda v: real(v) and v >= 0, "a finite number >= 0", kind=float),
-    Option("loss", "l1", "l1 | mse (per sample summed over components, mean over the batch)", one_of(LOSSES),
-           f"one of {', '.join(LOSSES)}"),
+    Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
+           one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
     Option("seed", 0, "initialisation and batch-order seed, >= 0", count(0), "an integer >= 0", kind=int),
-    Option("restarts", None, "restarts over initialisations, as the claims train LNNs off their qddot ~ 0 plateau: "
-           "this many inits (>= 2) train side by side for --restart-steps steps, the lowest training loss goes on "
-           "for --steps (default: none)", lambda v: v is None or count(2)(v), "an integer >= 2", kind=int),
-    Option("restart_steps", None, "steps of each restart (default: --steps / 8)",
+    Option("restarts", BY_KIND, "restarts over initialisations, as the claims train LNNs off their qddot ~ 0 plateau: "
+           "this many inits (>= 2; 0: none) train side by side for --restart-steps steps, the lowest training loss "
+           "goes on for --steps" + KIND, lambda v: v is None or v == 0 or count(2)(v), "0 or an integer >= 2",
+           kind=int),
+    Option("restart_steps", None, "steps of each restart (default: --steps x the kind's ratio, or / 8)",
            lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
-    Option("restart_keep", None, "successive halving: at half their steps only this many restarts (the lowest "
-           "training losses) go on (default: all)", lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
-    Option("guard_clip", None, "gradient-spike guard: clip the gradient's norm to this (the double-pendulum claims: "
-           "100; default: none)", lambda v: v is None or (real(v) and v > 0), "a number > 0", kind=float),
-    Option("guard_skip", None, "gradient-spike guard: skip a step whose gradient norm is at least this many times "
-           "the recent median (the claims: 10; default: none)", lambda v: v is None or (real(v) and v > 0),
-           "a number > 0", kind=float),
+    Option("restart_keep", BY_KIND, "successive halving: at half their steps only this many restarts (the lowest "
+           "training losses) go on" + KIND, lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
+    Option("restart_batch", BY_KIND, "batch size of the restarts" + KIND + "; --batch where the kind has none",
+           lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
+    Option("restart_lr", None, "peak rate of the restarts' one-cycle (default: --lr x the kind's ratio, or --lr)",
+           lambda v: v is None or (real(v) and v > 0), "a finite number > 0", kind=float),
+    Option("guard_clip", BY_KIND, "gradient-spike guard: clip the gradient's norm to this (0: no clip)" + KIND,
+           lambda v: v is None or (real(v) and v >= 0), "a number >= 0", kind=float),
+    Option("guard_skip", BY_KIND, "gradient-spike guard: skip a step whose gradient norm is at least this many times "
+           "the recent median (0: no skip)" + KIND, lambda v: v is None or (real(v) and v >= 0), "a number >= 0",
+           kind=float),
     Option("delan_eps", 0.01, "DeLaN: epsilon of M = L L^T + eps I", lambda v: real(v) and v >= 0,
            "a finite number >= 0", kind=float),
     Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", real, "a finite number", kind=float),
     Option("angle_wrap", False, "input feature: wrap q to [-pi, pi) before the MLP", switch=True),
+    Option("periodic", (), "input feature: coordinates fed to the network as cos and sin (angles recorded unwrapped); "
+           "e.g. 0,1 (default: none)", lambda v: isinstance(v, tuple | list) and all(count(0)(k) for k in v),
+           "none or comma-separated coordinate indices >= 0 such as 0,1", text="none",
+           parse=lambda t: () if t == "none" else tuple(int(x) if x.strip().isdigit() else x for x in t.split(","))),
     Option("dissipation", False, "lnn, hnn, delan: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: "
            "viscous friction per coordinate) beside the Lagrangian or Hamiltonian, for data that lose energy",
            switch=True),
-    Option("input_scale", None, "input feature: multipliers of the MLP inputs [q, qdot(, qddot)]: none, auto (1 / "
-           "standard deviation over the training rows) or numbers such as 1,1,0.3,0.3",
+    Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q, qdot(, qddot)]: none, auto (1 / "
+           "standard deviation over the training rows) or numbers such as 1,1,0.3,0.3" + KIND,
            lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(real(x) and x > 0 for x in v)),
-           "none, auto or positive numbers such as 1,1,0.3,0.3", parse=scale, text="none"),
+           "none, auto or positive numbers such as 1,1,0.3,0.3", parse=scale),
     Option("system", None, "a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "
            "evaluation compares against (default: none)"),
     Option("energy", None, "your energy function E(q, qdot) as module:function (importable from here; (N, d) "
@@ -162,13 +184,14 @@ def resolve(given: dict) -> SimpleNamespace:
 
 
 def check(values: dict) -> None:
+    """Options left at BY_KIND are not checked here (`kind_defaults.fill` fills and checks them)."""
     for o in OPTIONS:
-        if o.name in values and o.valid is not None and not o.valid(values[o.name]):
+        if o.name in values and values[o.name] is not BY_KIND and o.valid is not None and not o.valid(values[o.name]):
             v = values[o.name]
             shown = ",".join(map(str, v)) if o.name == "hidden" and isinstance(v, tuple) else v
             raise ValueError(f"{o.cli}: {shown!r} is not valid; expected {o.expected}")
     keep, restarts = values.get("restart_keep"), values.get("restarts")
-    if keep is not None and (restarts is None or keep >= restarts):
+    if BY_KIND not in (keep, restarts) and keep is not None and (not restarts or keep >= restarts):
         raise ValueError(f"--restart-keep: {keep!r} needs --restarts above it (the restarts that go on after the "
                          f"first half)")
     if values.get("dissipation") and values.get("model") == "baseline":
@@ -192,18 +215,22 @@ def add_arguments(parser) -> None:
         if o.switch:
             parser.add_argument(o.cli, action="store_true", help=o.help)
         elif o.parse is not None:
-            parser.add_argument(o.cli, default=o.text, help=o.help)
+            parser.add_argument(o.cli, default=None if o.default is BY_KIND else o.text, help=o.help)
         elif o.name == "split":   # no default: the file's kind decides
             parser.add_argument(o.cli, choices=SPLITS, help=o.help)
         else:
-            parser.add_argument(o.cli, type=o.kind, default=o.default, required=o.required, help=o.help)
+            parser.add_argument(o.cli, type=o.kind, default=None if o.default is BY_KIND else o.default,
+                                required=o.required, help=o.help)
 
 
 def from_args(args) -> dict:
+    """The keywords given; an option the model kind sets is left out where its flag is not given."""
     out = {}
     for o in OPTIONS:
         v = getattr(args, o.cli[2:].replace("-", "_"))
         if o.old:
             v = renamed("fit", v, getattr(args, "old_" + o.name), o.text if o.parse is not None else o.default, o.cli, o.old)
+        if v is None and o.default is BY_KIND:
+            continue
         out[o.name] = o.parse(v) if o.parse is not None else v
     return out

@@ -30,9 +30,9 @@ import numpy as np
 
 from replication import results as R
 from replication.claims.base import ModelEntry
+from replication.fit import kind_defaults, trajectories, userdata
 from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
-from replication.fit import trajectories, userdata
 from replication.run.units import Unit, run_unit
 from replication.training.protocol import Data, Guard, Protocol, Scouting
 from replication.training.schedules import Constant, OneCycle
@@ -50,10 +50,13 @@ def task_of(model: str, has_tau: bool, path) -> str:
     return "inverse_dynamics" if has_tau else "acceleration"
 
 
-def auto_scale(reference: str, task: str, kind: str) -> tuple:
-    """1 / the standard deviation of each MLP input over the training rows (1 where it is 0), 6 digits."""
+def auto_scale(reference: str, task: str, kind: str, periodic: tuple = ()) -> tuple:
+    """1 / the standard deviation of each MLP input over the training rows (1 where it is 0), 6 digits; the
+    periodic coordinates' inputs are their cos and sin, in the MLP's layout (`models.spec`)."""
     b = userdata.batch_of(userdata.rows(reference, "train"), task)
-    x = b["q"] if kind == "delan" else np.concatenate([b[k] for k in ("q", "qdot", "extra") if k in b], 1)
+    q = np.concatenate([np.stack([np.cos(c), np.sin(c)], 1) if k in periodic else c[:, None]
+                        for k, c in enumerate(b["q"].T)], 1)
+    x = q if kind == "delan" else np.concatenate([q, *(b[k] for k in ("qdot", "extra") if k in b)], 1)
     sd = np.std(x, axis=0)
     return tuple(float(f"{1.0 / s:.6g}") if s > 0 else 1.0 for s in sd)
 
@@ -86,9 +89,8 @@ class FitSource:
 def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
     their defaults where not given)."""
-    o = fit_options.resolve(options)
+    o, task = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
-    task = _checked_task(o, path)   # every check that needs no work, before the output folder is made
     out = R.output_folder(out, "--out")
     prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps)
     tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test",
@@ -97,10 +99,11 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     n_train = prep.counts["train"]
     data = Data(recipe=prep.reference, n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)))  # the file's split
-    schedule = OneCycle(lr=o.lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
+    schedule = OneCycle(lr=o.lr, start=o.lr_start, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
     batch = min(o.batch, n_train)
-    scouting = Scouting(count=o.restarts, steps=o.restart_steps or max(o.steps // 8, 2), batch=batch, schedule=schedule,
-                        keep=o.restart_keep) if o.restarts else None
+    scouting = Scouting(count=o.restarts, steps=o.restart_steps, batch=min(o.restart_batch, n_train),
+                        schedule=OneCycle(lr=o.restart_lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle"
+                        else Constant(lr=o.restart_lr), keep=o.restart_keep) if o.restarts else None
     guard = Guard(clip=o.guard_clip, skip=o.guard_skip) if (o.guard_clip or o.guard_skip) else None
     protocol = Protocol(data=data, task=task, steps=o.steps, batch=batch, loss=o.loss, l2=o.weight_decay,
                         schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=max(1, o.steps // 100))
@@ -124,22 +127,34 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
 
 
-def _checked_task(o, path: str) -> str:
-    """The task the data and model give, after every check that needs no work done: the options, the
-    input scale's width, the energy function, the test file's columns."""
+def resolved(data, options: dict):
+    """(options with the model kind's defaults filled in (`replication.fit.kind_defaults`), the task the data
+    and model give), after every check that needs no work done: the options, the input scale's width, the
+    energy function, the test file's columns."""
+    o = fit_options.resolve(options)
+    path = str(Path(data).resolve())
     fit_options.check(vars(o))
     if o.split is not None:
         fit_data.check_options(o.split, o.heldout)
     trajectories.check_options(o.window, o.polyorder)
     raw = userdata.read(path)[1]
     task = task_of(o.model, "tau" in raw, path)
+    o = kind_defaults.fill(o, task)
+    if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
+        from models import ModelSpec
+        try:
+            ModelSpec(kind=o.model, dof=raw["q"].shape[1], periodic=tuple(o.periodic), angle_wrap=bool(o.angle_wrap))
+        except ValueError as e:
+            raise ValueError(f"--periodic: {e}") from None
     if isinstance(o.input_scale, tuple):
         dof = raw["q"].shape[1]
         width = dof if o.model == "delan" else 3 * dof if task == "inverse_dynamics" else 2 * dof
+        width += len(o.periodic)
         if len(o.input_scale) != width:
             names = "q" if o.model == "delan" else "q, qdot, qddot" if task == "inverse_dynamics" else "q, qdot"
+            periodic = f"; cos and sin of q_{', q_'.join(map(str, o.periodic))} in place of each" if o.periodic else ""
             raise ValueError(f"--input-scale: {len(o.input_scale)} numbers given; this {o.model}'s MLP takes {width} "
-                             f"inputs ({names}, {dof} each)")
+                             f"inputs ({names}, {dof} each{periodic})")
     if o.energy:  # importable and of the right shape, before any work
         from replication.fit.evaluate import energy_function
 
@@ -150,7 +165,7 @@ def _checked_task(o, path: str) -> str:
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return task
+    return o, task
 
 
 def _model_spec(o, prep, task: str) -> dict:
@@ -163,6 +178,9 @@ def _model_spec(o, prep, task: str) -> dict:
         spec["dissipation"] = True
     if task == "inverse_dynamics" and o.model == "baseline":
         spec["extra_inputs"] = prep.dof
+    if o.periodic:
+        spec["periodic"] = tuple(o.periodic)
     if o.input_scale is not None:
-        spec["input_scale"] = auto_scale(prep.reference, task, o.model) if o.input_scale == "auto" else o.input_scale
+        spec["input_scale"] = (auto_scale(prep.reference, task, o.model, tuple(o.periodic)) if o.input_scale == "auto"
+                               else o.input_scale)
     return spec

@@ -16,7 +16,6 @@ from pathlib import Path
 import pandas as pd
 
 from replication import results as R
-from replication.fit import options as fit_options
 from replication.tuning import search
 
 
@@ -26,9 +25,9 @@ def _score(record: dict) -> float | None:
 
 
 def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progress=None, **options):
-    from replication.fit.task import fit
+    from replication.fit.task import fit, resolved
 
-    o = fit_options.resolve(options)
+    o = resolved(data, options)[0]   # the model kind's defaults where not given
     if not o.heldout or o.split == "none":
         raise ValueError("--tune: needs held-out rows of the training data to choose by (--holdout-fraction > 0 "
                          "and --holdout other than none); the test file is never read while choosing")

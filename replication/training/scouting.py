@@ -215,8 +215,8 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     best = choose(tails)
     record = {"init_seeds": seeds, "tail_loss": tails, "scout_steps": per, **record,
               "chosen": None if best is None else seeds[best]}
-    if best is None:   # every scout stopped: the first one's failure stands for the run
-        o = outcomes[0]
+    if best is None:   # every scout stopped: the first failure stands for the run (not a scout left at the cut)
+        o = next((x for x in outcomes if x.failure), outcomes[0])
         o.scouting, o.steps_done = record, sum(x.steps_done for x in outcomes)
         o.samples = o.steps_done * o.batch
         return o

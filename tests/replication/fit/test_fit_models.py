@@ -41,7 +41,7 @@ def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
                "delan_offset": 1.0, "input_scale": "auto"}
     d = fit(data, model="delan", out=tmp_path / "out", split="none", test=_arm_trajectories(tmp_path / "t.csv", 2),
             **options, **TINY)
-    assert d["status"] == "ok" and d["protocol"]["task"] == "inverse_dynamics" and d["metric"] == "test_l1"
+    assert d["status"] == "ok" and d["protocol"]["task"] == "inverse_dynamics" and d["metric"] == "test_mse"  # the kind's loss
     p, s = d["protocol"], d["model_spec"]
     assert (s["activation"], p["l2"], p["schedule"]["kind"], s["delan_eps"], s["delan_diag_offset"]) == ("tanh", 1e-5,
                                                                                                  "constant", 0.1, 1.0)

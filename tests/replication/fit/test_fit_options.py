@@ -3,6 +3,7 @@ function's, every option is checked by its own rule, and an unknown keyword is r
 import pytest
 
 from replication.cli import build_parser
+from replication.fit import kind_defaults
 from replication.fit import options as fit_options
 from replication.fit.task import fit
 
@@ -10,7 +11,8 @@ from replication.fit.task import fit
 def test_the_command_lines_defaults_are_the_functions():
     args = build_parser().parse_args(["fit", "--data", "d.csv", "--model", "lnn"])
     given = fit_options.from_args(args)
-    assert set(given) == set(fit_options.BY_NAME)
+    by_kind = {o.name for o in fit_options.OPTIONS if o.default is fit_options.BY_KIND}
+    assert set(given) == set(fit_options.BY_NAME) - by_kind   # the kind's defaults come in after the data is read
     assert vars(fit_options.resolve(given)) == vars(fit_options.resolve({"model": "lnn"}))
 
 
@@ -20,7 +22,9 @@ def test_every_flag_is_in_the_help_with_its_default(capsys):
     out = " ".join(capsys.readouterr().out.split())
     for o in fit_options.OPTIONS:
         assert o.cli in out
-        if not o.switch and o.default is not None and not o.required:
+        if o.default is fit_options.BY_KIND:
+            assert " ".join(o.help.split()) in out and fit_options.KIND.strip() in o.help, o.name
+        elif not o.switch and o.default is not None and not o.required:
             shown = o.text if o.parse is not None else o.default
             assert f"(default: {shown})" in out, o.name
 
@@ -36,3 +40,39 @@ def test_each_option_is_checked_by_its_own_rule(name, value):
 def test_an_unknown_keyword_is_refused(tmp_path):
     with pytest.raises(TypeError, match="unknown options stepz"):
         fit(tmp_path / "d.csv", out=tmp_path / "o", stepz=3)
+
+
+@pytest.mark.parametrize("kind, task", sorted(kind_defaults.SOURCES))
+def test_a_fit_at_its_defaults_trains_as_the_claim_that_tuned_its_kind(tmp_path, kind, task):
+    """The protocol `fit` builds from the kind's defaults is the claim's quick protocol with its adopted tuning
+    in every training part (schedule, restarts and their halving, guard, batch, steps, loss, L2, width)."""
+    from replication.claims.base import per_profile
+    from replication.fit import task as fit_task
+    from replication.training.protocol import Guard, Scouting
+    from replication.training.schedules import Constant, OneCycle
+
+    claim, entry, p = kind_defaults._entry(kind, task)
+    assert p == entry.protocol(per_profile(claim.protocols, "quick"), "quick")
+    o = kind_defaults.fill(fit_options.resolve({"model": kind}), task)
+    schedule = OneCycle(lr=o.lr, start=o.lr_start, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(o.lr)
+    assert (schedule, o.steps, o.batch, o.loss, o.weight_decay) == (p.schedule, p.steps, p.batch, p.loss, p.l2)
+    assert o.hidden == entry.widths("quick") and o.activation == entry.spec_fields("quick")["activation"]
+    assert (Guard(o.guard_clip, o.guard_skip) if o.guard_clip else None) == p.guard
+    scouting = Scouting(o.restarts, o.restart_steps, o.restart_batch, OneCycle(lr=o.restart_lr, min_ratio=o.lr_min_ratio),
+                        o.restart_keep) if o.restarts else None
+    assert scouting == p.scouting
+    assert (o.input_scale == "auto") == ("input_scale" in entry.spec_fields("quick"))
+    assert fit_task.LOSS_NAMES[o.loss]
+
+
+def test_a_given_option_beats_the_kinds_default_and_zero_turns_a_part_off():
+    o = kind_defaults.fill(fit_options.resolve({"model": "lnn", "steps": 300, "lr": 0.02, "restarts": 4,
+                                                "guard_clip": 0}), "acceleration")
+    d = kind_defaults.defaults("lnn", "acceleration")
+    assert (o.steps, o.lr, o.restarts, o.guard_clip, o.guard_skip) == (300, 0.02, 4, None, d["guard_skip"])
+    assert o.restart_keep is None   # the kind keeps 4 of 16: not of 4
+    assert o.restart_steps == round(300 * d["restart_fraction"]) and o.restart_lr == pytest.approx(0.02 * d["restart_lr_ratio"])
+    off = kind_defaults.fill(fit_options.resolve({"model": "lnn", "restarts": 0}), "acceleration")
+    assert (off.restarts, off.restart_keep) == (None, None)
+    with pytest.raises(ValueError, match="^--restarts: 1 is not valid"):
+        kind_defaults.fill(fit_options.resolve({"model": "lnn", "restarts": 1}), "acceleration")

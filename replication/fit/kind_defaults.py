@@ -1,0 +1,105 @@
+"""`lagbench fit`'s defaults per model kind, read from the suite's own protocols.
+
+A fit trains as the claim that tuned its kind does: the registered protocol of that claim's model under the
+`quick` profile with its adopted `lagbench tune` choice (`replication.claims.get` applies it), so the LNN
+gets the double-pendulum claims' restarts over initialisations with halving, their gradient-spike guard,
+schedule, width and budget, and a change of a claim's protocol or tuning moves these defaults with it.
+
+`SOURCES`: (kind, task) -> (claim id, model label): the LNN and an acceleration baseline from claim 1 (the
+double pendulum, where the q-double-dot plateau is), the HNN from the HNN claim's pendulum, DeLaN and an
+inverse-dynamics baseline (data with tau) from the two-link arm's claim.
+`defaults(kind, task) -> dict`: fit option name -> value for every option in `FROM_PROTOCOL`, and the
+restarts' `restart_fraction` (their steps / the protocol's) and `restart_lr_ratio` (their peak / the protocol's).
+`source(kind, task) -> str`: where they come from, for the console and the result's record.
+
+What the claims set for their system rather than for training stays the user's choice: wrapping angles
+(the double pendulum's q are angles; a user's may not be), and the claims' fixed input scale becomes
+`--input-scale auto` (1 / each input's standard deviation over the training rows) where a claim scales its
+inputs. The restarts' length and peak rate follow `--steps` and `--lr` in the claim's proportions (as a
+tuned rate scales a claim's restarts with it); their one-cycle starts at OneCycle's default phase, as the
+claims' restarts do.
+"""
+from __future__ import annotations
+
+from functools import cache
+
+from replication.training.schedules import OneCycle
+
+PROFILE = "quick"
+SOURCES = {("lnn", "acceleration"): ("dp_loss", "lnn"), ("baseline", "acceleration"): ("dp_loss", "baseline"),
+           ("hnn", "hamiltonian"): ("hnn_energy", "hnn_pendulum"), ("delan", "inverse_dynamics"): ("delan_arm", "delan"),
+           ("delan", "acceleration"): ("delan_arm", "delan"), ("baseline", "inverse_dynamics"): ("delan_arm", "ff")}
+FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr_start", "lr_min_ratio", "weight_decay",
+                 "loss", "restarts", "restart_keep", "restart_batch", "guard_clip", "guard_skip", "input_scale")
+
+
+def _entry(kind: str, task: str):
+    from replication.claims import get
+    from replication.claims.base import per_profile
+
+    claim_id, label = SOURCES[(kind, task)]
+    claim = get(claim_id)
+    entry = next(m for m in claim.models if m.label == label)
+    return claim, entry, entry.protocol(per_profile(claim.protocols, PROFILE), PROFILE)
+
+
+@cache
+def _defaults(kind: str, task: str) -> tuple:
+    _, entry, p = _entry(kind, task)
+    one_cycle = isinstance(p.schedule, OneCycle)
+    s = p.scouting
+    if s is not None and isinstance(s.schedule, OneCycle) and s.schedule.start != OneCycle.start:
+        raise ValueError(f"{kind}: the claim's restarts start their one-cycle at phase {s.schedule.start}; fit's start at "
+                         f"{OneCycle.start}")
+    out = {"steps": p.steps, "batch": p.batch, "hidden": entry.widths(PROFILE),
+           "activation": entry.spec_fields(PROFILE).get("activation", "softplus"),
+           "lr": p.schedule.lr, "schedule": "onecycle" if one_cycle else "constant",
+           "lr_start": p.schedule.start if one_cycle else OneCycle.start,
+           "lr_min_ratio": p.schedule.min_ratio if one_cycle else OneCycle.min_ratio,
+           "weight_decay": p.l2, "loss": p.loss,
+           "restarts": s.count if s else None, "restart_keep": s.keep if s else None,
+           "restart_batch": s.batch if s else None,
+           # the restarts' length and peak rate as fractions of the fit's --steps and --lr
+           "restart_fraction": s.steps / p.steps if s else None, "restart_lr_ratio": s.schedule.lr / p.schedule.lr if s else None,
+           "guard_clip": p.guard.clip if p.guard else None, "guard_skip": p.guard.skip if p.guard else None,
+           "input_scale": "auto" if entry.spec_fields(PROFILE).get("input_scale") is not None else None}
+    return tuple(out.items())
+
+
+def defaults(kind: str, task: str) -> dict:
+    """Fit option -> value, as the claim that tuned this kind trains it under `quick`."""
+    return dict(_defaults(kind, task))
+
+
+def source(kind: str, task: str) -> str:
+    claim, entry, _ = _entry(kind, task)
+    return f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
+
+
+def fill(o, task: str):
+    """The options `o` (`options.resolve`'s namespace) with every BY_KIND value set from `defaults(o.model,
+    task)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch and peak rate
+    from --steps, --batch and --lr where not given; then checked as a whole."""
+    from types import SimpleNamespace
+
+    from replication.fit import options as fit_options
+
+    d, v = defaults(o.model, task), dict(vars(o))
+    given = {k for k, x in v.items() if x is not fit_options.BY_KIND}
+    fit_options.check({k: v[k] for k in given})   # the given values (the defaults are valid)
+    v.update({k: d[k] for k in FROM_PROTOCOL if k not in given})
+    for k in ("restarts", "guard_clip", "guard_skip"):
+        if v[k] == 0:
+            v[k] = None
+    if not v["restarts"]:
+        v.update(restarts=None, restart_keep=None if "restart_keep" not in given else v["restart_keep"])
+    elif "restart_keep" not in given and v["restart_keep"] is not None and v["restart_keep"] >= v["restarts"]:
+        v["restart_keep"] = None   # the kind's halving does not fit fewer restarts than it keeps
+    if v["restarts"]:
+        v["restart_steps"] = v["restart_steps"] or max(2, round(v["steps"] * (d["restart_fraction"] or 1 / 8)))
+        v["restart_batch"] = v["restart_batch"] or v["batch"]
+        v["restart_lr"] = v["restart_lr"] or v["lr"] * (d["restart_lr_ratio"] or 1.0)
+    if isinstance(v["hidden"], list):
+        v["hidden"] = tuple(v["hidden"])
+    fit_options.check(v)   # the relations (restarts and their halving) with the defaults in
+    return SimpleNamespace(**v)
