@@ -106,7 +106,8 @@ def cmd_fit(args):
         for bar in bars:
             bar.close()
         rollouts.close()
-    folder = Path(args.out) / "units" / "fit" / args.framework / args.model / f"seed{args.seed}"
+    label = args.model + ("_dissipative" if args.dissipation else "")   # a dissipative fit's own folder
+    folder = Path(args.out) / "units" / "fit" / args.framework / label / f"seed{args.seed}"
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
         return 1

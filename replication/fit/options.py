@@ -156,8 +156,9 @@ OPTIONS = (
     Option("dissipation", False, "lnn, hnn, delan: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: "
            "viscous friction per coordinate) beside the Lagrangian or Hamiltonian, for data that lose energy",
            switch=True),
-    Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q, qdot(, qddot)]: none, auto (1 / "
-           "standard deviation over the training rows) or numbers such as 1,1,0.3,0.3" + KIND,
+    Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q (cos, sin for --periodic), "
+           "qdot(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as 1,1,0.3,0.3"
+           + KIND,
            lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(real(x) and x > 0 for x in v)),
            "none, auto or positive numbers such as 1,1,0.3,0.3", parse=scale),
     Option("system", None, "a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "

@@ -1,6 +1,6 @@
 """The dissipative fit of docs/fit.md ('Friction: a dissipative fit'), run as written from its own text: on a
 pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction and rolls
-out better than the conservative LNN, which cannot lose energy, and than the baseline."""
+out better than the conservative LNN, which cannot lose energy; the baseline, trained alike, tracks best."""
 import json
 import re
 import shlex
@@ -26,7 +26,7 @@ def metrics(tmp_path_factory):
         for args in commands:
             assert main([*args, "--quiet"] if args[0] == "fit" else args) == 0, args
     report = (folder / "report" / "friction" / "REPORT.md").read_text()
-    assert "Recommended on this data: lnn_dissipative (jax, seed 0)" in report   # 2 x better than the rest
+    assert "Recommended on this data: baseline (jax, seed 0)" in report   # the others over 2 x its rollout error
     return {p.parts[-3]: json.loads(p.read_text())["metrics"]
             for p in folder.glob("results/friction/units/fit/*/*/seed0/result.json")}
 
@@ -37,10 +37,10 @@ def test_the_dissipative_lnn_recovers_the_friction(metrics):
     assert "test_dissipation_coefficient_0" not in metrics["lnn"]
 
 
-def test_it_rolls_out_better_than_the_conservative_lnn_and_the_baseline(metrics):
+def test_it_rolls_out_better_than_the_conservative_lnn(metrics):
     d, lnn, base = metrics["lnn_dissipative"], metrics["lnn"], metrics["baseline"]
     assert d["test_rollout_gmean_err"] < 0.5 * lnn["test_rollout_gmean_err"]
-    assert d["test_rollout_gmean_err"] < base["test_rollout_gmean_err"]
+    assert base["test_rollout_gmean_err"] < 0.5 * d["test_rollout_gmean_err"]   # as the doc's table says
     assert d["test_l1"] < 0.1 * d["null_test_l1"]
     # the conservative LNN keeps the energy the pendulum loses
     assert lnn["test_energy_err_final"] > 5 * d["test_energy_err_final"]

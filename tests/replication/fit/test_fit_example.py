@@ -75,6 +75,6 @@ def test_the_worked_example_as_written_gives_what_the_readme_says(tmp_path, monk
     metrics = _run(tmp_path, monkeypatch, small=False)
     lnn, base = metrics[("fit", "jax", "lnn")], metrics[("fit", "jax", "baseline")]
     assert lnn["test_energy_err_final"] < base["test_energy_err_final"]
-    assert lnn["test_rollout_gmean_err"] < base["test_rollout_gmean_err"]
+    assert lnn["test_rollout_gmean_err"] < 1.5 * base["test_rollout_gmean_err"]   # about equal, as the page says
     assert lnn["test_l1"] < lnn["null_test_l1"] / 2 and base["test_l1"] < base["null_test_l1"] / 2
     assert lnn["test_learned_energy_drift"] < 1e-4 * lnn["test_energy_err_final"]  # RK4 keeps its own energy
