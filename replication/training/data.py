@@ -17,6 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 import systems
+from systems.arm_data import ARMS  # arm recipes by name
 
 HELDOUT_SEED = 1_000_000_000  # the original code's PRNGKey(int(1e9)) test set, by analogy
 
@@ -103,12 +104,16 @@ def recipe_iid(protocol, n, rng):
 
 
 def recipe_arm(protocol, n, rng, kind="train"):
-    """Two-link arm inverse dynamics along smooth trajectories: inputs q, qdot, extra=qddot, target tau."""
+    """An arm's inverse dynamics along smooth trajectories (the recipe names the arm: `two_link_arm`, or
+    `four_joint_arm`): inputs q, qdot, extra=qddot, target tau, each (n, dof)."""
     from systems.datasets import arm_dataset
 
     n_traj = arm_trajectories(n)
-    d = arm_dataset(kind=kind, n_traj=n_traj, n_points=-(-n // n_traj), seed=int(rng.integers(2**31)))
-    q, qdot, qddot, tau = (np.asarray(d[k]).reshape(-1, 2)[:n] for k in ("q", "qdot", "qddot", "tau"))
+    arm = next(a for a in ARMS if protocol.data.recipe.startswith(a))
+    other = {} if arm == "two_link_arm" else {"system": arm}   # the two-link arm's cache keys as they are
+    d = arm_dataset(kind=kind, n_traj=n_traj, n_points=-(-n // n_traj), seed=int(rng.integers(2**31)), **other)
+    dof = np.asarray(d["q"]).shape[-1]
+    q, qdot, qddot, tau = (np.asarray(d[k]).reshape(-1, dof)[:n] for k in ("q", "qdot", "qddot", "tau"))
     return {"q": q, "qdot": qdot, "extra": qddot, "target": tau, "qddot": qddot}
 
 
@@ -127,9 +132,9 @@ def recipe_for(protocol):
         return recipe_file
     if protocol.data.recipe.endswith("_iid"):
         return recipe_iid
-    if protocol.data.recipe.startswith("two_link_arm"):
+    if protocol.data.recipe.startswith(ARMS):
         return recipe_arm
-    raise ValueError(f"unknown data recipe {protocol.data.recipe!r}; valid: <system>_iid, two_link_arm")
+    raise ValueError(f"unknown data recipe {protocol.data.recipe!r}; valid: <system>_iid, {', '.join(ARMS)}")
 
 
 def heldout(protocol, seed: int = HELDOUT_SEED, **kw) -> dict:

@@ -22,3 +22,14 @@ def test_the_training_cache_key_changes_with_the_pool_rule_and_only_for_small_po
     assert datamod.targets_version(ARM) == "arm-min-8-trajectories"
     assert datamod.targets_version(ARM.replace(**{"data.n_train": 4096})) == ""
     assert datamod.targets_version(ARM.replace(**{"data.n_train": 1600})) == ""
+
+
+def test_the_four_joint_arm_is_a_recipe_of_its_own():
+    """A protocol whose data recipe names the four-joint arm draws its trajectories: 4 columns, exact torques."""
+    four = ARM.replace(**{"data.recipe": "four_joint_arm"})
+    assert datamod.recipe_for(four) is datamod.recipe_arm
+    pool = datamod.recipe_arm(four, 64, np.random.default_rng(0))
+    assert all(pool[k].shape == (64, 4) for k in ("q", "qdot", "extra", "target"))
+    assert np.isfinite(pool["target"]).all() and np.ptp(pool["q"], 0).min() > 0
+    two = datamod.recipe_arm(ARM, 64, np.random.default_rng(0))
+    assert two["q"].shape == (64, 2)
