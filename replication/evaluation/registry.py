@@ -4,6 +4,7 @@
 is not current (the runner re-evaluates it, reusing its cached training). Raise it whenever a routine
 changes what a metric means or adds one a verdict reads."""
 from replication.evaluation.arm import eval_arm
+from replication.evaluation.control import eval_control
 from replication.evaluation.exact import eval_exact_lagrangian
 from replication.evaluation.pace import eval_pace
 from replication.evaluation.precision import eval_precision
@@ -19,4 +20,4 @@ EVALUATION_VERSION = 3
 EVALUATIONS = {"heldout": eval_heldout, "heldout_trajectories": eval_heldout_trajectories, "pace": eval_pace,
                "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,
-               "precision": eval_precision, "fit": eval_fit}
+               "precision": eval_precision, "fit": eval_fit, "control": eval_control}

@@ -168,3 +168,12 @@ def test_a_missing_adopted_tuning_file_is_an_error(tmp_path, monkeypatch):
             tuned.records()
     finally:
         tuned.records.cache_clear()
+
+
+def test_the_control_claim_trains_claim_9s_models_with_its_choice(record_file):
+    adopt.adopt(_write(record_file, _ledger("delan_arm", profile="smoke", knobs={"lr": 3.0, "width": 0.5})))
+    arm, control = (tuned.apply(untuned(c)) for c in ("delan_arm", "delan_control"))
+    for label in ("delan", "ff"):
+        a, b = arm.entry(label), control.entry(label)
+        assert a.widths("smoke") == b.widths("smoke") == tuple(w // 2 for w in untuned("delan_arm").entry(label).widths("smoke"))
+        assert a.protocol(arm.protocol("smoke"), "smoke") == b.protocol(control.protocol("smoke"), "smoke")
