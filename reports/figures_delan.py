@@ -1,6 +1,6 @@
 """The DeLaN paper's figures recreated from a claim's arrays: the torque decomposition (inertial,
-Coriolis/centrifugal, gravity: predicted against true) and the torque traces per joint on trajectories
-the models never saw, truth against each model."""
+Coriolis/centrifugal, gravity: predicted against true), the torque traces per joint on trajectories
+the models never saw, truth against each model, and closed-loop tracking of an unseen reference."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -74,4 +74,40 @@ def torque_traces(units: list[Unit], path: Path) -> bool:
         ax.set_ylabel(f"torque joint {j + 1} (N m)")
     axes[0].legend(fontsize=7)
     fig.suptitle("Inverse dynamics on unseen trajectories: torque per joint")
+    return save(fig, path)
+
+
+def tracking(units: list[Unit], path: Path) -> bool:
+    """Closed-loop tracking of the first unseen reference (claim 12's `test_t`, `test_q_ref`, `test_q`): each
+    joint's reference against the angle each learned controller executed (first seed of each model and
+    framework), and the tracking error's norm over time on a log axis."""
+    found = {}
+    for (model, fw), group in _groups(units).items():
+        for u in sorted(group, key=lambda u: str(u.seed)):
+            arr = u.arrays() or {}
+            if {"test_t", "test_q_ref", "test_q"} <= set(arr):
+                found[(model, fw)] = arr
+                break
+    if not found:
+        return False
+    first = next(iter(found.values()))
+    t, ref = np.asarray(first["test_t"], float), np.asarray(first["test_q_ref"], float)
+    dof = ref.shape[-1]
+    fig, axes = new_figure(ncols=dof + 1, width=3.4 * (dof + 1), height=3.2)
+    models, fws = model_colours([k[0] for k in found]), style_index([k[1] for k in found])
+    for j in range(dof):
+        axes[j].plot(t, ref[:, j], color="k", lw=2, alpha=0.5, label="reference")
+        axes[j].set_xlabel("time (s)")
+        axes[j].set_ylabel(f"joint {j + 1} angle (rad)")
+    for (model, fw), arr in found.items():
+        q = np.asarray(arr["test_q"], float)
+        style = {"color": models[model], "ls": LINESTYLES[fws[fw] % 4], "lw": 1, "label": f"{model} ({fw})"}
+        for j in range(dof):
+            axes[j].plot(t, q[:, j], **style)
+        axes[dof].plot(t, np.maximum(np.linalg.norm(q - ref, axis=-1), 1e-12), **style)
+    axes[dof].set_yscale("log")
+    axes[dof].set_xlabel("time (s)")
+    axes[dof].set_ylabel("|q - q_ref| (rad)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Computed-torque tracking of an unseen reference at 500 Hz")
     return save(fig, path)

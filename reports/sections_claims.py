@@ -168,6 +168,9 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
                                         "against the truth's, log axis", "timeseries.csv"),
         ("torques", FD.torque_traces, "Torque per joint on the unseen trajectories: truth against each model "
                                       "trained on the full data set (first seed)", "arrays.npz"),
+        ("tracking", FD.tracking, "Computed-torque tracking at 500 Hz of the first unseen reference: each joint's "
+                                  "reference against the executed angle, and the error's norm (log axis), per learned "
+                                  "controller (first seed)", "arrays.npz"),
         ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
                                                  "(predicted against true)", "arrays.npz"),
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
