@@ -65,10 +65,10 @@ def linear_span(ax, axis: str = "y") -> float:
 def save(fig: Figure, path: Path) -> bool:
     """Render to memory, then replace ``path`` atomically (never writing through a symlink there). A linear
     axis whose positive values span more than `LINEAR_DECADES` becomes a log axis first (one outlier must not
-    flatten every other curve)."""
+    flatten every other curve), unless the figure marks it linear (`ax.keep_linear`, e.g. a time axis)."""
     for ax in fig.axes:
         for axis in ("x", "y"):
-            if linear_span(ax, axis) > LINEAR_DECADES:
+            if axis not in getattr(ax, "keep_linear", ()) and linear_span(ax, axis) > LINEAR_DECADES:
                 (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI)

@@ -95,6 +95,8 @@ def tracking(units: list[Unit], path: Path) -> bool:
     dof = ref.shape[-1]
     fig, axes = new_figure(ncols=dof + 1, width=3.4 * (dof + 1), height=3.2)
     models, fws = model_colours([k[0] for k in found]), style_index([k[1] for k in found])
+    for ax in axes:
+        ax.keep_linear = ("x",)   # time from 0: a linear axis
     for j in range(dof):
         axes[j].plot(t, ref[:, j], color="k", lw=2, alpha=0.5, label="reference")
         axes[j].set_xlabel("time (s)")

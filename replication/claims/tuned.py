@@ -29,7 +29,7 @@ from replication.claims.base import PROFILES, per_profile
 
 FILE = Path(__file__).with_name("tuned.json")
 # claim -> (the claim whose tuning it takes, {its label: that claim's label}); the claims share trainings
-SHARED = {"dp_energy": ("dp_loss", {}), "delan_control": ("delan_arm", {}),
+SHARED = {"dp_energy": ("dp_loss", {}), "delan_tracking": ("delan_arm", {}),
           "precision": ("dp_loss", {f"{m}_{d}": m for m in ("lnn", "baseline") for d in ("f32", "f64")})}
 
 

@@ -1,5 +1,5 @@
 """The two-link arm's models and protocols, shared by claim 9 (torque prediction, `delan_arm`) and claim 12
-(tracking control, `delan_control`), which train the same full-data models once.
+(tracking control, `delan_tracking`), which train the same full-data models once.
 
 Protocol after the original PyTorch example (reference delan §3): 2 x 64 softplus, batch 512,
 Adam lr 5e-4, weight decay 1e-5 (as an L2 term), torque MSE; trained on one family of smooth

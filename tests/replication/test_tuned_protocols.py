@@ -172,7 +172,7 @@ def test_a_missing_adopted_tuning_file_is_an_error(tmp_path, monkeypatch):
 
 def test_the_control_claim_trains_claim_9s_models_with_its_choice(record_file):
     adopt.adopt(_write(record_file, _ledger("delan_arm", profile="smoke", knobs={"lr": 3.0, "width": 0.5})))
-    arm, control = (tuned.apply(untuned(c)) for c in ("delan_arm", "delan_control"))
+    arm, control = (tuned.apply(untuned(c)) for c in ("delan_arm", "delan_tracking"))
     for label in ("delan", "ff"):
         a, b = arm.entry(label), control.entry(label)
         assert a.widths("smoke") == b.widths("smoke") == tuple(w // 2 for w in untuned("delan_arm").entry(label).widths("smoke"))

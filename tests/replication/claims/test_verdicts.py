@@ -35,7 +35,7 @@ def _metrics(cid, label, good: bool) -> dict:
     if cid == "delan_arm":
         out = {"torque_mse_test": win if label.startswith("delan") else lose, "torque_mse_train": 1.0}
         return out | ({"mass_matrix_min_eig": 0.1 if good else -0.1} if label == "delan" else {})
-    if cid == "delan_control":
+    if cid == "delan_tracking":
         return {"tracking_mse_test": win if label == "delan" else lose,
                 "tracking_mse_train_x2": win if label == "delan" else lose}
     if cid == "hnn_energy":

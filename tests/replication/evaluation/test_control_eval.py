@@ -42,7 +42,7 @@ def test_a_null_model_is_pd_alone_and_fails_the_bar():
     m = _evaluate(lambda q, v, a: np.zeros_like(q))
     for f in FAMILIES:
         assert m[f"tracking_mse_{f}"] == pytest.approx(m[f"null_tracking_mse_{f}"], rel=1e-12)
-    bar = get("delan_control").bars[0]
+    bar = get("delan_tracking").bars[0]
     stats = {k: Stat.of([v]) for k, v in m.items()}
     ok, _, per = competence((bar,), {"delan": stats, "ff": stats})
     assert not ok and not per["delan"][0]

@@ -22,7 +22,7 @@ METRIC = "tracking_mse_test"
 EVAL = {"smoke": {"n_refs": 2, "duration": 0.5}, "quick": {"n_refs": 8, "duration": 4.0},
         "full": {"n_refs": 8, "duration": 4.0}, "paper": {"n_refs": 8, "duration": 4.0}}
 CLAIM = Claim(
-    id="delan_control", number=12, paper="DeLaN", section="§5, tracking control of the 2-link arm",
+    id="delan_tracking", number=12, paper="DeLaN", section="§5, tracking control of the 2-link arm",
     title="DeLaN's inverse model tracks unseen and faster references better than a feed-forward net's",
     system="two_link_arm", models=MODELS, protocols=arm.PROTOCOLS, evaluate="control",
     metric=METRIC, metric_label="tracking MSE of the joint angles (rad^2) on unseen (test-family) references, "
