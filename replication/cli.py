@@ -192,6 +192,8 @@ def build_parser():
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_run)
     from replication.studies.control_cli import add_command as add_control
+    from replication.studies.online_cli import add_command as add_online
+    from replication.studies.robustness_cli import add_command as add_robustness
     from replication.tuning.cli import add_command as add_tune
 
     add_tune(sub)
@@ -238,6 +240,8 @@ def build_parser():
                    "stiff_chain)")
     s.set_defaults(func=cmd_stiff)
     add_control(sub)
+    add_online(sub)
+    add_robustness(sub)
     return p
 
 

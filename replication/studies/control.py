@@ -14,6 +14,7 @@ accelerations x 4). Controllers: each learned inverse model of claim 9 trained o
 model can give) and PD alone (tau_hat = 0, the null controller). Gains are fixed and declared (`KP`,
 `KD`), low enough that the feed-forward term has to do most of the work, as in the paper.
 
+`hold(plant, q, v, tau, h)` is the plant over one control period (the online study's too, `online.py`);
 `track(inverse, refs, ...) -> dict` simulates one controller; `control_study(results, ...) -> DataFrame`
 runs every controller on every family; `write_study(results, folder)` (`lagbench control`, into
 RESULTS/control) writes FOLDER/tracking.csv (one row per controller, framework, seed and family: tracking
@@ -48,21 +49,38 @@ def references(family: str, n: int = N_REFS, duration: float = DURATION, rate: f
     return {"t": d["t"] / k, "q": d["q"], "qdot": d["qdot"] * k, "qddot": d["qddot"] * k * k}
 
 
-def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=KP, kd=KD) -> dict:
+def hold(plant, q, v, tau, h: float, substeps: int = SUBSTEPS):
+    """The plant over one control period under the held torque: `substeps` RK4 steps of h seconds on (B, dof)
+    float64 states. Returns q, v at the period's end and the acceleration at its start (what the plant does
+    under tau at the tick: the measured q-double-dot of an online learner's sample)."""
+    def f(q_, v_):
+        return v_, plant.acceleration(q_, v_, tau=tau)
+
+    a0 = None
+    for _ in range(substeps):   # RK4 under the held torque
+        k1 = f(q, v)
+        a0 = k1[1] if a0 is None else a0
+        k2 = f(q + 0.5 * h * k1[0], v + 0.5 * h * k1[1])
+        k3 = f(q + 0.5 * h * k2[0], v + 0.5 * h * k2[1])
+        k4 = f(q + h * k3[0], v + h * k3[1])
+        q = q + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        v = v + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+    return q, v, a0
+
+
+def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=KP, kd=KD, plant=None) -> dict:
     """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, 2)
-    float64 arrays, or None for PD alone. Returns q, tau (B, T, 2) and a diverged mask (B,)."""
+    float64 arrays, or None for PD alone; `plant` anything with `.acceleration(q, qdot, tau=)` (default the
+    SymPy two-link arm). Returns q, tau (B, T, 2) and a diverged mask (B,)."""
     import systems
 
-    plant = systems.get("two_link_arm")
+    plant = plant or systems.get("two_link_arm")
     qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
     b, n_t, dof = qd.shape
     q, v = qd[:, 0].copy(), vd[:, 0].copy()
     h = 1.0 / rate / substeps
     qs, taus = np.zeros((b, n_t, dof)), np.zeros((b, n_t, dof))
     bad = np.zeros(b, bool)
-
-    def f(q_, v_, tau):
-        return v_, plant.acceleration(q_, v_, tau=tau)
 
     for i in range(n_t):
         qs[:, i] = q
@@ -73,13 +91,7 @@ def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=
         if i == n_t - 1:
             break
         with np.errstate(over="ignore", invalid="ignore"):   # a diverging state is caught below
-            for _ in range(substeps):   # RK4 under the held torque
-                k1 = f(q, v, tau)
-                k2 = f(q + 0.5 * h * k1[0], v + 0.5 * h * k1[1], tau)
-                k3 = f(q + 0.5 * h * k2[0], v + 0.5 * h * k2[1], tau)
-                k4 = f(q + h * k3[0], v + h * k3[1], tau)
-                q = q + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-                v = v + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+            q, v, _ = hold(plant, q, v, tau, h, substeps)
             now = ~np.isfinite(q).all(-1) | ~np.isfinite(v).all(-1) | (np.abs(np.c_[q, v]) > DIVERGED).any(-1)
         bad |= now
         q[bad], v[bad] = qd[bad, i + 1], vd[bad, i + 1]   # parked on the reference; scored as diverged
