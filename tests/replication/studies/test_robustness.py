@@ -37,6 +37,8 @@ def test_a_tiny_run_writes_the_declared_tables_and_the_figure_inside_out(tiny_ru
     learned = df[df["model"].isin(list(R.MODELS))]
     assert (learned["params"] > 1000).all() and learned["b0"].notna().sum() == 2
     assert not rec["recommended"].isin([R.NULL, "exact"]).any()
+    summary = (folder / "summary.md").read_text().splitlines()   # a row per scene, its pick the recommendation's
+    assert len(summary) == 2 + 2 and [row.split(" | ")[-1].rstrip(" |") for row in summary[2:]] == list(rec["recommended"])
 
 
 def test_a_zero_torque_predictor_is_the_null_and_is_never_recommended():
