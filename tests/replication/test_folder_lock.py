@@ -21,8 +21,8 @@ def _data(path):
 
 def _fit_cli(data, out, steps=2):
     return [sys.executable, "-m", "replication.cli", "fit", "--data", str(data), "--model", "baseline",
-            "--steps", str(steps), "--hidden", "8", "--batch", "16", "--framework", "torch", "--quiet",
-            "--device", "cpu", "--out", str(out)]
+            "--steps", str(steps), "--hidden", "8", "--batch", "16", "--restarts", "0", "--framework", "torch",
+            "--quiet", "--device", "cpu", "--out", str(out)]
 
 
 def test_a_second_writer_is_refused_in_one_line_and_writes_nothing(tmp_path):
