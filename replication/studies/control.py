@@ -68,6 +68,12 @@ def hold(plant, q, v, tau, h: float, substeps: int = SUBSTEPS):
     return q, v, a0
 
 
+def diverged(q, v):
+    """(B,) bool: a state (q, v) (B, dof) that is not finite or has left `DIVERGED`."""
+    with np.errstate(invalid="ignore"):
+        return ~np.isfinite(q).all(-1) | ~np.isfinite(v).all(-1) | (np.abs(np.c_[q, v]) > DIVERGED).any(-1)
+
+
 def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=KP, kd=KD, plant=None) -> dict:
     """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, 2)
     float64 arrays, or None for PD alone; `plant` anything with `.acceleration(q, qdot, tau=)` (default the
@@ -92,8 +98,7 @@ def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=
             break
         with np.errstate(over="ignore", invalid="ignore"):   # a diverging state is caught below
             q, v, _ = hold(plant, q, v, tau, h, substeps)
-            now = ~np.isfinite(q).all(-1) | ~np.isfinite(v).all(-1) | (np.abs(np.c_[q, v]) > DIVERGED).any(-1)
-        bad |= now
+        bad |= diverged(q, v)
         q[bad], v[bad] = qd[bad, i + 1], vd[bad, i + 1]   # parked on the reference; scored as diverged
     return {"q": qs, "tau": taus, "diverged": bad}
 

@@ -98,8 +98,7 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
                 tau = ff + kp * (qd[r, i] - q) + kd * (vd[r, i] - v)
                 with np.errstate(over="ignore", invalid="ignore"):   # a diverging state is caught below
                     q_next, v_next, a = C.hold(plant, q, v, tau, h, substeps)
-                bad = not (np.isfinite(q_next).all() and np.isfinite(v_next).all()
-                           and np.abs(np.c_[q_next, v_next]).max() <= C.DIVERGED)
+                bad = bool(C.diverged(q_next, v_next)[0])
                 t2 = time.perf_counter()
                 if learns and not bad:
                     buf.add(q[0], v[0], a[0], tau[0])
