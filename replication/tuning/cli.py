@@ -9,7 +9,8 @@ def cmd_tune(args):
 
     frameworks = tuple(x.strip() for x in args.frameworks.split(",") if x.strip()) or ("jax",)
     ledger = tune(args.claim, profile=args.profile, n_configs=args.configs, n_seeds=args.seeds,
-                  frameworks=frameworks, out=args.out or f"results/tune/{args.claim}", progress=not args.quiet)
+                  frameworks=frameworks, out=args.out or f"results/tune/{args.claim}", progress=not args.quiet,
+                  widths=[x for x in args.widths.split(",") if x.strip()] if args.widths else None)
     for label, m in ledger["models"].items():
         scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in m["scores"].items())
         print(f"{label:<22} chose config {m['chosen']} {m['chosen_knobs']} of {m['configs_tried']} ({scores})")
@@ -29,6 +30,9 @@ def add_command(sub) -> None:
     s.add_argument("--profile", default="quick", choices=PROFILES, help="the budget to tune at (default: quick)")
     s.add_argument("--configs", type=int, default=4,
                    help="configurations per model, the same for every model (default: 4)")
+    s.add_argument("--widths", help="a width sweep instead of the search: comma-separated multipliers of the "
+                   "registered widths (e.g. 2,4,8), each at the registered rate, the registered setting first, "
+                   "every model alike (--configs is then unused)")
     s.add_argument("--seeds", type=int, default=1, help="development seeds per configuration (default: 1)")
     s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")
     s.add_argument("--out", help="results folder (default: results/tune/<claim>)")

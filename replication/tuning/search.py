@@ -7,6 +7,8 @@ The sample budget, the restarts and the input scaling stay the registered ones: 
 budget (restarts or none) would compare configurations at unequal budgets, and input scales are per system.
 `configs(n, seed=0) -> [knob values]`: the registered setting first (all multipliers 1), then n - 1 other
 combinations drawn without replacement (generator `seed`); the same list for every model.
+`sweep(widths) -> [knob values]`: a width sweep, the registered setting first, then each width multiplier at the
+registered rate (`lagbench tune --widths`): how far a model's error falls as it widens, the same for every model.
 `apply(entry, base, profile, knobs) -> ModelEntry`: the model with those knob values under `profile`.
 """
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from replication.claims.tuned import scaled_widths, with_knobs
 
-__all__ = ["KNOBS", "REGISTERED", "SIZE", "apply", "configs", "scaled_widths"]
+__all__ = ["KNOBS", "REGISTERED", "SIZE", "apply", "configs", "scaled_widths", "sweep"]
 
 KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
 REGISTERED = {"lr": 1.0, "width": 1.0}
@@ -32,6 +34,16 @@ def configs(n: int, seed: int = 0) -> list[dict]:
     others = [c for c in grid if c != REGISTERED]
     order = np.random.default_rng(seed).permutation(len(others))
     return [dict(REGISTERED), *[others[i] for i in order[:n - 1]]]
+
+
+def sweep(widths) -> list[dict]:
+    try:
+        values = [float(w) for w in widths]
+    except (TypeError, ValueError):
+        values = []
+    if not values or not all(0 < w < float("inf") for w in values):
+        raise ValueError(f"--widths: {','.join(map(str, widths))!r} is not valid; expected positive width multipliers")
+    return [dict(REGISTERED), *[{"lr": 1.0, "width": w} for w in dict.fromkeys(values) if w != 1.0]]
 
 
 def apply(entry, base, profile: str, knobs: dict):

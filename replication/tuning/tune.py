@@ -1,7 +1,8 @@
 """`lagbench tune --claim ID`: every model of a claim searched alike on the development split.
 
-`tune(claim, profile, n_configs, n_seeds, frameworks, out, progress) -> ledger`: for each configuration of
-`search.configs` (the same list for every model), each trained model of the claim under `profile` is
+`tune(claim, profile, n_configs, n_seeds, frameworks, out, progress, widths=None) -> ledger`: for each
+configuration of `search.configs` (or, given `widths`, of the width sweep `search.sweep(widths)`; the same
+list for every model), each trained model of the claim under `profile` is
 trained with it on the development seeds (`splits.DEV`: seeds 0.., the development draws; never the test
 split) and scored by its development held-out error: `heldout_l1` where the evaluation gives it, else the
 claim's metric (lower is better), averaged over seeds and frameworks. The units go to
@@ -35,11 +36,11 @@ def score_metric(result: dict, claim) -> float | None:
 
 @R.writes
 def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int = 1, frameworks=("jax",),
-         out="results/tune", progress: bool = True) -> dict:
+         out="results/tune", progress: bool = True, widths=None) -> dict:
     claim = untuned(claim_id)   # the search is around the claim as written, never around an adopted choice
     if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
-    grid = search.configs(n_configs)
+    grid = search.sweep(widths) if widths else search.configs(n_configs)
     labels = [e.label for e in claim.models if e.runs_in(profile) and e.train]
     if not labels:
         raise ValueError(f"--claim {claim_id}: trains no model under profile {profile!r}")
@@ -64,7 +65,9 @@ def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int
     df = pd.DataFrame(rows)
     R.write_csv(out / "ledger.csv", df)
     ledger = {"schema": R.SCHEMA, "claim": claim.id, "profile": profile, "split": "dev",
-              "search": {n: list(v) for n, v in search.KNOBS.items()}, "configs": grid,
+              "search": ({"lr": [1.0], "width": sorted({c["width"] for c in grid})} if widths else
+                         {n: list(v) for n, v in search.KNOBS.items()}),
+              "kind": "width sweep" if widths else "search", "configs": grid,
               "seeds": splits.DEV.seeds(n_seeds), "frameworks": list(frameworks), "models": {}}
     for label, g in df.groupby("model", sort=False):
         mean = g.groupby("config")["score"].mean()   # a failed unit scores nothing; a config of failures, NaN

@@ -67,3 +67,19 @@ def test_tune_command_refuses_a_bad_count_in_one_line(tmp_path, capsys):
     assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--configs", "99", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--configs" in err
+
+
+def test_a_width_sweep_gives_every_model_the_registered_setting_then_each_width():
+    assert search.sweep(["2", "4", "2", "1"]) == [search.REGISTERED, {"lr": 1.0, "width": 2.0}, {"lr": 1.0, "width": 4.0}]
+    for bad in (["0"], ["x"], [], ["inf"]):
+        with pytest.raises(ValueError, match="--widths"):
+            search.sweep(bad)
+
+
+def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_path, capsys):
+    assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--widths", "2,-1", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--widths" in err
+    ledger = tune("dp_loss", profile="smoke", n_seeds=1, out=tmp_path, progress=False, widths=["2"])
+    assert ledger["kind"] == "width sweep" and ledger["search"] == {"lr": [1.0], "width": [1.0, 2.0]}
+    assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
