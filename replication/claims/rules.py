@@ -12,6 +12,9 @@ is "inconclusive" (noise decides).
   reproduced if a / b >= 1 / factor over every pair (b lower, or a lower by less than the factor).
 - ``similar(a, b, within, metric)``: a / b inside [1 / within, within] over every pair (not reproduced:
   wholly outside).
+- ``matched_better_by(a, b, factor, metric, level, within)``: ``better_by`` on two models read at matched
+  accuracy: decided only if their ``level`` metric (the held-out error where each was read) is within a
+  factor ``within`` of each other for every seed pair, else "inconclusive" (the accuracies differ).
 - ``fails(bad, goods, factor, metric)``: bad / good > factor over every pair, for every good.
 - ``below_null(metric, fraction, model)``: the model's metric at most fraction x the null predictor's.
 - ``bound(metric, upper=, lower=, models=)``: every seed of the models inside the bounds (exact results,
@@ -33,7 +36,7 @@ from replication.claims.stats import Interval, Stat, hodges_lehmann, ratio_inter
 VERDICTS = ("reproduced", "partly", "not reproduced", "inconclusive", "not run")
 PART_VERDICTS = ("reproduced", "not reproduced", "inconclusive", "not run")
 __all__ = ["VERDICTS", "PART_VERDICTS", "Outcome", "Stat", "separated", "wilson", "better_by", "similar",
-           "fails", "bound", "below_null", "faster", "never"]
+           "matched_better_by", "fails", "bound", "below_null", "faster", "never"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +101,22 @@ def similar(a: str, b: str, within: float, metric: str):
                        {"reproduced": f"inside [1/{within:g}, {within:g}] for every seed pair",
                         "not reproduced": f"outside [1/{within:g}, {within:g}] for every seed pair",
                         "inconclusive": f"across the edge of [1/{within:g}, {within:g}]"})
+
+
+def matched_better_by(a: str, b: str, factor: float, metric: str, level: str, within: float):
+    matched, ordered = similar(a, b, within, level), better_by(a, b, factor, metric)
+
+    def rule(v):
+        m = matched(v)
+        if m.verdict == "not run":
+            return m
+        if m.verdict != "reproduced":
+            return Outcome("inconclusive", f"accuracies not matched within {within:g} ({level}: {m.reason})",
+                           m.interval)
+        out = ordered(v)
+        return Outcome(out.verdict, f"at matched {level} ({m.interval}), {metric} by {factor:g}: {out.reason}",
+                       out.interval, out.sensitivity)
+    return rule
 
 
 def fails(bad: str, goods: tuple, factor: float, metric: str):

@@ -8,6 +8,7 @@ are judged by the same code; ground truth comes from `systems` in float64.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -51,6 +52,11 @@ class Context:
     log: list | None = None   # the training log rows (`TrainOutcome.log`), for routines that read the pace
     split: object = DEV   # `replication.run.splits.Split`: the held-out draw and the draws' seeds evaluated on
     progress: object = None   # progress(label, done, total) or None: a routine's long work, for a progress bar
+    tracked: dict | None = None   # the training's kept checkpoints (`Tracking.keep`; `evaluation.matched`)
+
+
+# what the matched checkpoint's evaluation records (`evaluation.matched`)
+MATCHED = ("heldout_l1", "energy_err_final", "energy_err_final_median", "rollout_gmean_err")
 
 
 @dataclass
@@ -224,4 +230,11 @@ def eval_energy_rollout(ctx) -> Evaluation:
         "gmean_err": geometric_mean_over_time(err), "chaos_floor_gmean_err": geometric_mean_over_time(floor),
         **vpt_columns})
     out.arrays = {"t": t, "q_true": q[:3], "q_pred": qp[:3]}
+    if cfg.get("match_heldout_l1"):   # the same evaluation at the checkpoint nearest a registered accuracy
+        from replication.evaluation.matched import at_level
+
+        plain = {k: v for k, v in cfg.items() if k not in ("match_heldout_l1", "float32_truth")}
+        out.metrics.update(at_level(ctx, cfg["match_heldout_l1"],
+                                    lambda c: {k: v for k, v in eval_energy_rollout(dataclasses.replace(c, cfg=plain)).metrics.items()
+                                               if k in MATCHED}))
     return out

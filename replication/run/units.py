@@ -83,6 +83,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
         ctx.log = outcome.log
+        ctx.tracked = outcome.tracked
     where = dev.resolve(dev.request(), unit.framework)
     with dev.placed(unit.framework, where):   # the model's evaluation on the run's device
         ev = EVALUATIONS[unit.claim.evaluate](ctx)

@@ -23,6 +23,7 @@ class TrainOutcome:
     cohort: dict | None = None    # trained side by side with other seeds (`Protocol.cohort`): {"seeds": [...]}
     step_mode: str | None = None  # "jit" (JAX); "compiled" or "eager" (PyTorch, `compile_torch`); phases joined by " + "
     device: dict | None = None    # where it computed (`replication.training.device.describe`)
+    tracked: dict | None = None   # kept parameters at the tracked steps (`Tracking.keep`, `tracking.Tracker.checkpoints`)
 
     @property
     def samples_per_s(self) -> float:

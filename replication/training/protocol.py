@@ -124,6 +124,8 @@ class Protocol:
         d["schedule"] = schedule_to_dict(self.schedule)
         for name in PARTS:
             d[name] = dataclasses.asdict(d[name]) if d[name] is not None else None
+        if d["tracking"] is not None and not d["tracking"]["keep"]:
+            del d["tracking"]["keep"]   # only a kept tracking is stored: other protocols keep their keys
         if self.scouting is not None:
             d["scouting"] = {**dataclasses.asdict(self.scouting), "schedule": schedule_to_dict(self.scouting.schedule)}
         return {"version": KEY_VERSION, **d}

@@ -124,12 +124,17 @@ class Scouting:
 @dataclass(frozen=True)
 class Tracking:
     """Held-out loss every `every` steps (`replication.training.tracking`), for work-precision curves; a
-    multiple of the protocol's log_every. It reads the model and changes no training number."""
+    multiple of the protocol's log_every. It reads the model and changes no training number. `keep`: the
+    training also keeps the parameters at each of those steps (`TrainOutcome.tracked`), so that an evaluation
+    can read the model at a chosen held-out error (claim 2 at matched accuracy); stored only when True, so
+    protocols without it keep their keys."""
 
     every: int
+    keep: bool = False
 
     def __post_init__(self):
         check(integer(self.every) and self.every >= 1, f"tracking every must be a positive integer, got {self.every!r}")
+        check(isinstance(self.keep, bool), f"tracking keep must be True or False, got {self.keep!r}")
         object.__setattr__(self, "every", int(self.every))
 
 

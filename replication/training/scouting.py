@@ -231,7 +231,7 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
                         snapshot=snapshot.phase("continuation") if snapshot else None)
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
     if t:
-        t.merge([out.log])
+        t.merge([out])
     out.samples = out.steps_done * out.batch + scouting_samples(protocol)
     out.steps_done += scouting_samples(protocol) // outcomes[0].batch
     out.train_time_s += outcomes[best].train_time_s

@@ -4,11 +4,14 @@
 steps and at the last, it evaluates each member's data loss (the protocol's own loss, no L2 term) on the
 first `TRACK_STATES` held-out states through a NumPy adapter (`replication.evaluation.adapters`; JAX compiles it once
 per spec). It records step, samples, the training seconds so far (the loop's `step_seconds`: optimiser
-steps only, the first compiling step and these evaluations left out) and `heldout_loss`. `merge(logs)`
-writes them into the training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of
-the same step (a tracking step is also a log step: `tracking.every` is a multiple of `log_every`).
+steps only, the first compiling step and these evaluations left out) and `heldout_loss`. With
+`tracking.keep` it also keeps each member's parameters at those steps. `merge(outcomes)` writes the rows into
+the outcomes' training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of the same
+step (a tracking step is also a log step: `tracking.every` is a multiple of `log_every`) and, when kept, the
+parameters as `outcome.tracked` (`checkpoints(i)`: {"step": (n,), "p/<name>": (n, ...) stacked}).
 The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
-Its rows travel in a training's snapshots (`snapshot_state`, `restore_snapshot`; `replication.training.snapshots`).
+Its rows and kept parameters travel in a training's snapshots (`snapshot_state`, `restore_snapshot`;
+`replication.training.snapshots`).
 """
 from __future__ import annotations
 
@@ -29,6 +32,8 @@ class Tracker:
         self.framework, self.spec, self.protocol = framework, spec, protocol
         self.offset_steps, self.offset_samples, self.offset_seconds = offset_steps, offset_samples, offset_seconds
         self.rows: list[list[dict]] = []
+        self.keep = bool(protocol.tracking.keep)
+        self.kept: list[list[dict]] = []   # per member, the parameters at each tracked step (with keep)
 
     def _loss(self, params) -> float:
         m = adapter(self.framework, self.spec, params)
@@ -44,23 +49,51 @@ class Tracker:
         members = params if isinstance(params, list) else [params]
         while len(self.rows) < len(members):
             self.rows.append([])
+            self.kept.append([])
         for i, theta in enumerate(members):
             with np.errstate(all="ignore"):
                 loss = self._loss(theta)
             self.rows[i].append({"step": k + self.offset_steps, "heldout_loss": loss,
                                  "train_s": float(info["step_seconds"]) + self.offset_seconds,
                                  "samples": (k + 1) * p.batch + self.offset_samples})
+            if self.keep:
+                self.kept[i].append({n: np.array(a, copy=True) for n, a in theta.items()})
         return False
 
+    def checkpoints(self, i: int) -> dict | None:
+        """Member i's kept parameters: {"step": (n,) int, "p/<name>": (n, ...)}; None without keep or rows."""
+        if not self.keep or i >= len(self.kept) or not self.kept[i]:
+            return None
+        kept = self.kept[i]
+        steps = np.array([r["step"] for r in self.rows[i][:len(kept)]], np.int64)
+        return {"step": steps, **{f"p/{n}": np.stack([c[n] for c in kept]) for n in kept[0]}}
+
     def snapshot_state(self):
-        return self.rows, {}
+        arrays = {}
+        for i in range(len(self.kept)):
+            for name, a in (self.checkpoints(i) or {}).items():
+                arrays[f"m{i}/{name}"] = a
+        return self.rows, arrays
 
     def restore_snapshot(self, meta, arrays):
         self.rows = [[dict(r) for r in member] for member in meta]
+        self.kept = [unstack({k.split("/", 1)[1]: v for k, v in arrays.items() if k.startswith(f"m{i}/")})
+                     for i in range(len(self.rows))]
 
-    def merge(self, logs: list[list[dict]]) -> None:
-        """Add the tracked columns to each member's log rows of the same step (in place)."""
-        for log, rows in zip(logs, self.rows, strict=False):
+    def merge(self, outcomes) -> None:
+        """Add the tracked columns to each member's log rows of the same step (in place); with keep, set each
+        outcome's `tracked` to its member's kept parameters."""
+        for i, (out, rows) in enumerate(zip(outcomes, self.rows, strict=False)):
             at = {r["step"]: r for r in rows}
-            for row in log:
+            for row in out.log:
                 row.update({k: v for k, v in at.get(row["step"], {}).items() if k != "step"})
+            if self.keep:
+                out.tracked = self.checkpoints(i)
+
+
+def unstack(checkpoints: dict | None) -> list[dict]:
+    """`checkpoints(i)`'s arrays back to one parameter dict per kept step (init_params layout)."""
+    if not checkpoints or "step" not in checkpoints:
+        return []
+    names = [k for k in checkpoints if k.startswith("p/")]
+    return [{n[2:]: checkpoints[n][j] for n in names} for j in range(len(checkpoints["step"]))]

@@ -1,8 +1,9 @@
 """Train one (framework, spec, protocol, seed), with a cache so that claims sharing a model train it once.
 
 `train_cached(out, framework, spec, protocol, seed)` -> TrainOutcome. The cache folder
-`OUT/trained/<framework>/<key>/` holds checkpoint.npz (last good parameters), train_log.csv and
-train.json (timings, failure, file checksums); a corrupt entry is retrained, never trusted. While it
+`OUT/trained/<framework>/<key>/` holds checkpoint.npz (last good parameters), train_log.csv, tracked.npz
+(the parameters at the tracked steps, where the protocol keeps them) and result.json (timings, failure,
+file checksums); a corrupt entry is retrained, never trusted. While it
 trains, `inflight/` there holds its snapshots (`replication.training.snapshots`): a run killed mid-training
 resumes each training from its last one, and they are removed once the training is stored.
 """
@@ -69,7 +70,7 @@ def run_training(framework, spec, protocol, seed, on_log=None, snapshot=None) ->
     out = trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
                                    on_log=on_log, hooks=(t,) if t else (), snapshot=snapshot)
     if t:
-        t.merge([out.log])
+        t.merge([out])
     return out
 
 
@@ -98,7 +99,7 @@ def train_cohort(framework, spec, protocol, seeds, on_log=None, snapshot=None) -
                                                 [BatchStream(protocol, s) for s in seeds], on_log=first,
                                                 hooks=(t,) if t else (), snapshot=snapshot)
     if t:
-        t.merge([o.log for o in outcomes])
+        t.merge(outcomes)
     for o in outcomes:
         o.cohort = {"seeds": list(seeds)}
     return outcomes
@@ -116,12 +117,15 @@ def _cached(folder: Path) -> TrainOutcome | None:
                         log=pd.read_csv(folder / "train_log.csv").to_dict("records"),
                         failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
                         batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
-                        cohort=meta.get("cohort"), step_mode=meta.get("step_mode"), device=meta.get("device"))
+                        cohort=meta.get("cohort"), step_mode=meta.get("step_mode"), device=meta.get("device"),
+                        tracked=R.load_npz(folder / "tracked.npz") if "tracked.npz" in meta["files"] else None)
 
 
 def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
     files = {"checkpoint.npz": R.write_npz(folder / "checkpoint.npz", outcome.params),
              "train_log.csv": R.write_csv(folder / "train_log.csv", log_frame(outcome.log))}
+    if outcome.tracked:
+        files["tracked.npz"] = R.write_npz(folder / "tracked.npz", outcome.tracked)
     R.write_json(folder / "result.json", {"failure": outcome.failure, "train_time_s": outcome.train_time_s,
                                           "steps_done": outcome.steps_done, "batch": outcome.batch, "files": files,
                                           "scouting": outcome.scouting, "samples": outcome.samples,

@@ -15,6 +15,7 @@ from replication.claims.rules import (
     bound,
     fails,
     faster,
+    matched_better_by,
     never,
     separated,
     similar,
@@ -76,6 +77,25 @@ def test_better_by_not_run_when_a_model_is_missing():
 ])
 def test_similar(values, expected):
     assert similar("a", "b", 3.0, M)(v(**values)).verdict == expected
+
+
+def _matched(a, b, level_a, level_b):
+    return {"a": {M: Stat.of(a), "lvl": Stat.of(level_a)}, "b": {M: Stat.of(b), "lvl": Stat.of(level_b)}}
+
+
+@pytest.mark.parametrize("values, expected", [
+    (((1.0, 1.1), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "reproduced"),
+    (((1.0, 1.1), (5.0, 6.0), (0.2, 0.25), (0.5, 0.6)), "inconclusive"),       # a is far more accurate there
+    (((1.0, 1.1), (5.0, 6.0), (0.5, 0.55), (0.5, math.inf)), "inconclusive"),  # b never got near the level
+    (((3.0, 3.1), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "not reproduced"),
+    (((math.inf, 1.0), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "inconclusive"),  # a diverged once
+    (((math.inf, math.inf), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "not reproduced"),
+    (((0.0, 0.0), (5.0, 6.0), (40.0, 40.0), (0.5, 0.6)), "inconclusive"),       # a null: never matched
+])
+def test_matched_better_by_decides_only_at_matched_accuracy(values, expected):
+    out = matched_better_by("a", "b", 3.0, M, "lvl", 1.5)(_matched(*values))
+    assert out.verdict == expected, out.reason
+    assert matched_better_by("a", "b", 3.0, M, "lvl", 1.5)({"a": {M: Stat.of((1.0,))}}).verdict == "not run"
 
 
 @pytest.mark.parametrize("values, expected", [

@@ -16,7 +16,8 @@ def _metrics(cid, label, good: bool) -> dict:
     if cid in ("dp_loss",):
         return {"heldout_l1": 0.07 if good or label == "lnn" else 7.0}
     if cid == "dp_energy":
-        return {"energy_err_final": win if label == "lnn" else lose, "n_diverged": 0}
+        return {"energy_err_final": win if label == "lnn" else lose, "n_diverged": 0,
+                "matched_energy_err_final": win if label == "lnn" else lose, "matched_heldout_l1": 0.5}
     if cid == "rel_coords":
         return {"heldout_l1_qddot": lose if label.startswith("hnn_qqdot") and label != "hnn_qqdot_control" else win}
     if cid == "wave_lgn":

@@ -15,7 +15,7 @@ from replication.training.schedules import OneCycle
 from replication.training.train import train_cached, train_key
 
 SPEC = LNN                                            # the chaotic double-pendulum LNN: any drift would show
-ONE = GUARDED.replace(steps=30, tracking=Tracking(every=5))        # guard acting often, held-out tracking
+ONE = GUARDED.replace(steps=30, tracking=Tracking(every=5, keep=True))   # guard acting often, tracking, kept checkpoints
 COHORT = GUARDED.replace(steps=24, batch=8, cohort=3)
 SCOUTED = GUARDED.replace(scouting=Scouting(count=3, steps=8, batch=8, schedule=OneCycle(lr=3e-3, start=GUARDED.schedule.start)), steps=16)
 SCOUTED_CUT = SCOUTED.replace(**{"scouting.keep": 2})           # 3 scouts to step 4, the 2 lowest on to 8
@@ -52,6 +52,9 @@ def _same(a, b):
         assert keys == set(rb) - TIMING
         differ = [k for k in keys if not (ra[k] == rb[k] or (np.isnan(ra[k]) and np.isnan(rb[k])))]
         assert not differ, (ra["step"], differ)
+    assert (a.tracked is None) == (b.tracked is None)
+    for k in a.tracked or {}:
+        assert np.array_equal(a.tracked[k], b.tracked[k]), k
     assert (a.failure, a.steps_done, a.samples, a.scouting, a.skipped_steps) == \
         (b.failure, b.steps_done, b.samples, b.scouting, b.skipped_steps)
 
@@ -76,6 +79,11 @@ def test_one_model_resumes_bit_for_bit(tmp_path, fw):
     assert steps[0] == 17, "the resumed run started over instead of going on from its snapshot"
     assert [r["step"] for r in out.log if "heldout_loss" in r] == [0, 5, 10, 15, 20, 25, 29]
     assert ref.skipped_steps > 0   # the guard acted, so its restored history mattered
+    assert list(out.tracked["step"]) == [0, 5, 10, 15, 20, 25, 29]   # the kept checkpoints survive the kill
+    for k in ref.params:
+        assert np.array_equal(out.tracked[f"p/{k}"][-1], ref.params[k])   # the last one is the final model
+    cached = train_cached(tmp_path / "ref", fw, SPEC, ONE, 2)   # and come back from the cache
+    assert all(np.array_equal(cached.tracked[k], ref.tracked[k]) for k in ref.tracked)
 
 
 @pytest.mark.parametrize("fw", ["jax", "torch"])

@@ -43,6 +43,18 @@ def test_a_scouted_run_tracks_its_continuation_with_the_scouts_samples_counted()
     assert tracked[0]["train_s"] > 0   # the scouts' time counts
 
 
+def test_kept_checkpoints_are_stored_only_when_asked_so_other_protocols_keep_their_keys():
+    from replication.training.protocol import Protocol
+
+    assert PLAIN.replace(tracking=Tracking(every=4)).to_dict()["tracking"] == {"every": 4}
+    kept = PLAIN.replace(tracking=Tracking(every=4, keep=True))
+    assert kept.to_dict()["tracking"] == {"every": 4, "keep": True}
+    assert Protocol.from_dict(kept.to_dict()) == kept
+    assert Protocol.from_dict(PLAIN.replace(tracking=Tracking(every=4)).to_dict()).tracking.keep is False
+    with pytest.raises(ValueError, match="keep"):
+        Tracking(every=4, keep="yes")
+
+
 def test_tracking_must_fall_on_logged_steps():
     with pytest.raises(ValueError, match="not a multiple of log_every"):
         PLAIN.replace(tracking=Tracking(every=3))
