@@ -5,7 +5,9 @@ configuration of `search.configs` (or, given `widths`, of the width sweep `searc
 list for every model), each trained model of the claim under `profile` is
 trained with it on the development seeds (`splits.DEV`: seeds 0.., the development draws; never the test
 split) and scored by its development held-out error: `heldout_l1` where the evaluation gives it, else the
-claim's metric (lower is better), averaged over seeds and frameworks. The units go to
+claim's metric (lower is better), averaged over seeds and frameworks; a pooled claim (a pace study: claims 6
+and 7) by its pace instead, the median over seeds of the samples to leave the plateau (+inf: never), as its
+verdict reads pace over a sample of seeds (run it with the claim's seed count, one cohort). The units go to
 OUT/config<k>/units/...; the ledger to OUT/ledger.json and OUT/ledger.csv: per model and configuration
 its knob values and score, and per model the configurations tried, the chosen one (the lowest score)
 and the split they were scored on ("dev").
@@ -27,11 +29,21 @@ from replication.run.executor import run_units
 from replication.run.units import Unit
 from replication.tuning import search
 
+PACE = "samples_to_leave"   # a pooled claim's score: training samples until the plateau is left (+inf: never)
+
 
 def score_metric(result: dict, claim) -> float | None:
     m = result.get("metrics") or {}
+    if claim.pooled:   # a pace study decides by pace, so its search is scored by pace (never leaving: +inf)
+        v = m.get(PACE)
+        return float(v) if isinstance(v, int | float) and not math.isnan(v) else None
     v = m.get("heldout_l1", m.get(claim.metric))
     return float(v) if isinstance(v, int | float) and math.isfinite(v) else None
+
+
+def scored_by(claim) -> str:
+    return (f"median {PACE} over the seeds (+inf: never left)" if claim.pooled
+            else f"mean over seeds of heldout_l1 (else {claim.metric})")
 
 
 @R.writes
@@ -67,10 +79,11 @@ def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int
     ledger = {"schema": R.SCHEMA, "claim": claim.id, "profile": profile, "split": "dev",
               "search": ({"lr": [1.0], "width": sorted({c["width"] for c in grid})} if widths else
                          {n: list(v) for n, v in search.KNOBS.items()}),
-              "kind": "width sweep" if widths else "search", "configs": grid,
+              "kind": "width sweep" if widths else "search", "scored_by": scored_by(claim), "configs": grid,
               "seeds": splits.DEV.seeds(n_seeds), "frameworks": list(frameworks), "models": {}}
     for label, g in df.groupby("model", sort=False):
-        mean = g.groupby("config")["score"].mean()   # a failed unit scores nothing; a config of failures, NaN
+        by = g.groupby("config")["score"]   # a failed unit scores nothing; a config of failures, NaN
+        mean = by.median() if claim.pooled else by.mean()
         best = int(mean.idxmin()) if mean.notna().any() else None
         ledger["models"][label] = {"configs_tried": int(g["config"].nunique()), "scored_on": "dev",
                                    "scores": {int(c): (None if pd.isna(v) else float(v)) for c, v in mean.items()},

@@ -83,3 +83,18 @@ def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_p
     ledger = tune("dp_loss", profile="smoke", n_seeds=1, out=tmp_path, progress=False, widths=["2"])
     assert ledger["kind"] == "width sweep" and ledger["search"] == {"lr": [1.0], "width": [1.0, 2.0]}
     assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
+
+
+def test_a_pace_study_is_tuned_by_its_pace_over_a_sample_of_seeds(tmp_path):
+    import pandas as pd
+
+    ledger = tune("init_study", profile="smoke", n_configs=2, n_seeds=2, out=tmp_path, progress=False)
+    assert "samples_to_leave" in ledger["scored_by"] and ledger["seeds"] == [0, 1]
+    rows = pd.read_csv(tmp_path / "ledger.csv")
+    for label, m in ledger["models"].items():
+        g = rows[rows["model"] == label]
+        for k, v in m["scores"].items():
+            assert v == g[g["config"] == int(k)]["score"].median()   # the median over the seeds, +inf kept
+    r = json.loads((tmp_path / "config0/units/init_study/jax/lnn_init-kaiming/seed0/result.json").read_text())
+    assert rows[(rows["model"] == "lnn_init-kaiming") & (rows["config"] == 0) & (rows["seed"] == 0)]["score"].item() \
+        == r["metrics"]["samples_to_leave"]
