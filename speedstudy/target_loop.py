@@ -1,8 +1,10 @@
 """The training loop of the train-to-target study (`speedstudy.train_target`): one run from one
 init, or restarts over several inits, with a held-out evaluation at evenly spaced steps.
 
-`run_protocol(name, spec, protocol, seed=0, on_eval=None) -> (log, final model)`; `heldout_l1(spec,
-protocol)`: model -> held-out L1. Every phase is a run of the suite's one training loop (`replication.training.loop`:
+`run_protocol(name, spec, protocol, seed=0, on_eval=None, heldout_seed=HELDOUT_SEED) -> (log, final model)`;
+`heldout_l1(spec, protocol, seed=HELDOUT_SEED)`: model -> L1 on the held-out draw of generator `seed` (the
+development draw unless a test-split study asks for its own, `replication.run.splits`). The held-out L1 only
+fills the log: no training step, scout choice or stop reads it. Every phase is a run of the suite's one training loop (`replication.training.loop`:
 the scouts of a restarts protocol side by side through `replication.training.scouting`, a single run and the
 continuation with `train_jax.Stepper`); the held-out evaluations are its hook, and its step-only timing is
 the loop's `step_seconds`.
@@ -15,16 +17,17 @@ import numpy as np
 
 import models.jax
 from models import ModelSpec, init_params
+from replication.training import data as datamod
 from replication.training import loop, scouting, train_jax
-from replication.training.data import BatchStream, heldout
+from replication.training.data import HELDOUT_SEED, BatchStream
 from replication.training.objective import loss_value, predict
 from replication.training.schedules import learning_rate
 
 N_EVALS = 20
 
 
-def heldout_l1(spec, protocol):
-    data = {k: jnp.asarray(v, protocol.dtype) for k, v in heldout(protocol).items()}
+def heldout_l1(spec, protocol, seed: int = HELDOUT_SEED):
+    data = {k: jnp.asarray(v, protocol.dtype) for k, v in datamod.heldout(protocol, seed).items()}
 
     @eqx.filter_jit
     def l1(model):
@@ -38,10 +41,10 @@ class _Loop:
     from its own stream and appends a log row at each held-out evaluation; samples, steps, step-only wall
     seconds and skipped steps accumulate over phases."""
 
-    def __init__(self, name, spec, protocol, on_eval=None):
+    def __init__(self, name, spec, protocol, on_eval=None, heldout_seed=HELDOUT_SEED):
         self.name, self.on_eval, self.batch, self.spec = name, on_eval, protocol.batch, spec
         self.step = train_jax.make_step(spec, protocol)
-        self.evaluate = heldout_l1(spec, protocol)
+        self.evaluate = heldout_l1(spec, protocol, heldout_seed)
         self.log, self.steps, self.wall, self.skipped, self.compiled = [], 0, 0.0, 0, False
         self.extra = 0   # samples beyond steps x batch: scouts at a batch of their own
 
@@ -80,16 +83,18 @@ class _Loop:
         return self.steps * self.batch + self.extra
 
 
-def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None) -> tuple[list[dict], object]:
+def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=None,
+                 heldout_seed: int = HELDOUT_SEED) -> tuple[list[dict], object]:
     """Train for `scouting.budget_samples(protocol)` samples in all: (log with the held-out L1 at N_EVALS evenly spaced steps and the
-    last, the final model: the last one with a finite loss); on_eval(log) after each evaluation.
+    last, the final model: the last one with a finite loss); on_eval(log) after each evaluation;
+    heldout_seed: the generator seed of the held-out draw those evaluations read.
     Without `protocol.scouting`: one run from the init of `seed`. With K scouts: restarts (`replication.training.scouting`)
     over the inits seed .. seed + K - 1, trained side by side for the scouting's steps (a one-cycle over
     the scout, each evaluated once at its end), the one with the lowest training loss over its last 5 % of
     batches (the held-out set plays no part) then continued for protocol.steps with a new one-cycle
     and fresh Adam state, from batches of its own stream (seed + 1000). Every scout's samples count; the
     scouts' wall time is the one program's."""
-    loop = _Loop(name, spec, protocol, on_eval)
+    loop = _Loop(name, spec, protocol, on_eval, heldout_seed)
     if not protocol.scouting:
         model = models.jax.build(spec, init_params(spec, seed=seed))
         loop.row(model, "train", seed, learning_rate(protocol, 0), np.nan)

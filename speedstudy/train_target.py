@@ -46,11 +46,13 @@ whose Euler-Lagrange equations only partly fit. NaN for the baseline.
 The training loop is `target_loop.run_protocol` (the suite's optimiser step, batches, schedule and loss,
 plus a held-out evaluation every `budget / N_EVALS` samples). Held-out L1: `objective.loss_value`
 ("l1": per-sample sum of |q''_pred - q''_true| over components, mean over samples) on
-`data.heldout(protocol)` (`sizes` decides its size).
+`data.heldout(protocol, heldout_seed)` (`sizes` or --heldout-states decides its size; heldout_seed the
+split's, `replication.run.splits`: the development draw unless `lagbench train-target --split test`). The
+held-out L1 and `hessian_rel_err` only report: training never reads the held-out draw.
 
 `train_target_rows(sizes, progress) -> (rows, log)` (the bench's stage, at the preset's budget and widths);
-`study(budget, hidden, n_heldout, names, progress, on_eval, seed, on_model)` the same for any budget
-(`lagbench train-target`):
+`study(budget, hidden, n_heldout, names, progress, on_eval, seed, on_model, heldout_seed)` the same for any
+budget (`lagbench train-target`; seed: one init seed, or {protocol: init seed}):
   rows {protocol, model, description, hidden, budget, threshold, samples_to_reach, wall_s_to_reach, reached,
         best_l1, final_l1, seed, hessian_rel_err, skipped_steps, samples_per_s, wall_s, extrapolated_samples,
         extrapolation}:
@@ -77,8 +79,9 @@ import numpy as np
 import systems
 from models import ModelSpec
 from replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
+from replication.training import data as datamod
 from replication.training import scouting
-from replication.training.data import heldout
+from replication.training.data import HELDOUT_SEED
 from replication.training.protocol import Guard, Scouting
 from replication.training.schedules import OneCycle
 from speedstudy.target_loop import N_EVALS, run_protocol
@@ -157,12 +160,12 @@ def protocols(budget: int, n_heldout: int) -> dict[str, Entry]:
                                         "baseline")}
 
 
-def hessian_rel_err(model, spec, protocol) -> float:
-    """Median over the held-out states of ||H - c H_true||_F / ||c H_true||_F (module doc); NaN for models
-    without a velocity Hessian."""
+def hessian_rel_err(model, spec, protocol, heldout_seed: int = HELDOUT_SEED) -> float:
+    """Median over the held-out states (the draw of generator heldout_seed) of ||H - c H_true||_F /
+    ||c H_true||_F (module doc); NaN for models without a velocity Hessian."""
     if spec.kind != "lnn":
         return float("nan")
-    data = heldout(protocol)
+    data = datamod.heldout(protocol, heldout_seed)
     q, qd = (jnp.asarray(data[k], protocol.dtype) for k in ("q", "qdot"))
     h = np.asarray(model.velocity_hessian(q, qd), float)
     h_true = np.asarray(systems.get("double_pendulum", **dict(protocol.data.system_params))
@@ -223,12 +226,13 @@ def train_target_rows(sizes, progress=None) -> tuple[list[dict], list[dict]]:
     return study(sizes.target_budget, sizes.target_hidden, HELDOUT.get(sizes.name, 4096), progress=progress)
 
 
-def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None, seed: int = 0,
-          on_model=None):
+def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eval=None, seed=0,
+          on_model=None, heldout_seed: int = HELDOUT_SEED):
     """(rows, log) of the protocols `names` (default all of `protocols`) at `budget` samples and MLP widths
     `hidden`; `on_eval(log so far)` after every held-out evaluation (the CLI writes the log there); seed:
-    the init seed (restarts: the first of the RESTART_SEEDS scouted); `on_model(name, spec, model)` with each
-    protocol's final model (the CLI saves it)."""
+    the init seed (restarts: the first of those scouted), one for every protocol or a {name: seed} dict;
+    `on_model(name, spec, model)` with each protocol's final model (the CLI saves it); heldout_seed: the
+    generator seed of the held-out draw every evaluation reads."""
     if not budget >= 1:
         raise ValueError(f"the train-target budget must be at least 1 sample, got {budget!r}")
     table = protocols(int(budget), n_heldout)
@@ -243,11 +247,12 @@ def study(budget: int, hidden, n_heldout: int, names=None, progress=None, on_eva
         if progress:
             progress.set_postfix_str(f"train to target: {name}")
         each = (lambda lg, done=list(logs): on_eval(done + lg)) if on_eval else None
-        log, model = run_protocol(name, spec, proto, seed=seed, on_eval=each)
+        init = seed[name] if isinstance(seed, dict) else seed
+        log, model = run_protocol(name, spec, proto, seed=init, on_eval=each, heldout_seed=heldout_seed)
         logs += log
         if on_model:
             on_model(name, spec, model)
-        rows += summarise(name, desc, spec, proto, log, hessian_rel_err(model, spec, proto))
+        rows += summarise(name, desc, spec, proto, log, hessian_rel_err(model, spec, proto, heldout_seed))
         if progress:
             progress.update(1)
     return rows, logs

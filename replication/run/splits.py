@@ -2,10 +2,12 @@
 
 development ("dev")  seeds 0, 1, 2, ...; the held-out draw of generator seed `data.HELDOUT_SEED`; rollout
                      initial conditions from each claim's `ic_seed`. Every trial, study, speed target
-                     (`lagbench train-target`) and protocol choice reads this split and only this one.
+                     (`lagbench train-target`, its default) and protocol choice reads this split and only
+                     this one.
 test ("test")        seeds 1000, 1001, ...; a held-out draw of another generator seed; initial conditions
                      and sampled states from other seeds (`ic_seed` + 1000). `lagbench run` decides its
-                     verdicts on it (its default); no choice of a protocol has seen it.
+                     verdicts on it (its default), and `lagbench train-target --split test` measures the
+                     frozen protocols' time to the target on it; no choice of a protocol has seen it.
 
 Training reads neither split's evaluation draws: the held-out rows a training tracks or a scouting round
 selects by are always the development draw (its validation set), so a test run's trainings are those of
