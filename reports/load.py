@@ -42,7 +42,10 @@ BENCH_COLUMNS = {
 GPU_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("inference", "training", "scaling", "ratios")},
                "fast_paper": ["dof", "framework", "formulation", "mode", "batch", "samples_per_s"]}
 # `lagbench train-target --out ROOT` writes ROOT/train_target/ with the bench stage's two files
-TRAIN_TARGET_COLUMNS = {k: BENCH_COLUMNS[k] for k in ("train_target", "train_target_log")}
+# and, with --runs N > 1, distribution.csv (one row per run at the target held-out L1)
+TRAIN_TARGET_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("train_target", "train_target_log")},
+                        "distribution": ["protocol", "run", "init_seed", "split", "reached", "samples_to_reach",
+                                         "wall_s_to_reach", "final_l1"]}
 UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
 
 

@@ -49,3 +49,21 @@ def test_missing_columns_are_named_and_the_file_unused(tmp_path):
 def test_nothing_without_the_folder(tmp_path):
     (tmp_path / "res").mkdir()
     assert not any(getattr(b, "title", "").startswith("Train to target") for b in _blocks(tmp_path / "res", tmp_path))
+
+
+def test_the_distribution_over_runs_counts_every_run_and_takes_the_median_over_those_that_reached(tmp_path):
+    folder = tmp_path / "res" / "train_target"
+    folder.mkdir(parents=True)
+    pd.DataFrame([{"protocol": "restarts_halved", "run": r, "init_seed": 1000 + 16 * r, "chosen_seed": 1000 + 16 * r,
+                   "split": "test", "threshold": 0.069, "reached": wall is not None,
+                   "samples_to_reach": 3.6e7 if wall else float("nan"), "wall_s_to_reach": wall or float("nan"),
+                   "best_l1": 0.06, "final_l1": 0.06 if wall else 0.2, "hessian_rel_err": 0.01, "samples_per_s": 4e4,
+                   "budget": 4e7} for r, wall in enumerate((800.0, None, 900.0, 1000.0))]).to_csv(
+        folder / "distribution.csv", index=False)
+    blocks = _blocks(tmp_path / "res", tmp_path / "rep")
+    summary = next(b for b in blocks if getattr(b, "title", "").startswith("Time to the paper's held-out L1 0.069"))
+    row = summary.df.iloc[0]
+    assert row["reached"] == "3 of 4" and float(row["wall_s_to_reach_median"]) == 900.0
+    assert float(row["wall_s_to_reach_min"]) == 800.0 and float(row["wall_s_to_reach_max"]) == 1000.0
+    every = next(b for b in blocks if getattr(b, "title", "") == "Time to held-out L1 0.069, every run")
+    assert len(every.df) == 4
