@@ -32,6 +32,8 @@ BENCH_COLUMNS = {
     "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
     "ratios": ["operation", "jax", "torch", "ratio", "note"],
     "latency": ["system", "model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"],
+    "control_rate": ["model", "framework", "mode", "ticks", "mean_us", "median_us", "p99_us", "rate_hz_mean",
+                     "rate_hz_p99", "fits_500hz_mean", "fits_500hz_p99"],
     "train_target": ["protocol", "description", "budget", "threshold", "samples_to_reach", "reached", "best_l1",
                      "samples_per_s", "extrapolated_samples", "extrapolation"],
     "train_target_log": ["protocol", "samples", "heldout_l1"],
@@ -167,9 +169,8 @@ def _load_unit(root: Path, result_path: Path) -> Unit:
         missing = [k for k in UNIT_KEYS if k not in result]
         if missing:
             reason = "missing keys: " + ", ".join(missing)
-        elif (str(result["claim"]), str(result["framework"]), str(result["model"]), str(result["seed"])) != (
-            claim, fw, model, seed,
-        ) or len(parts) != 4:
+        elif (str(result["claim"]), str(result["framework"]), str(result["model"]), str(result["seed"])) \
+                != (claim, fw, model, seed) or len(parts) != 4:
             reason = "folder does not match claim/framework/model/seed in result.json"
     if reason is not None:
         return Unit(claim, fw, model, seed, unit_dir, rel, "corrupt", reason, result)

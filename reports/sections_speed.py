@@ -94,6 +94,18 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
                          "`models.torch.compiled` (torch.export + AOTInductor, parameters as constants), one call "
                          "into a compiled library; frozen: parameters compiled in as constants; sync: JAX's CPU "
                          "dispatch in the calling thread."))
+    if "control_rate" in res.bench:
+        cr = res.bench["control_rate"]
+        cols = [c for c in ["model", "framework", "mode", "ticks", "mean_us", "median_us", "p99_us", "rate_hz_mean",
+                            "rate_hz_p99", "fits_500hz_mean", "fits_500hz_p99", "hidden", "batch"] if c in cr.columns]
+        t = _bench_table(cr[cols])
+        for c in ("fits_500hz_mean", "fits_500hz_p99"):
+            t[c] = t[c].str.lower().map({"true": "yes", "false": "no"}).fillna(t[c])
+        b.add(Table("Control-loop rate on one core (the DeLaN paper's robot: 500 Hz)", t, ["bench/control_rate.csv"],
+                    note="Per tick of the two-link arm's computed-torque loop on one thread, the model's compute "
+                         "in microseconds (the feed-forward call; with learning also the replay-buffer write and "
+                         "the optimiser step on a minibatch of `batch`, as `lagbench online`; the simulated plant "
+                         "not counted), rate_hz = 1e6 / that time, and fits_500hz: below the 2 ms period."))
     _train_target(b, res.bench, "bench", out_dir, "Samples to reach held-out L1 thresholds (double-pendulum LNN; "
                   "paper: 7.3e-2 at ~3e8, a training loss; its held-out value was 6.9e-2), the speed study's budget")
     _train_target(b, res.train_target, "train_target", out_dir, "Train to target (lagbench train-target): samples "

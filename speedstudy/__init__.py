@@ -11,6 +11,10 @@ ignore):
   latency.csv     system, model, method, framework, dtype, mode, dispatch, threads, hidden, evals_per_s,
                   max_abs_diff, ops: DeLaN one-sample calls (`speedstudy.latency`; JAX through
                   `models.jax.compiled.compile_single`)
+  control_rate.csv model, framework, mode, ticks, mean_us, median_us, p99_us, rate_hz_mean, rate_hz_p99,
+                  fits_500hz_mean, fits_500hz_p99, ...: control ticks per second each learned inverse model of the
+                  two-link arm sustains on one core in the 500 Hz computed-torque loop, inference alone and
+                  with online learning (`speedstudy.control_rate`; quick and full presets only)
   training.csv    system, model, framework, mode, dtype, batch, steps_per_s, samples_per_s, hidden
                   (`speedstudy.training`)
   rollout.csv     system, solver, rtol, kind, model, source, wall_s, state_err, energy_err, dt, n_ics, t_end

@@ -14,6 +14,7 @@ from tqdm.auto import tqdm
 from replication.results import write_csv, write_json
 from replication.run import environment
 from speedstudy import (
+    control_rate,
     device,
     latency,
     learned,
@@ -119,7 +120,7 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
     sc_cases = list(scaling.lgn_cases(sizes)) + list(scaling.chain_cases(sizes))
     total = (len(cases) + 1 + training.n_training_cases(sizes) + rollout.n_rollout_cases(sizes) + len(sc_cases)
              + 2 * len(sizes.ratio_dofs) + structure.n_structure_cases() + train_target.n_cases(sizes)
-             + members.n_cases(sizes))
+             + members.n_cases(sizes) + (1 if sizes.control_s else 0))
     bar = tqdm(total=total, desc=f"lagbench bench ({sizes.name})", unit="case", disable=not progress)
     stage, t_start = _Stages(bar, bench, cache, notes, sizes.stages or STAGES), time.perf_counter()
     if sizes.stages:
@@ -130,6 +131,8 @@ def _run(out: Path, bench: Path, sizes, progress: bool, trained_from: Path, cach
         inf_rows = stage("inference", len(cases),
                          lambda: {"inference": _inference(cases, sizes, notes, bar)}, ["inference"])["inference"]
         lat_rows = stage("single-sample latency", 1, lambda: _latency(sizes, notes, bar), ["latency"])["latency"]
+        if sizes.control_s:   # a preset with no control-rate seconds has no such stage
+            stage("control rate", 1, lambda: _control_rate(sizes, notes, bar), ["control_rate"])
         train_rows = stage("training", training.n_training_cases(sizes),
                            lambda: {"training": training.training_rows(sizes, notes, bar)}, ["training"])["training"]
         stage("rollouts", rollout.n_rollout_cases(sizes),
@@ -162,6 +165,12 @@ def _latency(sizes, notes, bar) -> dict:
     rows = latency.latency_rows(sizes, notes)
     bar.update(1)
     return {"latency": rows}
+
+
+def _control_rate(sizes, notes, bar) -> dict:
+    rows = control_rate.control_rate_stage(sizes, notes)
+    bar.update(1)
+    return {"control_rate": rows}
 
 
 def _scaling(sc_cases, sizes, bar) -> dict:

@@ -119,10 +119,11 @@ class Sizes:
     members_hidden: tuple = (128, 128, 128)   # members vs one model (`speedstudy.members`)
     members_steps: int = 0         # steps per timing round (0: skip the stage)
     members_rounds: int = 3
+    control_s: float = 0.0         # simulated seconds per control-rate run (`speedstudy.control_rate`; 0: skip)
 
 
-STAGES = ("inference", "single-sample latency", "training", "rollouts", "scaling", "fast vs paper", "structure",
-          "train to target", "members")
+STAGES = ("inference", "single-sample latency", "control rate", "training", "rollouts", "scaling", "fast vs paper",
+          "structure", "train to target", "members")
 GPU_STAGES = ("inference", "training", "scaling", "fast vs paper")  # `lagbench bench --gpu`
 _SOLVERS = ("tsit5", "dopri5", "dopri8")
 TINY = Sizes("tiny", hidden=(16, 16), batches=(8,), dtypes=("float32",), lgn_hidden=(8, 8),
@@ -138,7 +139,7 @@ QUICK = Sizes("quick", hidden=(128, 128, 128), batches=(1, 256, 4096), dtypes=("
               train_hidden=(600, 600, 600), train_batch=512, train_steps=3, rollout_solvers=_SOLVERS,
               rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10), rollout_dts=(0.01, 0.003), rollout_t_end=10.0,
               rollout_ics=8, min_time=0.05, torch_compile=True, structure_batch=1024, wave_n=32, latency_s=2.0,
-              target_budget=500_000, target_hidden=(64, 64, 64), members_steps=1000)
+              target_budget=500_000, target_hidden=(64, 64, 64), members_steps=1000, control_s=6.0)
 FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), dtypes=("float32", "float64"),
              lgn_hidden=(64, 64, 64), lgn_n=(16, 64, 256, 1024, 4096), chain_d=(1, 2, 4, 8, 16, 32),
              chain_batch=512, ratio_batch=4096, ratio_hidden=(600, 600, 600), ratio_dofs=(2, 16), ratio_reps=3,
@@ -146,7 +147,7 @@ FULL = Sizes("full", hidden=(600, 600, 600), batches=(1, 16, 256, 4096, 65536), 
              rollout_rtols=(1e-4, 1e-6, 1e-8, 1e-10, 1e-12), rollout_dts=(0.01, 0.003, 0.001),
              rollout_t_end=20.0, rollout_ics=16, min_time=1.0, torch_compile=True, structure_batch=4096,
              wave_n=64, latency_s=2.0, latency_dtypes=("float32", "float64"), target_budget=5_000_000,
-             target_hidden=(128, 128, 128), members_steps=3000)
+             target_hidden=(128, 128, 128), members_steps=3000, control_s=20.0)
 # `lagbench bench --gpu`: the inference plane up to batch 65536, training at the protocol's batch and at 4096, the
 # scaling studies to n = 4096 and the fast/paper timing; PyTorch eager (no AOTInductor: its CUDA build is not
 # part of this study) against JAX jit, both on the GPU. The latency subprocesses, rollouts, structure and
