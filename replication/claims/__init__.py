@@ -1,5 +1,5 @@
 """The ten claims of the SPEC, by id, in the SPEC's order, then the hard-case claims (11: precision) and the
-DeLaN paper's control experiment (12: delan_tracking).
+DeLaN paper's control experiments (12: delan_tracking; 13: delan_online, learning online).
 
 `CLAIMS` holds each claim as it runs: its models with the protocols `lagbench tune` chose where a choice is
 adopted (`tuned.py`); `untuned(id)` the claim as its file writes it, the base every tuning searches around."""
@@ -7,6 +7,7 @@ from replication.claims import (
     activation_study,
     appendix_b,
     delan_arm,
+    delan_online,
     delan_table1,
     delan_tracking,
     dp_energy,
@@ -21,7 +22,7 @@ from replication.claims import (
 from replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
 
 _ALL = (dp_loss, dp_energy, rel_coords, wave_lgn, appendix_b, init_study, activation_study, delan_table1,
-        delan_arm, hnn_energy, precision, delan_tracking)
+        delan_arm, hnn_energy, precision, delan_tracking, delan_online)
 _WRITTEN = {m.CLAIM.id: m.CLAIM for m in sorted(_ALL, key=lambda m: m.CLAIM.number)}
 CLAIMS = {cid: tuned.apply(c) for cid, c in _WRITTEN.items()}
 

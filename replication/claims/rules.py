@@ -10,6 +10,8 @@ is "inconclusive" (noise decides).
 
 - ``better_by(a, b, factor, metric)``: reproduced if a / b < 1 / factor over every seed pair; not
   reproduced if a / b >= 1 / factor over every pair (b lower, or a lower by less than the factor).
+- ``sooner(a, b, metric)``: ``better_by(a, b, 1, metric)`` on times to reach a level per seed (+inf if never),
+  but "inconclusive" where no seed of either got there (two that never arrive say nothing of which is sooner).
 - ``similar(a, b, within, metric)``: a / b inside [1 / within, within] over every pair (not reproduced:
   wholly outside).
 - ``matched_better_by(a, b, factor, metric, level, within)``: ``better_by`` on two models read at matched
@@ -35,7 +37,7 @@ from replication.claims.stats import Interval, Stat, hodges_lehmann, ratio_inter
 
 VERDICTS = ("reproduced", "partly", "not reproduced", "inconclusive", "not run")
 PART_VERDICTS = ("reproduced", "not reproduced", "inconclusive", "not run")
-__all__ = ["VERDICTS", "PART_VERDICTS", "Outcome", "Stat", "separated", "wilson", "better_by", "similar",
+__all__ = ["VERDICTS", "PART_VERDICTS", "Outcome", "Stat", "separated", "wilson", "better_by", "sooner", "similar",
            "matched_better_by", "fails", "bound", "below_null", "faster", "never"]
 
 
@@ -88,6 +90,18 @@ def better_by(a: str, b: str, factor: float, metric: str):
                        {"reproduced": f"below 1/{factor:g} for every seed pair",
                         "not reproduced": f"not below 1/{factor:g} for any seed pair",
                         "inconclusive": f"across 1/{factor:g}: the seeds disagree"})
+
+
+def sooner(a: str, b: str, metric: str):
+    ordered = better_by(a, b, 1.0, metric)
+
+    def rule(v):
+        if (m := _missing(v, (a, b), metric)) is not None:
+            return m
+        if all(math.isinf(x) for s in (_get(v, a, metric), _get(v, b, metric)) for x in s.values):
+            return Outcome("inconclusive", f"{metric}: no seed of {a} or {b} got there, so neither is sooner")
+        return ordered(v)
+    return rule
 
 
 def similar(a: str, b: str, within: float, metric: str):

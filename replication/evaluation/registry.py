@@ -6,6 +6,7 @@ changes what a metric means or adds one a verdict reads."""
 from replication.evaluation.arm import eval_arm
 from replication.evaluation.control import eval_control
 from replication.evaluation.exact import eval_exact_lagrangian
+from replication.evaluation.online_claim import eval_online
 from replication.evaluation.pace import eval_pace
 from replication.evaluation.precision import eval_precision
 from replication.evaluation.routines import eval_energy_rollout, eval_heldout
@@ -20,4 +21,5 @@ EVALUATION_VERSION = 3
 EVALUATIONS = {"heldout": eval_heldout, "heldout_trajectories": eval_heldout_trajectories, "pace": eval_pace,
                "energy_rollout": eval_energy_rollout, "wave": eval_wave,
                "arm": eval_arm, "exact_lagrangian": eval_exact_lagrangian,
-               "precision": eval_precision, "fit": eval_fit, "control": eval_control}
+               "precision": eval_precision, "fit": eval_fit, "control": eval_control,
+               "online": eval_online}

@@ -53,6 +53,7 @@ class Context:
     split: object = DEV   # `replication.run.splits.Split`: the held-out draw and the draws' seeds evaluated on
     progress: object = None   # progress(label, done, total) or None: a routine's long work, for a progress bar
     tracked: dict | None = None   # the training's kept checkpoints (`Tracking.keep`; `evaluation.matched`)
+    seed: int = 0   # the unit's seed (a routine that builds its own model from it: `evaluation.online_claim`)
 
 
 # what the matched checkpoint's evaluation records (`evaluation.matched`)

@@ -79,7 +79,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         params = None
     ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
                   protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile),
-                  split=splits.of_seed(unit.seed), progress=on_progress)
+                  split=splits.of_seed(unit.seed), progress=on_progress, seed=unit.seed)
     if params is not None:
         ctx.model = adapter(unit.framework, spec, params)
         ctx.log = outcome.log

@@ -17,7 +17,7 @@ over its ticks of |q - q_d|^2, rad^2, summed over joints; ticks of a diverged re
 n_diverged (such ticks), inference_us_per_tick and learning_us_per_tick (mean wall-clock microseconds per
 tick of the feed-forward call and of the buffer write plus optimiser steps, time.perf_counter), steps (the
 optimiser steps taken so far). ticks: {"inference_us", "learning_us"}, each (T,) over the ticks that ran (a
-diverged reference's rest is skipped).
+diverged reference's rest is skipped), and "diverged_refs" (the references that diverged).
 
 `online_study(models, frameworks, seeds, seconds, ...) -> (curves, summary)`: PD alone and the true inverse
 dynamics (no learning, framework "numpy", seed "-"), then each model x framework x seed learning on `seconds`
@@ -28,7 +28,11 @@ PD alone's), t_reach_s (end of the first window at the bar; NaN: never), t_settl
 which every later window is at the bar), first/final window MSE and ratio, unseen_mse and its ratio to PD
 (the frozen final model tracking `n_unseen` references of the unseen family, `control.track`), compute per
 tick (mean, median and p99 of inference + learning, microseconds) and whether it fits the control period (mean,
-p99). `write_study(folder, ...)` writes FOLDER/curves.csv, summary.csv and setup.json (the settings, the
+p99). The pieces claim 13 shares (`replication.evaluation.online_claim`): `ratio_to_pd(windows, pd_windows)`
+(each window's MSE over PD alone's in the window that starts at the same time), `summary_row(w, ticks,
+threshold, window)` (a controller's summary columns from its windows with their ratios; NaN: never) and
+`unseen(ctrl, n_unseen, duration, seed)` (the frozen controller on the unseen family's references of generator
+seed `seed`). `write_study(folder, ...)` writes FOLDER/curves.csv, summary.csv and setup.json (the settings, the
 threshold's definition and the threads the timings ran on: `one_thread()`).
 """
 from __future__ import annotations
@@ -79,7 +83,7 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
         ctrl.warm(batch)   # compiled before the first tick, not inside it
     err, t_inf, t_learn = np.full(total, np.nan), np.zeros(total), np.zeros(total)
     h = 1.0 / rate / substeps
-    windows, done, tick = [], 0, 0
+    windows, done, tick, n_bad = [], 0, 0, 0
     for r in range(n_refs):
         q, v, bad = qd[r, :1].copy(), vd[r, :1].copy(), False   # (1, dof): the plant's batch of one
         for i in range(n_t - 1):
@@ -117,14 +121,15 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
                                 "learning_us_per_tick": 1e6 * float(t_learn[w].mean()), "steps": done})
                 if progress:
                     progress(tick - start)
+        n_bad += bad
     ran = np.isfinite(err)
-    return windows, {"inference_us": 1e6 * t_inf[ran], "learning_us": 1e6 * t_learn[ran]}
+    return windows, {"inference_us": 1e6 * t_inf[ran], "learning_us": 1e6 * t_learn[ran], "diverged_refs": n_bad}
 
 
-def _unseen(ctrl, n_unseen: int, duration: float) -> dict:
+def unseen(ctrl, n_unseen: int, duration: float, seed: int = C.SEED) -> dict:
     import systems
 
-    refs = C.references("test", n=n_unseen, duration=duration)
+    refs = C.references("test", n=n_unseen, duration=duration, seed=seed)
     if ctrl is None or isinstance(ctrl, str):
         inverse = None if ctrl is None else systems.get("two_link_arm").inverse_dynamics
     else:
@@ -133,7 +138,12 @@ def _unseen(ctrl, n_unseen: int, duration: float) -> dict:
     return {"unseen_mse": s.get("track_mse", math.nan), "unseen_diverged": s["n_diverged"]}
 
 
-def _summary_row(w: pd.DataFrame, ticks: dict, threshold: float, window: float) -> dict:
+def ratio_to_pd(windows: pd.DataFrame, pd_windows: pd.DataFrame) -> pd.Series:
+    """Each window's track_mse over PD alone's in the window that starts at the same t_start."""
+    return windows["track_mse"] / windows["t_start"].map(pd_windows.set_index("t_start")["track_mse"])
+
+
+def summary_row(w: pd.DataFrame, ticks: dict, threshold: float, window: float) -> dict:
     at_bar = (w["ratio_to_pd"] <= threshold).to_numpy()
     ends = w["t_start"].to_numpy() + window
     first = int(np.argmax(at_bar)) if at_bar.any() else None
@@ -174,18 +184,17 @@ def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,)
                                           seed=0 if s == "-" else int(s), seconds=seconds, progress=progress)
             key = {"controller": name, "framework": fw, "seed": s}
             curves += [{**key, **w} for w in windows]
-            rows.append((key, ticks, _unseen(ctrl, n_unseen, unseen_duration) if n_unseen else {}))
+            rows.append((key, ticks, unseen(ctrl, n_unseen, unseen_duration) if n_unseen else {}))
     df = pd.DataFrame(curves)
-    pd_mse = df[df["controller"] == "pd"].set_index("t_start")["track_mse"]
-    df["ratio_to_pd"] = df["track_mse"] / df["t_start"].map(pd_mse)
+    df["ratio_to_pd"] = ratio_to_pd(df, df[df["controller"] == "pd"])
     pd_unseen = rows[0][2].get("unseen_mse", math.nan)
     summary = []
-    for key, ticks, unseen in rows:
+    for key, ticks, scores in rows:
         w = df[(df["controller"] == key["controller"]) & (df["framework"] == key["framework"])
                & (df["seed"] == key["seed"])]
-        unseen = unseen or {"unseen_mse": math.nan, "unseen_diverged": math.nan}
-        summary.append({**key, **_summary_row(w, ticks, threshold, window), **unseen,
-                        "unseen_ratio_to_pd": unseen["unseen_mse"] / pd_unseen})
+        scores = scores or {"unseen_mse": math.nan, "unseen_diverged": math.nan}
+        summary.append({**key, **summary_row(w, ticks, threshold, window), **scores,
+                        "unseen_ratio_to_pd": scores["unseen_mse"] / pd_unseen})
     return df[CURVE_COLUMNS], pd.DataFrame(summary)[SUMMARY_COLUMNS]
 
 

@@ -19,6 +19,7 @@ from replication.claims.rules import (
     never,
     separated,
     similar,
+    sooner,
 )
 
 M = "m"
@@ -181,3 +182,16 @@ def test_a_model_under_two_bars_passes_only_if_it_passes_both():
     ok, _, per = competence((Bar(("a",), "heldout_l1"), Bar(("a",), None, max_diverged=0)), vals)
     assert not ok and per["a"][0] is False
     assert "heldout_l1 9 > 0.1 x null 10" in per["a"][1] and "0 diverged rollouts" in per["a"][1]
+
+
+@pytest.mark.parametrize("values, expected", [
+    (dict(a=(1.0, 2.0), b=(3.0, math.inf)), "reproduced"),
+    (dict(a=(1.0, math.inf), b=(math.inf, math.inf)), "inconclusive"),   # one seed of a got there: not every pair
+    (dict(a=(math.inf, math.inf), b=(2.0, math.inf)), "not reproduced"),
+    (dict(a=(math.inf, math.inf), b=(math.inf, math.inf)), "inconclusive"),   # never tie, never sooner
+])
+def test_sooner_reads_never_as_inf_and_decides_nothing_when_neither_got_there(values, expected):
+    out = sooner("a", "b", M)(v(**values))
+    assert out.verdict == expected, out.reason
+    assert better_by("a", "b", 1.0, M)(v(a=(math.inf,), b=(math.inf,))).verdict == "not reproduced"
+    assert sooner("a", "c", M)(v(a=(1.0,))).verdict == "not run"

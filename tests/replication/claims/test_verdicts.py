@@ -39,6 +39,8 @@ def _metrics(cid, label, good: bool) -> dict:
     if cid == "delan_tracking":
         return {"tracking_mse_test": win if label == "delan" else lose,
                 "tracking_mse_train_x2": win if label == "delan" else lose}
+    if cid == "delan_online":   # seconds of learning online to reach 0.1 x PD alone's tracking error
+        return {"t_reach_s": win if label == "delan" else lose}
     if cid == "hnn_energy":
         return {"energy_err_max": win if label.startswith("hnn") else lose, "n_diverged": 0}
     if cid == "precision":
