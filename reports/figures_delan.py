@@ -1,6 +1,7 @@
 """The DeLaN paper's figures recreated from a claim's arrays: the torque decomposition (inertial,
 Coriolis/centrifugal, gravity: predicted against true), the torque traces per joint on trajectories
-the models never saw, truth against each model, and closed-loop tracking of an unseen reference."""
+the models never saw, truth against each model, closed-loop tracking of an unseen reference, and the tracking
+error over time of models learning online (claim 13)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -112,4 +113,35 @@ def tracking(units: list[Unit], path: Path) -> bool:
     axes[dof].set_ylabel("|q - q_ref| (rad)")
     axes[0].legend(fontsize=7)
     fig.suptitle("Computed-torque tracking of an unseen reference at 500 Hz")
+    return save(fig, path)
+
+
+def online_learning(units: list[Unit], path: Path) -> bool:
+    """Learning online (claim 13's `window_end`, `window_ratio`): each window's tracking MSE over PD alone's in
+    the same window, against the seconds learned, one line per unit (colour: model, line style: framework), log
+    axis, with PD alone (1) and the unit's threshold (`eval_config` "threshold") dashed."""
+    found = [(u, u.arrays() or {}) for u in units]
+    found = [(u, a) for u, a in found if {"window_end", "window_ratio"} <= set(a)]
+    if not found:
+        return False
+    fig, axes = new_figure(height=3.4)
+    ax = axes[0]
+    ax.keep_linear = ("x",)
+    models, fws = model_colours([u.model for u, _ in found]), style_index([u.framework for u, _ in found])
+    labelled = set()
+    for u, arr in sorted(found, key=lambda x: (x[0].model, x[0].framework, str(x[0].seed))):
+        t, r = np.asarray(arr["window_end"], float), np.asarray(arr["window_ratio"], float)
+        key = (u.model, u.framework)
+        ax.plot(t, np.where(np.isfinite(r), r, np.nan), color=models[u.model], ls=LINESTYLES[fws[u.framework] % 4],
+                lw=1, alpha=0.8, label=None if key in labelled else f"{u.model} ({u.framework})")
+        labelled.add(key)
+    ax.axhline(1.0, color="k", lw=0.8, ls=":", label="PD alone")
+    threshold = ((getattr(found[0][0], "result", None) or {}).get("eval_config") or {}).get("threshold")
+    if threshold:
+        ax.axhline(float(threshold), color="k", lw=0.8, ls="--", label=f"{float(threshold):g} x PD alone")
+    ax.set_yscale("log")
+    ax.set_xlabel("time learning online (s)")
+    ax.set_ylabel("window tracking MSE / PD alone's")
+    ax.legend(fontsize=7)
+    fig.suptitle("Tracking error while learning online, 500 Hz (each seed)")
     return save(fig, path)

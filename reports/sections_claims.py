@@ -171,6 +171,8 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         ("tracking", FD.tracking, "Computed-torque tracking at 500 Hz of the first unseen reference: each joint's "
                                   "reference against the executed angle, and the error's norm (log axis), per learned "
                                   "controller (first seed)", "arrays.npz"),
+        ("online", FD.online_learning, "Learning online: each 0.5 s window's tracking MSE over PD alone's in the same "
+                                       "window, against the seconds learned, one line per seed", "arrays.npz"),
         ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
                                                  "(predicted against true)", "arrays.npz"),
         ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
