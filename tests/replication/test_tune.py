@@ -76,19 +76,24 @@ def test_a_width_sweep_gives_every_model_the_registered_setting_then_each_width(
             search.sweep(bad)
 
 
-def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_path, capsys):
+def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_path, capsys, monkeypatch):
     assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--widths", "2,-1", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--widths" in err
+    trained = []   # the units each configuration trains (the training itself is the search test's above)
+    monkeypatch.setattr("replication.tuning.tune.run_units", lambda units, *a, **k: trained.append(units))
     ledger = tune("dp_loss", profile="smoke", n_seeds=1, out=tmp_path, progress=False, widths=["2"])
     assert ledger["kind"] == "width sweep" and ledger["search"] == {"lr": [1.0], "width": [1.0, 2.0]}
     assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
+    widths = [{u.entry.label: u.entry.widths("smoke") for u in units} for units in trained]
+    base = untuned("dp_loss").entry("lnn").widths("smoke")
+    assert widths == [{"lnn": base, "baseline": base}, {"lnn": tuple(2 * w for w in base), "baseline": tuple(2 * w for w in base)}]
 
 
 def test_a_pace_study_is_tuned_by_its_pace_over_a_sample_of_seeds(tmp_path):
     import pandas as pd
 
-    ledger = tune("init_study", profile="smoke", n_configs=2, n_seeds=2, out=tmp_path, progress=False)
+    ledger = tune("init_study", profile="smoke", n_configs=1, n_seeds=2, out=tmp_path, progress=False)
     assert "samples_to_leave" in ledger["scored_by"] and ledger["seeds"] == [0, 1]
     rows = pd.read_csv(tmp_path / "ledger.csv")
     for label, m in ledger["models"].items():
