@@ -193,7 +193,9 @@ def _distribution(b: Section, d: pd.DataFrame | None) -> None:
                 ["train_target/distribution.csv"],
                 note="Each run its own inits (no two runs share one) and batches; wall seconds count training "
                      "steps only (compiling and the held-out evaluations excluded); a run that did not reach the "
-                     "target within the budget counts in the runs, not in the median."))
+                     "target within the budget counts in the runs, not in the median. load_15min_end: the machine's "
+                     "15-minute load average when the run ended (its own training threads included; cpus: the "
+                     "machine's CPU count), so a time says how busy the machine was."))
     b.add(Table("Time to held-out L1 0.069, every run", _bench_table(d.drop(columns=["threshold"], errors="ignore"),
                                                                      missing="-"), ["train_target/distribution.csv"]))
 

@@ -15,6 +15,10 @@ folder with other inputs, or with files and no inputs.json, is a one-line ValueE
 every run before any training. The returned rows are every run's train_target.csv rows with run, init_seed
 (the run's first init) and split columns.
 
+Each run also writes load.json: the machine's 1- and 15-minute load averages when its training ends and its
+CPU count, so that a time to the target says how busy the machine was (the 15-minute average over a run of
+about that length is its mean load; the run's own training threads count in it).
+
 `distribution(folder, rows, split, budget) -> (table, summary)` writes FOLDER/distribution.csv (DIST_COLUMNS:
 one row per run and protocol at CODE_HELDOUT_L1) and FOLDER/distribution.json (per protocol: runs, reached,
 median / min / max of samples_to_reach and wall_s_to_reach over the runs that reached the target, the split
@@ -26,6 +30,7 @@ step or scout choice reads it.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +44,8 @@ from speedstudy.train_target_run import run_study
 
 TARGET = train_target.CODE_HELDOUT_L1
 DIST_COLUMNS = ["protocol", "run", "init_seed", "chosen_seed", "split", "threshold", "reached", "samples_to_reach",
-                "wall_s_to_reach", "best_l1", "final_l1", "hessian_rel_err", "samples_per_s", "budget"]
+                "wall_s_to_reach", "best_l1", "final_l1", "hessian_rel_err", "samples_per_s", "budget",
+                "load_1min_end", "load_15min_end", "cpus"]
 STATS = ("samples_to_reach", "wall_s_to_reach")
 
 
@@ -81,6 +87,22 @@ def _finished(run_dir: Path, inputs: dict) -> bool:
     return False
 
 
+def _load_record() -> dict:
+    """The load averages now and the CPU count (NaN where the platform gives no load average)."""
+    try:
+        one, _, fifteen = os.getloadavg()
+    except OSError:
+        one = fifteen = float("nan")
+    return {"load_1min_end": round(one, 2), "load_15min_end": round(fifteen, 2), "cpus": os.cpu_count()}
+
+
+def _read_load(run_dir: Path) -> dict:
+    path = run_dir / "load.json"
+    if path.exists():
+        return json.loads(path.read_text())
+    return {"load_1min_end": float("nan"), "load_15min_end": float("nan"), "cpus": float("nan")}
+
+
 def run_many(folder: Path, budget, hidden, n_heldout: int, names, split: splits.Split, offset: int, runs: int,
              progress: bool = True) -> pd.DataFrame:
     names = list(names or train_target.protocols(1000, 1))
@@ -99,7 +121,8 @@ def run_many(folder: Path, budget, hidden, n_heldout: int, names, split: splits.
             write_json(run_dir / "inputs.json", inputs)
             df = run_study(run_dir, budget, hidden, n_heldout, names=names, seed=inputs["init_seeds"],
                            progress=progress, heldout_seed=split.heldout_seed, desc=f"run {r}", leave=False)
-        frames.append(df.assign(run=r, init_seed=df["protocol"].map(inputs["init_seeds"]), split=split.name))
+            write_json(run_dir / "load.json", _load_record())
+        frames.append(df.assign(**_read_load(run_dir), run=r, init_seed=df["protocol"].map(inputs["init_seeds"]), split=split.name))
     return pd.concat(frames, ignore_index=True)
 
 

@@ -74,6 +74,8 @@ def test_the_distribution_files_hold_one_row_per_run_and_protocol(test_runs):
     assert set(zip(table["protocol"], table["run"], strict=True)) == {(p, r) for p in PROTOCOLS for r in range(RUNS)}
     assert (table["split"] == "test").all() and np.allclose(table["threshold"], TT.CODE_HELDOUT_L1)
     assert (table["reached"] == table["samples_to_reach"].notna()).all()
+    assert (table["cpus"] >= 1).all() and (table["load_15min_end"] >= 0).all()
+    assert all((out / "train_target" / f"run{r}" / "load.json").exists() for r in range(RUNS))
     summary = json.loads((out / "train_target" / "distribution.json").read_text())
     assert summary["split"] == "test" and summary["budget"] == 4000 and summary["threshold"] == TT.CODE_HELDOUT_L1
     for name in PROTOCOLS:
