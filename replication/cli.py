@@ -66,7 +66,8 @@ def cmd_run(args):
     return 1 if summary.get("errors") else 0
 
 
-RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict")
+RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict",
+                  "control", "robustness")
 
 
 def _results_folder(results: Path) -> Path:
@@ -113,7 +114,7 @@ def cmd_bench(args):
     write_folder(Path(args.out))
     try:
         run_bench(out=args.out, quick=not args.full, trained_from=args.trained_from, resume=args.resume,
-                  gpu=args.gpu)
+                  gpu=args.gpu, stages=[x for x in (args.stages or "").split(",") if x.strip()])
     except NoGPUError as e:
         print(f"lagbench: error: {e}", file=sys.stderr)
         return 2
@@ -230,6 +231,9 @@ def build_parser():
     s.add_argument("--gpu", action="store_true", help="run JAX and PyTorch on the CUDA GPU instead, at the GPU "
                    "preset (inference to batch 65536, training, scaling, fast vs paper); writes OUT/bench_gpu/ "
                    "(LAGBENCH_BENCH_TINY=1: a seconds-long check of the same stages)")
+    s.add_argument("--stages", help="comma-separated stages to run, the rest skipped (default: all of the "
+                   "preset's); e.g. control-rate. Stages: inference, single-sample-latency, control-rate, training, "
+                   "rollouts, scaling, fast-vs-paper, structure, train-to-target, members")
     s.set_defaults(func=cmd_bench)
     add_train_target(sub)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "

@@ -28,6 +28,7 @@ from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
 from reports.sections_predict import predict_sections
+from reports.sections_robustness import robustness_sections
 from reports.sections_speed import speed_appendix, speed_sections
 from reports.sections_stiff import stiff_sections
 from reports.systems_table import systems_sections
@@ -42,8 +43,8 @@ APPENDIX = ("What the body's numbers rest on: every part with its interval, the 
 
 
 def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
-    """The report's body (the scorecard, a page per claim with its figures, the closed-loop control study,
-    speed against error) and its
+    """The report's body (the scorecard, a page per claim with its figures, the closed-loop control and
+    robustness studies, speed against error) and its
     appendix (everything else), as two lists of sections."""
     res = load_results(results_dir)
     mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
@@ -52,6 +53,7 @@ def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None 
         return sections, sources_sections(res, sections)
     moved: dict = {}   # figures a claim's page sends to its details in the appendix
     body = [scorecard_section(res)] + theme_sections(res, out_dir, moved) + control_sections(res, out_dir)
+    body += robustness_sections(res, out_dir)
     body += speed_sections(res, out_dir)
     appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]
     appendix += summary_sections(res) + claim_details(res, moved) + speed_appendix(res, out_dir)

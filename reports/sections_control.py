@@ -36,7 +36,7 @@ def _table(df: pd.DataFrame) -> pd.DataFrame:
                      "seeds": str(len(g)) if learned else "-", "tracking MSE (rad²)": _span(g["track_mse"]),
                      "/ PD alone": _span(g["ratio_to_pd"]), "torque effort (N²m²)": _span(g["torque_effort"]),
                      "diverged": str(int(g["n_diverged"].sum())),
-                     "flag": "NO BETTER THAN PD in a seed" if worse else ""})
+                     "flag": "NO BETTER THAN PD in a seed" if worse else "-"})
     return pd.DataFrame(rows)
 
 

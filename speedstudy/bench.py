@@ -2,6 +2,7 @@
 checkpointed (`speedstudy.resume`), and writes OUT/bench/ (the files and presets: `speedstudy`'s docstring)."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from contextlib import nullcontext
@@ -47,7 +48,8 @@ def _write(bench: Path, name: str, rows: list[dict]) -> None:
 
 
 def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool = True,
-              trained_from=None, resume: bool = False, gpu: bool = False, sizes: Sizes | None = None) -> dict:
+              trained_from=None, resume: bool = False, gpu: bool = False, sizes: Sizes | None = None,
+              stages=None) -> dict:
     """Run the study into OUT/bench/ (OUT/bench_gpu/ with gpu=True); returns the targets dict (also written
     as targets.json).
 
@@ -57,11 +59,18 @@ def run_bench(out, quick: bool = True, tiny: bool | None = None, progress: bool 
     checkpoints (OUT/bench/stages/, `speedstudy.resume`) instead of running them again.
     gpu: run both frameworks on the CUDA GPU (`device.gpu_session`; NoGPUError, before anything is
     written, where either framework sees none) at the GPU preset (GPU_TINY when tiny), its stages only.
-    sizes: a preset to use instead (tests)."""
+    sizes: a preset to use instead (tests).
+    stages: run only these stages of `STAGES` (names as there, or with "-" or "_" for the spaces); a
+    ValueError naming the unknown ones before anything is written."""
     if tiny is None:
         tiny = os.environ.get("LAGBENCH_BENCH_TINY", "") not in ("", "0")
     if sizes is None:
         sizes = (GPU_TINY if tiny else GPU) if gpu else (TINY if tiny else (QUICK if quick else FULL))
+    if stages:
+        def norm(x):
+            return str(x).strip().lower().replace("-", " ").replace("_", " ")
+        named = {norm(s): s for s in STAGES}
+        sizes = dataclasses.replace(sizes, stages=tuple(named.get(norm(x), str(x).strip()) for x in stages))
     unknown = [s for s in sizes.stages if s not in STAGES]
     if unknown:
         raise ValueError(f"preset {sizes.name}: unknown stages {unknown}; valid: {', '.join(STAGES)}")

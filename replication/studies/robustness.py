@@ -24,9 +24,9 @@ null's tracking; `params`, the model's parameter count; `b0`, `b1`, the learned 
 `recommend(df)`: per scene, magnitude and framework, the cheapest learned model (fewest parameters) whose
 median torque_nmse over seeds is within `WITHIN` (2x) of the best learned model's and clearly better than
 the null (at most `NULL_FRACTION` of its error, the suite's "did it learn" line); "none" when no model is.
-`write_study(out, ...)` writes OUT/scenes.csv, OUT/recommendation.csv, OUT/summary.md and OUT/advantage.png
-(`robustness_figure`), the recordings in OUT/data/ and the fits in OUT/fits/<scene>/seed<k>/ (a rerun
-reuses every fit of the same data and options).
+`write_study(out, ...)` writes OUT/scenes.csv, OUT/recommendation.csv, OUT/summary.md, OUT/advantage.png
+(`robustness_figure`), OUT/study.json (what it ran with), the recordings in OUT/data/ and the fits in
+OUT/fits/<scene>/seed<k>/ (a rerun reuses every fit of the same data and options).
 """
 from __future__ import annotations
 
@@ -154,7 +154,8 @@ def recommend(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def write_study(out, **kw) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """study(), then OUT/scenes.csv, OUT/recommendation.csv, OUT/summary.md and OUT/advantage.png."""
+    """study(), then OUT/scenes.csv, OUT/recommendation.csv, OUT/summary.md, OUT/advantage.png and
+    OUT/study.json (the framework, seeds, steps, fit options, sizes and data seeds it ran with)."""
     from replication import results as R
     from replication.studies.robustness_figure import advantage_figure
     from replication.studies.robustness_summary import summary_markdown
@@ -162,6 +163,9 @@ def write_study(out, **kw) -> tuple[pd.DataFrame, pd.DataFrame]:
     out = Path(out)
     df = study(out, **kw)
     rec = recommend(df)
+    R.write_json(out / "study.json", {"framework": kw.get("framework", "jax"), "seeds": [int(x) for x in
+                 kw.get("seeds", (0,))], "steps": int(kw.get("steps", STEPS)), "budget": budget(kw.get("steps", STEPS)),
+                 "sizes": {**SIZES, **(kw.get("sizes") or {})}, "train_seed": TRAIN_SEED, "test_seed": TEST_SEED})
     R.write_csv(out / "scenes.csv", df)
     R.write_csv(out / "recommendation.csv", rec)
     R.atomic_write_bytes(out / "summary.md", summary_markdown(df, rec).encode())

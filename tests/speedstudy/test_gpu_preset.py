@@ -71,3 +71,15 @@ def test_row_blocks_only_on_the_cpu(monkeypatch):
     out_gpu = blocking.in_row_blocks(fn, [x], rows_per_sample=1)
     assert calls == [10_000]
     np.testing.assert_array_equal(np.asarray(out), np.asarray(out_gpu))
+
+
+def test_stages_argument_runs_only_those_stages_and_refuses_unknown_names(tmp_path, capsys):
+    run_bench(tmp_path, sizes=TINY, stages=["single-sample_latency"], progress=False)
+    bench = tmp_path / "bench"
+    assert (bench / "latency.csv").is_file()
+    assert not any((bench / f"{f}.csv").exists() for f in ("inference", "training", "rollout", "scaling"))
+    assert json.loads((bench / "machine.json").read_text())["stages"] == ["single-sample latency"]
+    other = tmp_path / "other"
+    assert main(["bench", "--stages", "control-rate,inferance", "--out", str(other)]) == 2
+    assert "unknown stages ['inferance']" in capsys.readouterr().err
+    assert not (other / "bench").exists()

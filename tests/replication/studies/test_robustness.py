@@ -79,3 +79,23 @@ def test_bad_options_are_one_line_naming_the_option_and_write_nothing(tmp_path, 
     assert main(["robustness", "--out", str(tmp_path / "o"), option, bad, "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and option in err and not (tmp_path / "o").exists()
+
+
+def test_the_run_reaches_the_report_with_its_settings_table_and_figure(tiny_run, tmp_path):
+    import json
+
+    from reports.document import Figure, Table
+    from reports.load import load_results
+    from reports.sections_robustness import robustness_sections
+
+    settings = json.loads((tiny_run / "robustness" / "study.json").read_text())
+    assert settings["steps"] == 3 and settings["seeds"] == [0] and settings["sizes"] == TINY
+    (section,) = robustness_sections(load_results(tiny_run), tmp_path)
+    table = next(b for b in section.blocks if isinstance(b, Table)).df
+    rec = pd.read_csv(tiny_run / "robustness" / "recommendation.csv")
+    assert list(table["scene"]) == ["nominal", "coulomb-2"] and list(table["pick"]) == list(rec["recommended"])
+    text = " ".join(getattr(b, "text", "") for b in section.blocks)
+    assert "3 optimiser steps" in text and "PD alone" in text
+    (figure,) = [b for b in section.blocks if isinstance(b, Figure)]
+    assert (tmp_path / figure.path).stat().st_size > 1000
+    assert robustness_sections(load_results(tmp_path), tmp_path) == []   # no study: no section
