@@ -67,7 +67,7 @@ def cmd_run(args):
 
 
 RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict",
-                  "control", "robustness")
+                  "control", "control_four_joint_arm", "online_four_joint_arm", "robustness")
 
 
 def _results_folder(results: Path) -> Path:

@@ -27,6 +27,7 @@ from reports.sections_control import control_sections
 from reports.sections_fit import fit_sections, is_fit_results
 from reports.sections_frameworks import frameworks_sections
 from reports.sections_hessian import hessian_sections
+from reports.sections_online import online_sections
 from reports.sections_predict import predict_sections
 from reports.sections_robustness import robustness_sections
 from reports.sections_speed import speed_appendix, speed_sections
@@ -53,6 +54,7 @@ def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None 
         return sections, sources_sections(res, sections)
     moved: dict = {}   # figures a claim's page sends to its details in the appendix
     body = [scorecard_section(res)] + theme_sections(res, out_dir, moved) + control_sections(res, out_dir)
+    body += online_sections(res, out_dir)
     body += robustness_sections(res, out_dir)
     body += speed_sections(res, out_dir)
     appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]

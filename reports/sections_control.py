@@ -1,12 +1,18 @@
-"""The closed-loop control section: ``RESULTS/control/tracking.csv`` and ``traces.npz`` from ``lagbench control``.
+"""The closed-loop control sections: ``RESULTS/control/`` (the two-link arm with claim 9's models) and
+``RESULTS/control_four_joint_arm/`` (the four-joint arm with the models the study fits), each ``tracking.csv``
+and ``traces.npz`` from ``lagbench control [--system four_joint_arm]``.
 
-``control_sections(res, out_dir) -> list[Section]``: per reference family, controller and framework the
-tracking error over seeds (median [min, max]) and its ratio to PD alone, with a flag for a learned
-controller no better than PD; and a figure of the tracking error over time on the first unseen reference.
-Nothing when the study has not run (it is a study beside the claims, not a claim).
+``control_sections(res, out_dir) -> list[Section]``: a section per study folder that holds a tracking table
+(`STUDIES`, in order): per reference family, controller and framework the tracking error over seeds
+(median [min, max]) and its ratio to PD alone, with a flag for a learned controller no better than PD; and
+a figure of the tracking error over time on the first unseen reference. Nothing for a study that has not
+run (they are studies beside the claims, not claims).
 """
 from __future__ import annotations
 
+import json
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +24,47 @@ from reports.fmt import num
 from reports.load import Results
 
 FAMILIES = {"test": "unseen shapes (the test family)", "train_x2": "training family, twice as fast"}
+GAINS = "gains KP 20, KD 2 sqrt(20)"
+
+
+@dataclass(frozen=True)
+class Study:
+    folder: str    # under RESULTS
+    title: str
+    intro: str
+    figure: str    # under the report's folder
+    setup: Callable[[Path], str] | None = None   # the run's settings as a sentence, from the study folder
+
+
+def _four_joint_setup(folder: Path) -> str:
+    try:
+        s = json.loads((folder / "study.json").read_text())
+    except (OSError, ValueError):
+        return "The run's settings are not recorded (no study.json)."
+    z = s.get("training_data", {})
+    return (f"This run: {s.get('framework')}, seeds {', '.join(map(str, s.get('seeds', [])))}, {s.get('steps')} "
+            f"optimiser steps of batch 256 for each model alike, on {z.get('n_train')} training-family "
+            f"trajectories of {z.get('n_points')} samples (generator seed {s.get('train_seed')}); "
+            f"{s.get('n_refs')} references of {s.get('ref_duration_s')} s per family.")
+
+
+STUDIES = (
+    Study("control", "Closed-loop tracking control (study)",
+          "The DeLaN paper's experiment: claim 9's inverse models, trained offline on the full data set, give "
+          "the feed-forward torque of a computed-torque controller of the simulated two-link arm (500 Hz, "
+          f"the SymPy arm as the plant, {GAINS}) on references no model trained on. The "
+          "true inverse dynamics is the best a model can do; PD alone is the null controller. A study beside "
+          "the claims (`lagbench control`): it decides no verdict.", "figures/control_tracking.png"),
+    Study("control_four_joint_arm", "Closed-loop tracking control of the four-joint arm (study)",
+          "The same experiment on the SymPy four-joint arm (the first four joints of a Barrett WAM): DeLaN and the "
+          "feed-forward net are fitted by the study itself to the arm's training family under one equal budget "
+          "(claim 9's model kinds and widths, 64 x 64 softplus, Adam at 1e-3, torque MSE; claim 9's trained "
+          f"models are two-link models), then give the feed-forward torque at 500 Hz ({GAINS} on every joint) "
+          "on the two-link study's reference families. The true inverse dynamics is the best a model can do; "
+          "PD alone is the null controller. A study beside the claims (`lagbench control --system "
+          "four_joint_arm`): it decides no verdict.", "figures/control_four_joint_arm_tracking.png",
+          _four_joint_setup),
+)
 
 
 def _span(x: pd.Series) -> str:
@@ -67,19 +114,19 @@ def _figure(traces: dict, path: Path) -> bool:
     return F.save(fig, path)
 
 
-def control_sections(res: Results, out_dir: Path) -> list[Section]:
-    folder = res.root / "control"
+def study_section(res: Results, out_dir: Path, study: Study) -> list[Section]:
+    """The section of one study folder; nothing when it holds no readable tracking table."""
+    folder = res.root / study.folder
     try:
         df = pd.read_csv(folder / "tracking.csv")
     except (OSError, ValueError):
         return []
-    s = Section("Closed-loop tracking control (study)")
-    s.add(Para("The DeLaN paper's experiment: claim 9's inverse models, trained offline on the full data set, give "
-               "the feed-forward torque of a computed-torque controller of the simulated two-link arm (500 Hz, "
-               "the SymPy arm as the plant, gains KP 20, KD 2 sqrt(20)) on references no model trained on. The "
-               "true inverse dynamics is the best a model can do; PD alone is the null controller. A study beside "
-               "the claims (`lagbench control`): it decides no verdict."))
-    s.add(Table("Tracking error per controller (median [min, max] over seeds)", _table(df), ["control/tracking.csv"],
+    s = Section(study.title)
+    s.add(Para(study.intro))
+    if study.setup:
+        s.add(Para(study.setup(folder)))
+    s.add(Table("Tracking error per controller (median [min, max] over seeds)", _table(df),
+                [f"{study.folder}/tracking.csv"],
                 note="Tracking MSE: the mean over references and time of |q - q_ref|²; '/ PD alone' its ratio to the "
                      "PD controller's on the same references."))
     try:
@@ -87,8 +134,11 @@ def control_sections(res: Results, out_dir: Path) -> list[Section]:
             traces = {k: z[k] for k in z.files}
     except (OSError, ValueError):
         traces = {}
-    rel = "figures/control_tracking.png"
-    if _figure(traces, out_dir / rel):
-        s.add(Figure(rel, "Closed-loop tracking: the error on the first unseen reference over time, per controller "
-                          "(first seed of each framework).", ["control/traces.npz"]))
+    if _figure(traces, out_dir / study.figure):
+        s.add(Figure(study.figure, "Closed-loop tracking: the error on the first unseen reference over time, per "
+                                   "controller (first seed of each framework).", [f"{study.folder}/traces.npz"]))
     return [s]
+
+
+def control_sections(res: Results, out_dir: Path) -> list[Section]:
+    return [s for study in STUDIES for s in study_section(res, out_dir, study)]

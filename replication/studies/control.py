@@ -2,24 +2,29 @@
 
 Computed-torque control: tau = tau_hat(q_d, qdot_d, qddot_d) + KP (q_d - q) + KD (qdot_d - qdot), at
 `RATE` Hz with the torque held over each control period (zero-order hold). The plant is the SymPy ground
-truth (`systems.get("two_link_arm")`, forward dynamics under the torque) integrated by RK4 with `SUBSTEPS`
-steps per period in float64, independent of the controller. A batch of reference trajectories is tracked
-side by side from the reference's own initial state; a trajectory whose state leaves `DIVERGED` is marked
-diverged and scores no error.
+truth (`systems.get(system)`, forward dynamics under the torque; `system` one of `systems.arm_data.ARMS`,
+default `SYSTEM`, the two-link arm) integrated by RK4 with `SUBSTEPS` steps per period in float64,
+independent of the controller. A batch of reference trajectories is tracked side by side from the
+reference's own initial state; a trajectory whose state leaves `DIVERGED` is marked diverged and scores no
+error.
 
 References the models never trained on: the "test" family of `systems.arm_data` (other shapes, higher
 frequencies) and the training family played twice as fast ("train_x2": q_d(2t), so velocities x 2 and
 accelerations x 4). Controllers: each learned inverse model of claim 9 trained on the full data set
 (`delan`, `ff`; every framework and seed in the results folder), the true inverse dynamics (the best a
 model can give) and PD alone (tau_hat = 0, the null controller). Gains are fixed and declared (`KP`,
-`KD`), low enough that the feed-forward term has to do most of the work, as in the paper.
+`KD`; `gains(dof)` the same on every joint of an arm of `dof` joints), low enough that the feed-forward term
+has to do most of the work, as in the paper.
 
 `hold(plant, q, v, tau, h)` is the plant over one control period (the online study's too, `online.py`);
-`track(inverse, refs, ...) -> dict` simulates one controller; `control_study(results, ...) -> DataFrame`
-runs every controller on every family; `write_study(results, folder)` (`lagbench control`, into
-RESULTS/control) writes FOLDER/tracking.csv (one row per controller, framework, seed and family: tracking
-MSE per joint and overall, torque effort, diverged count, ratio to PD alone) and FOLDER/traces.npz (the
-first reference of each family and each controller's first-seed response) for the report.
+`track(inverse, refs, ...) -> dict` simulates one controller; `tracking_table(controllers, ...) ->
+(DataFrame, traces)` runs controllers (name, framework, seed, inverse) on every family of an arm;
+`control_study(results, ...)` runs claim 9's models and the two references on the two-link arm;
+`write_study(results, folder)` (`lagbench control`, into RESULTS/control) writes FOLDER/tracking.csv (one
+row per controller, framework, seed and family: tracking MSE per joint and overall, torque effort, diverged
+count, ratio to PD alone) and FOLDER/traces.npz (the first reference of each family and each controller's
+first-seed response) for the report. The four-joint arm's study, which fits its own models, is
+`arm4_control.py`.
 """
 from __future__ import annotations
 
@@ -28,24 +33,35 @@ import pandas as pd
 
 RATE = 500.0             # control ticks per second
 SUBSTEPS = 4             # plant RK4 steps per control period
-KP = np.array([20.0, 20.0])
-KD = 2.0 * np.sqrt(KP)   # critically damped for a unit inertia
+SYSTEM = "two_link_arm"  # the plant unless a study names another arm
+KP_GAIN = 20.0
+
+
+def gains(dof: int) -> tuple[np.ndarray, np.ndarray]:
+    """KP, KD (dof,): KP_GAIN on every joint, KD = 2 sqrt(KP) (critically damped for a unit inertia)."""
+    kp = np.full(int(dof), KP_GAIN)
+    return kp, 2.0 * np.sqrt(kp)
+
+
+KP, KD = gains(2)   # the two-link arm's
 DURATION = 4.0           # seconds per reference
 N_REFS = 8
 SEED = 2000              # the references' generator seed: no training or held-out draw of claim 9 uses it
 DIVERGED = 1e3
 MODELS = ("delan", "ff")
+FAMILIES = ("test", "train_x2")
 
 
-def references(family: str, n: int = N_REFS, duration: float = DURATION, rate: float = RATE, seed: int = SEED):
-    """q_d, qdot_d, qddot_d (n, T, 2) at the control ticks, and t (T,)."""
+def references(family: str, n: int = N_REFS, duration: float = DURATION, rate: float = RATE, seed: int = SEED,
+               system: str = SYSTEM):
+    """q_d, qdot_d, qddot_d (n, T, dof) of arm `system` at the control ticks, and t (T,)."""
     from systems.arm_data import arm_dataset
 
     fast = family == "train_x2"
     k = 2.0 if fast else 1.0
     base = "train" if fast else family
     n_t = int(round(duration * rate)) + 1
-    d = arm_dataset(base, n_traj=n, n_points=n_t, seed=seed, duration=k * duration, cache=False)
+    d = arm_dataset(base, n_traj=n, n_points=n_t, seed=seed, duration=k * duration, cache=False, system=system)
     return {"t": d["t"] / k, "q": d["q"], "qdot": d["qdot"] * k, "qddot": d["qddot"] * k * k}
 
 
@@ -74,15 +90,18 @@ def diverged(q, v):
         return ~np.isfinite(q).all(-1) | ~np.isfinite(v).all(-1) | (np.abs(np.c_[q, v]) > DIVERGED).any(-1)
 
 
-def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=KP, kd=KD, plant=None) -> dict:
-    """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, 2)
+def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=None, kd=None, plant=None,
+          system: str = SYSTEM) -> dict:
+    """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, dof)
     float64 arrays, or None for PD alone; `plant` anything with `.acceleration(q, qdot, tau=)` (default the
-    SymPy two-link arm). Returns q, tau (B, T, 2) and a diverged mask (B,)."""
+    SymPy arm `system`); kp, kd default `gains(dof)`. Returns q, tau (B, T, dof) and a diverged mask (B,)."""
     import systems
 
-    plant = plant or systems.get("two_link_arm")
+    plant = plant or systems.get(system)
     qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
     b, n_t, dof = qd.shape
+    kp = gains(dof)[0] if kp is None else kp
+    kd = gains(dof)[1] if kd is None else kd
     q, v = qd[:, 0].copy(), vd[:, 0].copy()
     h = 1.0 / rate / substeps
     qs, taus = np.zeros((b, n_t, dof)), np.zeros((b, n_t, dof))
@@ -132,19 +151,33 @@ def _learned(results) -> list:
     return out
 
 
-def control_study(results, families=("test", "train_x2"), n_refs: int = N_REFS, duration: float = DURATION,
-                  progress=None) -> tuple[pd.DataFrame, dict]:
+def references_controllers(system: str = SYSTEM) -> list:
+    """(name, framework, seed, inverse) of the true inverse dynamics of arm `system` and PD alone."""
     import systems
 
-    plant = systems.get("two_link_arm")
-    controllers = [("exact", "numpy", "-", lambda q, v, a: plant.inverse_dynamics(q, v, a)), ("pd", "numpy", "-", None)]
-    controllers += [(m, fw, seed, fitted.inverse_dynamics) for m, fw, seed, fitted in _learned(results)]
+    plant = systems.get(system)
+    return [("exact", "numpy", "-", lambda q, v, a: plant.inverse_dynamics(q, v, a)), ("pd", "numpy", "-", None)]
+
+
+def control_study(results, families=FAMILIES, n_refs: int = N_REFS, duration: float = DURATION,
+                  progress=None) -> tuple[pd.DataFrame, dict]:
+    """Claim 9's learned inverse models in RESULTS on the two-link arm, beside `references_controllers`."""
+    controllers = references_controllers() + [(m, fw, seed, fitted.inverse_dynamics)
+                                              for m, fw, seed, fitted in _learned(results)]
+    return tracking_table(controllers, families, n_refs, duration, progress=progress)
+
+
+def tracking_table(controllers, families=FAMILIES, n_refs: int = N_REFS, duration: float = DURATION,
+                   system: str = SYSTEM, progress=None) -> tuple[pd.DataFrame, dict]:
+    """Every controller (name, framework, seed, inverse) on `n_refs` references of each family of arm
+    `system`: the tracking table (one row per family and controller, with ratio_to_pd: `controllers` must
+    hold "pd") and the traces (each family's first reference and each controller's first-seed response)."""
     rows, traces = [], {}
     for family in families:
-        refs = references(family, n_refs, duration)
+        refs = references(family, n_refs, duration, system=system)
         traces[f"{family}__t"], traces[f"{family}__q_ref"] = refs["t"], refs["q"][0]
         for name, fw, seed, inverse in controllers:
-            sim = track(inverse, refs)
+            sim = track(inverse, refs, system=system)
             rows.append({"family": family, "controller": name, "framework": fw, "seed": seed, **scores(sim, refs)})
             key = f"{family}__{name}__{fw}"
             if key + "__q" not in traces:

@@ -1,26 +1,69 @@
-"""`lagbench control`: its command line (the study itself is `control.py`)."""
+"""`lagbench control`: its command line (the study itself is `control.py`; the four-joint arm's, which fits its
+own models, `arm4_control.py`).
+
+Every option is checked before any work (a one-line error naming it). `--system two_link_arm` (the default)
+tracks with claim 9's models in RESULTS and writes RESULTS/control/; any other arm of `systems.arm_data.ARMS`
+fits its models first and writes RESULTS/control_<system>/ (`--steps`, `--seeds`, `--framework` are its
+fit options, refused for the two-link arm, whose models are claim 9's)."""
 from __future__ import annotations
 
 from pathlib import Path
 
+FRAMEWORKS = ("jax", "torch")
+TWO_LINK = "two_link_arm"
 
-def cmd_control(args):
-    from tqdm.auto import tqdm
 
-    from replication.results import output_folder
-    from replication.studies.control import write_study
+def _fit_options(args) -> dict:
+    from replication.studies import arm4_control as A
+    from replication.studies.robustness_cli import _seeds, _steps
 
+    framework = args.framework or "jax"
+    if framework not in FRAMEWORKS:
+        raise ValueError(f"--framework {framework}: expected one of {', '.join(FRAMEWORKS)}")
+    return {"steps": _steps(args.steps or str(A.STEPS)), "framework": framework, "seeds": _seeds(args.seeds or ["0"])}
+
+
+def _check(args) -> dict:
+    from systems.arm_data import ARMS
+
+    if args.system not in ARMS:
+        raise ValueError(f"--system {args.system}: expected one of {', '.join(ARMS)}")
     results = Path(args.results)
     if not results.is_dir():
         raise ValueError(f"--results {results}: no such folder")
     if args.references < 1 or not args.duration > 0:
         raise ValueError(f"--references {args.references} --duration {args.duration}: need at least 1 reference "
                          "and a duration above 0 s")
-    folder = output_folder(results / "control", "--results")
+    if args.system == TWO_LINK:
+        given = [o for o, v in (("--steps", args.steps), ("--seeds", args.seeds), ("--framework", args.framework))
+                 if v is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)}: fit options of the arms other than {TWO_LINK}, whose models are "
+                             f"claim 9's trained units in --results")
+        return {}
+    return _fit_options(args)
+
+
+def cmd_control(args):
+    from tqdm.auto import tqdm
+
+    from replication.results import output_folder
+
+    fit = _check(args)
+    results, two_link = Path(args.results), args.system == TWO_LINK
+    folder = output_folder(results / ("control" if two_link else f"control_{args.system}"), "--results")
     bar = tqdm(desc="lagbench control", unit="controller", disable=args.quiet)
     try:
-        df = write_study(results, folder, n_refs=args.references, duration=args.duration,
-                         progress=lambda _: bar.update())
+        if two_link:
+            from replication.studies.control import write_study
+
+            df = write_study(results, folder, n_refs=args.references, duration=args.duration,
+                             progress=lambda _: bar.update())
+        else:
+            from replication.studies.arm4_control import write_study
+
+            df = write_study(folder, n_refs=args.references, duration=args.duration,
+                             progress=lambda what: (bar.set_postfix_str(what), bar.update()), **fit)
     finally:
         bar.close()
     cols = ["family", "controller", "framework", "seed", "track_mse", "ratio_to_pd", "n_diverged"]
@@ -30,15 +73,26 @@ def cmd_control(args):
 
 def add_command(sub) -> None:
     s = sub.add_parser("control", help="closed-loop tracking of the two-link arm with claim 9's learned inverse models "
-                                       "(writes RESULTS/control/ for the report)",
+                                       "(writes RESULTS/control/), or of the four-joint arm with models it fits "
+                                       "(RESULTS/control_four_joint_arm/)",
                        description="Computed-torque control at 500 Hz of the SymPy two-link arm (RK4 plant, 4 steps a "
                        "period) on references no model trained on (the unseen family, the training family twice "
                        "as fast), with each full-data DeLaN and feed-forward net of claim 9 in RESULTS, the true "
                        "inverse dynamics and PD alone (gains KP 20, KD 2 sqrt(20)). Writes RESULTS/control/"
-                       "tracking.csv and traces.npz.")
+                       "tracking.csv and traces.npz. With --system four_joint_arm it first fits DeLaN and the "
+                       "feed-forward net to the four-joint arm's training family under one budget (--steps, "
+                       "--seeds, --framework) and tracks the same families on the four-joint arm, writing "
+                       "RESULTS/control_four_joint_arm/ (tracking.csv, traces.npz, study.json, data/, fits/).")
     s.add_argument("--results", default="results/quick", help="a results folder holding claim 9's units "
                    "(default: results/quick)")
+    s.add_argument("--system", default=TWO_LINK, help="the arm: two_link_arm or four_joint_arm "
+                   "(default: two_link_arm)")
     s.add_argument("--references", type=int, default=8, help="reference trajectories per family (default: 8)")
     s.add_argument("--duration", type=float, default=4.0, help="seconds per reference (default: 4)")
+    s.add_argument("--steps", default=None, help="four-joint arm: optimiser steps of each model "
+                   "(default: 3000)")
+    s.add_argument("--seeds", nargs="+", default=None, help="four-joint arm: model seeds, comma- or "
+                   "space-separated (default: 0)")
+    s.add_argument("--framework", default=None, help="four-joint arm: jax | torch (default: jax)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_control)

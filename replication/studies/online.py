@@ -1,5 +1,7 @@
 """Learning online while tracking: computed-torque control of the two-link arm whose inverse model starts untrained
-and learns from the samples its own control loop produces (DeLaN's "learns online in real time").
+and learns from the samples its own control loop produces (DeLaN's "learns online in real time"). Every
+function takes `system`, the arm (`systems.arm_data.ARMS`; default `control.SYSTEM`, the two-link arm): its
+SymPy plant, its references, gains `control.gains(dof)` and learners of its `dof`.
 
 The loop is `control.py`'s: tau = tau_hat(q_d, qdot_d, qddot_d) + KP (q_d - q) + KD (qdot_d - qdot) at `RATE`
 (500) Hz, the torque held over each 2 ms period, the SymPy plant integrated by RK4 (`control.hold`, 4 steps a
@@ -59,22 +61,24 @@ SUMMARY_COLUMNS = [*KEY, "threshold", "t_reach_s", "t_settle_s", "first_window_m
                    "compute_us_median", "compute_us_p99", "fits_period_mean", "fits_period_p99"]
 
 
-def sequence(family: str, seconds: float, rate: float = C.RATE, seed: int = C.SEED) -> dict:
+def sequence(family: str, seconds: float, rate: float = C.RATE, seed: int = C.SEED, system: str = C.SYSTEM) -> dict:
     """References of `family` covering `seconds`: ceil(seconds / d) of d = min(control.DURATION, seconds)
     seconds each (`control.references`), played in order."""
     d = min(C.DURATION, seconds)
-    return C.references(family, n=math.ceil(seconds / d - 1e-9), duration=d, rate=rate, seed=seed)
+    return C.references(family, n=math.ceil(seconds / d - 1e-9), duration=d, rate=rate, seed=seed, system=system)
 
 
 def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: int = BATCH, buffer: int = BUFFER,
                window: float = WINDOW, seed: int = 0, seconds: float | None = None, rate: float = C.RATE,
-               substeps: int = C.SUBSTEPS, kp=C.KP, kd=C.KD, progress=None):
+               substeps: int = C.SUBSTEPS, kp=None, kd=None, progress=None, system: str = C.SYSTEM):
     import systems
     from replication.studies.online_learner import ReplayBuffer
 
-    plant = systems.get("two_link_arm")
+    plant = systems.get(system)
     qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
     n_refs, n_t, dof = qd.shape
+    kp = C.gains(dof)[0] if kp is None else kp
+    kd = C.gains(dof)[1] if kd is None else kd
     total = (n_t - 1) * n_refs if seconds is None else min((n_t - 1) * n_refs, int(round(seconds * rate)))
     per_window = max(1, int(round(window * rate)))
     learns = ctrl is not None and ctrl != "exact" and steps > 0
@@ -126,15 +130,15 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
     return windows, {"inference_us": 1e6 * t_inf[ran], "learning_us": 1e6 * t_learn[ran], "diverged_refs": n_bad}
 
 
-def unseen(ctrl, n_unseen: int, duration: float, seed: int = C.SEED) -> dict:
+def unseen(ctrl, n_unseen: int, duration: float, seed: int = C.SEED, system: str = C.SYSTEM) -> dict:
     import systems
 
-    refs = C.references("test", n=n_unseen, duration=duration, seed=seed)
+    refs = C.references("test", n=n_unseen, duration=duration, seed=seed, system=system)
     if ctrl is None or isinstance(ctrl, str):
-        inverse = None if ctrl is None else systems.get("two_link_arm").inverse_dynamics
+        inverse = None if ctrl is None else systems.get(system).inverse_dynamics
     else:
         inverse = ctrl.inverse
-    s = C.scores(C.track(inverse, refs), refs)
+    s = C.scores(C.track(inverse, refs, system=system), refs)
     return {"unseen_mse": s.get("track_mse", math.nan), "unseen_diverged": s["n_diverged"]}
 
 
@@ -166,25 +170,27 @@ def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,)
                  every: int = EVERY, steps: int = STEPS, batch: int = BATCH, buffer: int = BUFFER,
                  window: float = WINDOW, threshold: float = THRESHOLD, hidden=None, lr: float | None = None,
                  refs: dict | None = None, n_unseen: int = N_UNSEEN, unseen_duration: float = C.DURATION,
-                 progress=None) -> tuple[pd.DataFrame, pd.DataFrame]:
+                 progress=None, system: str = C.SYSTEM) -> tuple[pd.DataFrame, pd.DataFrame]:
     """See the module docstring. `refs`: the references to learn on (default `sequence("train", seconds)`);
     `hidden`, `lr`: the models' widths and learning rate (default claim 9's); n_unseen 0: no unseen score."""
+    import systems
     from replication.run.environment import torch_threads
     from replication.studies import online_learner as OL
 
-    refs = sequence("train", seconds) if refs is None else refs
+    refs = sequence("train", seconds, system=system) if refs is None else refs
+    dof = systems.get(system).dof
     plan = [("pd", "numpy", "-"), ("exact", "numpy", "-")]
     plan += [(m, fw, s) for m in models for fw in frameworks for s in seeds]
     curves, rows = [], []
     with torch_threads(1 if "torch" in frameworks else None):
         for name, fw, s in plan:
             ctrl = {"pd": None, "exact": "exact"}.get(name) if fw == "numpy" else \
-                OL.learner(name, fw, int(s), hidden or OL.HIDDEN, lr)
-            windows, ticks = run_online(ctrl, refs, every, steps, batch, buffer, window,
-                                          seed=0 if s == "-" else int(s), seconds=seconds, progress=progress)
+                OL.learner(name, fw, int(s), hidden or OL.HIDDEN, lr, dof=dof)
+            windows, ticks = run_online(ctrl, refs, every, steps, batch, buffer, window, seed=0 if s == "-" else int(s),
+                                        seconds=seconds, progress=progress, system=system)
             key = {"controller": name, "framework": fw, "seed": s}
             curves += [{**key, **w} for w in windows]
-            rows.append((key, ticks, unseen(ctrl, n_unseen, unseen_duration) if n_unseen else {}))
+            rows.append((key, ticks, unseen(ctrl, n_unseen, unseen_duration, system=system) if n_unseen else {}))
     df = pd.DataFrame(curves)
     df["ratio_to_pd"] = ratio_to_pd(df, df[df["controller"] == "pd"])
     pd_unseen = rows[0][2].get("unseen_mse", math.nan)
@@ -218,16 +224,18 @@ def one_thread() -> dict:
 def write_study(folder, settings: dict | None = None, **kw) -> tuple[pd.DataFrame, pd.DataFrame]:
     from pathlib import Path
 
+    import systems
     from replication import results as R
     from replication.run import environment
 
     folder = Path(folder)
     curves, summary = online_study(**kw)
+    kp, kd = C.gains(systems.get(kw.get("system", C.SYSTEM)).dof)
     R.write_csv(folder / "curves.csv", curves)
     R.write_csv(folder / "summary.csv", summary)
     R.write_json(folder / "setup.json", {
         **(settings or {}), **{k: v for k, v in kw.items() if k not in ("refs", "progress")},
         "threshold_definition": "a window's tracking MSE at most `threshold` x PD alone's in the same window",
-        "control_rate_hz": C.RATE, "period_us": PERIOD_US, "kp": C.KP.tolist(), "kd": C.KD.tolist(),
+        "control_rate_hz": C.RATE, "period_us": PERIOD_US, "kp": kp.tolist(), "kd": kd.tolist(),
         **environment.hardware(), "versions": environment.versions()})
     return curves, summary

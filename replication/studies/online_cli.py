@@ -1,7 +1,8 @@
 """`lagbench online`: its command line (the study is `online.py`, the learners `online_learner.py`).
 
 Every option is checked before any work (a one-line error naming it); the command writes only into
-OUT/online/. JAX and PyTorch are held to one thread (`online.one_thread`) before either starts computing."""
+OUT/online/ (the two-link arm, the default `--system`) or OUT/online_<system>/ (another arm). JAX and
+PyTorch are held to one thread (`online.one_thread`) before either starts computing."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -35,9 +36,14 @@ def _number(option: str, value: float, low: float, high: float = float("inf"), s
 def _check(args) -> dict:
     from replication.studies import control as C
     from replication.studies.online_learner import KINDS
+    from systems.arm_data import ARMS
 
+    if args.system not in ARMS:
+        raise ValueError(f"--system {args.system}: expected one of {', '.join(ARMS)}")
     tick = 1.0 / C.RATE
-    return {"seconds": _number("--seconds", args.seconds, tick, MAX_SECONDS, strict=False),
+    # the system is passed (and recorded in setup.json) only where it is not the default two-link arm
+    other = {} if args.system == C.SYSTEM else {"system": args.system}
+    return {**other, "seconds": _number("--seconds", args.seconds, tick, MAX_SECONDS, strict=False),
             "every": int(_number("--every", args.every, 1, strict=False)),
             "steps": int(_number("--steps", args.steps, 0, strict=False)),
             "batch": int(_number("--batch", args.batch, 1, strict=False)),
@@ -59,7 +65,7 @@ def cmd_online(args):
     from replication.studies import online as O
 
     kw = _check(args)
-    folder = output_folder(Path(args.out) / "online", "--out")
+    folder = output_folder(Path(args.out) / ("online" if "system" not in kw else f"online_{kw['system']}"), "--out")
     threads = O.one_thread()
     ticks = int(round(kw["seconds"] * O.C.RATE))
     n_ctrl = 2 + len(kw["models"]) * len(kw["frameworks"]) * len(kw["seeds"])
@@ -82,7 +88,7 @@ def add_command(sub) -> None:
     from replication.studies import online as O
 
     s = sub.add_parser("online", help="DeLaN and the feed-forward net learning online while they track the two-link "
-                                      "arm (writes OUT/online/)",
+                                      "arm (writes OUT/online/) or the four-joint arm (OUT/online_four_joint_arm/)",
                        description="Computed-torque control at 500 Hz of the SymPy two-link arm (as `lagbench "
                        "control`) whose inverse model starts untrained and learns from its own control loop: each "
                        "tick's (q, qdot, measured qddot, applied torque) enters a replay buffer, and every --every "
@@ -91,8 +97,12 @@ def add_command(sub) -> None:
                        "scored frozen on the unseen family. PD alone and the true inverse dynamics are the floors. "
                        "Writes OUT/online/curves.csv (per window: tracking MSE, microseconds of inference and of "
                        "learning per tick), summary.csv (time to reach the threshold, final and unseen MSE, compute "
-                       "per tick against the 2 ms period) and setup.json. See docs/online_control.md.")
-    s.add_argument("--out", required=True, help="results folder; writes OUT/online/")
+                       "per tick against the 2 ms period) and setup.json. With --system four_joint_arm the same on "
+                       "the SymPy four-joint arm, into OUT/online_four_joint_arm/. See docs/online_control.md.")
+    s.add_argument("--out", required=True, help="results folder; writes OUT/online/ (OUT/online_<system>/ for "
+                   "another arm than the two-link arm)")
+    s.add_argument("--system", default="two_link_arm", help="the arm: two_link_arm or four_joint_arm (its "
+                   "learners have 4 joints; default: two_link_arm)")
     s.add_argument("--seconds", type=float, default=20.0, help="simulated seconds of learning while tracking "
                    "(default: 20)")
     s.add_argument("--every", type=int, default=O.EVERY, help=f"learn every K control ticks (default: {O.EVERY})")

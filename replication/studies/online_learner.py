@@ -6,9 +6,9 @@ study (`replication.studies.online`).
 the suite's training batch for task "inverse_dynamics": {"q", "qdot", "extra" = qddot, "target" = tau}, each
 (batch, dof) float64.
 
-`learner(kind, framework, seed, hidden=HIDDEN, lr=None) -> JaxLearner | TorchLearner`: claim 9's model of that
-kind ("delan", or "ff": the feed-forward baseline given qddot as extra input; 2-layer softplus, xavier, float32)
-with fresh parameters (`models.init_params(spec, seed)`), trained by the suite's own optimiser step
+`learner(kind, framework, seed, hidden=HIDDEN, lr=None, dof=2) -> JaxLearner | TorchLearner`: claim 9's model of
+that kind ("delan", or "ff": the feed-forward baseline given qddot as extra input; 2-layer softplus, xavier,
+float32) for an arm of `dof` joints (2: the two-link arm's, 4: the four-joint arm's) with fresh parameters (`models.init_params(spec, seed)`), trained by the suite's own optimiser step
 (`replication.training.train_jax.Stepper` / `train_torch.Stepper`: Adam, torque MSE plus L2 1e-5, claim 9's
 quick protocol) at learning rate `lr` (default the protocol's 1e-3; 0 is the null learner, whose steps change
 no parameter). Each learner gives:
@@ -55,15 +55,18 @@ class ReplayBuffer:
         return {"q": q, "qdot": qdot, "extra": qddot, "target": tau}
 
 
-def claim_model(kind: str, hidden=HIDDEN):
-    """(ModelSpec, Protocol) of claim 9's model `kind` on the two-link arm: its spec fields at `hidden` and
-    its quick protocol (loss, L2, Adam, learning rate)."""
+def claim_model(kind: str, hidden=HIDDEN, dof: int = 2):
+    """(ModelSpec, Protocol) of claim 9's model `kind` for an arm of `dof` joints (claim 9's own: 2): its spec
+    fields at `hidden` and its quick protocol (loss, L2, Adam, learning rate)."""
     from models import ModelSpec
     from replication.claims.delan_arm import CLAIM, PROTOCOLS
 
     if kind not in KINDS:
         raise ValueError(f"model {kind!r}: valid {', '.join(KINDS)}")
-    spec = ModelSpec(dof=2, dtype="float32", hidden=tuple(hidden), **CLAIM.entry(kind).spec)
+    fields = dict(CLAIM.entry(kind).spec)
+    if "extra_inputs" in fields:   # the feed-forward net's qddot input: one per joint
+        fields["extra_inputs"] = int(dof)
+    spec = ModelSpec(dof=int(dof), dtype="float32", hidden=tuple(hidden), **fields)
     return spec, PROTOCOLS["quick"]
 
 
@@ -139,11 +142,12 @@ class TorchLearner(_Learner):
         return self._call(q, qdot, qddot)
 
 
-def learner(kind: str, framework: str, seed: int, hidden=HIDDEN, lr: float | None = None):
-    """A fresh learner of claim 9's model `kind` in `framework` ("jax" or "torch"), initialised from `seed`."""
+def learner(kind: str, framework: str, seed: int, hidden=HIDDEN, lr: float | None = None, dof: int = 2):
+    """A fresh learner of claim 9's model `kind` in `framework` ("jax" or "torch") for `dof` joints, initialised
+    from `seed`."""
     from models import init_params
 
-    spec, protocol = claim_model(kind, hidden)
+    spec, protocol = claim_model(kind, hidden, dof)
     lr = protocol.schedule.lr if lr is None else float(lr)
     if not (math.isfinite(lr) and lr >= 0):
         raise ValueError(f"learning rate {lr!r}: must be finite and >= 0")
