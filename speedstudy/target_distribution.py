@@ -39,6 +39,7 @@ from tqdm.auto import tqdm
 
 from replication.results import write_csv, write_json
 from replication.run import splits
+from replication.training.protocol import canonical_hash
 from speedstudy import train_target
 from speedstudy.train_target_run import run_study
 
@@ -133,7 +134,15 @@ def _stats(values) -> dict:
     return {"median": float(np.median(v)), "min": float(v.min()), "max": float(v.max())}
 
 
-def distribution(folder: Path, rows: pd.DataFrame, split: splits.Split, budget) -> tuple[pd.DataFrame, dict]:
+def protocol_hash(name: str, budget, n_heldout: int, hidden) -> str:
+    """16 hex digits identifying what protocol `name` trains at this budget, held-out size and width (its
+    protocol dict and the widths), the same in every run of it: the record that the protocol did not change."""
+    p = train_target.protocols(int(budget), int(n_heldout))[name].protocol
+    return canonical_hash({"protocol": p.to_dict(), "hidden": [int(h) for h in hidden]}, 16)
+
+
+def distribution(folder: Path, rows: pd.DataFrame, split: splits.Split, budget, n_heldout: int | None = None,
+                 hidden=None) -> tuple[pd.DataFrame, dict]:
     at = rows[np.isclose(rows["threshold"].astype(float), TARGET)]
     table = at.assign(chosen_seed=at["seed"], threshold=TARGET, reached=at["samples_to_reach"].notna())
     table = table[DIST_COLUMNS].sort_values(["protocol", "run"], kind="stable").reset_index(drop=True)
@@ -144,6 +153,8 @@ def distribution(folder: Path, rows: pd.DataFrame, split: splits.Split, budget) 
                      "init_seeds": [int(s) for s in g["init_seed"]],
                      "note": f"median over the runs that reached it; {len(hit)} of {len(g)} reached",
                      **{k: _stats(hit[k]) for k in STATS}}
+        if n_heldout is not None and hidden is not None:
+            per[name]["protocol_hash"] = protocol_hash(name, budget, n_heldout, hidden)
     summary = {"threshold": TARGET, "split": split.name, "heldout_seed": int(split.heldout_seed),
                "budget": int(budget), "protocols": per}
     write_csv(folder / "distribution.csv", table)

@@ -47,7 +47,7 @@ def cmd_train_target(args):
             df = dist.run_many(folder, args.budget, hidden, heldout, names, split, args.seed, args.runs,
                                progress=not args.quiet)
     if args.runs > 1:
-        _, summary = dist.distribution(folder, df, split, args.budget)
+        _, summary = dist.distribution(folder, df, split, args.budget, n_heldout=heldout, hidden=hidden)
         print(f"held-out L1 <= {dist.TARGET:g} on the {split.name} split (median, min, max over the runs that "
               f"reached it):")
         print(dist.summary_table(summary).to_string(index=False))

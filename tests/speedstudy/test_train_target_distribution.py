@@ -17,6 +17,7 @@ from speedstudy import target_distribution as TD
 from speedstudy import train_target as TT
 
 TINY = ["--budget", "4000", "--hidden", "8,8", "--heldout-states", "64", "--quiet"]
+HELDOUT, WIDTHS = 64, (8, 8)
 PROTOCOLS = ["variant", "restarts_halved"]
 RUNS = 2
 
@@ -83,9 +84,12 @@ def test_the_distribution_files_hold_one_row_per_run_and_protocol(test_runs):
         assert p["runs"] == RUNS and p["reached"] == int(rows["reached"].sum()) and p["split"] == "test"
         assert p["note"] == f"median over the runs that reached it; {p['reached']} of {RUNS} reached"
         assert p["init_seeds"] == list(rows["init_seed"]) and p["budget"] == int(rows["budget"].iloc[0])
+        assert p["protocol_hash"] == TD.protocol_hash(name, 4000, HELDOUT, WIDTHS)
         hit = rows.loc[rows["reached"], "wall_s_to_reach"]
         assert p["wall_s_to_reach"]["median"] == (float(hit.median()) if len(hit) else None)
     assert "restarts_halved" in printed and f"of {RUNS}" in printed
+    hashes = {summary["protocols"][n]["protocol_hash"] for n in PROTOCOLS}
+    assert len(hashes) == 2 and TD.protocol_hash("variant", 8000, HELDOUT, WIDTHS) not in hashes   # budget counts
 
 
 def test_rerunning_the_command_reuses_the_finished_runs(test_runs, tmp_path, monkeypatch):
