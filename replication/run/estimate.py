@@ -80,13 +80,14 @@ def _shape(framework, spec, protocol) -> str:
 
 def estimate(units, out, jobs: int = 1, torch_threads: int | None = None) -> dict:
     """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
-    "probes": configurations timed}."""
+    "probes": configurations timed, "by_claim": {claim id: seconds}}. A training that several claims share
+    (claims 1, 2 and 11 train the same double-pendulum models) counts for the first claim planned with it."""
     with threads_of_torch(torch_threads if any(u.framework == "torch" for u in units) else None):
         return _estimate(units, out, jobs)
 
 
 def _estimate(units, out, jobs: int) -> dict:
-    per_step, todo, cached = {}, {}, 0
+    per_step, todo, cached, owner = {}, {}, 0, {}
     for u in units:
         if not u.entry.train:
             continue
@@ -94,6 +95,7 @@ def _estimate(units, out, jobs: int) -> dict:
         group = _group(u)   # a cohort of seeds trains as one program
         if group in todo:
             continue
+        owner[group] = u.claim.id
         if (Path(out) / "trained" / u.framework / train_key(u.framework, spec, p, u.seed) / "result.json").exists():
             cached += 1
             todo[group] = 0.0
@@ -109,8 +111,12 @@ def _estimate(units, out, jobs: int) -> dict:
         todo[group] = plain * p.steps + sum(members[m] * n for m, n in scout_parts(p))
     total = sum(todo.values())
     in_order = [todo.get(_group(c[0]), 0.0) for c in chains(units)]
+    by_claim: dict = {}
+    for group, seconds in todo.items():
+        by_claim[owner[group]] = by_claim.get(owner[group], 0.0) + seconds
     return {"train_s": total, "wall_s": scheduled_wall(in_order, jobs),
-            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step)}
+            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step),
+            "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1]))}
 
 
 def _group(u):

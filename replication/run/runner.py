@@ -142,6 +142,9 @@ def announce(profile, units, todo, out, jobs, executor="local") -> dict:
           f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
           f"worker{'s' if jobs != 1 else ''} (evaluation not included; {where}; {hw['cpu']}, GPU: {hw['gpu']}). "
           f"Interrupt at any time: the run resumes where it stopped.", flush=True)
+    if len(est["by_claim"]) > 1:   # where the time goes, the costliest first (shared trainings: first claim)
+        print("lagbench: training by claim: " + ", ".join(f"{c} {s / 3600:.2f} h" for c, s in est["by_claim"].items()
+                                                        if s > 0), flush=True)
     return est
 
 

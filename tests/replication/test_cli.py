@@ -68,6 +68,19 @@ def test_estimate_wall_follows_the_executor_chains(tmp_path, monkeypatch):
     assert estimate(units, tmp_path, jobs=3)["wall_s"] == pytest.approx(2 * per_training)   # 4 on 3: two rounds
 
 
+def test_estimate_says_where_the_time_goes_by_claim(tmp_path, monkeypatch):
+    # a shared training counts once, for the first claim planned with it; the claims' seconds add up
+    from replication.run import estimate as E
+
+    monkeypatch.setattr(E, "_plain_step", lambda *a: 1.0)
+    monkeypatch.setattr(E, "_members_step", lambda *a: 1.0)
+    units = plan("smoke", claims=["dp_loss", "dp_energy", "hnn_energy"], frameworks=("jax",))
+    est = estimate(units, tmp_path)
+    assert set(est["by_claim"]) == {"dp_loss", "hnn_energy"}   # dp_energy trains nothing of its own
+    assert sum(est["by_claim"].values()) == pytest.approx(est["train_s"])
+    assert list(est["by_claim"].values()) == sorted(est["by_claim"].values(), reverse=True)
+
+
 def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, monkeypatch):
     # workers train on one PyTorch thread; probes at this process's default ran up to 34x slow (estimate.py)
     import torch
