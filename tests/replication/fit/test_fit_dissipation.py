@@ -6,16 +6,31 @@ import re
 import shlex
 from pathlib import Path
 
+import dataclasses
+
+import numpy as np
 import pytest
 
+import systems
 from replication.cli import main
+from replication.evaluation.adapters import adapter
+from replication.evaluation.routines import Evaluation
+from replication.fit import userdata
+from replication.fit.dissipation import (
+    ABLATION_MIN,
+    HESSIAN_RESIDUAL_MAX,
+    OFF,
+    dissipation_metrics,
+    without_dissipation_l1,
+)
+from replication.fit.load import Padded, load_fitted
 
 DOC = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 MARKER = "<!-- dissipative example: tests/replication/fit/test_fit_dissipation.py runs this block -->"
 
 
 @pytest.fixture(scope="module")
-def metrics(tmp_path_factory):
+def friction_folder(tmp_path_factory):
     folder = tmp_path_factory.mktemp("friction")
     text = DOC.read_text(encoding="utf-8")
     block = re.search(r"```bash\n(.*?)```", text[text.index(MARKER):], re.S).group(1)
@@ -27,14 +42,36 @@ def metrics(tmp_path_factory):
             assert main([*args, "--quiet"] if args[0] == "fit" else args) == 0, args
     report = (folder / "report" / "friction" / "REPORT.md").read_text()
     assert "Recommended on this data: baseline (jax, seed 0)" in report   # the others over 2 x its rollout error
+    return folder
+
+
+@pytest.fixture(scope="module")
+def metrics(friction_folder):
     return {p.parts[-3]: json.loads(p.read_text())["metrics"]
-            for p in folder.glob("results/friction/units/fit/*/*/seed0/result.json")}
+            for p in friction_folder.glob("results/friction/units/fit/*/*/seed0/result.json")}
 
 
 def test_the_dissipative_lnn_recovers_the_friction(metrics):
     m = metrics["lnn_dissipative"]
     assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
     assert "test_dissipation_coefficient_0" not in metrics["lnn"]
+    assert m["test_dissipation_ablation"] >= ABLATION_MIN   # the friction carries its accuracy
+
+
+def test_a_fit_whose_friction_carries_nothing_reports_none(friction_folder):
+    """The same trained model with its dissipation removed: it still learned (better than the null) and its
+    velocity Hessian is as close to c M, but the friction it would report explains nothing of the data."""
+    f = load_fitted(next(friction_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
+    params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
+    g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
+    rows = userdata.rows(str(next(friction_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
+    out = Evaluation()
+    out.metrics.update({"test_l1": without_dissipation_l1(f, rows), "null_test_l1": f.result["metrics"]["null_test_l1"]})
+    dissipation_metrics(g, rows, "test", systems.get("pendulum"), out)
+    assert out.metrics["test_dissipation_ablation"] == pytest.approx(1.0)
+    assert out.metrics["test_dissipation_hessian_residual"] <= HESSIAN_RESIDUAL_MAX
+    assert "test_dissipation_coefficient_0" not in out.metrics
+    assert out.counters["test_dissipation_coefficient"].startswith("not estimated: the friction does not carry")
 
 
 def test_it_rolls_out_better_than_the_conservative_lnn(metrics):
