@@ -30,11 +30,14 @@ def numbers(folder: str, split: str) -> dict:
     return out
 
 
+def fmt(x) -> str:
+    return f"{x:.3g}"
+
+
 def cell(values) -> str:
     v = [x for x in values if x is not None]
     if not v:
         return "–"
-    fmt = (lambda x: f"{x:.3g}")
     return fmt(median(v)) + (f" ({fmt(min(v))}–{fmt(max(v))})" if len(v) > 1 else "") + f" [{len(v)}]"
 
 

@@ -1,12 +1,11 @@
 """The dissipative fit of docs/fit.md ('Friction: a dissipative fit'), run as written from its own text: on a
 pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction and rolls
 out better than the conservative LNN, which cannot lose energy; the baseline, trained alike, tracks best."""
+import dataclasses
 import json
 import re
 import shlex
 from pathlib import Path
-
-import dataclasses
 
 import numpy as np
 import pytest
