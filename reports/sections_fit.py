@@ -37,7 +37,8 @@ ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"
                    ("decomposition_scale", "DeLaN: factor to the system's L (accelerations fix L up to one)"),
                    *((f"dissipation_coefficient_{k}", f"friction q{k} in the system's units (--dissipation)")
                      for k in range(4)),
-                   ("dissipation_hessian_residual", "--dissipation: learned velocity Hessian against c M, residual")]
+                   ("dissipation_hessian_residual", "--dissipation: learned velocity Hessian against c M, residual"),
+                   ("dissipation_ablation", "--dissipation: one-step error without the learned friction / with it")]
 
 
 def is_fit_results(res: Results) -> bool:

@@ -41,6 +41,7 @@ def friction_folder(tmp_path_factory):
             assert main([*args, "--quiet"] if args[0] == "fit" else args) == 0, args
     report = (folder / "report" / "friction" / "REPORT.md").read_text()
     assert "Recommended on this data: baseline (jax, seed 0)" in report   # the others over 2 x its rollout error
+    assert "one-step error without the learned friction / with it" in report
     return folder
 
 
