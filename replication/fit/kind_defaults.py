@@ -1,4 +1,5 @@
-"""`lagbench fit`'s defaults per model kind, read from the suite's own protocols.
+"""`lagbench fit`'s defaults per model kind, read from the suite's own protocols (and, for an LNN on a
+trajectory file, the budget of a registered fit study: `ON_RECORDINGS`).
 
 A fit trains as the claim that tuned its kind does: the registered protocol of that claim's model under the
 `quick` profile with its adopted `lagbench tune` choice (`replication.claims.get` applies it), so the LNN
@@ -8,9 +9,13 @@ schedule, width and budget, and a change of a claim's protocol or tuning moves t
 `SOURCES`: (kind, task) -> (claim id, model label): the LNN and an acceleration baseline from claim 1 (the
 double pendulum, where the q-double-dot plateau is), the HNN from the HNN claim's pendulum, DeLaN and an
 inverse-dynamics baseline (data with tau) from the two-link arm's claim.
-`defaults(kind, task) -> dict`: fit option name -> value for every option in `FROM_PROTOCOL`, and the
-restarts' `restart_fraction` (their steps / the protocol's) and `restart_lr_ratio` (their peak / the protocol's).
-`source(kind, task) -> str`: where they come from, for the console and the result's record.
+`ON_RECORDINGS`: (kind, task) -> the factor on the claim's steps for a trajectory file, where a registered fit
+study chose a longer budget for recorded trajectories than the claim's i.i.d. states need
+(`docs/decisions/fit_budget.md`: every form got the same candidates; the LNN's held-out error chose 3 x).
+`defaults(kind, task, recording=False) -> dict`: fit option name -> value for every option in `FROM_PROTOCOL`,
+and the restarts' `restart_fraction` (their steps / the protocol's) and `restart_lr_ratio` (their peak / the
+protocol's).
+`source(kind, task, recording=False) -> str`: where they come from, for the console.
 
 What the claims set for their system rather than for training stays the user's choice: wrapping angles
 (the double pendulum's q are angles; a user's may not be), and the claims' fixed input scale becomes
@@ -29,6 +34,7 @@ PROFILE = "quick"
 SOURCES = {("lnn", "acceleration"): ("dp_loss", "lnn"), ("baseline", "acceleration"): ("dp_loss", "baseline"),
            ("hnn", "hamiltonian"): ("hnn_energy", "hnn_pendulum"), ("delan", "inverse_dynamics"): ("delan_arm", "delan"),
            ("delan", "acceleration"): ("delan_arm", "delan"), ("baseline", "inverse_dynamics"): ("delan_arm", "ff")}
+ON_RECORDINGS = {("lnn", "acceleration"): 3}
 FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr_start", "lr_min_ratio", "weight_decay",
                  "loss", "restarts", "restart_keep", "restart_batch", "guard_clip", "guard_skip", "input_scale")
 
@@ -44,14 +50,14 @@ def _entry(kind: str, task: str):
 
 
 @cache
-def _defaults(kind: str, task: str) -> tuple:
+def _defaults(kind: str, task: str, recording: bool) -> tuple:
     _, entry, p = _entry(kind, task)
     one_cycle = isinstance(p.schedule, OneCycle)
     s = p.scouting
     if s is not None and isinstance(s.schedule, OneCycle) and s.schedule.start != OneCycle.start:
         raise ValueError(f"{kind}: the claim's restarts start their one-cycle at phase {s.schedule.start}; fit's start at "
                          f"{OneCycle.start}")
-    out = {"steps": p.steps, "batch": p.batch, "hidden": entry.widths(PROFILE),
+    out = {"steps": p.steps * (ON_RECORDINGS.get((kind, task), 1) if recording else 1), "batch": p.batch, "hidden": entry.widths(PROFILE),
            "activation": entry.spec_fields(PROFILE).get("activation", "softplus"),
            "lr": p.schedule.lr, "schedule": "onecycle" if one_cycle else "constant",
            "lr_start": p.schedule.start if one_cycle else OneCycle.start,
@@ -66,25 +72,28 @@ def _defaults(kind: str, task: str) -> tuple:
     return tuple(out.items())
 
 
-def defaults(kind: str, task: str) -> dict:
-    """Fit option -> value, as the claim that tuned this kind trains it under `quick`."""
-    return dict(_defaults(kind, task))
+def defaults(kind: str, task: str, recording: bool = False) -> dict:
+    """Fit option -> value, as the claim that tuned this kind trains it under `quick`; with `recording` (a
+    trajectory file), the steps times the kind's `ON_RECORDINGS` factor."""
+    return dict(_defaults(kind, task, recording))
 
 
-def source(kind: str, task: str) -> str:
+def source(kind: str, task: str, recording: bool = False) -> str:
     claim, entry, _ = _entry(kind, task)
-    return f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
+    factor = ON_RECORDINGS.get((kind, task), 1) if recording else 1
+    return (f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
+            + (f", {factor} x its steps on a trajectory file (docs/decisions/fit_budget.md)" if factor != 1 else ""))
 
 
-def fill(o, task: str):
+def fill(o, task: str, recording: bool = False):
     """The options `o` (`options.resolve`'s namespace) with every BY_KIND value set from `defaults(o.model,
-    task)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch and peak rate
-    from --steps, --batch and --lr where not given; then checked as a whole."""
+    task, recording)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch and
+    peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
     from types import SimpleNamespace
 
     from replication.fit import options as fit_options
 
-    d, v = defaults(o.model, task), dict(vars(o))
+    d, v = defaults(o.model, task, recording), dict(vars(o))
     given = {k for k, x in v.items() if x is not fit_options.BY_KIND}
     fit_options.check({k: v[k] for k in given})   # the given values (the defaults are valid)
     v.update({k: d[k] for k in FROM_PROTOCOL if k not in given})

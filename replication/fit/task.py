@@ -127,6 +127,11 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
 
 
+def is_recording(data) -> bool:
+    """Whether `data` is a trajectory file (a recording), not a file of state samples."""
+    return "traj" in userdata.read(str(Path(data).resolve()))[1]
+
+
 def resolved(data, options: dict):
     """(options with the model kind's defaults filled in (`replication.fit.kind_defaults`), the task the data
     and model give), after every check that needs no work done: the options, the input scale's width, the
@@ -139,7 +144,7 @@ def resolved(data, options: dict):
     trajectories.check_options(o.window, o.polyorder)
     raw = userdata.read(path)[1]
     task = task_of(o.model, "tau" in raw, path)
-    o = kind_defaults.fill(o, task)
+    o = kind_defaults.fill(o, task, recording="traj" in raw)
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from models import ModelSpec
         try:

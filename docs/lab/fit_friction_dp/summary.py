@@ -19,6 +19,8 @@ def numbers(folder: str, split: str) -> dict:
     """{model label: {key: [value per seed]}} of every fit under `folder`."""
     out: dict = defaultdict(lambda: defaultdict(list))
     for f in sorted(glob.glob(f"{folder}/**/units/fit/*/*/seed*/result.json", recursive=True)):
+        if "/starved/" in f:   # a deliberately starved control, reported by its own console line
+            continue
         r = json.load(open(f))
         m, model = r["metrics"], f.split("/")[-3]
         row = out[model]

@@ -32,7 +32,9 @@ def test_a_row_says_what_the_kind_gets(label):
     _, source, budget, widths, rate, loss, restarts, guard, scale = _table()[label]
     claim, entry, _ = kind_defaults._entry(kind, task)
     assert source.startswith(f"claim {claim.number}, {entry.label}")
-    assert budget == f"{d['steps']:,} x {d['batch']}".replace(",", " ")
+    factor = kind_defaults.ON_RECORDINGS.get((kind, task), 1)
+    on_file = f" ({factor} x the steps on a trajectory file)" if factor != 1 else ""
+    assert budget == f"{d['steps']:,} x {d['batch']}".replace(",", " ") + on_file
     w = d["hidden"]
     assert len(set(w)) == 1 and widths == f"{w[0]} x {len(w)}, {d['activation']}"
     assert float(rate.split(",")[0]) == pytest.approx(d["lr"])

@@ -76,3 +76,29 @@ def test_a_given_option_beats_the_kinds_default_and_zero_turns_a_part_off():
     assert (off.restarts, off.restart_keep) == (None, None)
     with pytest.raises(ValueError, match="^--restarts: 1 is not valid"):
         kind_defaults.fill(fit_options.resolve({"model": "lnn", "restarts": 1}), "acceleration")
+
+
+def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claims(tmp_path):
+    """`ON_RECORDINGS` multiplies the kind's steps for a trajectory file only (the restarts follow the steps);
+    every other default and every other kind stays the claim's."""
+    import numpy as np
+
+    from replication.fit.task import resolved
+
+    t = np.arange(40) * 0.01
+    traj = tmp_path / "traj.csv"
+    np.savetxt(traj, np.column_stack([np.repeat([0, 1], 20), np.tile(t[:20], 2), np.sin(t), np.cos(t)]),
+               delimiter=",", header="traj,t,q0,q1", comments="")
+    states = tmp_path / "states.csv"
+    np.savetxt(states, np.column_stack([np.sin(t), np.cos(t), t, -t, t ** 2, 1 - t]), delimiter=",",
+               header="q0,q1,qdot0,qdot1,qddot0,qddot1", comments="")
+    for kind in ("lnn", "baseline"):
+        factor = kind_defaults.ON_RECORDINGS.get((kind, "acceleration"), 1)
+        on_file, on_states = resolved(traj, {"model": kind})[0], resolved(states, {"model": kind})[0]
+        claim = kind_defaults.defaults(kind, "acceleration")
+        assert (on_states.steps, on_file.steps) == (claim["steps"], factor * claim["steps"])
+        assert on_file.restart_steps == max(2, round(on_file.steps * claim["restart_fraction"]))
+        same = {k: v for k, v in vars(on_file).items() if k not in ("steps", "restart_steps")}
+        assert same == {k: v for k, v in vars(on_states).items() if k not in ("steps", "restart_steps")}
+        assert resolved(traj, {"model": kind, "steps": 50})[0].steps == 50   # a given --steps wins
+    assert kind_defaults.ON_RECORDINGS[("lnn", "acceleration")] > 1
