@@ -9,10 +9,8 @@ import numpy as np
 
 from replication.evaluation.adapters import adapter
 from replication.evaluation.metrics import heldout_errors
-from replication.fit import userdata
 from replication.fit.competence import competence
 from replication.fit.load import Padded
-from replication.training.objective import predict
 
 KEEP = 2000   # states of the set (at most) the velocity Hessian is compared on
 
@@ -70,5 +68,5 @@ def without_dissipation_l1(f, r) -> float:
     """The one-step L1 on the rows `r` of the fitted model `f` with its dissipation removed (b = 0)."""
     params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
     g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
-    b = userdata.batch_of(r, g.task)
-    return heldout_errors(predict(g.model, g.spec.kind, g.task, b, np.concatenate), b["target"])["l1"]
+    b, pred = g.one_step(r)
+    return heldout_errors(pred, b["target"])["l1"]

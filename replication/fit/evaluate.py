@@ -53,7 +53,6 @@ from replication.fit import userdata
 from replication.fit.dissipation import dissipation_metrics
 from replication.fit.load import Fitted, Padded, load_fitted
 from replication.fit.trajectories import starts
-from replication.training.objective import predict
 
 KEEP = 2000   # rows kept for the parity and decomposition figures
 
@@ -64,8 +63,7 @@ def _quantities(task, dof):
 
 
 def _one_step(f: Fitted, r, name, out: Evaluation, rows: list):
-    b = userdata.batch_of(r, f.task)
-    pred = predict(f.model, f.spec.kind, f.task, b, np.concatenate)
+    b, pred = f.one_step(r)
     e, null = heldout_errors(pred, b["target"]), null_errors(b["target"])
     out.metrics.update({f"{name}_l1": e["l1"], f"{name}_mse": e["mse"], f"null_{name}_l1": null["l1"],
                         f"null_{name}_mse": null["mse"]})

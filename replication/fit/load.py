@@ -95,6 +95,14 @@ class Fitted:
     def task(self) -> str:
         return self.protocol.task
 
+    def one_step(self, rows: dict) -> tuple[dict, np.ndarray]:
+        """(the batch of `rows` for this model's task, the model's prediction of its target on it)."""
+        from replication.fit import userdata
+        from replication.training.objective import predict
+
+        b = userdata.batch_of(rows, self.task)
+        return b, predict(self.model, self.spec.kind, self.task, b, np.concatenate)
+
     def acceleration(self, q, qdot, tau=None):
         if self.task == "hamiltonian":
             return self.model.time_derivative(q, qdot, None)[1]
