@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The friction double pendulum of docs/fit.md: many short recordings (400 releases of 1 s at 100 Hz) with
 # viscous friction FRICTION on both angles, noise 0.001 on q and 2 % of the frames dropped; a test file of 8
-# recordings of 4 s. Each model fitted at its kind's defaults (nothing but --seed set) for SEEDS seeds, each
-# fit into a folder of its own; then the summary table.
+# recordings of 4 s. Each model fitted at claim 1's budget (the kind's defaults, with the LNNs' --steps given
+# as the claim's: on a trajectory file their default is 3 x, docs/decisions/fit_budget.md) for SEEDS seeds,
+# each fit into a folder of its own; then the summary table.
 #   bash docs/lab/fit_friction_dp/run.sh OUT [FRICTION] [SEEDS]
 set -euo pipefail
 out=${1:?give a results folder}; b=${2:-0.2}; seeds=${3:-3}
@@ -12,7 +13,7 @@ $sim --trajectories 8 --duration 4 --seed 1 --out "$out/data/test.csv"
 fit="lagbench fit --data $out/data/train.csv --test $out/data/test.csv --system double_pendulum --angle-wrap --quiet"
 for ((s = 0; s < seeds; s++)); do
   $fit --model baseline --seed "$s" --out "$out/s$s-baseline"
-  $fit --model lnn --seed "$s" --out "$out/s$s-lnn"
-  $fit --model lnn --dissipation --seed "$s" --out "$out/s$s-lnn_dissipative"
+  $fit --model lnn --steps 23437 --seed "$s" --out "$out/s$s-lnn"
+  $fit --model lnn --dissipation --steps 23437 --seed "$s" --out "$out/s$s-lnn_dissipative"
 done
 python "$(dirname "$0")/summary.py" "$out" "$b"
