@@ -49,6 +49,10 @@ def _entry(kind: str, task: str):
     return claim, entry, entry.protocol(per_profile(claim.protocols, PROFILE), PROFILE)
 
 
+def _steps_factor(kind: str, task: str, recording: bool) -> int:
+    return ON_RECORDINGS.get((kind, task), 1) if recording else 1
+
+
 @cache
 def _defaults(kind: str, task: str, recording: bool) -> tuple:
     _, entry, p = _entry(kind, task)
@@ -57,7 +61,7 @@ def _defaults(kind: str, task: str, recording: bool) -> tuple:
     if s is not None and isinstance(s.schedule, OneCycle) and s.schedule.start != OneCycle.start:
         raise ValueError(f"{kind}: the claim's restarts start their one-cycle at phase {s.schedule.start}; fit's start at "
                          f"{OneCycle.start}")
-    out = {"steps": p.steps * (ON_RECORDINGS.get((kind, task), 1) if recording else 1), "batch": p.batch, "hidden": entry.widths(PROFILE),
+    out = {"steps": p.steps * _steps_factor(kind, task, recording), "batch": p.batch, "hidden": entry.widths(PROFILE),
            "activation": entry.spec_fields(PROFILE).get("activation", "softplus"),
            "lr": p.schedule.lr, "schedule": "onecycle" if one_cycle else "constant",
            "lr_start": p.schedule.start if one_cycle else OneCycle.start,
@@ -80,7 +84,7 @@ def defaults(kind: str, task: str, recording: bool = False) -> dict:
 
 def source(kind: str, task: str, recording: bool = False) -> str:
     claim, entry, _ = _entry(kind, task)
-    factor = ON_RECORDINGS.get((kind, task), 1) if recording else 1
+    factor = _steps_factor(kind, task, recording)
     return (f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
             + (f", {factor} x its steps on a trajectory file (docs/decisions/fit_budget.md)" if factor != 1 else ""))
 
