@@ -2,6 +2,7 @@
 holds its lock (`results.output_folder`, let go by `results.writing` when the command ends); a second one
 is refused with one line naming the holder, before it writes anything."""
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -49,14 +50,20 @@ def test_two_fits_into_one_folder_at_once_never_both_report_success(tmp_path):
     """The second starts while the first holds the folder: it is refused, and the folder holds the first
     fit alone, whole."""
     data, out = _data(tmp_path / "d.npz"), tmp_path / "out"
-    # long enough (tens of seconds) that the second starts, imports and asks while the first trains
-    first = subprocess.Popen(_fit_cli(data, out, steps=60_000), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    # the first is paused (SIGSTOP) as soon as it holds the folder, so that it is still mid-fit however long
+    # the second takes to start, import and ask; then it goes on and ends (seconds of training)
+    first = subprocess.Popen(_fit_cli(data, out, steps=5_000), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              text=True)
     deadline = time.time() + 120
     while time.time() < deadline and f"pid {first.pid}" not in ((out / R.LOCK_NAME).read_text()
                                                                   if (out / R.LOCK_NAME).exists() else ""):
-        time.sleep(0.05)
-    second = subprocess.run(_fit_cli(_data(tmp_path / "e.npz"), out), capture_output=True, text=True, timeout=300)
+        time.sleep(0.01)
+    first.send_signal(signal.SIGSTOP)
+    try:
+        second = subprocess.run(_fit_cli(_data(tmp_path / "e.npz"), out), capture_output=True, text=True,
+                                timeout=300)
+    finally:
+        first.send_signal(signal.SIGCONT)
     stdout, stderr = first.communicate(timeout=300)
     assert first.returncode == 0, stderr
     assert second.returncode == 2 and f"pid {first.pid}" in second.stderr, second.stderr
