@@ -129,7 +129,12 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
 
 def is_recording(data) -> bool:
     """Whether `data` is a trajectory file (a recording), not a file of state samples."""
-    return "traj" in userdata.read(str(Path(data).resolve()))[1]
+    return _recording(userdata.read(str(Path(data).resolve()))[1])
+
+
+def _recording(raw: dict) -> bool:
+    """Whether parsed data (`userdata.read`'s arrays) hold trajectories: a trajectory index column."""
+    return "traj" in raw
 
 
 def resolved(data, options: dict):
@@ -144,7 +149,7 @@ def resolved(data, options: dict):
     trajectories.check_options(o.window, o.polyorder)
     raw = userdata.read(path)[1]
     task = task_of(o.model, "tau" in raw, path)
-    o = kind_defaults.fill(o, task, recording="traj" in raw)
+    o = kind_defaults.fill(o, task, recording=_recording(raw))
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from models import ModelSpec
         try:
