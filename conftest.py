@@ -13,18 +13,6 @@ from replication.run.environment import one_thread_env
 if os.environ.get("PYTEST_XDIST_WORKER"):
     os.environ.update(one_thread_env(os.environ))
 
-# The tests compile the same JAX programs many times over (the smoke run, then its reruns, resumptions and
-# the command line's subprocesses), so under tox (which sets LAGBENCH_CACHE) they share JAX's persistent
-# compilation cache in a folder of that cache: a program compiled once in any test process is read back in
-# the others. A size limit turns on JAX's file lock, as the two workers and their subprocesses read and write
-# it at once. Compiled code gives the numbers a fresh compilation gives; nothing here changes a tested value.
-# Set before any test module imports JAX (its configuration reads these at import); subprocesses inherit them.
-if os.environ.get("LAGBENCH_CACHE") and "JAX_COMPILATION_CACHE_DIR" not in os.environ:
-    os.environ.update({"JAX_COMPILATION_CACHE_DIR": os.path.join(os.environ["LAGBENCH_CACHE"], "jax-tests"),
-                       "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS": "0",
-                       "JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES": "0",
-                       "JAX_COMPILATION_CACHE_MAX_SIZE": str(4 * 2**30)})
-
 
 @pytest.fixture(scope="session", autouse=True)
 def _cache_dir(tmp_path_factory):
