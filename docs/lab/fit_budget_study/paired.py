@@ -3,11 +3,13 @@ rollout error over the baseline's (both fitted on the same file with the same se
 
     python docs/lab/fit_budget_study/paired.py FOLDER [FOLDER ...]
 """
-import glob
-import json
 import sys
 from math import comb
+from pathlib import Path
 from statistics import median
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "fit_friction_dp"))
+from summary import fits  # noqa: E402  (the lab's reader of fit folders)
 
 RIVAL, MODEL, KEY = "baseline", "lnn_dissipative", "test_rollout_gmean_err"
 
@@ -15,11 +17,8 @@ RIVAL, MODEL, KEY = "baseline", "lnn_dissipative", "test_rollout_gmean_err"
 def errors(folder: str) -> dict:
     """{(folder, fit seed): {model: test rollout error}} of the fits under `folder` (the starved control aside)."""
     out: dict = {}
-    for f in sorted(glob.glob(f"{folder}/**/units/fit/*/*/seed*/result.json", recursive=True)):
-        if "/starved/" in f:
-            continue
-        parts = f.split("/")
-        out.setdefault((folder, parts[-2]), {})[parts[-3]] = json.load(open(f))["metrics"][KEY]
+    for model, seed, r in fits(folder):
+        out.setdefault((folder, seed), {})[model] = r["metrics"][KEY]
     return out
 
 

@@ -15,14 +15,20 @@ ROWS = [("one-step L1 / null", "l1_ratio"), ("rollout error (geometric mean)", "
         ("friction, angle 2 (true {b})", "dissipation_coefficient_1"), ("training time (s)", "train_time_s")]
 
 
-def numbers(folder: str, split: str) -> dict:
-    """{model label: {key: [value per seed]}} of every fit under `folder`."""
-    out: dict = defaultdict(lambda: defaultdict(list))
+def fits(folder: str):
+    """(model label, seed folder name, result record) of every fit under `folder`, in path order."""
     for f in sorted(glob.glob(f"{folder}/**/units/fit/*/*/seed*/result.json", recursive=True)):
         if "/starved/" in f:   # a deliberately starved control, reported by its own console line
             continue
-        r = json.load(open(f))
-        m, model = r["metrics"], f.split("/")[-3]
+        parts = f.split("/")
+        yield parts[-3], parts[-2], json.load(open(f))
+
+
+def numbers(folder: str, split: str) -> dict:
+    """{model label: {key: [value per seed]}} of every fit under `folder`."""
+    out: dict = defaultdict(lambda: defaultdict(list))
+    for model, _, r in fits(folder):
+        m = r["metrics"]
         row = out[model]
         row["l1_ratio"].append(m[f"{split}_l1"] / m[f"null_{split}_l1"])
         for key in ("rollout_gmean_err", "vpt_s", "energy_err_final", "dissipation_coefficient_0",
