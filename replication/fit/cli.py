@@ -66,14 +66,14 @@ def cmd_fit(args):
     from tqdm.auto import tqdm
 
     from replication.fit import kind_defaults
-    from replication.fit.task import LOSS_NAMES, fit, is_recording, resolved
+    from replication.fit.task import LOSS_NAMES, fit, resolved
     from replication.training import device
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
-    o, task = resolved(args.data, given)   # a refused option: one line, nothing written
+    o, task, recording = resolved(args.data, given)   # a refused option: one line, nothing written
     if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
-        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, is_recording(args.data))} where not given "
+        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, recording)} where not given "
               f"({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
               f"{f', {o.restarts} restarts' if o.restarts else ''}{', spike guard' if o.guard_clip or o.guard_skip else ''})",
               file=sys.stderr)

@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -89,7 +91,7 @@ class FitSource:
 def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
     their defaults where not given)."""
-    o, task = resolved(data, options)   # every check that needs no work, before the output folder is made
+    o, task, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps)
@@ -127,20 +129,18 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
 
 
-def is_recording(data) -> bool:
-    """Whether `data` is a trajectory file (a recording), not a file of state samples."""
-    return _recording(userdata.read(str(Path(data).resolve()))[1])
+class Resolved(NamedTuple):
+    """`resolved`'s answer: the options with the model kind's defaults filled in, the task the data and model
+    give, and whether the data are a trajectory file (a recording) rather than a file of state samples."""
+    options: SimpleNamespace
+    task: str
+    recording: bool
 
 
-def _recording(raw: dict) -> bool:
-    """Whether parsed data (`userdata.read`'s arrays) hold trajectories: a trajectory index column."""
-    return "traj" in raw
-
-
-def resolved(data, options: dict):
-    """(options with the model kind's defaults filled in (`replication.fit.kind_defaults`), the task the data
-    and model give), after every check that needs no work done: the options, the input scale's width, the
-    energy function, the test file's columns."""
+def resolved(data, options: dict) -> Resolved:
+    """The options with the model kind's defaults filled in (`replication.fit.kind_defaults`), the task and
+    whether the data are a recording (a trajectory index column), after every check that needs no work done:
+    the options, the input scale's width, the energy function, the test file's columns."""
     o = fit_options.resolve(options)
     path = str(Path(data).resolve())
     fit_options.check(vars(o))
@@ -148,8 +148,8 @@ def resolved(data, options: dict):
         fit_data.check_options(o.split, o.heldout)
     trajectories.check_options(o.window, o.polyorder)
     raw = userdata.read(path)[1]
-    task = task_of(o.model, "tau" in raw, path)
-    o = kind_defaults.fill(o, task, recording=_recording(raw))
+    task, recording = task_of(o.model, "tau" in raw, path), "traj" in raw
+    o = kind_defaults.fill(o, task, recording=recording)
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from models import ModelSpec
         try:
@@ -175,7 +175,7 @@ def resolved(data, options: dict):
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return o, task
+    return Resolved(o, task, recording)
 
 
 def _model_spec(o, prep, task: str) -> dict:

@@ -101,4 +101,33 @@ def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claim
         same = {k: v for k, v in vars(on_file).items() if k not in ("steps", "restart_steps")}
         assert same == {k: v for k, v in vars(on_states).items() if k not in ("steps", "restart_steps")}
         assert resolved(traj, {"model": kind, "steps": 50})[0].steps == 50   # a given --steps wins
+        assert (resolved(traj, {"model": kind}).recording, resolved(states, {"model": kind}).recording) == (True, False)
     assert kind_defaults.ON_RECORDINGS[("lnn", "acceleration")] > 1
+
+
+def test_the_console_line_names_where_a_recordings_defaults_come_from(tmp_path, monkeypatch, capsys):
+    """`lagbench fit` on a trajectory file says, before training, that the LNN's steps are the claim's times
+    the trajectory-file factor; on a file of states it names the claim alone."""
+    import numpy as np
+
+    from replication.cli import main
+    from replication.fit import task
+
+    def stop(*args, **kwargs):
+        raise ValueError("stopped before training")
+
+    monkeypatch.setattr(task, "fit", stop)
+    t = np.arange(40) * 0.01
+    traj = tmp_path / "traj.csv"
+    np.savetxt(traj, np.column_stack([np.repeat([0, 1], 20), np.tile(t[:20], 2), np.sin(t), np.cos(t)]),
+               delimiter=",", header="traj,t,q0,q1", comments="")
+    states = tmp_path / "states.csv"
+    np.savetxt(states, np.column_stack([np.sin(t), np.cos(t), t, -t, t ** 2, 1 - t]), delimiter=",",
+               header="q0,q1,qdot0,qdot1,qddot0,qddot1", comments="")
+    factor = kind_defaults.ON_RECORDINGS[("lnn", "acceleration")]
+    lines = {}
+    for name, path in (("traj", traj), ("states", states)):
+        assert main(["fit", "--data", str(path), "--model", "lnn", "--out", str(tmp_path / name)]) != 0
+        lines[name] = next(ln for ln in capsys.readouterr().err.splitlines() if "defaults from" in ln)
+    assert f"{factor} x its steps on a trajectory file" in lines["traj"]
+    assert "on a trajectory file" not in lines["states"]
