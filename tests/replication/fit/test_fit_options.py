@@ -78,20 +78,26 @@ def test_a_given_option_beats_the_kinds_default_and_zero_turns_a_part_off():
         kind_defaults.fill(fit_options.resolve({"model": "lnn", "restarts": 1}), "acceleration")
 
 
+def _trajectory_and_state_files(folder):
+    """A two-trajectory file (traj, t, q) and a file of state samples (q, qdot, qddot) of two coordinates."""
+    import numpy as np
+
+    t = np.arange(40) * 0.01
+    traj = folder / "traj.csv"
+    np.savetxt(traj, np.column_stack([np.repeat([0, 1], 20), np.tile(t[:20], 2), np.sin(t), np.cos(t)]),
+               delimiter=",", header="traj,t,q0,q1", comments="")
+    states = folder / "states.csv"
+    np.savetxt(states, np.column_stack([np.sin(t), np.cos(t), t, -t, t ** 2, 1 - t]), delimiter=",",
+               header="q0,q1,qdot0,qdot1,qddot0,qddot1", comments="")
+    return traj, states
+
+
 def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claims(tmp_path):
     """`ON_RECORDINGS` multiplies the kind's steps for a trajectory file only (the restarts follow the steps);
     every other default and every other kind stays the claim's."""
-    import numpy as np
-
     from replication.fit.task import resolved
 
-    t = np.arange(40) * 0.01
-    traj = tmp_path / "traj.csv"
-    np.savetxt(traj, np.column_stack([np.repeat([0, 1], 20), np.tile(t[:20], 2), np.sin(t), np.cos(t)]),
-               delimiter=",", header="traj,t,q0,q1", comments="")
-    states = tmp_path / "states.csv"
-    np.savetxt(states, np.column_stack([np.sin(t), np.cos(t), t, -t, t ** 2, 1 - t]), delimiter=",",
-               header="q0,q1,qdot0,qdot1,qddot0,qddot1", comments="")
+    traj, states = _trajectory_and_state_files(tmp_path)
     for kind in ("lnn", "baseline"):
         factor = kind_defaults.ON_RECORDINGS.get((kind, "acceleration"), 1)
         on_file, on_states = resolved(traj, {"model": kind})[0], resolved(states, {"model": kind})[0]
@@ -108,8 +114,6 @@ def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claim
 def test_the_console_line_names_where_a_recordings_defaults_come_from(tmp_path, monkeypatch, capsys):
     """`lagbench fit` on a trajectory file says, before training, that the LNN's steps are the claim's times
     the trajectory-file factor; on a file of states it names the claim alone."""
-    import numpy as np
-
     from replication.cli import main
     from replication.fit import task
 
@@ -117,13 +121,7 @@ def test_the_console_line_names_where_a_recordings_defaults_come_from(tmp_path, 
         raise ValueError("stopped before training")
 
     monkeypatch.setattr(task, "fit", stop)
-    t = np.arange(40) * 0.01
-    traj = tmp_path / "traj.csv"
-    np.savetxt(traj, np.column_stack([np.repeat([0, 1], 20), np.tile(t[:20], 2), np.sin(t), np.cos(t)]),
-               delimiter=",", header="traj,t,q0,q1", comments="")
-    states = tmp_path / "states.csv"
-    np.savetxt(states, np.column_stack([np.sin(t), np.cos(t), t, -t, t ** 2, 1 - t]), delimiter=",",
-               header="q0,q1,qdot0,qdot1,qddot0,qddot1", comments="")
+    traj, states = _trajectory_and_state_files(tmp_path)
     factor = kind_defaults.ON_RECORDINGS[("lnn", "acceleration")]
     lines = {}
     for name, path in (("traj", traj), ("states", states)):
