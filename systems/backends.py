@@ -56,10 +56,22 @@ def namespace(backend: str) -> dict:
     return ns
 
 
+_FLOAT32 = np.dtype(np.float32)
+
+
 def result_dtype(*xs):
-    """float32 only if every floating input is float32; float64 otherwise."""
-    names = {str(getattr(x, "dtype", "float64")).replace("torch.", "") for x in xs if x is not None}
-    return "float32" if names == {"float32"} else "float64"
+    """float32 only if every input given (not None) is float32, and there is one; float64 otherwise (an input
+    without a dtype, a Python number or list, counts as float64). Called on every evaluation of a system, so
+    NumPy's and JAX's dtypes are compared directly and only other libraries' by name."""
+    seen = False
+    for x in xs:
+        if x is None:
+            continue
+        d = getattr(x, "dtype", None)
+        if not (d == _FLOAT32 if isinstance(d, np.dtype) else str(d).replace("torch.", "") == "float32"):
+            return "float64"
+        seen = True
+    return "float32" if seen else "float64"
 
 
 def as_array(x, backend: str, dtype: str):

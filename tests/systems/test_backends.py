@@ -59,6 +59,22 @@ def test_float32_stays_float32(backend, conv):
     np.testing.assert_allclose(np.asarray(out), ref, rtol=1e-3, atol=1e-4)
 
 
+F32 = (np.zeros(2, np.float32), np.float32(1.0), jnp.zeros(2, jnp.float32), torch.zeros(2))
+F64_OR_OTHER = (np.zeros(2), 1.0, [1.0, 2.0], jnp.zeros(2), torch.zeros(2, dtype=torch.float64),
+                torch.zeros(2, dtype=torch.float16), np.zeros(2, np.int64), np.zeros(2, ">f4"))
+
+
+def test_the_result_is_float32_only_where_every_given_input_is():
+    from systems.backends import result_dtype
+
+    assert result_dtype() == result_dtype(None) == "float64"
+    for a in F32:
+        assert result_dtype(a) == result_dtype(a, None) == "float32", a
+        assert all(result_dtype(a, b) == "float32" for b in F32), a
+        for b in F64_OR_OTHER:
+            assert result_dtype(b) == result_dtype(a, b) == result_dtype(b, None, a) == "float64", (a, b)
+
+
 def test_jax_backend_works_under_jit_and_vmap():
     import jax
 
