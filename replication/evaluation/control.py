@@ -6,7 +6,8 @@ The unit's model gives the feed-forward torque of the computed-torque controller
 independently of the controller), on `n_refs` references of `duration` seconds of each family in
 `FAMILIES`: "train" (the family the models trained on, new references: the competence bar's), "test" (the
 unseen family) and "train_x2" (the training family twice as fast). The references are drawn from
-`control.SEED` + the split's draw offset, so the test split tracks references no choice has seen.
+`control.SEED` + the split's draw offset, so the test split tracks references no choice has seen. The three
+families share their ticks, so each controller tracks all of them in one batch.
 
 Metrics per family f: `tracking_mse_<f>` (mean over references and ticks of the squared joint-angle error
 summed over joints; +inf if any reference diverged, as the energy claims count a diverged rollout),
@@ -31,19 +32,29 @@ N_REFS, DURATION = control.N_REFS, control.DURATION
 
 
 @lru_cache(maxsize=8)
-def _references(family: str, n_refs: int, duration: float, seed: int) -> dict:
-    return control.references(family, n_refs, duration, seed=seed)
+def _references(n_refs: int, duration: float, seed: int) -> tuple[dict, dict]:
+    """Every family's references stacked into one batch (they share the ticks), and each family's slice of
+    it: a controller is simulated once for all three families."""
+    per = {family: control.references(family, n_refs, duration, seed=seed) for family in FAMILIES}
+    refs = {k: np.concatenate([per[f][k] for f in FAMILIES]) for k in ("q", "qdot", "qddot")}
+    refs["t"] = per[FAMILIES[0]]["t"]
+    return refs, {f: slice(i * n_refs, (i + 1) * n_refs) for i, f in enumerate(FAMILIES)}
+
+
+def _family(d: dict, rows: slice) -> dict:
+    """One family's part of a stacked reference batch or simulation."""
+    return {k: v if k == "t" else v[rows] for k, v in d.items()}
 
 
 @lru_cache(maxsize=8)
-def _floors(family: str, n_refs: int, duration: float, seed: int) -> tuple[dict, dict]:
-    """(PD alone's scores, the true inverse dynamics' scores) on the family's references."""
+def _floors(n_refs: int, duration: float, seed: int) -> dict:
+    """family -> (PD alone's scores, the true inverse dynamics' scores) on the family's references."""
     import systems
 
-    refs, plant = _references(family, n_refs, duration, seed), systems.get("two_link_arm")
-    pd = control.scores(control.track(None, refs), refs)
-    truth = control.scores(control.track(lambda q, v, a: plant.inverse_dynamics(q, v, a), refs), refs)
-    return pd, truth
+    (refs, rows), plant = _references(n_refs, duration, seed), systems.get("two_link_arm")
+    pd = control.track(None, refs)
+    truth = control.track(lambda q, v, a: plant.inverse_dynamics(q, v, a), refs)
+    return {f: tuple(control.scores(_family(sim, r), _family(refs, r)) for sim in (pd, truth)) for f, r in rows.items()}
 
 
 def eval_control(ctx) -> Evaluation:
@@ -55,11 +66,15 @@ def eval_control(ctx) -> Evaluation:
         return np.asarray(predict(m, kind, task, {"q": q, "qdot": v, "extra": a}, np.concatenate), float)
 
     out, diverged = Evaluation(), 0
-    for i, family in enumerate(FAMILIES):
-        refs = _references(family, n_refs, duration, seed)
-        sim = control.track(inverse, refs)
+    stacked, rows = _references(n_refs, duration, seed)
+    if ctx.progress:
+        ctx.progress("tracking", 0, 1)
+    sim_all = control.track(inverse, stacked)
+    floors = _floors(n_refs, duration, seed)
+    for family in FAMILIES:
+        refs, sim = _family(stacked, rows[family]), _family(sim_all, rows[family])
         s = control.scores(sim, refs)
-        pd, truth = _floors(family, n_refs, duration, seed)
+        pd, truth = floors[family]
         bad = s["n_diverged"] > 0
         out.metrics[f"tracking_mse_{family}"] = float("inf") if bad else s["track_mse"]
         for j in range(refs["q"].shape[-1]):
@@ -71,7 +86,7 @@ def eval_control(ctx) -> Evaluation:
         diverged += s["n_diverged"]
         if family == "test":
             out.arrays.update(test_t=refs["t"], test_q_ref=refs["q"][0], test_q=sim["q"][0])
-        if ctx.progress:
-            ctx.progress("tracking", i + 1, len(FAMILIES))
+    if ctx.progress:
+        ctx.progress("tracking", 1, 1)
     out.metrics["n_diverged"] = diverged
     return out

@@ -57,3 +57,18 @@ def test_the_test_split_tracks_other_references():
     a = _evaluate(lambda q, v, a: np.zeros_like(q))
     b = _evaluate(lambda q, v, a: np.zeros_like(q), split=TEST)
     assert a["null_tracking_mse_test"] != b["null_tracking_mse_test"]
+
+
+def test_tracking_the_families_in_one_batch_gives_each_familys_own_numbers():
+    """The three families are simulated side by side; each scores as when tracked on its own."""
+    from replication.studies import control
+
+    def fn(q, v, a):
+        return 0.8 * PLANT.inverse_dynamics(q, v, a)
+
+    m = _evaluate(fn)
+    for f in FAMILIES:
+        refs = control.references(f, 2, 0.4, seed=control.SEED + DEV.draw_offset)
+        alone = control.scores(control.track(fn, refs), refs)
+        assert m[f"tracking_mse_{f}"] == alone["track_mse"], f
+        assert m[f"torque_effort_{f}"] == alone["torque_effort"], f
