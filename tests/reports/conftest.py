@@ -14,6 +14,12 @@ def results_dir(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def small_results_dir(tmp_path_factory) -> Path:
+    """Two claims' results: for the tests of what the tool does with its folders, which any report shows."""
+    return write_results(tmp_path_factory.mktemp("small_results"), only=("dp_loss", "dp_energy"))
+
+
+@pytest.fixture(scope="session")
 def built(results_dir, tmp_path_factory) -> dict:
     from reports import build_report
 

@@ -21,9 +21,9 @@ def test_a_symlinked_report_is_replaced_not_written_through(tmp_path):
     assert not paths["markdown"].is_symlink() and "Nothing was run" in paths["markdown"].read_text()
 
 
-def test_only_the_tools_own_unchanged_files_are_removed(results_dir, tmp_path):
+def test_only_the_tools_own_unchanged_files_are_removed(small_results_dir, tmp_path):
     out = tmp_path / "out"
-    first = build_report(results_dir, out, pdf=False)["figures"]
+    first = build_report(small_results_dir, out, pdf=False)["figures"]
     assert len(first) >= 2
     mine = out / "figures" / "my_plot.png"
     mine.write_bytes(b"user's own")
@@ -74,14 +74,14 @@ def test_a_killed_builds_temporaries_and_figures_are_cleaned_by_the_next(results
     assert (out / "figures" / ".notes.tmp").read_text() == "a user's own file"
 
 
-def test_report_prints_a_path_with_undecodable_bytes_escaped(results_dir, tmp_path):
+def test_report_prints_a_path_with_undecodable_bytes_escaped(small_results_dir, tmp_path):
     import os
     import subprocess
     import sys
 
     out = os.fsencode(str(tmp_path)) + b"/rep\xffort"
     env = {**os.environ, "PYTHONIOENCODING": "utf-8"}
-    r = subprocess.run([sys.executable, "-m", "replication.cli", "report", "--results", str(results_dir),
+    r = subprocess.run([sys.executable, "-m", "replication.cli", "report", "--results", str(small_results_dir),
                         "--out", os.fsdecode(out)], capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, r.stderr
     assert "\\udcff" in r.stdout and os.path.isdir(out)
@@ -98,25 +98,25 @@ def test_the_pdf_shows_characters_its_fonts_lack_as_code_points():
     assert "q̇" in s and "γ × 3 − 1 ≈ 2" in s and '\\"' in s
 
 
-def test_the_default_report_folder_follows_the_results_folder(results_dir, tmp_path, monkeypatch):
+def test_the_default_report_folder_follows_the_results_folder(small_results_dir, tmp_path, monkeypatch):
     """`report --results X/full` writes report/full, never over another run's report/quick."""
     import shutil
 
     full = tmp_path / "runs" / "full"
-    shutil.copytree(results_dir, full)
+    shutil.copytree(small_results_dir, full)
     monkeypatch.chdir(tmp_path)
     assert main(["report", "--results", str(full)]) in (0, None)
     assert (tmp_path / "report" / "full" / "REPORT.md").is_file() and not (tmp_path / "report" / "quick").exists()
 
 
-def test_no_pdf_writes_the_markdown_alone_and_a_missing_typst_says_what_to_do(results_dir, tmp_path, monkeypatch,
-                                                                               capsys):
+def test_no_pdf_writes_the_markdown_alone_and_a_missing_typst_says_what_to_do(small_results_dir, tmp_path,
+                                                                               monkeypatch, capsys):
     out = tmp_path / "md"
-    assert main(["report", "--results", str(results_dir), "--out", str(out), "--no-pdf"]) in (0, None)
+    assert main(["report", "--results", str(small_results_dir), "--out", str(out), "--no-pdf"]) in (0, None)
     assert (out / "REPORT.md").is_file() and not (out / "REPORT.pdf").exists() and not (out / "REPORT.typ").exists()
     monkeypatch.setitem(sys.modules, "typst", None)   # `import typst` raises ImportError
     capsys.readouterr()
-    assert main(["report", "--results", str(results_dir), "--out", str(tmp_path / "nopdf")]) == 2
+    assert main(["report", "--results", str(small_results_dir), "--out", str(tmp_path / "nopdf")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("lagbench: error: the PDF report needs typst") and "--no-pdf" in err and "\n" not in err
     assert (tmp_path / "nopdf" / "REPORT.md").is_file()   # written before the PDF: nothing computed is lost

@@ -1,6 +1,7 @@
 """The dissipative fit of docs/fit.md ('Friction: a dissipative fit'), run as written from its own text: on a
-pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction and rolls
-out better than the conservative LNN, which cannot lose energy; the baseline, trained alike, tracks best."""
+pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction (the default
+run: the block's data and its dissipative fit) and rolls out better than the conservative LNN, which cannot lose
+energy; the baseline, trained alike, tracks best (`tox -e slow`: the whole block)."""
 import dataclasses
 import json
 import re
@@ -28,43 +29,61 @@ DOC = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 MARKER = "<!-- dissipative example: tests/replication/fit/test_fit_dissipation.py runs this block -->"
 
 
-@pytest.fixture(scope="module")
-def friction_folder(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("friction")
+def _block() -> list[list[str]]:
     text = DOC.read_text(encoding="utf-8")
     block = re.search(r"```bash\n(.*?)```", text[text.index(MARKER):], re.S).group(1)
     commands = [shlex.split(ln)[1:] for ln in block.splitlines() if ln.startswith("lagbench ")]
     assert [c[0] for c in commands] == ["simulate", "simulate", "fit", "fit", "fit", "report"]
+    assert "--dissipation" in commands[2]
+    return commands
+
+
+def _run(folder, commands):
     with pytest.MonkeyPatch.context() as mp:
         mp.chdir(folder)
         for args in commands:
             assert main([*args, "--quiet"] if args[0] == "fit" else args) == 0, args
+
+
+def _metrics(folder) -> dict:
+    return {p.parts[-3]: json.loads(p.read_text())["metrics"]
+            for p in folder.glob("results/friction/units/fit/*/*/seed0/result.json")}
+
+
+@pytest.fixture(scope="module")
+def dissipative_folder(tmp_path_factory):
+    """The block's data, its dissipative fit and the report of that fit (the default run's part of the block)."""
+    folder = tmp_path_factory.mktemp("friction")
+    block = _block()
+    _run(folder, [*block[:3], block[5]])
     report = (folder / "report" / "friction" / "REPORT.md").read_text()
-    assert "Recommended on this data: baseline (jax, seed 0)" in report   # the others over 2 x its rollout error
     assert "one-step error without the learned friction / with it" in report
     return folder
 
 
 @pytest.fixture(scope="module")
-def metrics(friction_folder):
-    return {p.parts[-3]: json.loads(p.read_text())["metrics"]
-            for p in friction_folder.glob("results/friction/units/fit/*/*/seed0/result.json")}
+def friction_folder(dissipative_folder):
+    """The whole block: the conservative LNN and the baseline fitted beside it, and the report of all three."""
+    _run(dissipative_folder, _block()[3:])
+    report = (dissipative_folder / "report" / "friction" / "REPORT.md").read_text()
+    assert "Recommended on this data: baseline (jax, seed 0)" in report   # the others over 2 x its rollout error
+    return dissipative_folder
 
 
-def test_the_dissipative_lnn_recovers_the_friction(metrics):
-    m = metrics["lnn_dissipative"]
+def test_the_dissipative_lnn_recovers_the_friction(dissipative_folder):
+    m = _metrics(dissipative_folder)["lnn_dissipative"]
     assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
-    assert "test_dissipation_coefficient_0" not in metrics["lnn"]
     assert m["test_dissipation_ablation"] >= ABLATION_MIN   # the friction carries its accuracy
+    assert m["test_l1"] < 0.1 * m["null_test_l1"]
 
 
-def test_a_fit_whose_friction_carries_nothing_reports_none(friction_folder):
+def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     """The same trained model with its dissipation removed: it still learned (better than the null) and its
     velocity Hessian is as close to c M, but the friction it would report explains nothing of the data."""
-    f = load_fitted(next(friction_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
+    f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
     params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
     g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
-    rows = userdata.rows(str(next(friction_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
+    rows = userdata.rows(str(next(dissipative_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
     out = Evaluation()
     out.metrics.update({"test_l1": without_dissipation_l1(f, rows), "null_test_l1": f.result["metrics"]["null_test_l1"]})
     dissipation_metrics(g, rows, "test", systems.get("pendulum"), out)
@@ -74,11 +93,13 @@ def test_a_fit_whose_friction_carries_nothing_reports_none(friction_folder):
     assert out.counters["test_dissipation_coefficient"].startswith("not estimated: the friction does not carry")
 
 
-def test_it_rolls_out_better_than_the_conservative_lnn(metrics):
+@pytest.mark.slow   # slow: two more fits and a report (about 2 minutes on 2 cores)
+def test_it_rolls_out_better_than_the_conservative_lnn(friction_folder):
+    metrics = _metrics(friction_folder)
     d, lnn, base = metrics["lnn_dissipative"], metrics["lnn"], metrics["baseline"]
+    assert "test_dissipation_coefficient_0" not in lnn
     assert d["test_rollout_gmean_err"] < 0.5 * lnn["test_rollout_gmean_err"]
     assert base["test_rollout_gmean_err"] < 0.5 * d["test_rollout_gmean_err"]   # as the doc's table says
-    assert d["test_l1"] < 0.1 * d["null_test_l1"]
     # the conservative LNN keeps the energy the pendulum loses
     assert lnn["test_energy_err_final"] > 5 * d["test_energy_err_final"]
 
