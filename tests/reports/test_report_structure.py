@@ -1,5 +1,6 @@
 """The report a reader gets through: a body of the scorecard, a page per claim (its verdict, parts, decisive
 numbers and figures) and speed against error, with every dump, table of counters and study in the appendix."""
+import pytest
 from result_fixtures import CLAIMS, NOT_RUN_CLAIM
 
 from reports.build import TITLE, body_and_appendix
@@ -10,8 +11,15 @@ DUMPS = ("competence bars", "rollout metrics", "all recorded metrics", "Reasons 
          "Registered protocols", "Tuning ledger", "Units per claim")
 
 
-def test_every_claim_has_a_page_with_its_numbers_and_a_figure_and_the_dumps_are_in_the_appendix(results_dir, tmp_path):
-    body, appendix = body_and_appendix(results_dir, tmp_path)
+@pytest.fixture(scope="module")
+def sections(results_dir, tmp_path_factory):
+    """(body, appendix, folder): the report's sections built once from the fixture results into folder."""
+    folder = tmp_path_factory.mktemp("structure")
+    return (*body_and_appendix(results_dir, folder), folder)
+
+
+def test_every_claim_has_a_page_with_its_numbers_and_a_figure_and_the_dumps_are_in_the_appendix(sections):
+    body, appendix, _ = sections
     pages = {s.title.split(": ", 1)[1]: s for s in body if s.title.startswith("Claim ")}
     assert set(pages) == {c[0] for c in CLAIMS}
     for cid, page in pages.items():
@@ -34,8 +42,8 @@ def test_every_claim_has_a_page_with_its_numbers_and_a_figure_and_the_dumps_are_
     assert {"Cross-framework agreement", "Environment", "Findings: paper against original code"} <= set(titles)
 
 
-def test_the_papers_figures_are_recreated_with_the_figure_each_stands_for(results_dir, tmp_path):
-    body, _ = body_and_appendix(results_dir, tmp_path)
+def test_the_papers_figures_are_recreated_with_the_figure_each_stands_for(sections):
+    body, _, folder = sections
     captions = {s.title.split(": ", 1)[1]: [b.caption for b in s.blocks if isinstance(b, Figure)]
                 for s in body if s.title.startswith("Claim ")}
     for cid, figure in (("dp_energy", "LNN Fig. 2(b)"), ("dp_energy", "LNN Fig. 2(a)"), ("rel_coords", "LNN Fig. 3"),
@@ -44,17 +52,17 @@ def test_the_papers_figures_are_recreated_with_the_figure_each_stands_for(result
         assert any(figure in c for c in captions[cid]), (cid, figure)
     # the relativistic rollouts are drawn once, as the paper's per-model panels
     assert not any("Trajectory: truth against each model" in c for c in captions["rel_coords"])
-    assert (tmp_path / "figures" / "rel_coords_panels.png").stat().st_size > 0
+    assert (folder / "figures" / "rel_coords_panels.png").stat().st_size > 0
 
 
-def test_the_body_is_short_and_the_appendix_starts_a_page(results_dir, tmp_path):
-    body, appendix = body_and_appendix(results_dir, tmp_path)
-    _, pdf = write_pdf(TITLE, body, tmp_path)
+def test_the_body_is_short_and_the_appendix_starts_a_page(sections):
+    body, appendix, folder = sections
+    _, pdf = write_pdf(TITLE, body, folder)
     n_body = page_count(pdf)
     assert n_body <= 20
-    _, pdf = write_pdf(TITLE, body + appendix, tmp_path)
+    _, pdf = write_pdf(TITLE, body + appendix, folder)
     assert page_count(pdf) > n_body
-    typ = (tmp_path / "REPORT.typ").read_text()
+    typ = (folder / "REPORT.typ").read_text()
     assert typ.index('#set heading(numbering: "A.1")') < typ.index('"Appendix"')
 
 
