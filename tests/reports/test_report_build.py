@@ -152,9 +152,9 @@ def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
     assert "below the competence bar" in full["dp_energy"][5]
 
 
-def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(results_dir, tmp_path):
+def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(small_results_dir, tmp_path):
     res = tmp_path / "res"
-    shutil.copytree(results_dir, res)
+    shutil.copytree(small_results_dir, res)
     run = json.loads((res / "run.json").read_text())
     run["finished"] = None
     run["planned_units"] = [f"dp_loss/{fw}/{m}/seed{k}" for fw in ("jax", "torch") for m in ("lnn", "baseline")
@@ -189,9 +189,9 @@ def test_the_metric_dumps_sit_in_an_appendix_and_shared_trainings_are_drawn_once
     from reports.load import load_results
     from reports.sections_claims import claim_section
 
-    titles = [s.title for s in build_sections(results_dir, tmp_path / "a")]
-    dumps = [t for s in build_sections(results_dir, tmp_path / "b") for b in s.blocks
-             if "all recorded metrics" in getattr(b, "title", "") for t in [s.title]]
+    sections = build_sections(results_dir, tmp_path / "a")
+    titles = [s.title for s in sections]
+    dumps = [s.title for s in sections for b in s.blocks if "all recorded metrics" in getattr(b, "title", "")]
     assert dumps and set(dumps) == {"Appendix: all recorded metrics"}
     assert titles.index("Appendix: all recorded metrics") > titles.index("Environment")
     res = load_results(results_dir)
