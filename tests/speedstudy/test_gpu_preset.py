@@ -74,11 +74,11 @@ def test_row_blocks_only_on_the_cpu(monkeypatch):
 
 
 def test_stages_argument_runs_only_those_stages_and_refuses_unknown_names(tmp_path, capsys):
-    run_bench(tmp_path, sizes=TINY, stages=["single-sample_latency"], progress=False)
+    run_bench(tmp_path, sizes=TINY, stages=["fast-vs_paper"], progress=False)
     bench = tmp_path / "bench"
-    assert (bench / "latency.csv").is_file()
-    assert not any((bench / f"{f}.csv").exists() for f in ("inference", "training", "rollout", "scaling"))
-    assert json.loads((bench / "machine.json").read_text())["stages"] == ["single-sample latency"]
+    assert (bench / "fast_paper.csv").is_file() and (bench / "matmul.csv").is_file()
+    assert not any((bench / f"{f}.csv").exists() for f in ("inference", "latency", "training", "rollout", "scaling"))
+    assert json.loads((bench / "machine.json").read_text())["stages"] == ["fast vs paper"]
     other = tmp_path / "other"
     assert main(["bench", "--stages", "control-rate,inferance", "--out", str(other)]) == 2
     assert "unknown stages ['inferance']" in capsys.readouterr().err
