@@ -93,7 +93,7 @@ def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     assert out.counters["test_dissipation_coefficient"].startswith("not estimated: the friction does not carry")
 
 
-@pytest.mark.slow   # slow: two more fits and a report (about 2 minutes on 2 cores)
+@pytest.mark.slow   # slow: two more fits and a report (about a minute on 2 cores)
 def test_it_rolls_out_better_than_the_conservative_lnn(friction_folder):
     metrics = _metrics(friction_folder)
     d, lnn, base = metrics["lnn_dissipative"], metrics["lnn"], metrics["baseline"]
