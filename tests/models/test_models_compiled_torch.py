@@ -17,6 +17,7 @@ def _model(**kw):
     return models.torch.build(spec, init_params(spec, seed=1))
 
 
+@pytest.mark.slow   # slow: a speed-study compile path (`lagbench bench`'s quick preset); the paths verdicts use stay in the default run
 def test_delan_inverse_dynamics_matches_method_and_checks_inputs():
     m = _model()
     f = compile_single(m, "inverse_dynamics")

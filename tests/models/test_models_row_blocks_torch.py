@@ -86,6 +86,7 @@ def test_fixed_batch_is_compiled_for_its_block_and_called_per_block():
         f(a, b[:-1])
 
 
+@pytest.mark.slow   # slow: a speed-study compile path (`lagbench bench`'s quick preset); the paths verdicts use stay in the default run
 def test_any_batch_library_blocks_large_batches_only():
     f = compile_batched(_fn, 2, 3, "float64", rows_per_sample=5)
     calls = _counting(f)

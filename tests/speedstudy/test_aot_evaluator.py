@@ -3,11 +3,13 @@ dynamic batch (the truth's batch shape comes from `systems.backends.broadcast_sh
 torch's symbolic sizes), gives the NumPy truth's numbers (float64) at batch sizes other than the traced
 one. One small compile per timed thread count (pendulum, one degree of freedom)."""
 import numpy as np
+import pytest
 
 import systems
 from speedstudy.evaluators import TorchAotEvaluator, make_evaluator
 
 
+@pytest.mark.slow   # slow: a speed-study compile path (`lagbench bench`'s quick preset); the paths verdicts use stay in the default run
 def test_truth_any_batch_matches_numpy():
     s = systems.get("pendulum")
     ev = make_evaluator("torch", kind="truth", dtype="float64", system=s, mode="aoti")
