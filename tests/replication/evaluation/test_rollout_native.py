@@ -2,7 +2,7 @@
 (`rollout.rollout` over the adapter's field) to float rounding: for each field (an LNN's acceleration, an
 HNN's own flow, DeLaN under interpolated torques), on a grid with uneven intervals, in float64 models so that
 rounding is all that may differ; a diverging row is frozen at NaN at the same times; a PyTorch rollout long
-enough to compile its step gives the eager numbers."""
+enough to compile its step gives the eager numbers (`tox -e slow`)."""
 import numpy as np
 import pytest
 
@@ -75,6 +75,7 @@ def test_a_diverging_row_is_nan_from_then_on_as_in_the_numpy_rollout(framework):
     np.testing.assert_allclose(z[0], ref[0], rtol=1e-12)
 
 
+@pytest.mark.slow   # slow: 30-50 s building the step's library; building such libraries (`compile_batched`) stays in the default run
 def test_a_long_torch_rollout_compiles_its_step_and_gives_the_eager_numbers(monkeypatch):
     spec = _spec("delan")
     view = adapter("torch", spec, init_params(spec, seed=1))

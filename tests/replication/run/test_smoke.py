@@ -50,12 +50,11 @@ def test_frameworks_agree_on_the_exact_lagrangian(smoke_results):
     assert len(ab) == 4 and (ab["max_abs_err"] <= 1e-12).all()
 
 
-def test_a_rerun_skips_finished_units(smoke_results):
-    from replication.run.runner import run
-
+def test_a_rerun_skips_finished_units(smoke_results, smoke_frameworks):
     out, _ = smoke_results
     before = {p: p.stat().st_mtime_ns for p in out.glob("units/*/*/*/seed*/result.json")}
-    run(profile="smoke", out=out, claims=["dp_loss"], progress=False)
+    run(profile="smoke", out=out, claims=["dp_loss"], frameworks=tuple(sorted(smoke_frameworks("dp_loss"))),
+        progress=False)
     after = {p: p.stat().st_mtime_ns for p in out.glob("units/*/*/*/seed*/result.json")}
     assert before == after
 
@@ -69,5 +68,6 @@ def test_report_builds_from_real_smoke_results(smoke_results, tmp_path):
     for cid in CLAIMS:
         assert cid in md
     health = md.split("**Velocity-Hessian health per unit**")[1].split("\n## ")[0]
-    assert "| dp_loss | jax | lnn |" in health and "| dp_loss | torch | lnn |" in health  # logged in training
+    # logged in training, in both frameworks
+    assert "| dp_loss | jax | lnn |" in health and "| activation_study | torch | lnn_act-" in health
     assert paths["pdf"].read_bytes()[:4] == b"%PDF"

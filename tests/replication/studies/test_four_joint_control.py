@@ -29,8 +29,8 @@ def tiny_run(tmp_path_factory):
 
 
 def test_the_gains_keep_the_true_inverse_dynamics_at_the_floor_and_pd_alone_finite():
-    refs = C.references("test", n=1, duration=0.3, system="four_joint_arm")
-    assert refs["q"].shape == (1, 151, 4)
+    refs = C.references("test", n=1, duration=0.1, system="four_joint_arm")
+    assert refs["q"].shape == (1, 51, 4)
     kp, kd = C.gains(4)
     assert np.array_equal(kp, np.full(4, 20.0)) and np.allclose(kd, 2 * np.sqrt(20.0))
     exact = C.scores(C.track(ARM4.inverse_dynamics, refs, system="four_joint_arm"), refs)
@@ -38,7 +38,7 @@ def test_the_gains_keep_the_true_inverse_dynamics_at_the_floor_and_pd_alone_fini
     assert exact["n_diverged"] == pd_alone["n_diverged"] == 0
     assert exact["track_mse"] < 1e-4 and exact["track_mse"] < 1e-3 * pd_alone["track_mse"]
     assert np.isfinite(pd_alone["track_mse"]) and pd_alone["track_mse"] > 1e-3
-    fine = C.references("test", n=1, duration=0.3, rate=2000.0, system="four_joint_arm")
+    fine = C.references("test", n=1, duration=0.1, rate=2000.0, system="four_joint_arm")
     finer = C.scores(C.track(ARM4.inverse_dynamics, fine, rate=2000.0, system="four_joint_arm"), fine)
     assert finer["track_mse"] < 0.1 * exact["track_mse"]   # what is left is the hold over a control period
 
