@@ -49,17 +49,9 @@ def worker_group(nodeid: str) -> str:
     return WORKER_GROUP.get(path, path)
 
 
-def pytest_collection_modifyitems(config, items):
-    """The groups of the expensive session fixtures first: the workers start on the longest work and the
-    short files fill in after, so that neither worker is left with a long group at the end."""
-    items.sort(key=lambda item: worker_group(item.nodeid) not in SHARED_SESSION_FIXTURES)
-
-
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
     from xdist.scheduler import LoadScopeScheduling
-
-    config.option.loadscopereorder = False   # the groups in collection order: the expensive ones first
 
     class ByWorkerGroup(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:

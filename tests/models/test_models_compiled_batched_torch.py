@@ -56,6 +56,7 @@ def test_model_acceleration_any_batch(kind):
         np.testing.assert_allclose(f(q, qdot).numpy(), want.numpy(), rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.slow   # slow: 15 s of compiling; what it builds serves the HNN rollouts that compile their step (slow too)
 def test_hnn_exports_and_matches_the_autograd_gradient():
     """The HNN's hand-written input gradient goes through torch.export (torch.func.grad did not); the
     compiled (dH/dy, -dH/dx) matches autograd's gradient of the eager Hamiltonian at any batch size."""

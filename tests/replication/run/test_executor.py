@@ -27,20 +27,25 @@ def test_units_sharing_a_model_form_one_chain():
     assert [executor._cost(c) for c in chains] == sorted((executor._cost(c) for c in chains), reverse=True)
 
 
-def _jax_rows(df, claims):
-    df = df[df["claim"].isin(claims) & (df["framework"] == "jax")]
+# a scouted training and untrained evaluations: two kinds of chain, three chains for two workers
+CLAIMS_2, MODELS_2 = ["dp_loss", "appendix_b"], ["baseline", "lnn_exact_fast", "lnn_exact_paper"]
+
+
+def _jax_rows(df, claims, models):
+    df = df[df["claim"].isin(claims) & df["model"].isin(models) & (df["framework"] == "jax")]
     return df.sort_values(["claim", "model", "seed"]).reset_index(drop=True)
 
 
 def test_two_workers_give_the_serial_numbers(smoke_results, tmp_path):
     """Against the session's serial smoke run (every claim, one after another in this process)."""
-    claims = ["dp_loss", "appendix_b"]   # a scouted training and an untrained evaluation: two kinds of chain
-    runner.run(profile="smoke", out=tmp_path / "two", claims=claims, frameworks=("jax",), progress=False, jobs=2)
-    a, b = (_jax_rows(pd.read_csv(d / "summary" / "units.csv"), claims) for d in (smoke_results[0], tmp_path / "two"))
+    runner.run(profile="smoke", out=tmp_path / "two", claims=CLAIMS_2, frameworks=("jax",), models=MODELS_2,
+               progress=False, jobs=2)
+    a, b = (_jax_rows(pd.read_csv(d / "summary" / "units.csv"), CLAIMS_2, MODELS_2)
+            for d in (smoke_results[0], tmp_path / "two"))
     timing = list(TIMING)   # the wall-clock columns (not, e.g., the Lyapunov time)
     a = a.drop(columns=timing).dropna(axis="columns", how="all")   # the serial run's table has every claim's columns
     pd.testing.assert_frame_equal(a, b.drop(columns=timing)[a.columns])
-    assert len(a) == len(runner.plan("smoke", claims=claims, frameworks=("jax",)))
+    assert len(a) == len(runner.plan("smoke", claims=CLAIMS_2, frameworks=("jax",), models=MODELS_2)) == 3
 
 
 def test_jobs_must_be_a_positive_integer(tmp_path):
@@ -141,7 +146,7 @@ def test_a_dead_worker_loses_only_its_chain(tmp_path):
     other unit is written."""
     import threading
 
-    todo = runner.plan("smoke", claims=["dp_loss", "appendix_b"], frameworks=("jax",))
+    todo = runner.plan("smoke", claims=CLAIMS_2, frameworks=("jax",), models=MODELS_2)
     killed = []
 
     def kill_first_worker():
