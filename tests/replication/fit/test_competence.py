@@ -23,7 +23,8 @@ def data(tmp_path_factory):
 
 
 def test_a_starved_fit_is_flagged_and_strict_fails_it(data, tmp_path, capsys):
-    argv = ["fit", "--data", str(data), "--model", "baseline", "--steps", "1", "--hidden", "8", "--quiet"]
+    argv = ["fit", "--data", str(data), "--model", "baseline", "--steps", "1", "--restarts", "0", "--hidden", "8",
+            "--quiet"]
     assert main([*argv, "--out", str(tmp_path / "a")]) == 0
     out = capsys.readouterr().out
     assert out.startswith("done: ") and "BETTER THAN THE NULL PREDICTOR" in out and "x the null predictor's" in out

@@ -109,7 +109,7 @@ def test_a_starved_fit_reports_no_friction(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for args in (["simulate", "--system", "pendulum", "--set", "friction=0.3", "--trajectories", "4", "--out", "d.csv"],
                  ["fit", "--data", "d.csv", "--model", "lnn", "--dissipation", "--system", "pendulum", "--steps", "5",
-                  "--hidden", "16,16", "--out", "r", "--quiet"]):
+                  "--restarts", "0", "--hidden", "16,16", "--out", "r", "--quiet"]):
         assert main(args) == 0
     d = json.loads(next(tmp_path.glob("r/units/fit/*/lnn_dissipative/seed0/result.json")).read_text())
     assert not any(k.startswith("heldout_dissipation_coefficient") for k in d["metrics"])

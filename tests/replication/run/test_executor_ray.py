@@ -1,8 +1,8 @@
 """Units as tasks on a real local Ray instance (2 CPUs, started once for this module): the local executor's
-numbers, a killed worker retried, an interrupted driver resumed; marked slow: past its retries a unit
+numbers; marked slow: a killed worker retried, an interrupted driver resumed, past its retries a unit
 recorded as an error and redone by a rerun, and Ctrl-C on the command line joining with --address.
 Three PyTorch smoke units, two sharing one trained model (a chain). A worker's first unit costs seconds
-(imports, first compilations): every killed worker is a new one, so the default tests kill two."""
+(imports, first compilations), and every killed worker is a new one."""
 import json
 import os
 import signal
@@ -133,6 +133,7 @@ def test_ray_gives_the_local_numbers_and_writes_only_where_told(cluster, local, 
     assert any((cluster["worker"] / "cache").rglob("*.py"))          # the generated code, built there
 
 
+@pytest.mark.slow
 def test_a_killed_worker_is_retried(cluster, local, tmp_path):
     s, killed = run_killing(cluster["worker"], tmp_path)
     assert killed, "no worker was seen running the unit"
