@@ -19,10 +19,15 @@ ONE_FRAMEWORK = {"dp_loss": "jax", "dp_energy": "jax",   # one training chain (c
                  "delan_tracking": "torch"}   # claim 12 tracks with claim 9's arm trainings: one framework for both
 
 
+def frameworks_of(cid: str) -> set:
+    """The frameworks the session's smoke run runs claim `cid` in."""
+    return {ONE_FRAMEWORK[cid]} if cid in ONE_FRAMEWORK else {"jax", "torch"}
+
+
 def smoke_plan(plan):
-    """`runner.plan` with each claim of `ONE_FRAMEWORK` kept in its framework only."""
+    """`runner.plan` with each claim kept to `frameworks_of` it."""
     def planned(*args, **kwargs):
-        return [u for u in plan(*args, **kwargs) if ONE_FRAMEWORK.get(u.claim.id, u.framework) == u.framework]
+        return [u for u in plan(*args, **kwargs) if u.framework in frameworks_of(u.claim.id)]
     return planned
 
 
@@ -38,5 +43,5 @@ def smoke_results(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def smoke_frameworks():
-    """The frameworks the session's smoke run ran a claim in: claim id -> set."""
-    return lambda cid: {ONE_FRAMEWORK[cid]} if cid in ONE_FRAMEWORK else {"jax", "torch"}
+    """`frameworks_of`, for the tests that read the session's smoke run."""
+    return frameworks_of

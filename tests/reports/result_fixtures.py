@@ -169,6 +169,7 @@ def write_bench(root: Path) -> None:
 
 def write_results(root: Path, only=None) -> Path:
     """Every claim of `CLAIMS`, or the ids in `only` (the corrupt unit's claim among them)."""
+    assert only is None or CORRUPT[0] in only, f"the corrupt unit belongs to {CORRUPT[0]}"
     rng = np.random.default_rng(0)
     claims = [claim_record(c) for c in CLAIMS if only is None or c[0] in only]
     write_json(root / "run.json", {"profile": "smoke", "frameworks": FRAMEWORKS, "seeds": SEEDS,
