@@ -2,6 +2,8 @@
 unless LAGBENCH_CACHE is set (tox sets it), so repeated runs reuse generated code."""
 
 import os
+import shutil
+import tempfile
 
 import pytest
 
@@ -21,6 +23,22 @@ if os.environ.get("PYTEST_XDIST_WORKER"):
 TEST_XLA = "--xla_backend_optimization_level=0"
 if not os.environ.get("LAGBENCH_TEST_OPTIMISED_XLA") and TEST_XLA not in os.environ.get("XLA_FLAGS", ""):
     os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} {TEST_XLA}".strip()
+
+# JAX keeps its compiled programs for the test run in one temporary folder, shared by both workers and by every
+# process a test starts (the CLI, the run's worker processes): a program compiled again by another test, worker
+# or resumed run is read back instead (a sixth less time for the model and training tests:
+# docs/lab/test_suite_time.md). The folder is made empty by the process that starts the run and removed when the
+# run ends, so no test reads a compilation from another run.
+_OWN_JAX_CACHE = None
+if not os.environ.get("JAX_COMPILATION_CACHE_DIR"):
+    _OWN_JAX_CACHE = tempfile.mkdtemp(prefix="lagbench-tests-jax-")
+    os.environ["JAX_COMPILATION_CACHE_DIR"] = _OWN_JAX_CACHE
+    os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")
+
+
+def pytest_unconfigure(config):
+    if _OWN_JAX_CACHE:
+        shutil.rmtree(_OWN_JAX_CACHE, ignore_errors=True)
 
 
 @pytest.fixture(scope="session", autouse=True)
