@@ -9,6 +9,7 @@ import threading
 from pathlib import Path
 
 from replication.results import DiskFull, writing
+from replication.run import jax_cache
 from replication.training.device import HELP as DEVICE_HELP
 from speedstudy.bench_cli import add_bench
 from speedstudy.train_target_cli import add_train_target
@@ -135,7 +136,8 @@ EPILOG = """usual workflows:
   lagbench fit --data FILE --model lnn && lagbench report --results results/fit
 
 environment variables:
-  LAGBENCH_CACHE          generated code, datasets and trainings cache (default .cache/)
+  LAGBENCH_CACHE          generated code, datasets, trainings and compiled programs cache (default .cache/)
+  LAGBENCH_JAX_CACHE      0: JAX compiles every program anew (default: kept in LAGBENCH_CACHE/jax-compiled/)
   LAGBENCH_DEVICE         auto | cpu | gpu, as --device
   LAGBENCH_TORCH_COMPILE  off: PyTorch trains eagerly; on: compiles every phase it can
   LAGBENCH_TF32           1: allow TF32 matrix products on a GPU (default: full float32)
@@ -246,6 +248,7 @@ def main(argv=None):
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
+    jax_cache.private()   # compiled programs shared with the processes the command starts and later commands
     try:
         with writing():   # the folders the command locks are let go when it ends
             code = args.func(args)
