@@ -237,6 +237,9 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
+READS_ONLY = ("list", "report", "table")   # commands that compile nothing, so make no compilation cache
+
+
 def main(argv=None):
     """Every error is one line on stderr and a non-zero exit: 2 for bad input or an OS error (a file
     where a folder belongs, no permission, a full disk), 130 for Ctrl-C and 143 for SIGTERM (with how to
@@ -248,7 +251,8 @@ def main(argv=None):
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminate)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
-    jax_cache.private()   # compiled programs shared with the processes the command starts and later commands
+    if args.command not in READS_ONLY:   # compiled programs shared with the processes it starts and later commands
+        jax_cache.private()
     try:
         with writing():   # the folders the command locks are let go when it ends
             code = args.func(args)

@@ -69,3 +69,12 @@ def test_the_folder_is_named_by_the_install_and_the_cpu(monkeypatch):
     monkeypatch.setattr(jax_cache.importlib.metadata, "version", lambda name: "0.0.1")
     other_jax = jax_cache.host_digest()
     assert len({here, other_cpu, other_jax}) == 3
+
+
+def test_a_command_that_compiles_nothing_makes_no_cache_folder(tmp_path, monkeypatch, capsys):
+    from replication.cli import main
+
+    monkeypatch.delenv("JAX_COMPILATION_CACHE_DIR")   # set for the test run by conftest.py
+    monkeypatch.setenv("LAGBENCH_CACHE", str(tmp_path))
+    assert main(["list"]) == 0
+    assert not (tmp_path / "jax-compiled").exists() and "JAX_COMPILATION_CACHE_DIR" not in os.environ
