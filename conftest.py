@@ -34,6 +34,9 @@ if not os.environ.get("JAX_COMPILATION_CACHE_DIR"):
     _OWN_JAX_CACHE = tempfile.mkdtemp(prefix="lagbench-tests-jax-")
     os.environ["JAX_COMPILATION_CACHE_DIR"] = _OWN_JAX_CACHE
     os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")
+    # a size limit turns on JAX's file lock around every read and write of the folder, so that no process reads
+    # an entry another is still writing (JAX would warn, and the tests turn warnings into errors)
+    os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(8 * 1024 ** 3))
 
 
 def pytest_unconfigure(config):

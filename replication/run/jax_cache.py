@@ -12,13 +12,16 @@ every program compiles as usual. The subfolder is named by a digest of the JAX a
 and the CPU's model and vector features (`host_digest`): XLA compiles CPU code for the host's instruction set,
 so a host or an install that differs never reads another's programs. Within it JAX keys each entry by the
 program, its XLA flags and compile options. Programs that compile in under `MIN_COMPILE_S` are not kept; the
-folder holds at most `MAX_BYTES`, the least recently used going first. A JAX_COMPILATION_CACHE_DIR already set
+folder holds at most `MAX_BYTES`, the least recently used going first; that limit also turns on JAX's file lock
+around every read and write (the `filelock` package, which PyTorch brings; without it nothing is cached), so
+that no process reads an entry another is still writing. A JAX_COMPILATION_CACHE_DIR already set
 is the user's choice and is kept; LAGBENCH_JAX_CACHE=0 turns the cache off.
 """
 from __future__ import annotations
 
 import hashlib
 import importlib.metadata
+import importlib.util
 import logging
 import os
 import platform
@@ -81,7 +84,7 @@ def private() -> bool:
     where the cache stays off."""
     if os.environ.get(ENV):
         return True
-    if os.environ.get(OFF, "") == "0":
+    if os.environ.get(OFF, "") == "0" or importlib.util.find_spec("filelock") is None:
         return False
     where = folder()
     if where is None:
