@@ -7,6 +7,7 @@ import tempfile
 
 import pytest
 
+from replication.run import jax_cache
 from replication.run.environment import one_thread_env
 
 # Under pytest-xdist the workers share the machine's cores, so each computes on one thread (JAX's XLA,
@@ -33,10 +34,10 @@ _OWN_JAX_CACHE = None
 if not os.environ.get("JAX_COMPILATION_CACHE_DIR"):
     _OWN_JAX_CACHE = tempfile.mkdtemp(prefix="lagbench-tests-jax-")
     os.environ["JAX_COMPILATION_CACHE_DIR"] = _OWN_JAX_CACHE
-    os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")
-    # a size limit turns on JAX's file lock around every read and write of the folder, so that no process reads
-    # an entry another is still writing (JAX would warn, and the tests turn warnings into errors)
-    os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(8 * 1024 ** 3))
+    # as `lagbench` sets them: its size limit also turns on JAX's file lock, so that no process reads an entry
+    # another is still writing (JAX would warn, and the tests turn warnings into errors)
+    os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", str(jax_cache.MIN_COMPILE_S))
+    os.environ.setdefault("JAX_COMPILATION_CACHE_MAX_SIZE", str(jax_cache.MAX_BYTES))
 
 
 def pytest_unconfigure(config):

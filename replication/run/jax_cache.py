@@ -67,7 +67,9 @@ def folder() -> Path | None:
     root = Path(os.environ.get("LAGBENCH_CACHE") or ".cache") / "jax-compiled"
     sub = root / host_digest()
     try:
-        sub.mkdir(parents=True, exist_ok=True, mode=0o700)
+        root.mkdir(parents=True, exist_ok=True, mode=0o700)
+        if _own(root):   # checked before anything is made inside it: never through a symlink
+            sub.mkdir(exist_ok=True, mode=0o700)
         owned = _own(root) and _own(sub)
     except OSError as exc:
         log.warning("JAX compilation cache off: cannot make %s (%s)", sub, exc)

@@ -60,6 +60,7 @@ def test_a_folder_that_is_not_this_users_own_is_not_used(tmp_path, monkeypatch, 
         root.mkdir(parents=True)
         root.chmod(0o777)
     assert jax_cache.folder() is None
+    assert not any((tmp_path / "elsewhere" if how == "symlink" else root).iterdir())   # nothing made inside it
 
 
 def test_the_folder_is_named_by_the_install_and_the_cpu(monkeypatch):
