@@ -17,6 +17,7 @@ import io
 import json
 import math
 import os
+import stat
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -82,6 +83,13 @@ def read_nofollow(path) -> bytes:
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     with os.fdopen(fd, "rb") as fh:
         return fh.read()
+
+
+def own_folder(path) -> bool:
+    """Whether ``path`` is a real folder (not a symlink) of this user's that no one else may write: where the
+    suite keeps what it will execute (its cache key, compiled code). OSError where it cannot be looked at."""
+    st = os.lstat(path)
+    return stat.S_ISDIR(st.st_mode) and st.st_uid == os.getuid() and not st.st_mode & 0o022
 
 
 LOCK_NAME = ".lagbench.lock"

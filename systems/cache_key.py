@@ -29,6 +29,8 @@ import stat
 import tempfile
 from pathlib import Path
 
+from replication.results import own_folder
+
 log = logging.getLogger(__name__)
 
 
@@ -60,7 +62,7 @@ def _key(folder: str) -> bytes | None:
     d = Path(folder)
     try:
         d.mkdir(mode=0o700, parents=True, exist_ok=True)
-        if not _private(os.lstat(d), stat.S_ISDIR, 0o022):
+        if not own_folder(d):
             raise PermissionError(f"{d} is not this user's folder, writable by no one else (no symlink)")
         path = d / "key"
         found = _read_key(path)

@@ -17,10 +17,10 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import stat
 import tempfile
 from pathlib import Path
 
+from replication.results import own_folder
 from systems.cache import cache_dir
 
 log = logging.getLogger("lagbench")
@@ -39,11 +39,11 @@ def private() -> bool:
     folder = cache_dir("torchinductor")
     try:
         folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-        st = os.lstat(folder)
+        owned = own_folder(folder)
     except OSError as exc:
         log.warning("torch compiling off: cannot make inductor's cache folder %s (%s)", folder, exc)
         return False
-    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o022:
+    if not owned:
         log.warning("torch compiling off: %s is not a folder of this user's that no one else may write", folder)
         return False
     os.environ[ENV] = str(folder.resolve())

@@ -25,10 +25,10 @@ import importlib.util
 import logging
 import os
 import platform
-import stat
 import sys
 from pathlib import Path
 
+from replication.results import own_folder
 from replication.run.environment import cpu_description
 
 log = logging.getLogger("lagbench")
@@ -56,11 +56,6 @@ def host_digest() -> str:
     return hashlib.sha256("\x1f".join(parts).encode()).hexdigest()[:16]
 
 
-def _own(path: Path) -> bool:
-    st = os.lstat(path)
-    return stat.S_ISDIR(st.st_mode) and st.st_uid == os.getuid() and not st.st_mode & 0o022
-
-
 def folder() -> Path | None:
     # the suite's cache root as `systems.cache.cache_dir` has it; importing `systems` would import JAX, whose
     # settings must be in the environment first
@@ -68,9 +63,9 @@ def folder() -> Path | None:
     sub = root / host_digest()
     try:
         root.mkdir(parents=True, exist_ok=True, mode=0o700)
-        if _own(root):   # checked before anything is made inside it: never through a symlink
+        if own_folder(root):   # checked before anything is made inside it: never through a symlink
             sub.mkdir(exist_ok=True, mode=0o700)
-        owned = _own(root) and _own(sub)
+        owned = own_folder(root) and own_folder(sub)
     except OSError as exc:
         log.warning("JAX compilation cache off: cannot make %s (%s)", sub, exc)
         return None
