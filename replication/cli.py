@@ -51,12 +51,14 @@ def cmd_list(args):
 
 
 def cmd_run(args):
+    from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
     from replication.run.runner import run
     from replication.training import device
 
-    device.apply(args.device, _csv(args.frameworks) or ("jax", "torch"))
+    frameworks = _csv(args.frameworks)   # None: the profile's (`PROFILE_FRAMEWORKS`)
+    device.apply(args.device, frameworks or PROFILE_FRAMEWORKS.get(args.profile, FRAMEWORKS))
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
-                  frameworks=_csv(args.frameworks) or ("jax", "torch"), seeds=args.seeds, models=_csv(args.models),
+                  frameworks=frameworks, seeds=args.seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
                   dry_run=args.dry_run, split=args.split, add_models=args.add_model)
     if summary.get("dry_run"):
@@ -160,7 +162,8 @@ def build_parser():
     s.add_argument("--claims", help="comma-separated claim ids (default: all; see `lagbench list`)")
     s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
                    "list`)")
-    s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
+    s.add_argument("--frameworks", help="comma-separated: jax, torch (default: the profile's: jax for quick, the "
+                   "preliminary profile; jax,torch for smoke, full and paper)")
     s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module "
                    "(factory(dof)) or equinox Module (factory(dof, key)) mapping (q, qdot) to q-double-dot, trained "
                    "in every claim it fits beside the paper's models (repeatable; README 'Compare your own model')")

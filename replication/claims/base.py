@@ -23,7 +23,12 @@ PROFILES = ("smoke", "quick", "full", "paper")
 # a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`
 # except where a claim says otherwise (longer budgets, more seeds, the paper's evaluation horizon)
 KINDS = ("claim", "check")
-__all__ = ["PROFILES", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
+FRAMEWORKS = ("jax", "torch")
+# the frameworks a profile trains and decides in when a run names none: `quick`, the preliminary profile, in
+# JAX alone (training both frameworks would double its time; the tests hold PyTorch's steps equal to JAX's on
+# identical weights and batches); the profiles of record in both, a claim's parts decided in each
+PROFILE_FRAMEWORKS = {"smoke": FRAMEWORKS, "quick": ("jax",), "full": FRAMEWORKS, "paper": FRAMEWORKS}
+__all__ = ["PROFILES", "FRAMEWORKS", "PROFILE_FRAMEWORKS", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
 
 
 def per_profile(table: dict, profile: str, default=None):

@@ -1,7 +1,8 @@
 """Frozen protocols: what decides each claim under each profile, registered before its test-split run.
 
 `fingerprint(claim, profile) -> dict`: everything that decides the claim's numbers and its verdict under
-the profile: per model that runs, its model spec fields, widths and protocol; the evaluation config; the
+the profile: the frameworks it is decided in (the profile's), per model that runs, its model spec fields,
+widths and protocol; the evaluation config; the
 seed count; the competence bars; the parts (the models they read and control, their rule and the rule's
 parameters); the variants; the metric.
 `protocol_hash(claim, profile) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its canonical JSON).
@@ -23,7 +24,7 @@ from datetime import date
 from functools import lru_cache
 from pathlib import Path
 
-from replication.claims.base import PROFILES
+from replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
 from replication.training.protocol import canonical_hash
 
 FILE = Path(__file__).with_name("registrations.json")
@@ -42,7 +43,8 @@ def fingerprint(claim, profile: str) -> dict:
     models = {m.label: {"spec": m.spec_fields(profile), "hidden": list(m.widths(profile)),
                         "protocol": m.protocol(base, profile).to_dict()}
               for m in claim.models if m.runs_in(profile)}
-    return {"claim": claim.id, "profile": profile, "models": models, "eval": claim.evaluation_config(profile),
+    return {"claim": claim.id, "profile": profile, "frameworks": list(PROFILE_FRAMEWORKS[profile]), "models": models,
+            "eval": claim.evaluation_config(profile),
             "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
             "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],
             "variants": [v.describe() for v in claim.variants]}

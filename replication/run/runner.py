@@ -19,6 +19,7 @@ from pathlib import Path
 from models.spec import USER_KIND
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
+from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
 from replication.claims import get as get_claim
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
@@ -31,7 +32,6 @@ from replication.run.units import Unit
 from replication.training import device as dev
 
 log = logging.getLogger("lagbench")
-FRAMEWORKS = ("jax", "torch")
 LONG_PROFILES = ("full", "paper")   # profiles that print their units and an estimated duration first
 
 
@@ -41,13 +41,15 @@ def _once(option: str, values) -> None:
         raise ValueError(f"{option}: {', '.join(twice)} given more than once; name each at most once")
 
 
-def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = None, models=None,
+def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, models=None,
          split: str = "dev", added=()) -> list:
-    """The units of a run; a ValueError naming the option if any is invalid or nothing would run. `added`:
-    a user's models (`replication.run.added_models.Added`), each entering the claims it fits, in its own
-    framework."""
+    """The units of a run; a ValueError naming the option if any is invalid or nothing would run. `frameworks`:
+    None for the profile's (`PROFILE_FRAMEWORKS`). `added`: a user's models (`replication.run.added_models.Added`),
+    each entering the claims it fits, in its own framework (named in `frameworks` where those are given)."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
+    given = frameworks is not None
+    frameworks = tuple(frameworks) if given else PROFILE_FRAMEWORKS[profile]
     splits.get(split)
     for fw in frameworks:
         if fw not in FRAMEWORKS:
@@ -63,7 +65,7 @@ def plan(profile: str, claims=None, frameworks=FRAMEWORKS, seeds: int | None = N
                          f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
     extra = {c.id: [e for a in added for e in added_models.entries(c, a, profile)] for c in chosen}
-    for a in added:
+    for a in added if given else ():
         if a.framework not in frameworks:
             raise ValueError(f"--add-model {a.name}: it runs in {a.framework} (its own framework: PyTorch for a "
                              f"torch.nn.Module, JAX for an equinox Module); add {a.framework} to --frameworks")
@@ -184,7 +186,7 @@ def executor_of(executor, jobs, address):
 
 
 @R.writes
-def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS, seeds=None, models=None,
+def run(profile="quick", out="results/quick", claims=None, frameworks=None, seeds=None, models=None,
         progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT,
         add_models=()) -> dict:
     """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`)."""
@@ -204,7 +206,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=FRAMEWORKS
         return {"dry_run": True, "units": len(units), "todo": len(todo), "estimate": estimate}
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
-    manifest = {"schema": R.SCHEMA, "profile": profile, "split": split, "frameworks": list(frameworks), "seeds": seeds,
+    manifest = {"schema": R.SCHEMA, "profile": profile, "split": split,
+                "frameworks": list(frameworks if frameworks is not None else PROFILE_FRAMEWORKS[profile]), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
                 "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source,
                                   "framework": a.framework} for a in added],
