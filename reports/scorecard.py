@@ -141,12 +141,17 @@ def variants_table(res: Results) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}
+
+
 def made_by(res: Results) -> str:
-    """Which run this is: profile, split, commit, hardware and date, from run.json."""
+    """Which run this is: profile, split, frameworks, commit, hardware and date, from run.json."""
     run = res.run or {}
     hw = run.get("hardware") or {}
     where = f"{hw.get('cpu', 'unknown CPU')}, {hw.get('cores', '?')} cores" + (f", GPU {hw['gpu']}" if hw.get("gpu") else "")
-    return (f"Profile {run.get('profile') or res.verdict_profile or 'unknown'}, {res.split} split; commit "
+    names = [FRAMEWORK_NAMES.get(f, f) for f in res.frameworks]
+    fws = f"{names[0]} alone" if len(names) == 1 else " and ".join(names) if names else "no framework"
+    return (f"Profile {run.get('profile') or res.verdict_profile or 'unknown'}, {res.split} split, {fws}; commit "
             f"{run.get('commit') or 'unknown'}; {where}; started {run.get('started') or 'unknown'}"
             + (f", finished {run['finished']}." if run.get("finished") else ", not finished."))
 

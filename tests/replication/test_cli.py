@@ -118,6 +118,24 @@ def test_full_profile_inherits_quick_where_a_claim_is_silent():
     assert w.protocol() == wq.protocol() and w.spec() == wq.spec()
 
 
+def test_a_run_trains_in_its_profiles_frameworks_unless_told():
+    from replication.claims.base import PROFILE_FRAMEWORKS
+    from replication.claims.registration import fingerprint
+
+    # quick, the preliminary profile, decides in JAX alone; the profiles of record in both frameworks
+    assert PROFILE_FRAMEWORKS["quick"] == ("jax",)
+    assert PROFILE_FRAMEWORKS["full"] == PROFILE_FRAMEWORKS["paper"] == ("jax", "torch")
+    assert {u.framework for u in plan("quick", claims=["hnn_energy"])} == {"jax"}
+    assert {u.framework for u in plan("full", claims=["hnn_energy"])} == {"jax", "torch"}
+    # named frameworks are what runs, in any profile
+    assert {u.framework for u in plan("quick", claims=["hnn_energy"], frameworks=("jax", "torch"))} == {"jax", "torch"}
+    assert {u.framework for u in plan("full", claims=["hnn_energy"], frameworks=("torch",))} == {"torch"}
+    # the frameworks a claim is decided in are part of what is registered for it
+    from replication.claims import get
+    assert fingerprint(get("hnn_energy"), "quick")["frameworks"] == ["jax"]
+    assert fingerprint(get("hnn_energy"), "full")["frameworks"] == ["jax", "torch"]
+
+
 def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     import pandas as pd
 

@@ -145,6 +145,7 @@ def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
     assert rows["dp_loss"][3].startswith("LNN") and rows["dp_loss"][2]   # the paper's section and what it says
     assert re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][6]) and re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][7])
     assert len(rows["dp_energy"][9]) <= 120
+    assert re.search(r"Profile \w+, \w+ split, JAX and PyTorch; commit ", md)   # the frameworks it was decided in
     parts = table_rows(md, "Parts of the paper claims")
     assert parts["dp_loss"][2] == "similar held-out loss" and parts["dp_loss"][3] == "reproduced"
     assert re.fullmatch(r"\S+ \[\S+, \S+\]", parts["dp_loss"][5])   # JAX: point [low, high]

@@ -55,6 +55,15 @@ def test_the_model_enters_each_claim_it_fits_once_per_system_with_the_paper_mode
         assert added_models.entries(CLAIMS[cid], a, "quick") == [], cid
 
 
+def test_a_pytorch_model_joins_quicks_jax_run_in_its_own_framework(model_file):
+    # quick trains the paper's models in JAX alone unless frameworks are named; the user's module in PyTorch
+    (a,) = added_models.parse([f"mine={model_file}:make"])
+    units = plan("quick", claims=["hnn_energy"], added=[a])
+    assert {(u.entry.label.startswith("mine"), u.framework) for u in units} == {(False, "jax"), (True, "torch")}
+    with pytest.raises(ValueError, match="add torch to --frameworks"):   # named frameworks must include it
+        plan("quick", claims=["hnn_energy"], frameworks=("jax",), added=[a])
+
+
 def test_it_runs_in_pytorch_alone(model_file):
     (a,) = added_models.parse([f"mine={model_file}:make"])
     units = plan("smoke", claims=["dp_loss"], frameworks=("jax", "torch"), added=[a])
