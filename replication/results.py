@@ -92,6 +92,19 @@ def own_folder(path) -> bool:
     return stat.S_ISDIR(st.st_mode) and st.st_uid == os.getuid() and not st.st_mode & 0o022
 
 
+def make_own_folder(path) -> str | None:
+    """Make ``path`` (mode 0700, parents too) and check it with `own_folder`: None where it is this user's own,
+    else why it cannot be used (one line, for the caller's warning or error)."""
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True, mode=0o700)
+        if own_folder(path):
+            return None
+    except OSError as exc:
+        return f"cannot make {path} ({exc})"
+    return f"{path} is not a folder of this user's that no one else may write"
+
+
 LOCK_NAME = ".lagbench.lock"
 _LOCKS: dict = {}   # resolved folder -> the open lock file this process holds on it
 

@@ -29,7 +29,7 @@ import stat
 import tempfile
 from pathlib import Path
 
-from replication.results import own_folder
+from replication.results import make_own_folder
 
 log = logging.getLogger(__name__)
 
@@ -61,9 +61,9 @@ def _read_key(path: Path) -> bytes | None:
 def _key(folder: str) -> bytes | None:
     d = Path(folder)
     try:
-        d.mkdir(mode=0o700, parents=True, exist_ok=True)
-        if not own_folder(d):
-            raise PermissionError(f"{d} is not this user's folder, writable by no one else (no symlink)")
+        why = make_own_folder(d)
+        if why:
+            raise PermissionError(why)
         path = d / "key"
         found = _read_key(path)
         if found is None:

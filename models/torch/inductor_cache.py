@@ -20,7 +20,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from replication.results import own_folder
+from replication.results import make_own_folder
 from systems.cache import cache_dir
 
 log = logging.getLogger("lagbench")
@@ -37,14 +37,9 @@ def private() -> bool:
     if os.environ.get(ENV):
         return True
     folder = cache_dir("torchinductor")
-    try:
-        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-        owned = own_folder(folder)
-    except OSError as exc:
-        log.warning("torch compiling off: cannot make inductor's cache folder %s (%s)", folder, exc)
-        return False
-    if not owned:
-        log.warning("torch compiling off: %s is not a folder of this user's that no one else may write", folder)
+    why = make_own_folder(folder)
+    if why:
+        log.warning("torch compiling off: inductor's cache: %s", why)
         return False
     os.environ[ENV] = str(folder.resolve())
     return True

@@ -28,7 +28,7 @@ import platform
 import sys
 from pathlib import Path
 
-from replication.results import own_folder
+from replication.results import make_own_folder
 from replication.run.environment import cpu_description
 
 log = logging.getLogger("lagbench")
@@ -61,16 +61,9 @@ def folder() -> Path | None:
     # settings must be in the environment first
     root = Path(os.environ.get("LAGBENCH_CACHE") or ".cache") / "jax-compiled"
     sub = root / host_digest()
-    try:
-        root.mkdir(parents=True, exist_ok=True, mode=0o700)
-        if own_folder(root):   # checked before anything is made inside it: never through a symlink
-            sub.mkdir(exist_ok=True, mode=0o700)
-        owned = own_folder(root) and own_folder(sub)
-    except OSError as exc:
-        log.warning("JAX compilation cache off: cannot make %s (%s)", sub, exc)
-        return None
-    if not owned:
-        log.warning("JAX compilation cache off: %s is not a folder of this user's that no one else may write", sub)
+    why = make_own_folder(root) or make_own_folder(sub)   # the root checked before anything is made inside it
+    if why:
+        log.warning("JAX compilation cache off: %s", why)
         return None
     return sub.resolve()
 

@@ -19,8 +19,8 @@ from pathlib import Path
 from models.spec import USER_KIND
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
-from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
 from replication.claims import get as get_claim
+from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
