@@ -51,12 +51,12 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
+    from replication.claims.base import run_frameworks
     from replication.run.runner import run
     from replication.training import device
 
     frameworks = _csv(args.frameworks)   # None: the profile's (`PROFILE_FRAMEWORKS`)
-    device.apply(args.device, frameworks or PROFILE_FRAMEWORKS.get(args.profile, FRAMEWORKS))
+    device.apply(args.device, run_frameworks(args.profile, frameworks))
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=frameworks, seeds=args.seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,

@@ -28,7 +28,12 @@ FRAMEWORKS = ("jax", "torch")
 # JAX alone (training both frameworks would double its time; the tests hold PyTorch's steps equal to JAX's on
 # identical weights and batches); the profiles of record in both, a claim's parts decided in each
 PROFILE_FRAMEWORKS = {"smoke": FRAMEWORKS, "quick": ("jax",), "full": FRAMEWORKS, "paper": FRAMEWORKS}
-__all__ = ["PROFILES", "FRAMEWORKS", "PROFILE_FRAMEWORKS", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
+
+
+def run_frameworks(profile: str, frameworks=None) -> tuple:
+    """The frameworks a run trains in: those named, else the profile's (both for a profile not listed)."""
+    return tuple(frameworks) if frameworks is not None else PROFILE_FRAMEWORKS.get(profile, FRAMEWORKS)
+__all__ = ["PROFILES", "FRAMEWORKS", "PROFILE_FRAMEWORKS", "run_frameworks", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
 
 
 def per_profile(table: dict, profile: str, default=None):

@@ -20,7 +20,7 @@ from models.spec import USER_KIND
 from replication import results as R
 from replication.claims import CLAIMS, PROFILES
 from replication.claims import get as get_claim
-from replication.claims.base import FRAMEWORKS, PROFILE_FRAMEWORKS
+from replication.claims.base import FRAMEWORKS, run_frameworks
 from replication.claims.verdicts import write_summary
 from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
@@ -49,7 +49,7 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, m
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
     given = frameworks is not None
-    frameworks = tuple(frameworks) if given else PROFILE_FRAMEWORKS[profile]
+    frameworks = run_frameworks(profile, frameworks)
     splits.get(split)
     for fw in frameworks:
         if fw not in FRAMEWORKS:
@@ -207,7 +207,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     out = R.output_folder(out, "--out")
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "split": split,
-                "frameworks": list(frameworks if frameworks is not None else PROFILE_FRAMEWORKS[profile]), "seeds": seeds,
+                "frameworks": list(run_frameworks(profile, frameworks)), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
                 "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source,
                                   "framework": a.framework} for a in added],
