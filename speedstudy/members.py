@@ -22,7 +22,7 @@ per framework, is checked in `speedstudy.targets`.
 from __future__ import annotations
 
 from models import ModelSpec, init_params
-from replication.claims.double_pendulum import MODELS, PROTOCOLS
+from replication.claims.double_pendulum import MODELS, RESTARTS
 from replication.training import compile_torch, loop, scouting, train_jax, train_torch
 from replication.training.data import BatchStream
 
@@ -37,7 +37,7 @@ def _modes(sizes) -> list[tuple[str, str]]:
 def _case(sizes):
     lnn = next(m for m in MODELS if m.label == "lnn")
     spec = ModelSpec(dof=2, hidden=tuple(sizes.members_hidden), dtype="float32", **lnn.spec_fields("quick"))
-    scout = scouting.scout_protocol(PROTOCOLS["quick"])   # a scout of the quick double-pendulum protocol
+    scout = scouting.scout_protocol(RESTARTS)   # a scout of the double pendulum's restarts protocol
     return spec, scout.replace(steps=sizes.members_steps, data=scout.data.replace(n_train=scout.batch * 1000),
                                log_every=10**9, tracking=None)
 

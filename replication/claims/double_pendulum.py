@@ -53,22 +53,25 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, data=_data.replace(n_train=12
 # `docs/decisions/double_pendulum_protocol.md`. The tracked held-out loss keeps its checkpoints (`Tracking.keep`):
 # claim 2 reads both models at a matched held-out accuracy.
 GUARD = Guard(clip=100.0, skip=10.0)
+# RESTARTS: the 1.1e7-sample protocol above; `full` and `paper` build on it, as do claim 11's full protocol, the
+# pace studies' scouts (claims 6-7), the online learner's and the speed study's members
+RESTARTS = _base.replace(steps=6_000_000 // 256, batch=256, data=_data.replace(n_train=256 * 1000, n_heldout=20_000),
+                         log_every=250, schedule=OneCycle(lr=1e-2, start=0.1),
+                         scouting=Scouting(count=16, steps=15_625, batch=32, schedule=OneCycle(lr=1e-3, start=0.2), keep=4),
+                         tracking=Tracking(every=1000, keep=True), guard=GUARD)
 PROTOCOLS = {
     "smoke": _base.replace(scouting=Scouting(count=2, steps=10, batch=16, schedule=OneCycle(lr=1e-3, start=0.2)),
                            tracking=Tracking(every=5, keep=True), guard=GUARD),
-    "quick": _base.replace(steps=6_000_000 // 256, batch=256, data=_data.replace(n_train=256 * 1000, n_heldout=20_000),
-                           log_every=250, schedule=OneCycle(lr=1e-2, start=0.1),
-                           scouting=Scouting(count=16, steps=15_625, batch=32, schedule=OneCycle(lr=1e-3, start=0.2), keep=4),
-                           tracking=Tracking(every=1000, keep=True), guard=GUARD),
+    "quick": RESTARTS,
     "paper": _base.replace(steps=600_000, batch=512, data=_data.replace(n_train=512 * 2000, n_heldout=100_000),
                            log_every=2000),
 }
-# full: quick's 16 scouts halved to 4, the continuation at peak 2e-3 (from phase 0.2, as the scouts) for 4e7
+# full: RESTARTS's 16 scouts halved to 4, the continuation at peak 2e-3 (from phase 0.2, as the scouts) for 4e7
 # samples in all: the train-to-target study's `restarts_halved` at 3 x 128 (the same Protocol), judged on the
 # paper's 1e5 held-out states (`docs/decisions/double_pendulum_protocol.md`).
 FULL_SAMPLES = 40_000_000
-_full = PROTOCOLS["quick"].replace(data=PROTOCOLS["quick"].data.replace(n_heldout=100_000),
-                                   schedule=OneCycle(lr=2e-3, start=0.2), log_every=1000, tracking=Tracking(every=5000, keep=True))
+_full = RESTARTS.replace(data=RESTARTS.data.replace(n_heldout=100_000),
+                         schedule=OneCycle(lr=2e-3, start=0.2), log_every=1000, tracking=Tracking(every=5000, keep=True))
 PROTOCOLS["full"] = _full.replace(steps=(FULL_SAMPLES - scouting_samples(_full)) // _full.batch)
 
 

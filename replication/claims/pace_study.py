@@ -8,7 +8,7 @@ WIDTHS = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "full": dp.QUICK_W, "paper":
 # quick: 1.6e5 samples a seed at batch 32, sized to the 45-minute budget. Measured (8 seeds, 3 x 64, JAX and
 # PyTorch alike): cranmer2020 runs left the plateau after 2750-6750 steps, kaiming's after 750-4000
 PACE_STEPS = 5000
-_scout = scout_protocol(dp.PROTOCOLS["quick"])   # the claims 1-2 scouts: batch 32, peak 1e-3, guard
+_scout = scout_protocol(dp.RESTARTS)   # the claims 1-2 scouts: batch 32, peak 1e-3, guard
 PROTOCOLS = {"smoke": scout_protocol(dp.unkept(dp.PROTOCOLS["smoke"])).replace(cohort=2),
              "quick": _scout.replace(steps=PACE_STEPS, data=_scout.data.replace(n_heldout=10_000), log_every=100, cohort=8,
                                      tracking=Tracking(every=500)),

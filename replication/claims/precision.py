@@ -41,8 +41,8 @@ def _entries():
 MODELS = _entries()
 # quick: the double pendulum's continuation (batch 256, one-cycle at peak 1e-2 from phase 0.1, the spike guard)
 # from a fresh init, for 1.1e6 samples (a tenth of claim 1's quick budget), no restarts and no tracking
-QUICK = dp.PROTOCOLS["quick"].replace(steps=1_100_000 // 256, scouting=None, tracking=None)
-PROTOCOLS = {"smoke": dp.PROTOCOLS["smoke"], "quick": QUICK, "full": dp.PROTOCOLS["quick"],
+QUICK = dp.RESTARTS.replace(steps=1_100_000 // 256, scouting=None, tracking=None)
+PROTOCOLS = {"smoke": dp.PROTOCOLS["smoke"], "quick": QUICK, "full": dp.RESTARTS,
              "paper": dp.PROTOCOLS["paper"]}   # full: claim 1's quick protocol, on the reference's horizon (EVAL)
 EVAL = {
     "smoke": {**dp.EVAL["smoke"], "truth_integrator": "rk4"},

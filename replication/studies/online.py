@@ -4,7 +4,7 @@ function takes `system`, the arm (`systems.arm_data.ARMS`; default `control.SYST
 SymPy plant, its references, gains `control.gains(dof)` and learners of its `dof`.
 
 The loop is `control.py`'s: tau = tau_hat(q_d, qdot_d, qddot_d) + KP (q_d - q) + KD (qdot_d - qdot) at `RATE`
-(500) Hz, the torque held over each 2 ms period, the SymPy plant integrated by RK4 (`control.hold`, 4 steps a
+(500) Hz, the torque held over each 2 ms period, the SymPy plant integrated by RK4 (`control.period`, 4 steps a
 period, float64). One arm tracks the references of `refs` back to back, each from its own initial state (the
 arm is placed there when it starts). At every tick the executed sample (q, qdot, the plant's acceleration
 under the applied torque, that torque) goes into a `ReplayBuffer` of the last `buffer` samples, and every
@@ -87,6 +87,7 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
         ctrl.warm(batch)   # compiled before the first tick, not inside it
     err, t_inf, t_learn = np.full(total, np.nan), np.zeros(total), np.zeros(total)
     h = 1.0 / rate / substeps
+    step = C.period(plant, h, substeps, total)
     windows, done, tick, n_bad = [], 0, 0, 0
     for r in range(n_refs):
         q, v, bad = qd[r, :1].copy(), vd[r, :1].copy(), False   # (1, dof): the plant's batch of one
@@ -105,7 +106,7 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
                 t1 = time.perf_counter()
                 tau = ff + kp * (qd[r, i] - q) + kd * (vd[r, i] - v)
                 with np.errstate(over="ignore", invalid="ignore"):   # a diverging state is caught below
-                    q_next, v_next, a = C.hold(plant, q, v, tau, h, substeps)
+                    q_next, v_next, a = step(q, v, tau)
                 bad = bool(C.diverged(q_next, v_next)[0])
                 t2 = time.perf_counter()
                 if learns and not bad:

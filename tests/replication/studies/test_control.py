@@ -66,3 +66,31 @@ def test_the_report_shows_the_study_and_flags_a_controller_no_better_than_pd(tmp
                                            ("ff", "jax", "1000", 0.4))])
     t = _table(df).set_index("controller")
     assert t.loc["ff", "flag"].startswith("NO BETTER") and t.loc["delan", "flag"] == "-" and t.loc["pd", "flag"] == "-"
+
+
+@pytest.mark.parametrize("system", ["two_link_arm", "four_joint_arm"])
+def test_the_compiled_period_is_the_numpy_hold_to_rounding(system):
+    plant = systems.get(system)
+    rng = np.random.default_rng(0)
+    q, v, tau = (rng.normal(size=(3, plant.dof)) for _ in range(3))
+    h = 1.0 / C.RATE / C.SUBSTEPS
+    fast = C.period(plant, h, periods=C.COMPILE_FROM)
+    assert fast is not C.period(plant, h, periods=C.COMPILE_FROM - 1)
+    for _ in range(5):   # the states after five periods
+        want = C.hold(plant, q, v, tau, h)
+        got = fast(q, v, tau)
+        for w, g in zip(want, got):
+            assert isinstance(g, np.ndarray) and g.dtype == np.float64
+            np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-12)
+        q, v = want[0], want[1]
+    wild = fast(q, v, np.full_like(tau, 1e30))   # a diverging torque stays visible to `diverged`
+    assert C.diverged(wild[0], wild[1]).all()
+
+
+def test_a_long_track_gives_the_short_tracks_numbers(refs, monkeypatch):
+    exact = lambda q, v, a: PLANT.inverse_dynamics(q, v, a)   # noqa: E731
+    numpy = C.track(exact, refs)
+    monkeypatch.setattr(C, "COMPILE_FROM", 1)   # this track compiled
+    compiled = C.track(exact, refs)
+    np.testing.assert_allclose(compiled["q"], numpy["q"], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(compiled["tau"], numpy["tau"], rtol=1e-8, atol=1e-9)
