@@ -91,13 +91,15 @@ _COMPILED = {}
 
 def period(plant, h: float, substeps: int = SUBSTEPS, periods: int = COMPILE_FROM):
     """`hold` as a function (q, v, tau) -> (q, v, a0) of NumPy arrays. For a SymPy system (`systems.System`)
+    or a plant that says it traces (`traceable`: its `acceleration` takes backend="jax", a robustness scene's)
     and a track of at least `COMPILE_FROM` periods it is one compiled JAX program in float64 (the same RK4
-    through the plant's JAX backend: a period of the four-joint arm about 27x, of the two-link arm about 16x
-    faster than NumPy's 16 calls; the states agree to rounding, `tests/replication/studies/test_control.py`);
-    any other plant (a robustness scene's) and short tracks run `hold` in NumPy."""
+    through the plant's JAX backend: a period of the four-joint arm about 27x, of the two-link arm about 10x
+    faster than NumPy's 16 calls; the states agree to rounding, `tests/replication/studies/test_control.py`),
+    kept per plant by its repr, which names what it simulates; any other plant and short tracks run `hold`
+    in NumPy."""
     from systems.system import System
 
-    if not isinstance(plant, System) or periods < COMPILE_FROM:
+    if not (isinstance(plant, System) or getattr(plant, "traceable", False)) or periods < COMPILE_FROM:
         return lambda q, v, tau: hold(plant, q, v, tau, h, substeps)
     key = (repr(plant), float(h), int(substeps))
     if key not in _COMPILED:

@@ -87,35 +87,84 @@ def _learned_row(name, fitted) -> dict:
 
 
 def study(out, framework: str = "jax", seeds=(0,), steps: int = STEPS, scenes=None, sizes=None,
-          progress=None) -> pd.DataFrame:
+          progress=None, jobs: int = 1) -> pd.DataFrame:
     """The scenes table (COLUMNS), fitting into OUT/data and OUT/fits; `scenes` default SCENES, `sizes`
-    (the data and references) SIZES, both read when called; `progress(what)` after every model scored."""
+    (the data and references) SIZES, both read when called; `progress(what)` after every model scored.
+    `jobs` > 1: the scenes in that many worker processes (spawned, one thread each, as `lagbench run`'s
+    workers), each scene's rows as one scene alone gives them; progress then comes a scene at a time."""
+    out, scenes, z = Path(out), SCENES if scenes is None else scenes, {**SIZES, **(sizes or {})}
+    (out / "data").mkdir(parents=True, exist_ok=True)
+    args = [(scene, out, framework, tuple(seeds), steps, z) for scene in scenes]
+    rows = []
+    if int(jobs) <= 1:
+        for a in args:
+            rows += scene_rows(*a, progress=progress)
+    else:
+        for scene_done in _in_workers(args, int(jobs)):
+            rows += scene_done
+            for r in scene_done if progress else ():
+                progress(f"{r['scene']} {r['model']}" + (f" seed {r['seed']}" if r["seed"] != "-" else ""))
+    return with_ratios(pd.DataFrame(rows))
+
+
+def scene_rows(scene, out: Path, framework: str, seeds, steps: int, z: dict, progress=None) -> list[dict]:
+    """One scene's rows: the null and the exact model, then every model of MODELS fitted for every seed."""
     from replication.studies.control import references
 
-    out, scenes, z = Path(out), SCENES if scenes is None else scenes, {**SIZES, **(sizes or {})}
-    n_train, n_test, n_points = z["n_train"], z["n_test"], z["n_points"]
-    (out / "data").mkdir(parents=True, exist_ok=True)
     refs = references("test", z["n_refs"], z["ref_duration"])
-    rows = []
-    for scene in scenes:
-        plant = Plant(scene)
-        test = scene_data(scene, "test", n_test, n_points, TEST_SEED)
-        base = {"scene": scene.id, "kind": scene.kind, "magnitude": scene.magnitude, "unit": UNITS[scene.kind]}
-        for name, inverse in ((NULL, None), ("exact", plant.inverse_dynamics)):
-            rows.append({**base, "model": name, "framework": "numpy", "seed": "-", "params": 0,
-                         **score(inverse, test, refs, plant)})
+    plant, rows = Plant(scene), []
+    test = scene_data(scene, "test", z["n_test"], z["n_points"], TEST_SEED)
+    base = {"scene": scene.id, "kind": scene.kind, "magnitude": scene.magnitude, "unit": UNITS[scene.kind]}
+    for name, inverse in ((NULL, None), ("exact", plant.inverse_dynamics)):
+        rows.append({**base, "model": name, "framework": "numpy", "seed": "-", "params": 0,
+                     **score(inverse, test, refs, plant)})
+        if progress:
+            progress(f"{scene.id} {name}")
+    for seed in seeds:
+        data = out / "data" / f"{scene.id}-seed{seed}.npz"
+        write_recording(scene_data(scene, "train", z["n_train"], z["n_points"], TRAIN_SEED, noise_seed=seed), data, scene)
+        for name in MODELS:
+            fitted = fit_model(name, data, out / "fits" / scene.id / f"seed{seed}", framework, seed, steps)
+            rows.append({**base, "model": name, "framework": framework, "seed": str(seed),
+                         **_learned_row(name, fitted), **score(fitted.inverse_dynamics, test, refs, plant)})
             if progress:
-                progress(f"{scene.id} {name}")
-        for seed in seeds:
-            data = out / "data" / f"{scene.id}-seed{seed}.npz"
-            write_recording(scene_data(scene, "train", n_train, n_points, TRAIN_SEED, noise_seed=seed), data, scene)
-            for name in MODELS:
-                fitted = fit_model(name, data, out / "fits" / scene.id / f"seed{seed}", framework, seed, steps)
-                rows.append({**base, "model": name, "framework": framework, "seed": str(seed),
-                             **_learned_row(name, fitted), **score(fitted.inverse_dynamics, test, refs, plant)})
-                if progress:
-                    progress(f"{scene.id} {name} seed {seed}")
-    return with_ratios(pd.DataFrame(rows))
+                progress(f"{scene.id} {name} seed {seed}")
+    return rows
+
+
+def _scene_task(a):
+    return scene_rows(*a)
+
+
+def _worker_start():
+    import torch
+
+    from replication.run.environment import WORKER_THREADS
+
+    torch.set_num_threads(WORKER_THREADS)
+
+
+def _in_workers(args, jobs: int):
+    """Each scene's rows, in the scenes' order, from `jobs` spawned processes of one thread each."""
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    from replication.run.environment import one_thread_env
+
+    one = one_thread_env(os.environ)
+    saved = {k: os.environ.get(k) for k in one}
+    os.environ.update(one)   # inherited by the workers before they import JAX or PyTorch
+    try:
+        with ProcessPoolExecutor(min(jobs, len(args)), mp_context=get_context("spawn"),
+                                 initializer=_worker_start) as pool:
+            yield from pool.map(_scene_task, args)
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def with_ratios(df: pd.DataFrame) -> pd.DataFrame:

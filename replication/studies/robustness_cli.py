@@ -22,20 +22,26 @@ def _steps(text: str) -> int:
     return int(text)
 
 
+def _jobs(text: str) -> int:
+    if not text.strip().isdigit() or int(text) < 1:
+        raise ValueError(f"--jobs {text}: expected an integer >= 1 (worker processes)")
+    return int(text)
+
+
 def cmd_robustness(args):
     from tqdm.auto import tqdm
 
     from replication.results import output_folder
     from replication.studies import robustness as R
 
-    steps, seeds = _steps(args.steps), _seeds(args.seeds)
+    steps, seeds, jobs = _steps(args.steps), _seeds(args.seeds), _jobs(args.jobs)
     if args.framework not in FRAMEWORKS:
         raise ValueError(f"--framework {args.framework}: expected one of {', '.join(FRAMEWORKS)}")
     folder = output_folder(Path(args.out) / "robustness", "--out")
     total = len(R.SCENES) * (2 + len(seeds) * len(R.MODELS))
     bar = tqdm(total=total, desc="lagbench robustness", unit="model", disable=args.quiet)
     try:
-        df, rec = R.write_study(folder, framework=args.framework, seeds=seeds, steps=steps,
+        df, rec = R.write_study(folder, framework=args.framework, seeds=seeds, steps=steps, jobs=jobs,
                                 progress=lambda what: (bar.set_postfix_str(what), bar.update()))
     finally:
         bar.close()
@@ -59,5 +65,7 @@ def add_command(sub) -> None:
     s.add_argument("--steps", default="3000", help="optimiser steps of every model (default: 3000)")
     s.add_argument("--seeds", nargs="+", default=["0"], help="seeds, comma- or space-separated (default: 0)")
     s.add_argument("--framework", default="jax", help="jax | torch (default: jax)")
+    s.add_argument("--jobs", default="1", help="worker processes, a scene each at a time (default: 1; the "
+                                               "fits are the same in any number of workers up to rounding)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_robustness)

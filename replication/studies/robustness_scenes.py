@@ -24,8 +24,8 @@ file (.npz: traj, t, q, tau, with the exact qdot and qddot unless the scene has 
 already there with the same arrays is left untouched (the npz's bytes carry a time stamp, and the fits
 made from it are keyed by its bytes, so a rerun reuses them).
 
-`Plant(scene)`: `.acceleration(q, qdot, tau=...)` of the scene's arm on (B, 2) float64 arrays (the
-ground-truth forward dynamics, with the scene's friction), `.inverse_dynamics(q, qdot, qddot)` its exact
+`Plant(scene)`: `.acceleration(q, qdot, tau=..., backend=)` of the scene's arm on (B, 2) float64 arrays (the
+ground-truth forward dynamics, with the scene's friction; "numpy" or "jax"), `.inverse_dynamics(q, qdot, qddot)` its exact
 torques; `replication.studies.control.track(..., plant=Plant(scene))` tracks on it (on the nominal plant
 the frictionless arm's numbers bit for bit: tests/replication/studies/test_robustness_scenes.py).
 """
@@ -84,10 +84,20 @@ class Plant:
         self.scene = scene
         self.arm = systems.get("two_link_arm", friction=scene.friction)
 
-    def acceleration(self, q, qdot, tau):
+    traceable = True   # `acceleration(..., backend="jax")` traces: `control.period` compiles long tracks
+
+    def __repr__(self) -> str:   # what it simulates (`control.period` keys its compiled programs by it)
+        return f"Plant({self.scene!r})"
+
+    def acceleration(self, q, qdot, tau, backend: str = "numpy"):
         if self.scene.coulomb:
-            tau = tau - coulomb_torque(self.scene, qdot)
-        return self.arm.acceleration(q, qdot, tau=tau)
+            if backend == "numpy":
+                tau = tau - coulomb_torque(self.scene, qdot)
+            else:
+                import jax.numpy as jnp
+
+                tau = tau - self.scene.coulomb * jnp.tanh(qdot / V_S)
+        return self.arm.acceleration(q, qdot, backend=backend, tau=tau)
 
     def inverse_dynamics(self, q, qdot, qddot):
         return self.arm.inverse_dynamics(q, qdot, qddot) + coulomb_torque(self.scene, qdot)

@@ -74,7 +74,19 @@ def test_the_recommendation_is_the_cheapest_model_within_twice_the_best_error():
     assert rec["recommended"].item() == "ff" and rec["torque_nmse"].item() == 0.01
 
 
-@pytest.mark.parametrize("option, bad", [("--steps", "0"), ("--seeds", "x"), ("--framework", "tf")])
+def test_scenes_in_two_workers_give_the_table_of_one_process(tiny_run, tmp_path):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(R, "SCENES", (Scene("nominal"), Scene("coulomb", 2.0)))
+        mp.setattr(R, "SIZES", TINY)
+        assert main(["robustness", "--out", str(tmp_path), "--steps", "3", "--seeds", "0", "--jobs", "2", "--quiet"]) == 0
+    one, two = (pd.read_csv(f / "robustness" / "scenes.csv") for f in (tiny_run, tmp_path))
+    assert one[["scene", "model", "seed"]].equals(two[["scene", "model", "seed"]])
+    numbers = one.select_dtypes("number").columns
+    np.testing.assert_allclose(two[numbers].to_numpy(float), one[numbers].to_numpy(float), rtol=1e-4, atol=1e-8)
+
+
+@pytest.mark.parametrize("option, bad", [("--steps", "0"), ("--seeds", "x"), ("--framework", "tf"),
+                                         ("--jobs", "0")])
 def test_bad_options_are_one_line_naming_the_option_and_write_nothing(tmp_path, capsys, option, bad):
     assert main(["robustness", "--out", str(tmp_path / "o"), option, bad, "--quiet"]) == 2
     err = capsys.readouterr().err

@@ -77,3 +77,15 @@ def test_the_tracker_is_control_py_s_on_the_nominal_arm_and_feels_the_scene_s_fr
     exact = C.scores(C.track(sticky.inverse_dynamics, refs, plant=sticky), refs)["track_mse"]
     unaware = C.scores(C.track(ARM.inverse_dynamics, refs, plant=sticky), refs)["track_mse"]
     assert exact < 1e-2 * unaware
+
+
+def test_a_scene_s_plant_compiled_is_its_numpy_plant_to_rounding():
+    sticky = Plant(Scene("coulomb", 2.0))
+    rng = np.random.default_rng(1)
+    q, v, tau = (rng.normal(size=(3, 2)) for _ in range(3))
+    h = 1.0 / C.RATE / C.SUBSTEPS
+    compiled = C.period(sticky, h, periods=C.COMPILE_FROM)(q, v, tau)
+    for want, got in zip(C.hold(sticky, q, v, tau, h), compiled):
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    smooth = C.period(Plant(Scene("viscous", 2.0)), h, periods=C.COMPILE_FROM)(q, v, tau)   # not the same program
+    assert not np.allclose(smooth[1], compiled[1])
