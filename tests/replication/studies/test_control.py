@@ -79,7 +79,7 @@ def test_the_compiled_period_is_the_numpy_hold_to_rounding(system):
     for _ in range(5):   # the states after five periods
         want = C.hold(plant, q, v, tau, h)
         got = fast(q, v, tau)
-        for w, g in zip(want, got):
+        for w, g in zip(want, got, strict=True):
             assert isinstance(g, np.ndarray) and g.dtype == np.float64
             np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-12)
         q, v = want[0], want[1]

@@ -85,7 +85,7 @@ def test_a_scene_s_plant_compiled_is_its_numpy_plant_to_rounding():
     q, v, tau = (rng.normal(size=(3, 2)) for _ in range(3))
     h = 1.0 / C.RATE / C.SUBSTEPS
     compiled = C.period(sticky, h, periods=C.COMPILE_FROM)(q, v, tau)
-    for want, got in zip(C.hold(sticky, q, v, tau, h), compiled):
+    for want, got in zip(C.hold(sticky, q, v, tau, h), compiled, strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
     smooth = C.period(Plant(Scene("viscous", 2.0)), h, periods=C.COMPILE_FROM)(q, v, tau)   # not the same program
     assert not np.allclose(smooth[1], compiled[1])
