@@ -78,16 +78,54 @@ def _shape(framework, spec, protocol) -> str:
     return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
 
 
-def estimate(units, out, jobs: int = 1, torch_threads: int | None = None) -> dict:
+def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: bool = False) -> dict:
     """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
-    "probes": configurations timed, "by_claim": {claim id: seconds}}. A training that several claims share
-    (claims 1, 2 and 11 train the same double-pendulum models) counts for the first claim planned with it."""
-    with threads_of_torch(torch_threads if any(u.framework == "torch" for u in units) else None):
-        return _estimate(units, out, jobs)
+    "probes": configurations timed, "probes_reused": of those, read from OUT's `PROBES` file, "by_claim":
+    {claim id: seconds}}. A training that several claims share (claims 1, 2 and 11 train the same
+    double-pendulum models) counts for the first claim planned with it. `keep`: write this machine's probes
+    to OUT/`PROBES`, so that a resumed run on the same machine reuses them rather than probing again."""
+    threads = torch_threads if any(u.framework == "torch" for u in units) else None
+    known = _read_probes(out, threads)
+    with threads_of_torch(threads):
+        est = _estimate(units, out, jobs, known)
+    if keep:
+        from replication import results as R
+
+        R.write_json(Path(out) / PROBES, {"machine": _machine(threads), "per_step": {
+            k: [plain, {str(m): s for m, s in members.items()}] for k, (plain, members) in known.items()}})
+    return est
 
 
-def _estimate(units, out, jobs: int) -> dict:
-    per_step, todo, cached, owner = {}, {}, 0, {}
+# OUT's record of the probes (seconds per step of each configuration's shape), with the machine they ran on
+PROBES = "estimate_probes.json"
+
+
+def _machine(torch_threads) -> dict:
+    """What a probe's time depends on besides the configuration: the hardware, the device the run trains
+    on, PyTorch's threads and the versions of the frameworks."""
+    from replication.run import environment as env
+
+    hw = env.hardware()
+    return {**{k: hw.get(k) for k in ("cpu", "cpu_model", "cpu_features", "cores", "gpu")},
+            "device": dev.request(), "torch_threads": torch_threads, "probe_steps": PROBE_STEPS,
+            **{k: v for k, v in env.versions().items() if k in ("python", "jax", "jaxlib", "torch")}}
+
+
+def _read_probes(out, torch_threads) -> dict:
+    """The probes of OUT's record when they ran on this machine as it is now (else none)."""
+    try:
+        rec = json.loads((Path(out) / PROBES).read_text())
+        if rec.get("machine") != json.loads(json.dumps(_machine(torch_threads))):
+            return {}
+        return {k: (float(plain), {int(m): float(x) for m, x in members.items()})
+                for k, (plain, members) in rec["per_step"].items()}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}   # none, unreadable or of another form: probed again
+
+
+def _estimate(units, out, jobs: int, per_step: dict) -> dict:
+    """`per_step` {shape: (plain, {members: seconds})}: probes already known; the new ones are added to it."""
+    todo, cached, owner, reused, used = {}, 0, {}, set(), set()
     for u in units:
         if not u.entry.train:
             continue
@@ -101,6 +139,8 @@ def _estimate(units, out, jobs: int) -> dict:
             todo[group] = 0.0
             continue
         shape = _shape(u.framework, spec, p)   # the same step for another seed, init or budget costs the same
+        reused |= {shape} if shape in per_step and shape not in used else set()
+        used.add(shape)
         if shape not in per_step:
             if p.cohort:
                 per_step[shape] = (_members_step(u.framework, spec, p, p.cohort), {})
@@ -115,7 +155,8 @@ def _estimate(units, out, jobs: int) -> dict:
     for group, seconds in todo.items():
         by_claim[owner[group]] = by_claim.get(owner[group], 0.0) + seconds
     return {"train_s": total, "wall_s": scheduled_wall(in_order, jobs),
-            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached, "probes": len(per_step),
+            "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached,
+            "probes": len(used), "probes_reused": len(reused),
             "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1]))}
 
 

@@ -26,7 +26,7 @@ from replication.evaluation.registry import EVALUATION_VERSION
 from replication.fit.userdata import content_only
 from replication.run import added_models, splits
 from replication.run import environment as env
-from replication.run.estimate import describe, estimate
+from replication.run.estimate import PROBES, describe, estimate
 from replication.run.executor import run_units
 from replication.run.units import Unit
 from replication.training import device as dev
@@ -132,12 +132,16 @@ def set_aside(folder: Path) -> Path:
     raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
-def announce(profile, units, todo, out, jobs, executor="local") -> dict:
+def announce(profile, units, todo, out, jobs, executor="local", keep=False) -> dict:
     """Print the units a long profile will run and its estimated duration (`replication.run.estimate`),
-    its probes timed at the thread setting the units will train with."""
+    its probes timed at the thread setting the units will train with; `keep`: the probes are written to
+    OUT for a resumed run on this machine to reuse."""
     print(f"lagbench: profile {profile}: {len(units)} units, {len(todo)} to run:\n{describe(units, todo)}", flush=True)
     print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
-    est = estimate(todo, out, jobs, env.worker_torch_threads(executor, jobs))
+    est = estimate(todo, out, jobs, env.worker_torch_threads(executor, jobs), keep=keep)
+    if est["probes_reused"]:
+        print(f"lagbench: {est['probes_reused']} of {est['probes']} probes read from an earlier invocation on this "
+              f"machine (OUT/{PROBES}; remove it to probe again)", flush=True)
     hw = env.hardware()
     where = ", ".join(f"{fw} on the {dev.resolve(dev.request(), fw).upper()}" for fw in sorted({u.framework for u in todo}))
     print(f"lagbench: {est['trainings']} trainings to do ({est['cached']} reused from OUT/trained), estimated "
@@ -220,7 +224,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     todo = [u for u in units if not is_current(u, out, repairs)]
     manifest["repaired"] = repairs
     if profile in LONG_PROFILES and todo:
-        manifest["estimate"] = announce(profile, units, todo, out, jobs, executor)
+        manifest["estimate"] = announce(profile, units, todo, out, jobs, executor, keep=True)
         R.write_json(out / "run.json", manifest)
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()

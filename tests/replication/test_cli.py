@@ -81,6 +81,30 @@ def test_estimate_says_where_the_time_goes_by_claim(tmp_path, monkeypatch):
     assert list(est["by_claim"].values()) == sorted(est["by_claim"].values(), reverse=True)
 
 
+def test_a_resumed_run_on_the_same_machine_reuses_its_probes_and_another_machine_probes_again(tmp_path, monkeypatch):
+    from replication.run import environment as env
+    from replication.run import estimate as E
+
+    calls = []
+    monkeypatch.setattr(E, "_plain_step", lambda *a: calls.append("plain") or 2.0)
+    monkeypatch.setattr(E, "_members_step", lambda *a: calls.append("members") or 3.0)
+    units = plan("smoke", claims=["dp_loss"], frameworks=("jax",))
+    look = estimate(units, tmp_path)   # a look (a dry run) writes nothing
+    assert calls and not (tmp_path / E.PROBES).exists() and look["probes_reused"] == 0
+    first = estimate(units, tmp_path, keep=True)
+    assert (tmp_path / E.PROBES).is_file() and first["probes_reused"] == 0
+    calls.clear()
+    again = estimate(units, tmp_path, keep=True)
+    assert not calls and again["probes_reused"] == again["probes"] == first["probes"] > 0
+    assert again["train_s"] == first["train_s"] and again["wall_s"] == first["wall_s"]
+    monkeypatch.setattr(env, "hardware", lambda: {**env.hardware.__wrapped__(), "cpu": "another CPU"})
+    elsewhere = estimate(units, tmp_path)
+    assert calls and elsewhere["probes_reused"] == 0   # probed again where the machine differs
+    calls.clear()
+    (tmp_path / E.PROBES).write_text("{not json")
+    assert estimate(units, tmp_path)["probes_reused"] == 0 and calls   # an unreadable record: probed again
+
+
 def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, monkeypatch):
     # workers train on one PyTorch thread; probes at this process's default ran up to 34x slow (estimate.py)
     import torch
