@@ -117,8 +117,9 @@ def period(plant, h: float, substeps: int = SUBSTEPS, periods: int = COMPILE_FRO
     cpu = jax.devices("cpu")[0]   # the ground truth on the CPU, as in NumPy, on a machine with a GPU too
 
     def step(q, v, tau):
-        out = fn(*(jax.device_put(np.asarray(x, np.float64), cpu) for x in (q, v, tau)))
-        return tuple(np.array(x) for x in out)   # writable NumPy copies: the loops assign into them
+        with jax.default_device(cpu):
+            out = fn(np.asarray(q, np.float64), np.asarray(v, np.float64), np.asarray(tau, np.float64))
+            return tuple(np.array(x) for x in out)   # writable NumPy copies: the loops assign into them
     return step
 
 
