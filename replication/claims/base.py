@@ -100,7 +100,7 @@ class Claim:
     variants: tuple = ()     # `parts.Variant`s: departures from the paper, each judged on its own line
     kind: str = "claim"      # "claim" (a paper claim) or "check" (implementation, numerics)
     key: str = ""            # the model whose number the scorecard shows (default: the first)
-    seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": 3, "paper": 3})
+    seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": seed_rule.PRELIMINARY_SEEDS, "paper": 3})
     eval_config: dict = field(default_factory=dict)   # profile -> dict of evaluation settings
     pooled: bool = False     # the rule reads the seeds as one sample (a share), not each seed as a replication
 

@@ -7,6 +7,7 @@ trajectories. Data efficiency: the same models on smaller pools (`SIZES`), each 
 trajectories (`replication.training.data.arm_trajectories`), trained for as many steps as the full pool.
 """
 from replication.claims.base import ModelEntry
+from replication.claims.seed_rule import PRELIMINARY_SEEDS
 from replication.training.protocol import Data, Protocol
 from replication.training.schedules import Constant
 
@@ -37,4 +38,4 @@ PROTOCOLS = {"smoke": _base,
                                     schedule=Constant(lr=1e-3)),
              "paper": _base.replace(steps=40_000, batch=512, data=_data.replace(n_train=2459, n_heldout=4000), log_every=500)}
 PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
-SEEDS = {"smoke": 1, "quick": 3, "full": 5, "paper": 5}
+SEEDS = {"smoke": 1, "quick": PRELIMINARY_SEEDS, "full": 5, "paper": 5}
