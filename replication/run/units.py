@@ -80,12 +80,12 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
     ctx = Context(claim=unit.claim, entry=unit.entry, framework=unit.framework, spec=spec, params=params,
                   protocol=protocol, profile=unit.profile, cfg=unit.claim.evaluation_config(unit.profile),
                   split=splits.of_seed(unit.seed), progress=on_progress, seed=unit.seed)
-    if params is not None:
-        ctx.model = adapter(unit.framework, spec, params)
-        ctx.log = outcome.log
-        ctx.tracked = outcome.tracked
     where = dev.resolve(dev.request(), unit.framework)
-    with dev.placed(unit.framework, where):   # the model's evaluation on the run's device
+    with dev.placed(unit.framework, where):   # the model (its parameters too) and its evaluation on the run's device
+        if params is not None:
+            ctx.model = adapter(unit.framework, spec, params)
+            ctx.log = outcome.log
+            ctx.tracked = outcome.tracked
         ev = EVALUATIONS[unit.claim.evaluate](ctx)
     for name, df in ev.tables.items():
         files[name] = R.write_csv(folder / name, df)

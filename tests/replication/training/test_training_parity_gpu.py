@@ -34,3 +34,17 @@ def test_the_gpu_trains_as_the_cpu_does(framework):
     diffs, mismatches = compare(_on(framework, row, "cpu"), _on_gpu(framework, row))
     assert not mismatches, mismatches[:5]
     assert within(row, diffs), f"{diffs} beyond {row.tolerance}"
+
+
+@pytest.mark.parametrize("framework", ["jax", "torch"])
+def test_a_unit_trains_and_is_evaluated_on_the_gpu(tmp_path, monkeypatch, framework):
+    # the evaluation's model is built on the run's device, where its inputs are made (a PyTorch model built
+    # outside it kept its parameters on the CPU and failed on CUDA inputs)
+    from replication.run.runner import plan
+    from replication.run.units import run_unit
+
+    monkeypatch.setenv(device.ENV, "gpu")
+    unit = next(u for u in plan("smoke", claims=["dp_loss"], frameworks=(framework,), models=["lnn"]))
+    record = run_unit(unit, tmp_path)
+    assert record["status"] == "ok" and record["metrics"]["heldout_l1"] > 0
+    assert record["train_device"]["device"] == record["eval_device"]["device"] == "gpu"
