@@ -101,20 +101,17 @@ def period(plant, h: float, substeps: int = SUBSTEPS, periods: int = COMPILE_FRO
 
     if not (isinstance(plant, System) or getattr(plant, "traceable", False)) or periods < COMPILE_FROM:
         return lambda q, v, tau: hold(plant, q, v, tau, h, substeps)
+    import jax
+
     key = (repr(plant), float(h), int(substeps))
     if key not in _COMPILED:
-        import jax
-
         class _Jax:   # the plant through its JAX backend, for `hold` to trace
             @staticmethod
             def acceleration(q, v, tau):
                 return plant.acceleration(q, v, backend="jax", tau=tau)
 
         _COMPILED[key] = jax.jit(lambda q, v, tau: hold(_Jax, q, v, tau, h, substeps))
-    fn = _COMPILED[key]
-    import jax
-
-    cpu = jax.devices("cpu")[0]   # the ground truth on the CPU, as in NumPy, on a machine with a GPU too
+    fn, cpu = _COMPILED[key], jax.devices("cpu")[0]   # the ground truth on the CPU, as in NumPy, on a machine with a GPU too
 
     def step(q, v, tau):
         with jax.default_device(cpu):
