@@ -180,8 +180,12 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     from speedstudy import train_target as TT
     from speedstudy.target_loop import heldout_l1
 
+    from replication.training import device
+
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
-    l1 = heldout_l1(spec, proto)(models.jax.build(spec, params))
+    # where and as the command computed it (on a GPU it asks for full float32 products, not the default TF32)
+    with device.placed("jax", device.resolve(device.request(), "jax")):
+        l1 = heldout_l1(spec, proto)(models.jax.build(spec, params))
     assert l1 == pytest.approx(rows["final_l1"].iloc[0], rel=1e-5)
     assert "variant" in capsys.readouterr().out
 
