@@ -22,6 +22,41 @@ def one_thread_env(env) -> dict:
             "MKL_NUM_THREADS": str(WORKER_THREADS)}
 
 
+@contextmanager
+def one_thread_children():
+    """Processes started inside the block run JAX, PyTorch/OpenMP and MKL on one thread: `one_thread_env` is
+    set in this process's environment, which they inherit before they import either; put back afterwards
+    (processes already started keep theirs)."""
+    one = one_thread_env(os.environ)
+    saved = {k: os.environ.get(k) for k in one}
+    os.environ.update(one)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
+
+
+def _exit_with(parent: int, every: float = 1.0):
+    """Exit this process once its parent is no longer `parent` (the driver died; we were re-parented)."""
+    import time
+
+    while os.getppid() == parent:
+        time.sleep(every)
+    os._exit(1)
+
+
+def worker_start(driver: int):
+    """A worker process's start: PyTorch at `WORKER_THREADS`, and an exit of its own once its driver (the
+    process `driver`) is gone."""
+    import threading
+
+    import torch
+
+    torch.set_num_threads(WORKER_THREADS)
+    threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
+
+
 def worker_torch_threads(executor: str, jobs: int) -> int | None:
     """PyTorch's intra-op threads in the processes that will train a run's units: one in each worker
     process (`--jobs` > 1; `one_thread_env` and the worker's start) and in each Ray task; None with one

@@ -24,8 +24,6 @@ from __future__ import annotations
 import os
 import queue
 import signal
-import threading
-import time
 from multiprocessing import get_context
 
 from tqdm.auto import tqdm
@@ -36,7 +34,7 @@ from replication.run.chains import cost as _cost  # noqa: F401 - re-exported for
 from replication.run.chains import ref as _ref
 from replication.run.chains import run_chain as _run_chain
 from replication.run.chains import run_one as _one
-from replication.run.environment import WORKER_THREADS, one_thread_env
+from replication.run.environment import one_thread_children, worker_start
 from replication.training.scouting import progress_steps
 
 
@@ -62,25 +60,11 @@ def _serial(todo, out, profile, progress):
     return failures, errors
 
 
-def _exit_with(parent: int, every: float = 1.0):
-    """Exit this process once its parent is no longer `parent` (the driver died; we were re-parented)."""
-    while os.getppid() == parent:
-        time.sleep(every)
-    os._exit(1)
-
-
-def _worker_start(driver: int):
-    import torch
-
-    torch.set_num_threads(WORKER_THREADS)
-    threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
-
-
 def _worker_loop(driver: int, tasks, results):
     """A worker process: chains from `tasks` (None: stop), each answered on `results` as (chain id, done,
     error)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the driver's: it stops the workers
-    _worker_start(driver)
+    worker_start(driver)
     while (item := tasks.get()) is not None:
         cid, refs, out = item
         try:
@@ -146,49 +130,44 @@ class _Workers:
 def _parallel(todo, out, profile, progress, jobs):
     work = chains(todo)
     failures, errors = [], []
-    one = one_thread_env(os.environ)
-    saved = {k: os.environ.get(k) for k in one}
-    # inherited by the spawned workers before they import JAX or PyTorch; kept while they live, as they
-    # start on demand as chains are handed out
-    os.environ.update(one)
-    workers = _Workers(jobs)
-    bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
-    pending, held = list(enumerate(work)), {}
+    # the spawned workers start on demand as chains are handed out, each on one thread
+    with one_thread_children():
+        workers = _Workers(jobs)
+        bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
+        pending, held = list(enumerate(work)), {}
 
-    def record(done):
-        nonlocal failures, errors
-        for name, failure, error in done:
-            failures += [failure] if failure else []
-            errors += [error] if error else []
-            bar.update(1)
-            bar.set_postfix_str(name)
-    try:
-        while pending or held:
-            while pending and (slot := workers.idle()) is not None:
-                cid, chain = pending.pop(0)
-                held[cid] = chain
-                workers.assign(slot, cid, [_ref(u) for u in chain], out)
-            try:
-                cid, done, error, full = workers.results.get(timeout=0.5)
-            except queue.Empty:
-                # a worker that died loses the chain it held, not the run
-                for cid, code in workers.dead():
-                    record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
-                            for u in held.pop(cid)])
-                continue
-            if full is not None:
-                raise DiskFull(*full)
-            chain = held.pop(cid, None)
-            workers.finished(cid)
-            if chain is not None:
-                record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain])
-    except BaseException:
-        workers.close(wait=False)
-        raise
-    finally:
-        bar.close()
-        for k, v in saved.items():
-            os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
+        def record(done):
+            nonlocal failures, errors
+            for name, failure, error in done:
+                failures += [failure] if failure else []
+                errors += [error] if error else []
+                bar.update(1)
+                bar.set_postfix_str(name)
+        try:
+            while pending or held:
+                while pending and (slot := workers.idle()) is not None:
+                    cid, chain = pending.pop(0)
+                    held[cid] = chain
+                    workers.assign(slot, cid, [_ref(u) for u in chain], out)
+                try:
+                    cid, done, error, full = workers.results.get(timeout=0.5)
+                except queue.Empty:
+                    # a worker that died loses the chain it held, not the run
+                    for cid, code in workers.dead():
+                        record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
+                                for u in held.pop(cid)])
+                    continue
+                if full is not None:
+                    raise DiskFull(*full)
+                chain = held.pop(cid, None)
+                workers.finished(cid)
+                if chain is not None:
+                    record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain])
+        except BaseException:
+            workers.close(wait=False)
+            raise
+        finally:
+            bar.close()
     workers.close(wait=True)
     return failures, errors
 

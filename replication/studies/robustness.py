@@ -136,35 +136,17 @@ def _scene_task(a):
     return scene_rows(*a)
 
 
-def _worker_start():
-    import torch
-
-    from replication.run.environment import WORKER_THREADS
-
-    torch.set_num_threads(WORKER_THREADS)
-
-
 def _in_workers(args, jobs: int):
     """Each scene's rows, in the scenes' order, from `jobs` spawned processes of one thread each."""
     import os
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
-    from replication.run.environment import one_thread_env
+    from replication.run.environment import one_thread_children, worker_start
 
-    one = one_thread_env(os.environ)
-    saved = {k: os.environ.get(k) for k in one}
-    os.environ.update(one)   # inherited by the workers before they import JAX or PyTorch
-    try:
-        with ProcessPoolExecutor(min(jobs, len(args)), mp_context=get_context("spawn"),
-                                 initializer=_worker_start) as pool:
-            yield from pool.map(_scene_task, args)
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+    with one_thread_children(), ProcessPoolExecutor(min(jobs, len(args)), mp_context=get_context("spawn"),
+                                                    initializer=worker_start, initargs=(os.getpid(),)) as pool:
+        yield from pool.map(_scene_task, args)
 
 
 def with_ratios(df: pd.DataFrame) -> pd.DataFrame:

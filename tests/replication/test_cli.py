@@ -177,10 +177,9 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     params = load_npz(out / "train_target" / "variant.npz")
     assert spec.kind == "lnn" and spec.hidden == (8, 8)
     import models.jax
+    from replication.training import device
     from speedstudy import train_target as TT
     from speedstudy.target_loop import heldout_l1
-
-    from replication.training import device
 
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
     # where and as the command computed it (on a GPU it asks for full float32 products, not the default TF32)
