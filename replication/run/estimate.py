@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from replication import results as R
+from replication.run import environment as env
 from replication.run.chains import chains
 from replication.run.environment import torch_threads as threads_of_torch
 from replication.training import compile_torch
@@ -89,8 +91,6 @@ def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: 
     with threads_of_torch(threads):
         est = _estimate(units, out, jobs, known)
     if keep:
-        from replication import results as R
-
         R.write_json(Path(out) / PROBES, {"machine": _machine(threads), "per_step": {
             k: [plain, {str(m): s for m, s in members.items()}] for k, (plain, members) in known.items()}})
     return est
@@ -103,8 +103,6 @@ PROBES = "estimate_probes.json"
 def _machine(torch_threads) -> dict:
     """What a probe's time depends on besides the configuration: the hardware, the device the run trains
     on, PyTorch's threads and the versions of the frameworks."""
-    from replication.run import environment as env
-
     hw = env.hardware()
     return {**{k: hw.get(k) for k in ("cpu", "cpu_model", "cpu_features", "cores", "gpu")},
             "device": dev.request(), "torch_threads": torch_threads, "probe_steps": PROBE_STEPS,
