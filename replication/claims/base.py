@@ -33,6 +33,8 @@ PROFILE_FRAMEWORKS = {"smoke": FRAMEWORKS, "quick": ("jax",), "full": FRAMEWORKS
 def run_frameworks(profile: str, frameworks=None) -> tuple:
     """The frameworks a run trains in: those named, else the profile's (both for a profile not listed)."""
     return tuple(frameworks) if frameworks is not None else PROFILE_FRAMEWORKS.get(profile, FRAMEWORKS)
+
+
 __all__ = ["PROFILES", "FRAMEWORKS", "PROFILE_FRAMEWORKS", "run_frameworks", "VERDICTS", "KINDS", "Claim", "ModelEntry", "Part", "Variant", "per_profile"]
 
 

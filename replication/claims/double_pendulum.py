@@ -54,8 +54,8 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, data=_data.replace(n_train=12
 # `docs/decisions/double_pendulum_protocol.md`. The tracked held-out loss keeps its checkpoints (`Tracking.keep`):
 # claim 2 reads both models at a matched held-out accuracy.
 GUARD = Guard(clip=100.0, skip=10.0)
-# RESTARTS: the 1.1e7-sample protocol above; `full` and `paper` build on it, as do claim 11's full protocol, the
-# pace studies' scouts (claims 6-7), the online learner's and the speed study's members
+# RESTARTS: the 1.1e7-sample protocol above; `full` builds on it, as do claim 11's full protocol, the pace
+# studies' scouts (claims 6-7) and the speed study's members
 RESTARTS = _base.replace(steps=6_000_000 // 256, batch=256, data=_data.replace(n_train=256 * 1000, n_heldout=20_000),
                          log_every=250, schedule=OneCycle(lr=1e-2, start=0.1),
                          scouting=Scouting(count=16, steps=15_625, batch=32, schedule=OneCycle(lr=1e-3, start=0.2), keep=4),
@@ -82,7 +82,7 @@ def unkept(protocol):
     return protocol.replace(**{"tracking.keep": False}) if protocol.tracking else protocol
 
 
-# seeds by `seed_rule`: 3 in the preliminary quick profile, 5 in the profiles of record
+# seeds by `seed_rule`: PRELIMINARY_SEEDS in the preliminary quick profile, 5 in the profiles of record
 SEEDS = {"smoke": 1, "quick": PRELIMINARY_SEEDS, "full": 5, "paper": 5}
 
 # both models must have learned q-double-dot on the training distribution before they are compared

@@ -70,9 +70,10 @@ SCENES = (Scene("nominal"), Scene("viscous", 0.5), Scene("viscous", 2.0), Scene(
           Scene("sensor_noise", 0.003), Scene("sensor_noise", 0.03))
 
 
-def coulomb_torque(scene: Scene, qdot):
-    """The torque the joints' Coulomb friction takes, c tanh(qdot / V_S) (0 without it)."""
-    return scene.coulomb * np.tanh(np.asarray(qdot, np.float64) / V_S)
+def coulomb_torque(scene: Scene, qdot, xp=np):
+    """The torque the joints' Coulomb friction takes, c tanh(qdot / V_S) (0 without it), in float64 of the
+    array module `xp` (NumPy, or jax.numpy inside a compiled plant)."""
+    return scene.coulomb * xp.tanh(xp.asarray(qdot, xp.float64) / V_S)
 
 
 class Plant:
@@ -96,7 +97,7 @@ class Plant:
             else:
                 import jax.numpy as jnp
 
-                tau = tau - self.scene.coulomb * jnp.tanh(qdot / V_S)
+                tau = tau - coulomb_torque(self.scene, qdot, jnp)
         return self.arm.acceleration(q, qdot, backend=backend, tau=tau)
 
     def inverse_dynamics(self, q, qdot, qddot):
