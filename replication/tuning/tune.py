@@ -8,7 +8,9 @@ split) and scored by its development held-out error: `heldout_l1` where the eval
 claim's metric (lower is better), averaged over seeds and frameworks; a pooled claim (a pace study: claims 6
 and 7) by its pace instead, the median over seeds of the samples to leave the plateau (+inf: never), as its
 verdict reads pace over a sample of seeds (run it with the claim's seed count, one cohort). The units go to
-OUT/config<k>/units/...; the ledger to OUT/ledger.json and OUT/ledger.csv: per model and configuration
+OUT/config<k>/units/...; a rerun into the same OUT reads back the units already finished (a result of another
+protocol is set aside and redone, as `lagbench run` does) and continues a training in flight from its
+snapshot. The ledger goes to OUT/ledger.json and OUT/ledger.csv: per model and configuration
 its knob values and score, and per model the configurations tried, the chosen one (the lowest score)
 and the split they were scored on ("dev").
 What it does not do: change a claim. A ledger's choices reach the claim only when adopted
@@ -26,6 +28,7 @@ from replication import results as R
 from replication.claims import untuned
 from replication.run import splits
 from replication.run.executor import run_units
+from replication.run.runner import is_current
 from replication.run.units import Unit
 from replication.tuning import search
 
@@ -65,7 +68,9 @@ def tune(claim_id: str, profile: str = "quick", n_configs: int = 4, n_seeds: int
         units = [Unit(variant, e, fw, seed, profile) for e in models if e.label in labels for fw in frameworks
                  for seed in splits.DEV.seeds(n_seeds)]
         folder = out / f"config{k}"
-        run_units(units, folder, profile, progress, jobs=1)
+        todo = [u for u in units if not is_current(u, folder)]   # a rerun resumes: finished units are read back
+        if todo:
+            run_units(todo, folder, profile, progress, jobs=1)
         for u in units:
             try:
                 r = R.load_result(u.folder(folder))

@@ -61,6 +61,11 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
         assert m["chosen"] == min(finite, key=finite.get)
     assert json.loads((tmp_path / "ledger.json").read_text())["models"] == json.loads(json.dumps(models))
     assert protocol_hash(get("dp_loss"), "smoke") == before   # the claim is untouched
+    # a rerun into the same folder reads the finished units back: nothing trained or evaluated again
+    ran = []
+    monkeypatch.setattr("replication.tuning.tune.run_units", lambda units, *a, **k: ran.append(units))
+    again = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
+    assert ran == [] and again["models"] == ledger["models"]
 
 
 def test_tune_command_refuses_a_bad_count_in_one_line(tmp_path, capsys):
