@@ -12,8 +12,8 @@ width as a multiple): the tuning search's configurations and an adopted choice a
 `apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile, and
 under a profile the claim is silent about (a model that runs there exactly as under quick: `full` for most
 claims), quick's choice, the search having run at that profile's budget too.
-A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices, so that their
-trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models
+A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices (under the profile
+whose protocol it trains with), so that their trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models
 and profiles without a record keep their registered (hand-chosen) setting.
 `tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
 configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
@@ -28,9 +28,12 @@ from pathlib import Path
 from replication.claims.base import PROFILES, per_profile
 
 FILE = Path(__file__).with_name("tuned.json")
-# claim -> (the claim whose tuning it takes, {its label: that claim's label}); the claims share trainings
-SHARED = {"dp_energy": ("dp_loss", {}), "delan_tracking": ("delan_arm", {}),
-          "precision": ("dp_loss", {f"{m}_{d}": m for m in ("lnn", "baseline") for d in ("f32", "f64")})}
+# claim -> (the claim whose tuning it takes, {its label: that claim's label}, {its profile: that claim's
+# profile, where it trains under another profile's protocol}); the claims share trainings. Claim 11's `full`
+# trains under claim 1's quick protocol at quick's widths (`precision.PROTOCOLS`), so quick's search chose for it.
+SHARED = {"dp_energy": ("dp_loss", {}, {}), "delan_tracking": ("delan_arm", {}, {}),
+          "precision": ("dp_loss", {f"{m}_{d}": m for m in ("lnn", "baseline") for d in ("f32", "f64")},
+                        {"full": "quick"})}
 
 
 def scaled_widths(widths, factor: float) -> tuple:
@@ -60,8 +63,8 @@ def records() -> dict:
 
 def _record(claim_id: str, profile: str) -> tuple[dict | None, dict]:
     """The adopted record that serves the claim under the profile, and the label map into it."""
-    source, names = SHARED.get(claim_id, (claim_id, {}))
-    return records().get(source, {}).get(profile), names
+    source, names, profiles = SHARED.get(claim_id, (claim_id, {}, {}))
+    return records().get(source, {}).get(profiles.get(profile, profile)), names
 
 
 def _chosen(claim, rec: dict | None, names: dict, label: str) -> dict | None:

@@ -96,6 +96,21 @@ def test_claims_that_share_trainings_take_the_same_choice(record_file):
         assert pa.schedule == pb.schedule and pa.scouting == pb.scouting
 
 
+def test_a_claim_that_trains_under_another_profiles_protocol_takes_that_profiles_choice(record_file):
+    """Claim 11's full trains claim 1's quick protocol at quick's widths: claim 1's quick search chose for it,
+    and a search of claim 1 at full's own budget does not."""
+    adopt.adopt(_write(record_file, _ledger("dp_loss", knobs={"lr": 1.0, "width": 4.0})))
+    adopt.adopt(_write(record_file, _ledger("dp_loss", profile="full", knobs={"lr": 1 / 3, "width": 0.5})))
+    loss, precision, written = tuned.apply(untuned("dp_loss")), tuned.apply(untuned("precision")), untuned("precision")
+    for dtype in ("f32", "f64"):
+        m, w = precision.entry(f"baseline_{dtype}"), written.entry(f"baseline_{dtype}")
+        assert m.widths("full") == loss.entry("baseline").widths("quick") == tuple(4 * x for x in w.widths("full"))
+        assert (m.protocol(precision.protocol("full"), "full").schedule
+                == loss.entry("baseline").protocol(loss.protocol("quick"), "quick").schedule)
+    assert loss.entry("baseline").widths("full") == tuple(x // 2 for x in untuned("dp_loss").entry("baseline").widths("full"))
+    assert all(x["configs_tried"] == 4 for x in tuned.tuning(precision, "full").values())
+
+
 def test_every_adopted_choice_is_its_committed_ledgers():
     """Each record of tuned.json names the ledger it came from by hash; that ledger is committed under
     docs/lab/tuning/<claim>/ and chose exactly those knobs, on the development split, for every model alike."""

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The searches that choose `full`'s protocols where a claim runs in full otherwise than in quick (claims 1-2
-# and 11 through dp_loss, 3, 6, 7; the other claims run as in quick and take quick's adopted choices). Every
+# through dp_loss, 3, 6, 7; the other claims, check 11 among them, train as in quick and take quick's adopted
+# choices). Every
 # one reads the development split only; each is resumable (rerun this script: finished configurations are
 # read back, a training in flight continues from its snapshot). The searches are those of quick's tunes
 # (docs/lab/tuning/README.md) at full's budget: dp_loss a width sweep for both models alike, the others four
