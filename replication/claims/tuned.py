@@ -13,8 +13,9 @@ width as a multiple): the tuning search's configurations and an adopted choice a
 under a profile the claim is silent about (a model that runs there exactly as under quick: `full` for most
 claims), quick's choice, the search having run at that profile's budget too.
 A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices (under the profile
-whose protocol it trains with), so that their trainings stay one; a variant takes its paper model's choice (its departure is all that differs). Models
-and profiles without a record keep their registered (hand-chosen) setting.
+whose protocol it trains with), so that their trainings stay one; a variant takes its paper model's choice
+(its departure is all that differs). Models and profiles without a record keep their registered
+(hand-chosen) setting.
 `tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
 configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
 """
