@@ -113,10 +113,12 @@ def test_a_claim_that_trains_under_another_profiles_protocol_takes_that_profiles
 
 def test_every_adopted_choice_is_its_committed_ledgers():
     """Each record of tuned.json names the ledger it came from by hash; that ledger is committed under
-    docs/lab/tuning/<claim>/ and chose exactly those knobs, on the development split, for every model alike."""
+    docs/lab/tuning/<claim>/ (quick's) or docs/lab/tuning/<claim>_<profile>/ and chose exactly those knobs, on
+    the development split, for every model alike."""
     for claim_id, per in tuned.records().items():
         for profile, rec in per.items():
-            ledger = json.loads((ROOT / "docs" / "lab" / "tuning" / claim_id / "ledger.json").read_text())
+            folder = claim_id if profile == "quick" else f"{claim_id}_{profile}"
+            ledger = json.loads((ROOT / "docs" / "lab" / "tuning" / folder / "ledger.json").read_text())
             assert canonical_hash(ledger, 16) == rec["ledger_hash"] and ledger["profile"] == profile
             assert ledger["split"] == rec["split"] == "dev"
             for label, m in rec["models"].items():
