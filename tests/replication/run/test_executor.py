@@ -107,6 +107,19 @@ def _children(pid):
     return out
 
 
+def _workers(pid) -> list[int]:
+    """The process pool's workers among `pid`'s children; a child that exits while it is read (a short-lived
+    helper) is not one."""
+    out = []
+    for c in _children(pid):
+        try:
+            if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes():
+                out.append(c)
+        except OSError:
+            continue
+    return out
+
+
 def _running(pid) -> bool:
     try:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
@@ -122,13 +135,15 @@ def test_workers_exit_when_their_driver_is_killed(tmp_path):
     cmd = [sys.executable, "-m", "replication.cli", "run", "--profile", "smoke", "--claims", "dp_loss,appendix_b",
            "--frameworks", "jax", "--jobs", "2", "--quiet", "--out", str(out)]
     driver = subprocess.Popen(cmd, start_new_session=True)
-    deadline, workers = time.time() + 120, []
-    while time.time() < deadline and len(workers) < 2 and driver.poll() is None:
-        workers = [c for c in _children(driver.pid) if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
-        time.sleep(0.05)
-    assert len(workers) == 2, "the driver's two workers never started"
-    driver.kill()
-    driver.wait()
+    try:
+        deadline, workers = time.time() + 120, []
+        while time.time() < deadline and len(workers) < 2 and driver.poll() is None:
+            workers = _workers(driver.pid)
+            time.sleep(0.05)
+        assert len(workers) == 2, "the driver's two workers never started"
+    finally:   # the driver never outlives the test, whatever it asserts
+        driver.kill()
+        driver.wait()
     deadline = time.time() + 60
     while time.time() < deadline and any(_running(w) for w in workers):
         time.sleep(0.1)
@@ -152,7 +167,7 @@ def test_a_dead_worker_loses_only_its_chain(tmp_path):
     def kill_first_worker():
         deadline = time.time() + 120
         while time.time() < deadline:
-            workers = [c for c in _children(os.getpid()) if b"spawn_main" in Path(f"/proc/{c}/cmdline").read_bytes()]
+            workers = _workers(os.getpid())
             if workers:
                 time.sleep(1.0)   # it holds its first chain from the start; importing JAX alone takes longer
                 os.kill(workers[0], signal.SIGKILL)
