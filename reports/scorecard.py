@@ -189,10 +189,11 @@ def scorecard_section(res: Results) -> Section:
     s.add(Para("One line per paper claim, then one per check (checks test the implementation and the numerics "
                "and are not counted among the claims). The verdict is recomputed from the unit files by the "
                "runner's own rule (replication/claims/verdicts.py): each claim is decided on the models as the "
-               "paper specified them, part by part; a part whose models are below their competence bar (held-out "
-               "error at most a set fraction of a null predictor's, rollouts that do not diverge), or whose "
-               "positive control did not learn, is 'inconclusive'; an ordering holds only if it holds for every "
-               "pair of seeds (the interval shown). 'partly' means only: the named parts reproduced, the others "
+               "paper specified them, part by part; a part whose models are below their competence bar on any "
+               "seed (held-out error at most a set fraction of a null predictor's, rollouts that do not diverge), "
+               "or whose positive control did not learn, is 'inconclusive'; an ordering holds only if it holds "
+               "over the 90 % confidence interval of the ratio over seeds (the interval shown: Welch's t on log "
+               "ratios, wider with fewer seeds; the range over seed pairs beside it describes). 'partly' means only: the named parts reproduced, the others "
                "did not. Frameworks that disagree on a part make it 'inconclusive' and are listed below as a "
                "defect. A published number is 'like for like' only when it is the same kind of number "
                "(training loss, held-out error, energy error) measured under the same conditions; otherwise it "
@@ -225,8 +226,8 @@ def scorecard_appendix(res: Results) -> Section:
         parts = all_parts_table(res, kind)
         if parts is not None:
             s.add(Table(title, parts, ["summary/verdicts.json", "units/*/*/*/seed*/result.json"],
-                        note="Each part is decided per framework on the interval shown (point [low, high] over "
-                             "seeds or seed pairs)."))
+                        note="Each part is decided per framework on the interval shown (point [low, high], its "
+                             "confidence level and method; a bound reads the range over seeds)."))
     why = reasons_table(res)
     if why is not None:
         s.add(Table("Reasons in full (parts not reproduced)", why, ["summary/verdicts.json"]))

@@ -47,10 +47,13 @@ def published_entry(claim: dict, model: str) -> dict | None:
 
 
 def like_for_like(p: dict, units) -> tuple[bool, str]:
-    """`Published.like_for_like` against every unit's recorded evaluation config (all must match)."""
+    """`Published.like_for_like` against every unit's recorded evaluation config, widths and training samples
+    (all must match)."""
     pub = Published.from_dict(p)
     for u in units or [None]:
-        same, why = pub.like_for_like(u.result.get("eval_config") if u is not None else {})
+        r = u.result if u is not None else {}
+        same, why = pub.like_for_like(r.get("eval_config"), (r.get("model_spec") or {}).get("hidden"),
+                                      r.get("train_samples"))
         if not same:
             return False, why
     return True, ""

@@ -55,7 +55,8 @@ class ModelEntry:
     for this model (another data recipe, task, loss, learning rate, pool size...), optionally per
     profile as {profile: {...}}; `profile_spec` adds ModelSpec fields in one profile only, as
     {profile: {field: value}}; `train=False` marks a model evaluated without training; `profiles` limits
-    the profiles the model runs in."""
+    the profiles the model runs in; `tuned_as` names the model whose adopted tuning it takes (a positive
+    control: the same model on other data, tuned exactly as the model it vouches for)."""
 
     label: str
     spec: dict
@@ -64,6 +65,7 @@ class ModelEntry:
     train: bool = True
     profiles: tuple = PROFILES   # the profiles this model runs in
     profile_spec: dict = field(default_factory=dict)
+    tuned_as: str = ""
 
     def spec_fields(self, profile: str) -> dict:
         return {**self.spec, **per_profile(self.profile_spec, profile, {})}

@@ -29,7 +29,7 @@ CLAIM = Claim(
                                 "computed-torque control at 500 Hz",
     published={},
     verdict_rule="delan / ff < 1 in tracking MSE on unseen references and on the training family twice as fast "
-                 "(a part each), for every pair of seeds",
+                 "(a part each), over the 90 % interval of the seeds",
     parts=(Part("unseen references", better_by("delan", "ff", 1.0, METRIC), reads=("delan", "ff")),
            Part("references twice as fast", better_by("delan", "ff", 1.0, "tracking_mse_train_x2"),
                 reads=("delan", "ff"))),

@@ -3,8 +3,9 @@
 `fingerprint(claim, profile) -> dict`: everything that decides the claim's numbers and its verdict under
 the profile: the frameworks it is decided in (the profile's), per model that runs, its model spec fields,
 widths and protocol; the evaluation config; the
-seed count; the competence bars; the parts (the models they read and control, their rule and the rule's
-parameters); the variants; the metric.
+seed count; the competence bars; the parts (the models they read and control, their rule, the rule's
+parameters and a hash of the rule's code with every rule and statistics function it reaches); the
+variants; the metric.
 `protocol_hash(claim, profile) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its canonical JSON).
 `registrations()`: the committed records (`registrations.json`): {claim id: [line, ...]} oldest first, a
 line {"profile", "protocol_hash", "frozen" (the date it was frozen), "tuned_on" (the split its choices
@@ -19,23 +20,65 @@ current protocol matches none (nothing else changes).
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 from datetime import date
 from functools import lru_cache
 from pathlib import Path
 
+from replication.claims import bars, stats
 from replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
 from replication.training.protocol import canonical_hash
 
 FILE = Path(__file__).with_name("registrations.json")
 _SIMPLE = (str, int, float, bool, tuple, type(None))
+_RULE_MODULES = ("replication.claims.rules", "replication.claims.stats")
+
+
+def _code(fn, seen: set) -> list:
+    """The source of a function and of every function it closes over or calls by a module-level name in
+    the rule and statistics modules (the comparison code of a rule), each once, in a stable order."""
+    if id(fn) in seen or not callable(fn):
+        return []
+    seen.add(id(fn))
+    code = getattr(fn, "__code__", None)
+    if code is None:
+        return [repr(fn)]
+    try:
+        text = inspect.getsource(fn)
+    except (OSError, TypeError):
+        text = code.co_code.hex()
+    out = [f"{fn.__module__}.{fn.__qualname__}:\n{text}"]
+    for c in getattr(fn, "__closure__", None) or ():
+        v = c.cell_contents
+        if inspect.isfunction(v):
+            out += _code(v, seen)
+    glob = getattr(fn, "__globals__", {})
+    for name in code.co_names:
+        g = glob.get(name)
+        if inspect.isfunction(g) and g.__module__ in _RULE_MODULES:
+            out += _code(g, seen)
+        elif inspect.isclass(g) and g.__module__ in _RULE_MODULES:
+            try:
+                out.append(f"{g.__module__}.{g.__qualname__}:\n{inspect.getsource(g)}")
+            except (OSError, TypeError):
+                pass
+    return out
+
+
+def _constants() -> dict:
+    """The module constants the rules read (the interval's level)."""
+    return {"stats.LEVEL": stats.LEVEL}
 
 
 def _rule(rule) -> dict:
-    """A part's rule by name and the plain values it closes over (its models, metric and thresholds)."""
+    """A part's rule: its name, the plain values it closes over (its models, metric and thresholds), and a
+    hash of its code and of every rule or statistics function it reaches, so that any change to how a rule
+    compares is a new protocol."""
     cells = [c.cell_contents for c in (getattr(rule, "__closure__", None) or ())]
     return {"rule": getattr(rule, "__qualname__", repr(rule)),
-            "params": [repr(v) for v in cells if isinstance(v, _SIMPLE)]}
+            "params": [repr(v) for v in cells if isinstance(v, _SIMPLE)],
+            "code": canonical_hash({"sources": _code(rule, set()), "constants": _constants()}, 16)}
 
 
 def fingerprint(claim, profile: str) -> dict:
@@ -46,6 +89,7 @@ def fingerprint(claim, profile: str) -> dict:
     return {"claim": claim.id, "profile": profile, "frameworks": list(PROFILE_FRAMEWORKS[profile]), "models": models,
             "eval": claim.evaluation_config(profile),
             "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
+            "bars_code": canonical_hash({"source": inspect.getsource(bars), "share": bars.SHARE}, 16),
             "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],
             "variants": [v.describe() for v in claim.variants]}
 

@@ -3,21 +3,24 @@
 A rule is a function of ``v = {model label: {metric: Stat}}`` (one framework; every model it reads has
 passed its competence bar, see ``bars.py``) returning an ``Outcome``: a part's verdict ("reproduced",
 "not reproduced", "inconclusive" or "not run"; never "partly", which only a claim of several parts can
-be), its reason, the interval the decision read, and the verdict at half and at twice the suite's own
-threshold (``sensitivity``). Orderings read the interval over seeds (``stats.ratio_interval``: every
-pair of seeds), so a verdict holds for every seed of both models, and an interval across the threshold
-is "inconclusive" (noise decides).
+be), its reason, the interval the decision read, the threshold(s) it was read against with the distance
+of the interval's nearer end from them (``distance``, a factor >= 1), and the verdict at half and at twice
+the suite's own threshold (``sensitivity``). Orderings and similarities read the confidence interval of a
+ratio over seeds (``stats.ratio_interval``, at ``stats.LEVEL``: it widens as seeds fall, and one seed a
+model decides nothing), and an interval across the threshold is "inconclusive" (noise decides). "Every
+seed pair" below means: the whole interval.
 
-- ``better_by(a, b, factor, metric)``: reproduced if a / b < 1 / factor over every seed pair; not
-  reproduced if a / b >= 1 / factor over every pair (b lower, or a lower by less than the factor).
+- ``better_by(a, b, factor, metric)``: reproduced if a / b < 1 / factor over the interval; not
+  reproduced if a / b >= 1 / factor over it (b lower, or a lower by less than the factor).
 - ``sooner(a, b, metric)``: ``better_by(a, b, 1, metric)`` on times to reach a level per seed (+inf if never),
   but "inconclusive" where no seed of either got there (two that never arrive say nothing of which is sooner).
-- ``similar(a, b, within, metric)``: a / b inside [1 / within, within] over every pair (not reproduced:
-  wholly outside).
+- ``similar(a, b, within, metric)``: a / b inside [1 / within, within] over the interval (not reproduced:
+  wholly outside, and the reason says which model is the lower); its sensitivity reads sqrt(within) and
+  within^2 (half and twice the tolerance in log).
 - ``matched_better_by(a, b, factor, metric, level, within)``: ``better_by`` on two models read at matched
   accuracy: decided only if their ``level`` metric (the held-out error where each was read) is within a
-  factor ``within`` of each other for every seed pair, else "inconclusive" (the accuracies differ).
-- ``fails(bad, goods, factor, metric)``: bad / good > factor over every pair, for every good.
+  factor ``within`` of each other over the interval, else "inconclusive" (the accuracies differ).
+- ``fails(bad, goods, factor, metric)``: bad / good > factor over the interval, for every good.
 - ``below_null(metric, fraction, model)``: the model's metric at most fraction x the null predictor's.
 - ``bound(metric, upper=, lower=, models=)``: every seed of the models inside the bounds (exact results,
   tolerances; no ordering, no threshold of ours to vary).
@@ -47,10 +50,23 @@ class Outcome:
     reason: str
     interval: Interval | None = None
     sensitivity: dict = field(default_factory=dict)   # e.g. {"factor 1.5": "reproduced", "factor 6": ...}
+    thresholds: tuple = ()   # the value(s) the interval was read against
 
     def __post_init__(self):
         if self.verdict not in PART_VERDICTS:
             raise ValueError(f"a part's verdict is one of {PART_VERDICTS}, not {self.verdict!r}")
+
+    @property
+    def distance(self) -> float | None:
+        """The factor (>= 1) between the interval's nearer end and the nearest threshold: how far the
+        decision is from its edge (inf: an unbounded interval; None: no threshold read)."""
+        iv = self.interval
+        if iv is None or not self.thresholds:
+            return None
+        ends = [x for x in (iv.lo, iv.hi) if 0 < x < math.inf]
+        if not ends:
+            return math.inf
+        return min(max(e / t, t / e) for e in ends for t in self.thresholds if t > 0)
 
 
 def _get(v, label, metric):
@@ -68,10 +84,11 @@ def _below(iv: Interval, t: float) -> str:
 
 
 def _ratio_rule(a: str, b: str, metric: str, at, t: float, label: str, why: dict, what: str = "",
-                names: tuple = ()):
-    """A rule on the interval of a / b over seed pairs (``what`` names it; ``names`` the two sides in the
-    reason): ``at(interval, t)`` decides, and is also read at t / 2 and 2 t (the sensitivity); ``why`` words
-    each verdict."""
+                names: tuple = (), edges=lambda t: (t,), varied=lambda t: (t / 2, t * 2)):
+    """A rule on the confidence interval of a / b over seeds (``what`` names it; ``names`` the two sides in
+    the reason): ``at(interval, t)`` decides, and is also read at ``varied(t)`` (the sensitivity: half and
+    twice by default); ``why`` words each verdict (a callable of the interval, or a string); ``edges(t)``
+    are the thresholds the interval is read against."""
     shown = names or (a, b)
 
     def rule(v):
@@ -80,16 +97,17 @@ def _ratio_rule(a: str, b: str, metric: str, at, t: float, label: str, why: dict
         x, y = _get(v, a, metric), _get(v, b, metric)
         iv = ratio_interval(x, y, what or f"{a}/{b}")
         verdict = at(iv, t)
-        return Outcome(verdict, f"{shown[0]} {x} vs {shown[1]} {y}; {iv}: {why[verdict]}", iv,
-                       {f"{label} {t / 2:g}": at(iv, t / 2), f"{label} {t * 2:g}": at(iv, t * 2)})
+        text = why[verdict](iv) if callable(why[verdict]) else why[verdict]
+        return Outcome(verdict, f"{shown[0]} {x} vs {shown[1]} {y}; {iv}: {text}", iv,
+                       {f"{label} {w:g}": at(iv, w) for w in varied(t)}, edges(t))
     return rule
 
 
 def better_by(a: str, b: str, factor: float, metric: str):
     return _ratio_rule(a, b, metric, lambda iv, f: _below(iv, 1.0 / f), factor, "factor",
-                       {"reproduced": f"below 1/{factor:g} for every seed pair",
-                        "not reproduced": f"not below 1/{factor:g} for any seed pair",
-                        "inconclusive": f"across 1/{factor:g}: the seeds disagree"})
+                       {"reproduced": f"below 1/{factor:g} over the interval",
+                        "not reproduced": f"not below 1/{factor:g} anywhere in the interval",
+                        "inconclusive": f"across 1/{factor:g}: the seeds cannot tell"}, edges=lambda f: (1.0 / f,))
 
 
 def sooner(a: str, b: str, metric: str):
@@ -111,10 +129,15 @@ def similar(a: str, b: str, within: float, metric: str):
         if iv.hi < 1 / w or iv.lo > w:
             return "not reproduced"
         return "inconclusive"
+    def outside(iv):
+        lower = a if iv.hi < 1 else b
+        return (f"outside [1/{within:g}, {within:g}] over the interval: {lower} is lower by more than "
+                f"{within:g}x, a difference the claim of similarity does not make")
     return _ratio_rule(a, b, metric, at, within, "within",
-                       {"reproduced": f"inside [1/{within:g}, {within:g}] for every seed pair",
-                        "not reproduced": f"outside [1/{within:g}, {within:g}] for every seed pair",
-                        "inconclusive": f"across the edge of [1/{within:g}, {within:g}]"})
+                       {"reproduced": f"inside [1/{within:g}, {within:g}] over the interval",
+                        "not reproduced": outside,
+                        "inconclusive": f"across the edge of [1/{within:g}, {within:g}]"},
+                       edges=lambda w: (1.0 / w, w), varied=lambda w: (w ** 0.5, w ** 2))
 
 
 def matched_better_by(a: str, b: str, factor: float, metric: str, level: str, within: float):
@@ -129,7 +152,7 @@ def matched_better_by(a: str, b: str, factor: float, metric: str, level: str, wi
                            m.interval)
         out = ordered(v)
         return Outcome(out.verdict, f"at matched {level} ({m.interval}), {metric} by {factor:g}: {out.reason}",
-                       out.interval, out.sensitivity)
+                       out.interval, out.sensitivity, out.thresholds)
     return rule
 
 
@@ -150,11 +173,12 @@ def fails(bad: str, goods: tuple, factor: float, metric: str):
         verdict = at(ivs, factor)
         text = f"{bad} {x}; " + ", ".join(f"{g} {_get(v, g, metric)}" for g in goods)
         text += "; " + "; ".join(map(str, ivs))
-        why = {"reproduced": f"above {factor:g} for every seed pair",
-               "not reproduced": f"at most {factor:g} for every seed pair of some model",
+        why = {"reproduced": f"above {factor:g} over every interval",
+               "not reproduced": f"at most {factor:g} over the interval of some model",
                "inconclusive": f"across {factor:g}"}[verdict]
         return Outcome(verdict, f"{text}: {why}", min(ivs, key=lambda iv: iv.lo),
-                       {f"factor {factor / 2:g}": at(ivs, factor / 2), f"factor {factor * 2:g}": at(ivs, factor * 2)})
+                       {f"factor {factor / 2:g}": at(ivs, factor / 2), f"factor {factor * 2:g}": at(ivs, factor * 2)},
+                       (factor,))
     return rule
 
 
@@ -166,7 +190,11 @@ def bound(metric: str, *, upper: float | None = None, lower: float | None = None
         hi, lo = max(s.hi for s in vals.values()), min(s.lo for s in vals.values())
         over = upper is not None and not hi <= upper
         under = lower is not None and not lo > lower
-        iv = Interval(metric, sum(s.mean for s in vals.values()) / len(vals), lo, hi, "range over seeds")
+        iv = Interval(metric, sum(s.mean for s in vals.values()) / len(vals), lo, hi,
+                      "range over seeds (every seed inside the bounds)", None,
+                      tuple(s.n + s.dropped for s in vals.values()))
+        if any(s.dropped for s in vals.values()):
+            return Outcome("inconclusive", f"{metric}: a seed's value is NaN", iv)
         text = f"{metric} in [{lo:.3g}, {hi:.3g}] over {', '.join(vals)}"
         if over or under:
             return Outcome("not reproduced", text + (f", above {upper:g}" if over else "")
@@ -178,12 +206,12 @@ def bound(metric: str, *, upper: float | None = None, lower: float | None = None
 
 def below_null(metric: str, fraction: float, model: str):
     """``model``'s metric at most ``fraction`` x the null predictor's (``null_<metric>``, recorded beside it),
-    for every pair of seeds: a statement that the null predictor itself fails."""
+    over the interval: a statement that the null predictor itself fails."""
     null = f"{model} null"
     rule = _ratio_rule(model, null, metric, _below, fraction, "fraction",
                        {"reproduced": f"below {fraction:g}", "not reproduced": f"not below {fraction:g}",
                         "inconclusive": f"across {fraction:g}"}, what=f"{model} {metric}/null",
-                       names=(f"{model} {metric}", "the null's"))
+                       names=(f"{model} {metric}", "the null's"), edges=lambda f: (f,))
 
     def with_null(v):
         if (m := _missing(v, (model,), f"null_{metric}")) is not None:
@@ -218,7 +246,8 @@ def faster(ours: str, other: str, rivals: int, pace: str = "samples_to_leave", a
         why = {"reproduced": f"{ours} faster", "not reproduced": f"{other} faster",
                "inconclusive": "no difference at this level (too few seeds to tell, or none)"}[verdict]
         return Outcome(verdict, f"{text}; {iv}: {why}", iv,
-                       {f"alpha {alpha / 2:g}": at(x, y, alpha / 2)[1], f"alpha {alpha * 2:g}": at(x, y, alpha * 2)[1]})
+                       {f"alpha {alpha / 2:g}": at(x, y, alpha / 2)[1], f"alpha {alpha * 2:g}": at(x, y, alpha * 2)[1]},
+                       (1.0,))
     return rule
 
 
@@ -231,7 +260,7 @@ def never(bad: str, pace: str = "samples_to_leave"):
         vals = _get(v, bad, pace).values
         k = sum(math.isfinite(x) for x in vals)
         lo, hi = wilson(k, len(vals))
-        iv = Interval(f"{bad} share that got there", k / len(vals), lo, hi, "Wilson 95 %")
+        iv = Interval(f"{bad} share that got there", k / len(vals), lo, hi, "Wilson 95 %", 0.95, (len(vals),))
         if k:
             return Outcome("not reproduced", f"{bad} got there in {_share(vals)}: it can learn", iv)
         return Outcome("reproduced", f"{bad} got there in {_share(vals)}: never, within the budget", iv)

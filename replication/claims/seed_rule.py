@@ -1,34 +1,43 @@
 """How many test seeds a claim runs, fixed by a stated rule before its test run (and so registered with it).
 
-A claim whose rule reads each seed as a replication ("for every pair of seeds": the seed range of each
-model) decides on that range. The range [min, max] of n independent seeds covers a model's median over
-seeds with probability 1 - 2^(1 - n) (`median_coverage`): 50 % at 2 seeds, 75 % at 3, 93.75 % at 5. Profiles
-of record (`full`, `paper`) run at least `RECORD_SEEDS` (coverage at least `RECORD_COVERAGE`); `quick` runs
-`PRELIMINARY_SEEDS`, a preliminary profile its report says is one; `smoke` decides nothing. A pooled claim (a pace study)
+A claim whose rule reads each seed as a replication decides on the confidence interval of a ratio of two
+models' metric at `stats.LEVEL` (Welch's t on log ratios: `stats.ratio_interval`). With n seeds a model its
+half-width is `halfwidth(n)` = t(0.5 + LEVEL / 2, 2n - 2) x sqrt(2 / n) standard deviations of a seed's log
+metric (equal spreads; Welch's degrees of freedom are at most 2n - 2, so the true interval is at least this
+wide): 2.92 at 2 seeds, 1.74 at 3, 1.18 at 5. Profiles of record (`full`, `paper`) run the fewest seeds whose
+half-width is at most `RECORD_HALFWIDTH` (1.25: a difference of about one and a quarter seed spreads can be
+decided), `RECORD_SEEDS` = 5; `quick` runs `PRELIMINARY_SEEDS`, a preliminary profile its report says is one
+(its interval is wider, so it decides less, never more); `smoke` decides nothing. A pooled claim (a pace study)
 reads its seeds as one sample: it runs at least `stats.seeds_needed(0.05, rivals)` in every profile that
 decides. A check (an implementation or numerics check) needs no count of its own.
 `describe(claim, profile) -> str`: the rule and what the count gives, for claims.json and the report.
 """
 from __future__ import annotations
 
-from replication.claims.stats import seeds_needed
+import math
+
+from scipy.stats import t as student_t
+
+from replication.claims.stats import LEVEL, seeds_needed
 
 RECORD_PROFILES = ("full", "paper")
-RECORD_COVERAGE = 0.9
+RECORD_HALFWIDTH = 1.25
 PRELIMINARY = ("quick",)
-# the preliminary profile's seeds a model: 2, so that `quick` fits its 45 minutes on 2 cores; their range
-# covers a model's median with probability 50 % (its report says it is preliminary)
+# the preliminary profile's seeds a model: 2, so that `quick` fits its 45 minutes on 2 cores; its intervals
+# are then 2.5 times wider than at 5 seeds (its report says it is preliminary)
 PRELIMINARY_SEEDS = 2
 
 
-def median_coverage(n: int) -> float:
-    """The probability that the range of n independent draws covers their distribution's median."""
-    return 1.0 - 2.0 ** (1 - n) if n >= 1 else 0.0
+def halfwidth(n: int, level: float = LEVEL) -> float:
+    """The interval's half-width in seed standard deviations of the log metric, n seeds a model (inf below 2)."""
+    if n < 2:
+        return math.inf
+    return float(student_t.ppf(0.5 + level / 2, 2 * n - 2)) * math.sqrt(2 / n)
 
 
-def record_seeds(coverage: float = RECORD_COVERAGE) -> int:
-    n = 1
-    while median_coverage(n) < coverage:
+def record_seeds(limit: float = RECORD_HALFWIDTH) -> int:
+    n = 2
+    while halfwidth(n) > limit:
         n += 1
     return n
 
@@ -59,6 +68,6 @@ def describe(claim, profile: str) -> str:
         return (f"{n} seeds, pooled: at least {required(claim, profile)} so that a complete separation reaches "
                 f"p < 0.05 / {rivals(claim)} rivals with a 10x margin")
     kind = "preliminary" if profile in PRELIMINARY else "of record" if profile in RECORD_PROFILES else "other"
-    return (f"{n} seeds ({kind}): a model's seed range covers its median with probability "
-            f"{100 * median_coverage(n):.4g} %" + (f" (at least {100 * RECORD_COVERAGE:g} % of record)"
-                                                   if profile in RECORD_PROFILES else ""))
+    return (f"{n} seeds ({kind}): the {100 * LEVEL:g} % interval of a ratio spans +-{halfwidth(n):.3g} seed "
+            f"standard deviations" + (f" (at most {RECORD_HALFWIDTH:g} of record)" if profile in RECORD_PROFILES
+                                      else ""))

@@ -1,9 +1,14 @@
 """The statistics the verdict rules read: a metric over seeds, and the intervals of a comparison.
 
-- ``Stat``: a metric's values over seeds (+inf = a diverged rollout, never NaN).
-- ``ratio_interval(a, b)``: mean(a) / mean(b) with the exact range of a_i / b_j over every pair of seeds
-  (the seeds of two models are independent runs, so no pairing is privileged; with 3 seeds a model the
-  range holds 9 ratios). An ordering read on this interval holds for every seed of both models.
+- ``Stat``: a metric's values over seeds (+inf = a diverged rollout; a NaN or missing seed is counted in
+  ``dropped``, never silently lost).
+- ``ratio_interval(a, b, level)``: the ratio of two models' metric (their seeds are independent runs) with
+  its two-sided confidence interval at ``level`` (``LEVEL``, 90 %: each side a one-sided 5 % test). With
+  every value finite and positive, Welch's t interval on log10(a) - log10(b) (errors and times spread
+  multiplicatively; the t quantile and 1/sqrt(n) widen it as seeds fall, and one seed a model gives none);
+  with a diverged (+inf) or zero value, the exact rank interval (``hodges_lehmann``, +inf ranking last),
+  which at 2 seeds a model is unbounded; a NaN seed gives no interval. The range of a_i / b_j over every
+  seed pair is kept beside it as a description (``range_lo``, ``range_hi``), never decided on.
 - ``hodges_lehmann(x, y)``: the shift of log10(x) against log10(y) (the median of every pairwise
   difference; +inf for a run that never got there, two such runs tie) with its exact distribution-free
   interval from the Mann-Whitney U distribution (Lehmann 1975, ch. 2): the k-th smallest and largest
@@ -14,22 +19,30 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
+
+from scipy.stats import t as student_t
+
+# the two-sided confidence of every interval an ordering or a similarity is decided on
+LEVEL = 0.90
 
 
 @dataclass(frozen=True)
 class Stat:
-    """A metric's values over seeds (+inf = diverged). ``mean`` is +inf if any value is."""
+    """A metric's values over seeds (+inf = diverged), and how many seeds had none (NaN or missing).
+    ``mean`` is +inf if any value is."""
 
     values: tuple
+    dropped: int = 0
 
     @classmethod
     def of(cls, values) -> Stat:
-        vs = tuple(float(x) for x in values if x is not None and not math.isnan(float(x)))
+        vals = list(values)
+        vs = tuple(float(x) for x in vals if x is not None and not math.isnan(float(x)))
         if not vs:
             raise ValueError("Stat.of: no finite or infinite value (all missing or NaN)")
-        return cls(vs)
+        return cls(vs, len(vals) - len(vs))
 
     @property
     def n(self) -> int:
@@ -57,7 +70,8 @@ class Stat:
         return max(self.values)
 
     def __format__(self, spec) -> str:
-        return f"{self.mean:.3g}" if self.n == 1 else f"{self.mean:.3g} [{self.lo:.3g}, {self.hi:.3g}]"
+        text = f"{self.mean:.3g}" if self.n == 1 else f"{self.mean:.3g} [{self.lo:.3g}, {self.hi:.3g}]"
+        return text + (f" ({self.dropped} NaN seed{'s' if self.dropped > 1 else ''})" if self.dropped else "")
 
 
 def separated(a: Stat, b: Stat) -> bool:
@@ -76,25 +90,59 @@ def _ratio(x: float, y: float) -> float:
 
 @dataclass(frozen=True)
 class Interval:
-    """A point estimate with its interval, and how the interval was made."""
+    """A point estimate with its interval, its two-sided confidence ``level`` (None: a plain range, not a
+    confidence interval), the seeds it rests on, the range over seed pairs it describes, and how it was made."""
 
     what: str
     point: float
     lo: float
     hi: float
     method: str
+    level: float | None = None
+    seeds: tuple = ()                       # the seed count of each side
+    seed_range: tuple = field(default=())   # (lo, hi) of the value over every seed (pair), a description
 
     def to_dict(self) -> dict:
-        return {"what": self.what, "point": self.point, "lo": self.lo, "hi": self.hi, "method": self.method}
+        d = {"what": self.what, "point": self.point, "lo": self.lo, "hi": self.hi, "method": self.method,
+             "level": self.level, "seeds": list(self.seeds)}
+        if self.seed_range:
+            d["range_lo"], d["range_hi"] = self.seed_range
+        return d
 
     def __str__(self) -> str:
-        return f"{self.what} {self.point:.3g} [{self.lo:.3g}, {self.hi:.3g}] ({self.method})"
+        rng = f"; seed pairs {self.seed_range[0]:.3g}-{self.seed_range[1]:.3g}" if self.seed_range else ""
+        return f"{self.what} {self.point:.3g} [{self.lo:.3g}, {self.hi:.3g}] ({self.method}{rng})"
 
 
-def ratio_interval(a: Stat, b: Stat, what: str) -> Interval:
-    """mean(a) / mean(b) with the range of a_i / b_j over every pair of seeds."""
+def _log_t(a: tuple, b: tuple, level: float) -> tuple[float, float, float, float]:
+    """(point, lo, hi, df) of 10^(mean log10 a - mean log10 b) with Welch's t interval at ``level``."""
+    la, lb = [math.log10(x) for x in a], [math.log10(x) for x in b]
+    ma, mb = sum(la) / len(la), sum(lb) / len(lb)
+    va = sum((x - ma) ** 2 for x in la) / (len(la) - 1) / len(la)
+    vb = sum((x - mb) ** 2 for x in lb) / (len(lb) - 1) / len(lb)
+    d, se = ma - mb, math.sqrt(va + vb)
+    if se == 0:
+        return 10.0 ** d, 10.0 ** d, 10.0 ** d, math.inf
+    df = (va + vb) ** 2 / (va ** 2 / (len(la) - 1) + vb ** 2 / (len(lb) - 1))
+    half = float(student_t.ppf(0.5 + level / 2, df)) * se
+    return 10.0 ** d, 10.0 ** (d - half), 10.0 ** (d + half), df
+
+
+def ratio_interval(a: Stat, b: Stat, what: str, level: float = LEVEL) -> Interval:
+    """a over b with its confidence interval at ``level`` (the module docstring says which interval)."""
     pairs = [_ratio(x, y) for x in a.values for y in b.values]
-    return Interval(what, _ratio(a.mean, b.mean), min(pairs), max(pairs), f"range over all {len(pairs)} seed pairs")
+    rng, seeds = (min(pairs), max(pairs)), (a.n + a.dropped, b.n + b.dropped)
+    if a.dropped or b.dropped:
+        return Interval(what, _ratio(a.mean, b.mean), 0.0, math.inf, "no interval: a seed's value is NaN",
+                        level, seeds, rng)
+    if a.n < 2 or b.n < 2:
+        return Interval(what, _ratio(a.mean, b.mean), 0.0, math.inf, "no interval: one seed", level, seeds, rng)
+    if all(0 < x < math.inf for x in (*a.values, *b.values)):
+        point, lo, hi, df = _log_t(a.values, b.values, level)
+        how = f"Welch t on log ratios, df {df:.3g}" if math.isfinite(df) else "no spread over seeds"
+        return Interval(what, point, lo, hi, f"{100 * level:g} % interval, {how}", level, seeds, rng)
+    hl = hodges_lehmann(a.values, b.values, round(1 - level, 12), what)
+    return Interval(what, hl.point, hl.lo, hl.hi, hl.method + " (a diverged or zero seed)", level, seeds, rng)
 
 
 @cache
@@ -146,7 +194,8 @@ def hodges_lehmann(x, y, alpha: float, what: str) -> Interval:
     def ratio(s):
         return math.inf if s == math.inf else 0.0 if s == -math.inf else 10.0 ** s
     return Interval(what, ratio(mid) if math.isfinite(mid) or n else 1.0, ratio(lo), ratio(hi),
-                    f"Hodges-Lehmann, exact {100 * (1 - alpha):.3g} % interval" + ("" if k else ": too few seeds"))
+                    f"Hodges-Lehmann, exact {100 * (1 - alpha):.3g} % interval" + ("" if k else ": too few seeds"),
+                    1 - alpha, (len(x), len(y)))
 
 
 def seeds_needed(alpha: float, k: int, margin: float = 10.0) -> int:

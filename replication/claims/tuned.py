@@ -14,7 +14,8 @@ under a profile the claim is silent about (a model that runs there exactly as un
 claims), quick's choice, the search having run at that profile's budget too.
 A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices (under the profile
 whose protocol it trains with), so that their trainings stay one; a variant takes its paper model's choice
-(its departure is all that differs). Models and profiles without a record keep their registered
+(its departure is all that differs), and a positive control with `tuned_as` that of the model it vouches
+for. Models and profiles without a record keep their registered
 (hand-chosen) setting.
 `tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
 configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
@@ -70,7 +71,10 @@ def _record(claim_id: str, profile: str) -> tuple[dict | None, dict]:
 
 def _chosen(claim, rec: dict | None, names: dict, label: str) -> dict | None:
     """The record's choice for a model: a variant (a departure from the paper) takes its paper model's, so
-    that the departure is all that tells them apart."""
+    that the departure is all that tells them apart; a model with `tuned_as` (a positive control) takes
+    that model's."""
+    entry = next((m for m in claim.models if m.label == label), None)
+    label = (entry.tuned_as if entry is not None and entry.tuned_as else label)
     paper = {variant: p for v in claim.variants for p, variant in v.replaces}.get(label, label)
     return (rec or {}).get("models", {}).get(names.get(paper, paper))
 

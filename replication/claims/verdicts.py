@@ -4,11 +4,15 @@
 one row per unit with claim, framework, model, seed, status, its metrics and ``final_train_loss``.
 Each part of the claim (``claims.parts``) is decided per framework, on the units whose status is "ok":
 
-1. a model the part reads (or controls) whose every unit failed makes the part "inconclusive" (failed
-   units never count; the reason names them); a model with no unit at all, "not run";
-2. the competence bars (``claims.bars``): a model the part reads below its bar -> "inconclusive", with
-   the numbers; a positive control below its bar -> "inconclusive" (a failure says nothing then);
-3. the part's rule (``claims.rules``) on the seed statistics, which reads an interval over seeds.
+1. a model the part reads (or controls) with a failed unit makes the part "inconclusive" (a failed seed is
+   a failing seed, never dropped; the reason names it); a model with no unit at all, "not run";
+2. the competence bars (``claims.bars``), seed by seed: a model the part reads below its bar (any seed
+   below it) -> "inconclusive", with every seed's number, and "inconclusive: budget" where the part says
+   what the original needed; a positive control below its bar -> "inconclusive" (a failure says nothing);
+3. the part's rule (``claims.rules``) on the seed statistics, which reads a confidence interval over seeds.
+
+Each model's competence is recorded per seed (``competence.<framework>.<model>.per_seed``), and each part's
+interval with its ``level``, ``seeds``, the thresholds it was read against and the distance to them.
 
 A part's frameworks combine by ``parts.combine_frameworks`` (decided verdicts that differ:
 "inconclusive", flagged "frameworks disagree"); the claim's verdict is ``parts.claim_verdict`` of its
@@ -37,6 +41,8 @@ def frame(records) -> pd.DataFrame:
     for d in records:
         rows.append({**{k: d.get(k) for k in KEYS}, "split": d.get("split") or "dev", "profile": d.get("profile"),
                      "train_time_s": d.get("train_time_s"), "train_samples_per_s": d.get("train_samples_per_s"),
+                     "train_samples": d.get("train_samples"),
+                     "width": "x".join(str(h) for h in ((d.get("model_spec") or {}).get("hidden") or ())),
                      "wall_time_s": d.get("wall_time_s"), "final_train_loss": d.get("final_train_loss"),
                      "failure": (d.get("failure") or {}).get("kind"),
                      **{k: v for k, v in (d.get("metrics") or {}).items()},
@@ -70,52 +76,84 @@ def _numeric(x):
 
 
 def model_stats(units: pd.DataFrame) -> dict:
-    """{model: {metric: Stat}} over the rows of ``units`` (one framework), numeric columns only."""
+    """{model: {metric: Stat}} over the rows of ``units`` (one framework), numeric columns only; a seed whose
+    value is NaN or missing where another seed has one is counted in the Stat's ``dropped``."""
     out = {}
-    skip = set(KEYS) | {"split", "profile", "failure"}
+    skip = set(KEYS) | {"split", "profile", "failure", "width"}
     for label, g in units.groupby("model", sort=False):
         stats = {}
         for col in g.columns:
             if col in skip:
                 continue
-            vals = [v for v in map(_numeric, g[col]) if v is not None]
-            if vals:
+            vals = list(map(_numeric, g[col]))
+            if any(v is not None for v in vals):   # a seed without the value is counted (Stat.dropped), never lost
                 stats[col] = Stat.of(vals)
         out[str(label)] = stats
     return out
 
 
-def _decide_part(part, v: dict, per: dict, failed: dict) -> Outcome:
+def seed_rows(units: pd.DataFrame) -> dict:
+    """{model: [row dict per seed, failed units included]} of one framework's rows, in seed order."""
+    return {str(m): [r for _, r in g.sort_values("seed").iterrows()]
+            for m, g in units.groupby("model", sort=False)} if len(units) else {}
+
+
+def _decide_part(part, v: dict, per: dict, failed: dict, rows: dict) -> Outcome:
     """One part's outcome in one framework: usable models, their bars, the positive controls, the rule."""
     needed = (*part.reads, *part.controls)
     gone = [m for m in needed if m in failed]
     if gone:
-        return Outcome("inconclusive", "no usable model: " + "; ".join(f"{m}: every unit failed ({failed[m]})"
-                                                                      for m in gone))
+        return Outcome("inconclusive", "a failed seed is a failing seed: "
+                       + "; ".join(f"{m}: {failed[m]}" for m in gone))
     missing = [m for m in needed if m not in v]
     if missing:
         return Outcome("not run", "missing " + ", ".join(missing))
     below = [per[m][1] for m in part.reads if m in per and not per[m][0]]
-    if below:
-        return Outcome("inconclusive", ("inconclusive: budget; " if part.budget else "")
-                       + "below the competence bar: " + "; ".join(below) + (f" ({part.budget})" if part.budget else ""))
     weak = [per[m][1] if m in per else f"{m}: no bar" for m in part.controls if not per.get(m, (False, ""))[0]]
+    if below and part.budget is not None:
+        return _budget(part, rows, per, weak, below)
+    if below:
+        return Outcome("inconclusive", "below the competence bar: " + "; ".join(below))
     if weak:
         return Outcome("inconclusive", "the positive control did not learn, so a failure says nothing: "
                        + "; ".join(weak))
     return part.rule(v)
 
 
+def _budget(part, rows: dict, per: dict, weak: list, below: list) -> Outcome:
+    """A part that says a paper model learns, with a model below its bar: "not reproduced" only when the
+    model failed on every seed with the original's widths, budget and enough seeds, and the controls
+    learned in the same pipeline (`parts.Budget`); else "inconclusive: pipeline" or ": budget"."""
+    b, m = part.budget, part.budget.model
+    text = "below the competence bar: " + "; ".join(below)
+    if weak:
+        return Outcome("inconclusive", "inconclusive: pipeline (the positive control did not learn: "
+                       + "; ".join(weak) + "); " + text)
+    seeds = per.get(m, (True, "", []))[2] or []
+    if m not in per or any(x["passed"] for x in seeds):
+        return Outcome("inconclusive", text)
+    samples = min((_numeric(r.get("train_samples")) or 0.0 for r in rows.get(m, [])), default=0.0)
+    widths = {str(r.get("width") or "") for r in rows.get(m, [])}
+    width = tuple(int(x) for x in widths.pop().split("x") if x) if len(widths) == 1 else ()
+    short = b.shortfall(width, samples, len(seeds))
+    if short:
+        return Outcome("inconclusive", f"inconclusive: budget ({'; '.join(short)}); {text}")
+    return Outcome("not reproduced", f"{m} learned on none of {len(seeds)} seeds with the original's widths and at "
+                   f"least its {b.samples:.3g} samples, its positive controls learning in the same pipeline; {text}")
+
+
 def _framework(claim, s: pd.DataFrame, labels) -> tuple[dict, dict, dict, int]:
     """({part: Outcome}, competence {label: (passed, why)}, stats, failed units) of one framework's rows."""
     ok = s[s["status"] == "ok"]
     bad = s[s["status"] != "ok"]
-    failed = {m: ", ".join(sorted({k for k in g.get("failure", ()) if isinstance(k, str)})) or "failed"
-              for m, g in bad.groupby("model") if m in labels and m not in set(ok["model"])}
+    failed = {m: f"{len(g)} of {len(s[s['model'] == m])} seeds failed ("
+              + (", ".join(sorted({k for k in g.get("failure", ()) if isinstance(k, str)})) or "no result") + ")"
+              for m, g in bad.groupby("model") if m in labels}
     v = model_stats(ok)
-    _, _, per = competence(claim.bars, v)
-    per.update(added_competence(claim.bars, v, {m.label for m in claim.models}))
-    return {p.name: _decide_part(p, v, per, failed) for p in _active(claim, labels)}, per, v, len(bad)
+    rows = seed_rows(s)
+    _, _, per = competence(claim.bars, rows)
+    per.update(added_competence(claim.bars, rows, {m.label for m in claim.models}))
+    return {p.name: _decide_part(p, v, per, failed, rows) for p in _active(claim, labels)}, per, v, len(bad)
 
 
 def _active(claim, labels) -> list:
@@ -131,7 +169,9 @@ def _parts(claim, per_fw: dict, labels) -> list:
         out.append({**part.describe(), "verdict": verdict, "flag": flag,
                     "by_framework": {fw: o.verdict for fw, o in res.items()},
                     "reason": {fw: o.reason for fw, o in res.items()},
-                    "interval": {fw: o.interval.to_dict() for fw, o in res.items() if o.interval is not None},
+                    "interval": {fw: {**o.interval.to_dict(), "thresholds": list(o.thresholds),
+                                      "distance": o.distance}
+                                 for fw, o in res.items() if o.interval is not None},
                     "sensitivity": {fw: dict(o.sensitivity) for fw, o in res.items() if o.sensitivity}})
     return out
 
@@ -167,6 +207,13 @@ def _variant(claim, var, sub: pd.DataFrame, labels) -> dict:
     return {**line, "verdict": verdict, "reason": why, "parts": parts, "by_framework": by_fw}
 
 
+def _seed(x):
+    try:
+        return int(x)
+    except (TypeError, ValueError):
+        return x
+
+
 def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
     """The claim's verdict from ``units`` (rows of any claims; see the module docstring)."""
     sub = units[units["claim"] == claim.id] if len(units) else units
@@ -186,7 +233,10 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
     for fw, (per, v, n_bad) in detail.items():
         if n_bad:
             entry["failed_units"][fw] = n_bad
-        entry["competence"][fw] = {m: {"passed": p, "why": w} for m, (p, w) in per.items()}
+        entry["competence"][fw] = {m: {"passed": p, "why": w,
+                                       "per_seed": [{"seed": _seed(x["seed"]), "passed": bool(x["passed"]),
+                                                     "value": x["value"], "why": x["why"]} for x in ps]}
+                                   for m, (p, w, ps) in per.items()}
         entry["values"][fw] = {m: {"mean": st[claim.metric].mean, "std": st[claim.metric].std,
                                    "n": st[claim.metric].n} for m, st in v.items() if claim.metric in st}
     verdict, why = claim_verdict(_counted(parts))

@@ -72,6 +72,9 @@ def energy_errors(E_pred, E_true, scale) -> dict:
             "energy_err_max": float(np.mean(mx)) if len(d) else nan,
             # the median over every trajectory (a diverged one counts as +inf): robust to one blown-up rollout
             "energy_err_final_median": float(np.median(final)) if len(d) else nan,
+            # the spread over initial conditions beside the median (a diverged one ranks last)
+            "energy_err_final_q25": float(np.quantile(final, 0.25, method="lower")) if len(d) else nan,
+            "energy_err_final_q75": float(np.quantile(final, 0.75, method="higher")) if len(d) else nan,
             "energy_err_final_finite": float(np.mean(final[ok])) if ok.any() else nan,
             "n_diverged": int(diverged.sum()),
             "n_trajectories": int(d.shape[0])}

@@ -13,11 +13,14 @@ floors). With `ctx.model` given (a fixed model: the null-model tests), that mode
 nothing learns: a zero model is PD alone, a diverging one diverges.
 
 Settings (`cfg`, the claim's evaluation config; defaults `DEFAULTS`, the study's): seconds, every, steps,
-batch, buffer, window, threshold, n_unseen, unseen_duration, and tail (the share of the run's last windows the
-competence bar reads).
+batch, buffer, window, threshold, sustain, n_unseen, unseen_duration, and tail (the share of the run's last
+windows the competence bar reads).
 
-Metrics: `t_reach_s` (the end of the first window whose tracking MSE is at most `threshold` x PD alone's in
-the same window; +inf: never), `t_settle_s` (the end of the first window from which every later one is at it;
+Metrics: `t_reach_s` (the sustained crossing: the end of the first window of the first run of consecutive
+windows whose tracking MSE is at most `threshold` x PD alone's in the same window, lasting at least `sustain`
+seconds, `online.sustain_start`; +inf: never, and a run the end of the run cuts short does not count),
+`t_first_cross_s` (the end of the first window at the threshold, however briefly; +inf: never; recorded, not
+decided), `t_settle_s` (the end of the first window from which every later one is at it;
 +inf: never), `first_window_mse`, `final_window_mse` and `null_final_window_mse` (PD alone's), `final_ratio_to_pd`,
 `tail_mse` and `null_tail_mse` (the mean window MSE over the last `tail` of the windows, at least one, and PD
 alone's over the same windows: the competence bar's, steadier than one window of a learner whose error still
@@ -43,10 +46,11 @@ from replication.studies import online as O
 from replication.training.objective import predict
 
 DEFAULTS = {"seconds": 30.0, "every": O.EVERY, "steps": O.STEPS, "batch": O.BATCH, "buffer": O.BUFFER,
-            "window": O.WINDOW, "threshold": O.THRESHOLD, "n_unseen": O.N_UNSEEN, "unseen_duration": C.DURATION,
-            "tail": 0.25}
+            "window": O.WINDOW, "threshold": O.THRESHOLD, "sustain": O.SUSTAIN, "n_unseen": O.N_UNSEEN,
+            "unseen_duration": C.DURATION, "tail": 0.25}
 LEARNERS = {"delan": "delan", "baseline": "ff"}   # model kind -> the online learner's kind
-SUMMARY = ("t_reach_s", "t_settle_s", "first_window_mse", "final_window_mse", "final_ratio_to_pd",
+TIMES = ("t_reach_s", "t_first_cross_s", "t_settle_s")   # NaN in the study's summary (never) -> +inf here
+SUMMARY = (*TIMES, "first_window_mse", "final_window_mse", "final_ratio_to_pd",
            "inference_us_mean", "learning_us_mean", "compute_us_mean", "compute_us_p99")
 
 
@@ -121,12 +125,12 @@ def eval_online(ctx) -> Evaluation:
                                       seed=int(ctx.seed), seconds=s["seconds"], progress=progress)
         scores = O.unseen(ctrl, s["n_unseen"], s["unseen_duration"], seed)
     w = _windows(windows, pd_w)
-    row = O.summary_row(w, ticks, s["threshold"], s["window"])
+    row = O.summary_row(w, ticks, s["threshold"], s["window"], s["sustain"])
     null = _pd_unseen(s["n_unseen"], s["unseen_duration"], seed)
     bad = scores["unseen_diverged"] > 0
     out = Evaluation()
     m = out.metrics
-    m.update({k: math.inf if k in ("t_reach_s", "t_settle_s") and math.isnan(row[k]) else row[k] for k in SUMMARY})
+    m.update({k: math.inf if k in TIMES and math.isnan(row[k]) else row[k] for k in SUMMARY})
     m["null_final_window_mse"] = float(pd_w["track_mse"].iloc[-1])
     tail = max(1, math.ceil(s["tail"] * len(w) - 1e-9))
     m["tail_mse"] = float(w["track_mse"].iloc[-tail:].mean())

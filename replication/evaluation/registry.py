@@ -16,7 +16,8 @@ from replication.fit.evaluate import eval_fit
 
 # 2: null-predictor metrics for the competence bars; diverged rollouts count as +inf in the energy means
 # 3: valid prediction time, the chaos floor's from a 1e-8 perturbation and the Lyapunov time (energy rollouts)
-EVALUATION_VERSION = 3
+# 4: an HNN on canonical (q, p) rolled out by its own H, its velocity dH/dp (energy and short rollouts)
+EVALUATION_VERSION = 4
 
 EVALUATIONS = {"heldout": eval_heldout, "heldout_trajectories": eval_heldout_trajectories, "pace": eval_pace,
                "energy_rollout": eval_energy_rollout, "wave": eval_wave,

@@ -18,6 +18,7 @@ import pandas as pd
 
 import systems
 import systems.trajectories
+from replication.evaluation.canonical import canonical_rollout
 from replication.evaluation.metrics import (
     bounded_relative_error,
     energy_errors,
@@ -176,13 +177,8 @@ def _float32_truth(name, params, cfg_items):
 
 def _model_rollout(ctx, s, q0, qd0, t):
     p, m, d = ctx.protocol, ctx.model, s.dof
-    if p.task == "hamiltonian" and p.data.coords == "qp":
-        p0 = s.canonical_momentum(q0, qd0, backend="numpy")
-        z = rollout(hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d),
-                    np.concatenate([q0, p0], 1), t, ctx.cfg["dt"])
-        q, pp = z[..., :d], z[..., d:]
-        Mq = s.mass_matrix(np.nan_to_num(q), backend="numpy")
-        qd = np.where(np.isfinite(pp), np.linalg.solve(Mq, np.nan_to_num(pp)[..., None])[..., 0], np.nan)
+    if p.task == "hamiltonian" and p.data.coords == "qp":   # in (q, p) by its own H; qdot = dH/dp
+        q, qd, _ = canonical_rollout(m.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
         return q, qd
     if p.task == "hamiltonian":
         f = hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d)

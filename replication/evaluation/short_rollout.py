@@ -5,13 +5,16 @@ The initial states (and any per-sample system input, e.g. the relativistic field
 system's declared distribution with the rollout seed of the unit's split. A per-sample input rides in
 the integrated state with rate 0, so the suite's RK4 (`replication.evaluation.rollout`) keeps it with its
 trajectory. Model and truth are integrated by the same RK4 (the truth at the exact equations of motion,
-at step `dt`); the model's q-double-dot is read as the verdict reads it (`qddot_of_prediction`). Adds
-`arrays.npz`: t, q_true, qdot_true, q_pred, qdot_pred (n_ics, n_t, d); nothing a verdict reads.
+at step `dt`); a model on (q, qdot) by its q-double-dot as the verdict reads it (`qddot_of_prediction`),
+an HNN on canonical (q, p) in (q, p) by its own H from the true initial momentum, its velocity dH/dp
+(`replication.evaluation.canonical`). Adds `arrays.npz`: t, q_true, qdot_true, q_pred, qdot_pred
+(n_ics, n_t, d); nothing a verdict reads.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from replication.evaluation.canonical import canonical_rollout
 from replication.evaluation.rollout import rollout
 from replication.evaluation.routines import Evaluation, eval_heldout, qddot_of_prediction, system_of
 from replication.training import data as datamod
@@ -47,7 +50,7 @@ def model_qddot(ctx, s, names):
 
     def accel(q, qdot, inputs):
         kw = {k: inputs[:, i] for i, k in enumerate(names)}
-        # the true q-double-dot is a placeholder: no target is read (an HNN on (q, p) reads the truth's dp/dqdot)
+        # the true q-double-dot is a placeholder: no target is read
         batch = datamod._with_coords(s, {"q": q, "qdot": qdot, **kw}, p, np.zeros_like(q),
                                      extra=inputs if names else None)
         return qddot_of_prediction(p, batch, predict(ctx.model, ctx.spec.kind, p.task, batch, np.concatenate))
@@ -73,7 +76,19 @@ def eval_heldout_trajectories(ctx) -> Evaluation:
         return s.acceleration(q, qdot, backend="numpy", **{k: inp[:, i] for i, k in enumerate(names)})
     with np.errstate(all="ignore"):
         zt = rollout(_field(admitted(s, truth), d, n_in), z0, t, cfg["dt"])
-        zp = rollout(_field(model_qddot(ctx, s, names), d, n_in), z0, t, cfg["dt"])
-    out.arrays = {"t": t, "q_true": zt[..., :d], "qdot_true": zt[..., d:2 * d],
-                  "q_pred": zp[..., :d], "qdot_pred": zp[..., d:2 * d]}
+        q, qdot = _model_rollout(ctx, s, q0, qd0, names, inputs, t)
+    out.arrays = {"t": t, "q_true": zt[..., :d], "qdot_true": zt[..., d:2 * d], "q_pred": q, "qdot_pred": qdot}
     return out
+
+
+def _model_rollout(ctx, s, q0, qd0, names, inputs, t):
+    """(q, qdot) (n_ics, n_t, d) of the trained model from (q0, qd0) and the per-sample system inputs."""
+    p, d = ctx.protocol, q0.shape[1]
+    if p.task == "hamiltonian" and p.data.coords == "qp":
+        q, qdot, _ = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"],
+                                       extra=np.concatenate(inputs, 1) if names else None,
+                                       momentum_kw={k: inputs[i][:, 0] for i, k in enumerate(names)})
+        return q, qdot
+    z0 = np.concatenate([q0, qd0, *inputs], 1)
+    zp = rollout(_field(model_qddot(ctx, s, names), d, len(names)), z0, t, ctx.cfg["dt"])
+    return zp[..., :d], zp[..., d:2 * d]

@@ -21,6 +21,7 @@ from replication.run import splits
 from replication.training import device as dev
 from replication.training import hessian_probe
 from replication.training.outcome import log_frame
+from replication.training.scouting import budget_samples
 from replication.training.train import train_cached
 
 
@@ -99,6 +100,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "evaluation_version": EVALUATION_VERSION, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
         "train_time_s": outcome.train_time_s if outcome else 0.0,
         "train_steps": outcome.steps_done if outcome else 0,
+        "train_samples": budget_samples(protocol) if outcome else 0,
         "train_samples_per_s": outcome.samples_per_s if outcome else None,
         "final_train_loss": outcome.log[-1]["loss"] if outcome and outcome.log else None,
         "scouting": outcome.scouting if outcome else None,

@@ -26,15 +26,18 @@ dynamics (no learning, framework "numpy", seed "-"), then each model x framework
 of the training family (`control.references("train", ...)`, generator seed `control.SEED`). A window's
 ratio_to_pd is its MSE over PD alone's in the same window (the same references at the same times). Summary,
 one row per controller, framework and seed: `threshold` (the stated bar: a window MSE at most `threshold` x
-PD alone's), t_reach_s (end of the first window at the bar; NaN: never), t_settle_s (end of the window from
-which every later window is at the bar), first/final window MSE and ratio, unseen_mse and its ratio to PD
-(the frozen final model tracking `n_unseen` references of the unseen family, `control.track`), compute per
-tick (mean, median and p99 of inference + learning, microseconds) and whether it fits the control period (mean,
-p99). The pieces claim 13 shares (`replication.evaluation.online_claim`): `ratio_to_pd(windows, pd_windows)`
-(each window's MSE over PD alone's in the window that starts at the same time), `summary_row(w, ticks,
-threshold, window)` (a controller's summary columns from its windows with their ratios; NaN: never) and
-`unseen(ctrl, n_unseen, duration, seed)` (the frozen controller on the unseen family's references of generator
-seed `seed`). `write_study(folder, ...)` writes FOLDER/curves.csv, summary.csv and setup.json (the settings, the
+PD alone's), `sustain` (seconds the bar must hold), t_reach_s (the sustained crossing: end of the first window
+of the first run of consecutive windows at the bar lasting `sustain` seconds, `sustain_start`; NaN: never),
+t_first_cross_s (end of the first window at the bar, however briefly; NaN: never), t_settle_s (end of the
+window from which every later window is at the bar), first/final window MSE and ratio, unseen_mse and its
+ratio to PD (the frozen final model tracking `n_unseen` references of the unseen family, `control.track`),
+compute per tick (mean, median and p99 of inference + learning, microseconds) and whether it fits the control
+period (mean, p99). The pieces claim 13 shares (`replication.evaluation.online_claim`): `ratio_to_pd(windows,
+pd_windows)` (each window's MSE over PD alone's in the window that starts at the same time), `summary_row(w,
+ticks, threshold, window, sustain)` (a controller's summary columns from its windows with their ratios; NaN:
+never), `at_bar`, `sustain_windows`, `sustain_start` (the sustained crossing's pieces) and `unseen(ctrl,
+n_unseen, duration, seed)` (the frozen controller on the unseen family's references of generator seed
+`seed`). `write_study(folder, ...)` writes FOLDER/curves.csv, summary.csv and setup.json (the settings, the
 threshold's definition and the threads the timings ran on: `one_thread()`).
 """
 from __future__ import annotations
@@ -50,14 +53,15 @@ from replication.studies import control as C
 WINDOW = 0.5        # seconds of simulated time per curve point
 EVERY, STEPS, BATCH, BUFFER = 1, 1, 64, 5000   # learn at every tick, one step of 64; 10 s of samples
 THRESHOLD = 0.1     # the bar: window MSE <= THRESHOLD x PD alone's in the same window
+SUSTAIN = 5.0       # seconds the bar must hold to count as reached: 10 windows, longer than one reference (4 s)
 N_UNSEEN = 8
 PERIOD_US = 1e6 / C.RATE
 KEY = ["controller", "framework", "seed"]
 CURVE_COLUMNS = [*KEY, "t_start", "track_mse", "ratio_to_pd", "n_diverged", "inference_us_per_tick",
                  "learning_us_per_tick", "steps"]
-SUMMARY_COLUMNS = [*KEY, "threshold", "t_reach_s", "t_settle_s", "first_window_mse", "final_window_mse",
-                   "final_ratio_to_pd", "n_diverged_ticks", "steps", "unseen_mse", "unseen_ratio_to_pd",
-                   "unseen_diverged", "inference_us_mean", "learning_us_mean", "compute_us_mean",
+SUMMARY_COLUMNS = [*KEY, "threshold", "sustain", "t_reach_s", "t_first_cross_s", "t_settle_s", "first_window_mse",
+                   "final_window_mse", "final_ratio_to_pd", "n_diverged_ticks", "steps", "unseen_mse",
+                   "unseen_ratio_to_pd", "unseen_diverged", "inference_us_mean", "learning_us_mean", "compute_us_mean",
                    "compute_us_median", "compute_us_p99", "fits_period_mean", "fits_period_p99"]
 
 
@@ -148,17 +152,44 @@ def ratio_to_pd(windows: pd.DataFrame, pd_windows: pd.DataFrame) -> pd.Series:
     return windows["track_mse"] / windows["t_start"].map(pd_windows.set_index("t_start")["track_mse"])
 
 
-def summary_row(w: pd.DataFrame, ticks: dict, threshold: float, window: float) -> dict:
-    at_bar = (w["ratio_to_pd"] <= threshold).to_numpy()
+def at_bar(ratio, threshold: float) -> np.ndarray:
+    """(W,) bool: each window's ratio to PD alone at most `threshold`; NaN (no tick ran) and +inf (diverged)
+    are above it."""
+    r = np.asarray(ratio, dtype=np.float64)
+    return np.isfinite(r) & (np.nan_to_num(r, nan=np.inf) <= threshold)
+
+
+def sustain_windows(sustain: float, window: float) -> int:
+    """The number of consecutive windows that make `sustain` seconds: ceil(sustain / window), at least 1."""
+    return max(1, math.ceil(sustain / window - 1e-9))
+
+
+def sustain_start(at: np.ndarray, n: int) -> int | None:
+    """The index of the first window of the first run of at least `n` consecutive True windows of `at` (W,);
+    None when no run lasts `n` windows (a run the end of the windows cuts short does not count)."""
+    run = 0
+    for i, ok in enumerate(np.asarray(at, dtype=bool)):
+        run = run + 1 if ok else 0
+        if run == n:
+            return i - n + 1
+    return None
+
+
+def summary_row(w: pd.DataFrame, ticks: dict, threshold: float, window: float, sustain: float = SUSTAIN) -> dict:
+    """A controller's summary columns (module docstring) from its windows `w` with their `ratio_to_pd`. The
+    windows are `window` seconds each (a shorter last window counts as one)."""
+    at = at_bar(w["ratio_to_pd"], threshold)
     ends = w["t_start"].to_numpy() + window
-    first = int(np.argmax(at_bar)) if at_bar.any() else None
-    above = np.flatnonzero(~at_bar)
+    first, reach = sustain_start(at, 1), sustain_start(at, sustain_windows(sustain, window))
+    above = np.flatnonzero(~at)
     settle = 0 if not len(above) else above[-1] + 1   # the first window of the last run at the bar
     inf, learn = ticks["inference_us"], ticks["learning_us"]
     compute = inf + learn
     p99 = float(np.percentile(compute, 99)) if len(compute) else math.nan
-    return {"threshold": threshold, "t_reach_s": math.nan if first is None else float(ends[first]),
-            "t_settle_s": float(ends[settle]) if settle < len(at_bar) else math.nan,
+    return {"threshold": threshold, "sustain": sustain,
+            "t_reach_s": math.nan if reach is None else float(ends[reach]),
+            "t_first_cross_s": math.nan if first is None else float(ends[first]),
+            "t_settle_s": float(ends[settle]) if settle < len(at) else math.nan,
             "first_window_mse": float(w["track_mse"].iloc[0]), "final_window_mse": float(w["track_mse"].iloc[-1]),
             "final_ratio_to_pd": float(w["ratio_to_pd"].iloc[-1]), "n_diverged_ticks": int(w["n_diverged"].sum()),
             "steps": int(w["steps"].iloc[-1]), "inference_us_mean": float(np.mean(inf)),
@@ -169,9 +200,9 @@ def summary_row(w: pd.DataFrame, ticks: dict, threshold: float, window: float) -
 
 def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,), seconds: float = 20.0,
                  every: int = EVERY, steps: int = STEPS, batch: int = BATCH, buffer: int = BUFFER,
-                 window: float = WINDOW, threshold: float = THRESHOLD, hidden=None, lr: float | None = None,
-                 refs: dict | None = None, n_unseen: int = N_UNSEEN, unseen_duration: float = C.DURATION,
-                 progress=None, system: str = C.SYSTEM) -> tuple[pd.DataFrame, pd.DataFrame]:
+                 window: float = WINDOW, threshold: float = THRESHOLD, sustain: float = SUSTAIN, hidden=None,
+                 lr: float | None = None, refs: dict | None = None, n_unseen: int = N_UNSEEN,
+                 unseen_duration: float = C.DURATION, progress=None, system: str = C.SYSTEM) -> tuple[pd.DataFrame, pd.DataFrame]:
     """See the module docstring. `refs`: the references to learn on (default `sequence("train", seconds)`);
     `hidden`, `lr`: the models' widths and learning rate (default claim 9's); n_unseen 0: no unseen score."""
     import systems
@@ -200,7 +231,7 @@ def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,)
         w = df[(df["controller"] == key["controller"]) & (df["framework"] == key["framework"])
                & (df["seed"] == key["seed"])]
         scores = scores or {"unseen_mse": math.nan, "unseen_diverged": math.nan}
-        summary.append({**key, **summary_row(w, ticks, threshold, window), **scores,
+        summary.append({**key, **summary_row(w, ticks, threshold, window, sustain), **scores,
                         "unseen_ratio_to_pd": scores["unseen_mse"] / pd_unseen})
     return df[CURVE_COLUMNS], pd.DataFrame(summary)[SUMMARY_COLUMNS]
 
@@ -235,8 +266,9 @@ def write_study(folder, settings: dict | None = None, **kw) -> tuple[pd.DataFram
     R.write_csv(folder / "curves.csv", curves)
     R.write_csv(folder / "summary.csv", summary)
     R.write_json(folder / "setup.json", {
-        **(settings or {}), **{k: v for k, v in kw.items() if k not in ("refs", "progress")},
-        "threshold_definition": "a window's tracking MSE at most `threshold` x PD alone's in the same window",
+        **(settings or {}), "sustain": SUSTAIN, **{k: v for k, v in kw.items() if k not in ("refs", "progress")},
+        "threshold_definition": "a window's tracking MSE at most `threshold` x PD alone's in the same window; "
+                                "reached (t_reach_s) when consecutive windows stay at it for `sustain` seconds",
         "control_rate_hz": C.RATE, "period_us": PERIOD_US, "kp": kp.tolist(), "kd": kd.tolist(),
         **environment.hardware(), "versions": environment.versions()})
     return curves, summary

@@ -76,7 +76,7 @@ def metrics_for(cid, model, seed, rng) -> dict:
     base = {"lnn": 0.07, "baseline": 0.08, "hnn_qqdot": 0.4, "hnn_qp": 3e-4, "lgn": 0.02, "lnn_exact": 1e-15,
             "delan": 5e-4, "ff": 1e-2, "hnn": 0.01}.get(model.split("_n")[0], 0.05 * (1 + len(model) % 4))
     base *= (10000 / size) ** 0.5
-    m = {k: base * s * (1 + 0.05 * rng.standard_normal()) for k, s in
+    m = {k: base * s * (1 + 0.01 * rng.standard_normal()) for k, s in
          (("heldout_l1", 1), ("heldout_mse", 0.5), ("energy_err_final", 0.1), ("energy_err_max", 0.3),
           ("final_train_loss", 0.9), ("max_abs_err", 1), ("torque_mse_train", 0.5), ("torque_mse_test", 1),
           ("transfer_l1", 2))}

@@ -18,7 +18,8 @@ def tiny_run(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(O, "one_thread", lambda: {"test": "threads left as they are"})
         assert main(["online", "--system", "four_joint_arm", "--out", str(out), "--seconds", "0.2", "--window", "0.1",
-                     "--models", "delan,ff", "--frameworks", "jax", "--unseen-refs", "0", "--quiet"]) == 0
+                     "--models", "delan,ff", "--frameworks", "jax", "--unseen-refs", "0", "--sustain", "0.2",
+                     "--quiet"]) == 0
     return out
 
 
@@ -54,11 +55,11 @@ def test_the_summary_reaches_the_report_as_its_own_section(tiny_run, tmp_path):
     s = pd.read_csv(tiny_run / "online_four_joint_arm" / "summary.csv")
     assert table.sources == ["online_four_joint_arm/summary.csv"] and len(table.df) == len(s)
     assert list(table.df["controller"][:2]) == ["PD alone", "true inverse dynamics"]
-    assert table.df.loc[0, "reaches the bar at (s)"] == "never"   # PD alone is never 10x below itself
-    assert table.df.loc[1, "reaches the bar at (s)"] == "0.1"
+    assert table.df.loc[0, "reaches the bar, held (s)"] == "never"   # PD alone is never 10x below itself
+    assert table.df.loc[1, "reaches the bar, held (s)"] == table.df.loc[1, "first at the bar (s)"] == "0.1"
     assert table.df.loc[2, "compute per tick, mean / p99 (µs)"] != "-"
     text = " ".join(getattr(b, "text", "") for b in section.blocks)
-    assert "0.2 s of simulated time" in text
+    assert "0.2 s of simulated time" in text and "reached when held 0.2 s" in text
     assert online_sections(load_results(tmp_path), tmp_path) == []   # no study: no section
 
 
@@ -66,3 +67,18 @@ def test_a_bad_system_is_one_line(tmp_path, capsys):
     assert main(["online", "--system", "three_link_arm", "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--system" in err and not (tmp_path / "o").exists()
+
+
+def test_a_summary_without_the_first_crossing_shows_its_t_reach_as_the_first_crossing(tmp_path):
+    from reports.document import Table
+    from reports.load import load_results
+    from reports.sections_online import FOLDER, online_sections
+
+    (tmp_path / FOLDER).mkdir()
+    pd.DataFrame([{"controller": "ff", "framework": "jax", "seed": 0, "t_reach_s": 0.5, "t_settle_s": 9.0,
+                   "final_window_mse": 1e-4, "final_ratio_to_pd": 3e-4, "unseen_ratio_to_pd": 0.1,
+                   "compute_us_mean": 1000.0, "compute_us_p99": 2000.0, "fits_period_mean": True,
+                   "fits_period_p99": False}]).to_csv(tmp_path / FOLDER / "summary.csv", index=False)
+    (section,) = online_sections(load_results(tmp_path), tmp_path)
+    (table,) = [b for b in section.blocks if isinstance(b, Table)]
+    assert table.df.loc[0, "first at the bar (s)"] == "0.5" and table.df.loc[0, "reaches the bar, held (s)"] == "-"

@@ -38,3 +38,16 @@ def test_the_two_lagrangians_differ_in_structure_only_beyond_second_order():
     assert not a.structure["quadratic_kinetic"] and a.structure["separable"]
     with pytest.raises(ValueError, match="not quadratic"):
         a.mass_matrix(q)
+
+
+def test_the_speed_option_draws_slower_particles_under_the_same_lagrangian():
+    slow, fast = systems.get("relativistic", speed=0.1), systems.get("relativistic")
+    st = slow.sample_states(2000, np.random.default_rng(0))
+    assert np.abs(st["qdot"]).max() < 0.1 and np.abs(st["qdot"]).max() > 0.09
+    assert slow.definition.fingerprint() == fast.definition.fingerprint()   # the same Lagrangian
+    assert slow.options == {"speed": 0.1} and fast.options == {}            # so their datasets key apart
+    q, qd = st["q"], st["qdot"]
+    p = slow.canonical_momentum(q, qd, backend="numpy", g=st["g"])
+    assert np.max(np.abs(p / qd - 1)) < 0.016                               # qdot within 1.5 % of the momentum
+    with pytest.raises(ValueError, match="speed"):
+        systems.get("relativistic", speed=1.5)

@@ -62,3 +62,21 @@ class NoisyOracle(Zero):
     def acceleration(self, q, qdot, extra=None):
         a = self.system.acceleration(np.asarray(q, np.float64), np.asarray(qdot, np.float64))
         return a + self.noise * self.rng.standard_normal(a.shape)
+
+
+class FieldOracle(Zero):
+    """The relativistic particle's true q-double-dot, the field g read from the model's extra input, or with
+    g zeroed (``use_field=False``): a model whose relativistic input path is broken. On (q, qdot) its time
+    derivative is (qdot, q-double-dot), as an HNN on (q, qdot) predicts it."""
+
+    def __init__(self, spec, system, use_field=True):
+        super().__init__(spec)
+        self.system, self.use_field = system, use_field
+
+    def acceleration(self, q, qdot, extra=None):
+        q, qdot = np.asarray(q, np.float64), np.asarray(qdot, np.float64)
+        g = np.asarray(extra, np.float64)[..., 0] if self.use_field and extra is not None else np.zeros(q.shape[:-1])
+        return self.system.acceleration(q, qdot, backend="numpy", g=g)
+
+    def time_derivative(self, x, y, extra=None):
+        return np.asarray(y, np.float64), self.acceleration(x, y, extra)

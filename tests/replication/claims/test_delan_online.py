@@ -24,6 +24,7 @@ def test_both_models_learn_online_with_the_learners_fixed_settings_and_are_tuned
     for profile in PROFILES:
         e, p = CLAIM.evaluation_config(profile), CLAIM.protocol(profile)
         assert (e["every"], e["steps"], e["batch"], e["threshold"]) == (O.EVERY, O.STEPS, O.BATCH, O.THRESHOLD)
+        assert e["sustain"] == O.SUSTAIN == 5.0
         assert p == claim_model("delan")[1].replace(batch=O.BATCH, steps=round(e["seconds"] * O.C.RATE))
         assert tuned.tuning(CLAIM, profile) == {} and tuned.equal(tuned.tuning(CLAIM, profile))
     assert CLAIM.evaluation_config("quick")["seconds"] == 30.0 and CLAIM.evaluation_config("paper")["seconds"] == 60.0

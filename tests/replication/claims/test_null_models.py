@@ -11,7 +11,7 @@ A positive control passes with a model that learned and fails with a null, throu
 """
 import numpy as np
 import pytest
-from null_models import Diverging, NoisyOracle, Zero
+from null_models import Diverging, FieldOracle, NoisyOracle, Zero
 
 import models.torch.lnn as torch_lnn
 from models import init_params
@@ -33,6 +33,8 @@ def _model(kind, unit, seed):
     spec = unit.spec()
     if kind == "learned":
         return NoisyOracle(spec, system_of(unit.protocol()), seed=seed)
+    if kind in ("field", "field_zeroed"):
+        return FieldOracle(spec, system_of(unit.protocol()), use_field=kind == "field")
     if kind == "zero":
         return Zero(spec)
     if kind == "diverging":
@@ -98,3 +100,14 @@ def test_models_that_learned_are_judged_and_a_null_beside_them_is_caught(cid, ki
         assert "positive control did not learn" in v["reason"], v["reason"]
     learned = [m for m, k in kinds.items() if k == "learned"]
     assert all(v["competence"]["torch"][m]["passed"] for m in learned), v["competence"]
+
+
+@pytest.mark.parametrize("control, passes", [("field", True), ("field_zeroed", False)])
+def test_an_hnn_whose_relativistic_input_is_zeroed_fails_its_same_system_control(control, passes, monkeypatch):
+    """Claim 3's positive control is the HNN on (q, qdot) on the relativistic particle itself (speeds up to
+    0.1 c), through the same recipe and input path: one that reads the field learns it, one whose field input
+    is zeroed does not, so a broken input path cannot read as the failure the paper predicts."""
+    claim = CLAIMS["rel_coords"]
+    v = judge(claim, frame(_records(claim, "zero", monkeypatch, {"hnn_qqdot_slow": control})), "smoke")
+    assert v["competence"]["torch"]["hnn_qqdot_slow"]["passed"] is passes, v["competence"]["torch"]["hnn_qqdot_slow"]
+    assert v["verdict"] == "inconclusive", v["reason"]

@@ -24,7 +24,12 @@ def test_claims_publish_only_what_is_printed_and_say_what_it_is():
     assert CLAIMS["dp_loss"].published["lnn"].value == 6.89e-2
     assert CLAIMS["delan_arm"].published["delan"].other_data and "ff" not in CLAIMS["delan_arm"].published
     assert CLAIMS["precision"].published == {}
-    # the quick energy rollouts (10 ICs to t = 20) are not the published 40 ICs to t = 100
-    quick = CLAIMS["dp_energy"].eval_config["quick"]
-    assert not CLAIMS["dp_energy"].published["lnn"].like_for_like(quick)[0]
-    assert CLAIMS["dp_energy"].published["lnn"].like_for_like(CLAIMS["dp_energy"].eval_config["paper"])[0]
+    # every deciding profile rolls out the published 40 ICs to t = 100, but only the original's 3 x 600 models
+    # after at least half its 3.07e8 samples are measured like for like
+    pub, paper = CLAIMS["dp_energy"].published["lnn"], CLAIMS["dp_energy"].eval_config["paper"]
+    assert CLAIMS["dp_energy"].eval_config["quick"]["n_ics"] == 40 == paper["n_ics"]
+    assert pub.like_for_like(paper, (600, 600, 600), 3.1e8) == (True, "")
+    same, why = pub.like_for_like(paper, (128, 128, 128), 1.1e7)
+    assert not same and "width 128x128x128 (published 600x600x600)" in why and "1.1e+07 training samples" in why
+    assert not pub.like_for_like(paper, (600, 600, 600), 1e8)[0]      # under half the published budget
+    assert CLAIMS["rel_coords"].published["lnn"].width == (500, 500, 500, 500)

@@ -29,6 +29,27 @@ def test_a_changed_protocol_evaluation_or_threshold_is_unregistered(monkeypatch)
         assert not s["registered"] and s["frozen"] is None and s["registrations"] == before["registrations"]
 
 
+def test_a_rules_comparison_code_or_level_is_part_of_its_hash(monkeypatch):
+    """The same rule, name and thresholds, with other comparison code (a helper it reaches in rules.py or
+    stats.py) or another interval level, is a new protocol."""
+    from replication.claims import rules, stats
+
+    claim = get("dp_energy")
+    before = reg.protocol_hash(claim, "quick")
+
+    def _below(iv, t):   # the same name, a looser comparison
+        return "reproduced" if iv.hi <= t else "not reproduced" if iv.lo >= t else "inconclusive"
+    monkeypatch.setattr(rules, "_below", _below)
+    assert reg.protocol_hash(claim, "quick") != before
+    monkeypatch.undo()
+    assert reg.protocol_hash(claim, "quick") == before
+    monkeypatch.setattr(stats, "LEVEL", 0.8)
+    assert reg.protocol_hash(claim, "quick") != before
+    monkeypatch.undo()
+    monkeypatch.setattr(stats, "_log_t", lambda a, b, level: (1.0, 1.0, 1.0, 1.0))
+    assert reg.protocol_hash(claim, "quick") != before
+
+
 def test_register_appends_a_dated_line_for_a_changed_protocol_only(tmp_path, monkeypatch):
     monkeypatch.setattr(reg, "FILE", tmp_path / "registrations.json")
     reg.registrations.cache_clear()

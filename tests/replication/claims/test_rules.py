@@ -32,7 +32,7 @@ def v(**models):
 
 def test_stat_counts_a_diverged_seed_as_infinite_and_drops_nan():
     s = Stat.of([1.0, math.inf, float("nan"), None])
-    assert s.n == 2 and s.mean == math.inf and s.std == math.inf and s.hi == math.inf
+    assert s.n == 2 and s.dropped == 2 and s.mean == math.inf and s.std == math.inf and s.hi == math.inf
     assert Stat.of([math.inf, math.inf]).std == 0.0
     with pytest.raises(ValueError, match="no finite"):
         Stat.of([float("nan")])
@@ -51,18 +51,35 @@ def test_a_part_verdict_is_never_partly():
 
 
 @pytest.mark.parametrize("values, expected, half, twice", [
-    (dict(a=(1.0, 1.1, 0.9), b=(5.0, 5.5, 4.5)), "reproduced", "reproduced", "inconclusive"),  # 0.16-0.24
+    (dict(a=(1.0, 1.1, 0.9), b=(5.0, 5.5, 4.5)), "reproduced", "reproduced", "not reproduced"),  # 0.17-0.24
     (dict(a=(1.0, 1.1, 0.9), b=(2.0, 2.1, 1.9)), "not reproduced", "reproduced", "not reproduced"),   # 2x, not 3x
     (dict(a=(5.0, 5.5, 4.5), b=(1.0, 1.1, 0.9)), "not reproduced", "not reproduced", "not reproduced"),
     (dict(a=(1.0, 4.0, 0.5), b=(5.0, 3.0, 6.0)), "inconclusive", "inconclusive", "inconclusive"),   # seeds disagree
     (dict(a=(1.0, 1.1, 0.9), b=(math.inf, 8.0, 9.0)), "reproduced", "reproduced", "reproduced"),   # b diverged once
 ])
-def test_better_by_reads_every_seed_pair_and_reports_its_sensitivity(values, expected, half, twice):
+def test_better_by_reads_the_interval_and_reports_its_sensitivity(values, expected, half, twice):
     out = better_by("a", "b", 3.0, M)(v(**values))
     assert out.verdict == expected, out.reason
     assert out.sensitivity == {"factor 1.5": half, "factor 6": twice}
     a, b = values["a"], values["b"]
-    assert out.interval.lo == min(x / y for x in a for y in b) and out.interval.hi == max(x / y for x in a for y in b)
+    assert out.interval.seed_range == (min(x / y for x in a for y in b), max(x / y for x in a for y in b))
+    assert out.interval.level == 0.9 and out.interval.seeds == (3, 3) and out.thresholds == (1 / 3,)
+    iv = out.interval
+    assert out.distance == pytest.approx(min(max(e * 3, 1 / (e * 3)) for e in (iv.lo, iv.hi) if 0 < e < math.inf)) \
+        if math.isfinite(iv.hi) else out.distance >= 1
+
+
+def test_the_interval_widens_as_seeds_fall_and_one_seed_decides_nothing():
+    a5, b5 = (1.0, 1.1, 0.9, 1.05, 0.95), (5.0, 5.5, 4.5, 5.25, 4.75)
+    wide = [better_by("a", "b", 3.0, M)(v(a=a5[:n], b=b5[:n])).interval for n in (5, 3, 2)]
+    assert all(x.hi - x.lo < y.hi - y.lo for x, y in zip(wide, wide[1:], strict=False))
+    one = better_by("a", "b", 3.0, M)(v(a=(1.0,), b=(5.0,)))
+    assert one.verdict == "inconclusive" and "one seed" in one.interval.method
+
+
+def test_a_nan_seed_is_never_dropped():
+    out = better_by("a", "b", 3.0, M)(v(a=(1.0, 1.1, float("nan")), b=(5.0, 5.5, 4.5)))
+    assert out.verdict == "inconclusive" and "NaN" in out.interval.method and out.interval.seeds == (3, 3)
 
 
 def test_better_by_not_run_when_a_model_is_missing():
@@ -70,28 +87,39 @@ def test_better_by_not_run_when_a_model_is_missing():
 
 
 @pytest.mark.parametrize("values, expected", [
-    (dict(a=1.0, b=1.5), "reproduced"),
-    (dict(a=1.0, b=5.0), "not reproduced"),          # a 5x gap is not "similar", whatever a looser band says
-    (dict(a=1.0, b=50.0), "not reproduced"),
+    (dict(a=(1.0, 1.05, 0.95), b=(1.5, 1.4, 1.6)), "reproduced"),
+    (dict(a=(1.0, 1.02, 0.98), b=(5.0, 5.1, 4.9)), "not reproduced"),   # a 5x gap is not "similar"
+    (dict(a=(1.0, 1.02, 0.98), b=(50.0, 51.0, 49.0)), "not reproduced"),
     (dict(a=(1.0, 1.0), b=(2.0, 4.0)), "inconclusive"),
-    (dict(a=math.inf, b=1.0), "not reproduced"),
+    (dict(a=(math.inf, math.inf, math.inf), b=(1.0, 1.1, 0.9)), "not reproduced"),
+    (dict(a=1.0, b=1.5), "inconclusive"),                               # one seed: no interval
 ])
 def test_similar(values, expected):
-    assert similar("a", "b", 3.0, M)(v(**values)).verdict == expected
+    out = similar("a", "b", 3.0, M)(v(**values))
+    assert out.verdict == expected, out.reason
+    assert set(out.sensitivity) == {"within 1.73205", "within 9"}
+
+
+def test_similar_names_the_lower_model_when_it_is_far_lower():
+    out = similar("lnn", "baseline", 1.5, M)(v(lnn=(1.0, 1.02, 0.98), baseline=(2.8, 2.9, 2.7)))
+    assert out.verdict == "not reproduced" and "lnn is lower by more than 1.5x" in out.reason
 
 
 def _matched(a, b, level_a, level_b):
     return {"a": {M: Stat.of(a), "lvl": Stat.of(level_a)}, "b": {M: Stat.of(b), "lvl": Stat.of(level_b)}}
 
 
+LV = (0.5, 0.51, 0.49)
+
+
 @pytest.mark.parametrize("values, expected", [
-    (((1.0, 1.1), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "reproduced"),
-    (((1.0, 1.1), (5.0, 6.0), (0.2, 0.25), (0.5, 0.6)), "inconclusive"),       # a is far more accurate there
-    (((1.0, 1.1), (5.0, 6.0), (0.5, 0.55), (0.5, math.inf)), "inconclusive"),  # b never got near the level
-    (((3.0, 3.1), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "not reproduced"),
-    (((math.inf, 1.0), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "inconclusive"),  # a diverged once
-    (((math.inf, math.inf), (5.0, 6.0), (0.5, 0.55), (0.5, 0.6)), "not reproduced"),
-    (((0.0, 0.0), (5.0, 6.0), (40.0, 40.0), (0.5, 0.6)), "inconclusive"),       # a null: never matched
+    (((1.0, 1.1, 0.9), (5.0, 6.0, 5.5), LV, LV), "reproduced"),
+    (((1.0, 1.1, 0.9), (5.0, 6.0, 5.5), (0.2, 0.21, 0.19), LV), "inconclusive"),   # a is far more accurate there
+    (((1.0, 1.1, 0.9), (5.0, 6.0, 5.5), LV, (0.5, 0.51, math.inf)), "inconclusive"),  # b never got near the level
+    (((3.0, 3.1, 2.9), (5.0, 6.0, 5.5), LV, LV), "not reproduced"),
+    (((math.inf, 1.0, 1.1), (5.0, 6.0, 5.5), LV, LV), "inconclusive"),  # a diverged once
+    (((math.inf,) * 3, (5.0, 6.0, 5.5), LV, LV), "not reproduced"),
+    (((0.0, 0.0, 0.0), (5.0, 6.0, 5.5), (40.0, 40.0, 40.0), LV), "inconclusive"),       # a null: never matched
 ])
 def test_matched_better_by_decides_only_at_matched_accuracy(values, expected):
     out = matched_better_by("a", "b", 3.0, M, "lvl", 1.5)(_matched(*values))
@@ -112,9 +140,10 @@ def test_fails(values, expected):
 def test_below_null():
     def vals(x, null):
         return {"a": {M: Stat.of(x), f"null_{M}": Stat.of(null)}}
-    assert below_null(M, 0.5, "a")(vals((0.1, 0.2), (1.0, 1.0))).verdict == "reproduced"
+    assert below_null(M, 0.5, "a")(vals((0.1, 0.12, 0.11), (1.0, 1.0, 1.0))).verdict == "reproduced"
     assert below_null(M, 0.5, "a")(vals((1.0, 0.9), (1.0, 1.0))).verdict == "not reproduced"   # the null itself
     assert below_null(M, 0.5, "a")(vals((0.2, 0.9), (1.0, 1.0))).verdict == "inconclusive"
+    assert below_null(M, 0.5, "a")(vals((0.1, 0.2), (1.0, 1.0))).verdict == "inconclusive"   # 2 seeds this far apart
     assert below_null(M, 0.5, "a")({"a": {M: Stat.of((0.1,))}}).verdict == "not run"
 
 
@@ -148,11 +177,16 @@ def test_bound():
     assert bound(M, upper=1.0, models=("b",))(v(a=0.5)).verdict == "not run"
 
 
-def _with_null(model_value, null=10.0, n_div=None):
-    s = {"heldout_l1": Stat.of([model_value]), "null_heldout_l1": Stat.of([null])}
-    if n_div is not None:
-        s["n_diverged"] = Stat.of([n_div])
-    return s
+def _with_null(model_values, null=10.0, n_div=None, status=None):
+    """One model's seed rows: its metric per seed, the null's beside it, and optionally its diverged count."""
+    vals = model_values if isinstance(model_values, tuple) else (model_values,)
+    rows = []
+    for i, x in enumerate(vals):
+        r = {"seed": i, "status": (status or {}).get(i, "ok"), "heldout_l1": x, "null_heldout_l1": null}
+        if n_div is not None:
+            r["n_diverged"] = n_div
+        rows.append(r)
+    return rows
 
 
 def test_bar_passes_a_model_that_learned_and_stops_a_null_or_diverging_one():
@@ -160,11 +194,21 @@ def test_bar_passes_a_model_that_learned_and_stops_a_null_or_diverging_one():
     assert bar.check("a", _with_null(0.5))[0]
     assert not bar.check("a", _with_null(10.0))[0]           # the null itself
     assert not bar.check("a", _with_null(math.inf))[0]
-    assert not bar.check("a", {"heldout_l1": Stat.of([0.1])})[0]   # null not recorded: cannot pass
+    assert not bar.check("a", [{"seed": 0, "status": "ok", "heldout_l1": 0.1}])[0]   # null not recorded: cannot pass
     roll = Bar(("a",), None, max_diverged=0)
     assert roll.check("a", _with_null(0.5, n_div=0))[0]
     assert not roll.check("a", _with_null(0.5, n_div=1))[0]
     assert not roll.check("a", _with_null(0.5))[0]           # divergence not recorded
+
+
+def test_bar_reads_every_seed_and_a_failed_or_nan_seed_fails_it():
+    bar = Bar(("a",), "heldout_l1")
+    passed, why, per = bar.check("a", _with_null((0.011, 1.33)))      # a good seed cannot hide one at the null
+    assert not passed and [p["passed"] for p in per] == [True, False]
+    assert "1/2 seeds" in why and "0.011" in why and "1.33" in why    # every seed's value is shown
+    assert not bar.check("a", _with_null((0.5, float("nan"))))[0]
+    assert not bar.check("a", _with_null((0.5, 0.5), status={1: "failed"}))[0]
+    assert bar.check("a", _with_null((0.5, 0.6)))[0]
 
 
 def test_competence_all_and_any():
@@ -180,18 +224,19 @@ def test_competence_all_and_any():
 def test_a_model_under_two_bars_passes_only_if_it_passes_both():
     vals = {"a": _with_null(9.0, n_div=0)}
     ok, _, per = competence((Bar(("a",), "heldout_l1"), Bar(("a",), None, max_diverged=0)), vals)
-    assert not ok and per["a"][0] is False
-    assert "heldout_l1 9 > 0.1 x null 10" in per["a"][1] and "0 diverged rollouts" in per["a"][1]
+    assert not ok and per["a"][0] is False and per["a"][2][0]["passed"] is False
+    assert "9 > 0.1 x null 10" in per["a"][1] and "0 diverged rollouts" in per["a"][1]
 
 
 @pytest.mark.parametrize("values, expected", [
-    (dict(a=(1.0, 2.0), b=(3.0, math.inf)), "reproduced"),
-    (dict(a=(1.0, math.inf), b=(math.inf, math.inf)), "inconclusive"),   # one seed of a got there: not every pair
-    (dict(a=(math.inf, math.inf), b=(2.0, math.inf)), "not reproduced"),
-    (dict(a=(math.inf, math.inf), b=(math.inf, math.inf)), "inconclusive"),   # never tie, never sooner
+    (dict(a=(1.0, 2.0, 1.5), b=(3.0, math.inf, 4.0)), "reproduced"),
+    (dict(a=(1.0, math.inf, math.inf), b=(math.inf,) * 3), "inconclusive"),   # one seed of a got there
+    (dict(a=(math.inf,) * 3, b=(2.0, math.inf, 3.0)), "not reproduced"),
+    (dict(a=(math.inf,) * 3, b=(math.inf,) * 3), "inconclusive"),   # never tie, never sooner
+    (dict(a=(1.0, 2.0), b=(3.0, math.inf)), "inconclusive"),         # 2 seeds with a never: no exact interval
 ])
 def test_sooner_reads_never_as_inf_and_decides_nothing_when_neither_got_there(values, expected):
     out = sooner("a", "b", M)(v(**values))
     assert out.verdict == expected, out.reason
-    assert better_by("a", "b", 1.0, M)(v(a=(math.inf,), b=(math.inf,))).verdict == "not reproduced"
+    assert better_by("a", "b", 1.0, M)(v(a=(math.inf,) * 3, b=(math.inf,) * 3)).verdict == "not reproduced"
     assert sooner("a", "c", M)(v(a=(1.0,))).verdict == "not run"

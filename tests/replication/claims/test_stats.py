@@ -46,11 +46,22 @@ def test_too_few_seeds_give_an_unbounded_interval():
     assert iv.lo == 0.0 and iv.hi == math.inf and "too few seeds" in iv.method
 
 
-def test_ratio_interval_spans_every_seed_pair():
-    iv = ratio_interval(Stat.of([1.0, 2.0]), Stat.of([4.0, 8.0]), "a/b")
-    assert (iv.lo, iv.hi) == (1 / 8, 2 / 4) and iv.point == pytest.approx(1.5 / 6)
+def test_ratio_interval_is_welchs_t_on_log_ratios_with_the_seed_range_beside_it():
+    from scipy.stats import ttest_ind
+
+    a, b = (1.0, 2.0, 1.5), (4.0, 8.0, 5.0)
+    iv = ratio_interval(Stat.of(a), Stat.of(b), "a/b")
+    assert iv.seed_range == (1 / 8, 2 / 4) and iv.level == 0.9 and iv.seeds == (3, 3)
+    la, lb = np.log10(a), np.log10(b)
+    assert iv.point == pytest.approx(10 ** (la.mean() - lb.mean()))
+    # the interval's ends are where Welch's two-sided test of the log shift rejects at exactly 10 %
+    for end in (iv.lo, iv.hi):
+        p = ttest_ind(la - np.log10(end), lb, equal_var=False).pvalue
+        assert p == pytest.approx(0.10, abs=1e-6)
     iv = ratio_interval(Stat.of([1.0, math.inf]), Stat.of([math.inf]), "a/b")
-    assert (iv.lo, iv.hi) == (0.0, 1.0)      # two diverged runs tie
+    assert iv.seed_range == (0.0, 1.0) and (iv.lo, iv.hi) == (0.0, math.inf)      # one seed: no interval
+    iv = ratio_interval(Stat.of([1.0, 1.2, math.inf]), Stat.of([5.0, 6.0, 7.0]), "a/b")
+    assert "Hodges-Lehmann" in iv.method and iv.hi == math.inf                     # a diverged seed ranks last
 
 
 def test_seeds_needed_is_the_first_count_whose_complete_separation_has_the_margin():

@@ -9,7 +9,6 @@ import pytest
 import systems
 from replication.claims import get
 from replication.claims.bars import competence
-from replication.claims.stats import Stat
 from replication.evaluation.control import FAMILIES, eval_control
 from replication.run.splits import DEV, TEST
 
@@ -43,8 +42,8 @@ def test_a_null_model_is_pd_alone_and_fails_the_bar():
     for f in FAMILIES:
         assert m[f"tracking_mse_{f}"] == pytest.approx(m[f"null_tracking_mse_{f}"], rel=1e-12)
     bar = get("delan_tracking").bars[0]
-    stats = {k: Stat.of([v]) for k, v in m.items()}
-    ok, _, per = competence((bar,), {"delan": stats, "ff": stats})
+    row = [{"seed": 0, "status": "ok", **m}]
+    ok, _, per = competence((bar,), {"delan": row, "ff": row})
     assert not ok and not per["delan"][0]
 
 

@@ -7,7 +7,6 @@ import systems
 from models import ModelSpec, init_params
 from replication.claims import CLAIMS
 from replication.claims.bars import Bar, added_competence
-from replication.claims.stats import Stat
 from replication.evaluation.adapters import adapter
 from replication.run import added_models
 from replication.run.runner import plan
@@ -107,8 +106,8 @@ def test_an_edited_model_file_is_a_new_spec_and_the_same_seed_the_same_numbers(m
 
 def test_the_added_model_is_held_to_the_claims_first_bar():
     bars = (Bar(("lnn",), "heldout_l1"),)
-    v = {"lnn": {"heldout_l1": Stat.of([1.0]), "null_heldout_l1": Stat.of([50.0])},
-         "mine": {"heldout_l1": Stat.of([40.0]), "null_heldout_l1": Stat.of([50.0])}}
+    v = {"lnn": [{"seed": 0, "status": "ok", "heldout_l1": 1.0, "null_heldout_l1": 50.0}],
+         "mine": [{"seed": 0, "status": "ok", "heldout_l1": 40.0, "null_heldout_l1": 50.0}]}
     per = added_competence(bars, v, {"lnn"})
     assert set(per) == {"mine"} and per["mine"][0] is False and "40 > 0.1 x null 50" in per["mine"][1]
 

@@ -3,6 +3,8 @@
 that does not learn tracks every repetition of a reference exactly as the first, a null learner (learning rate
 0) changes nothing, a DeLaN learning online improves (the positive control), a diverging controller is marked,
 and the command writes both tables with their declared columns and refuses bad options with one line naming the option."""
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -79,7 +81,7 @@ def test_the_replay_buffer_keeps_the_last_samples_and_draws_training_batches():
 
 def test_a_tiny_study_writes_both_tables(tmp_path):
     curves, summary = O.write_study(tmp_path, models=("delan", "ff"), frameworks=("jax", "torch"), seconds=0.3,
-                                    window=0.1, hidden=TINY, n_unseen=1, unseen_duration=0.1)
+                                    window=0.1, sustain=0.2, hidden=TINY, n_unseen=1, unseen_duration=0.1)
     c, s = pd.read_csv(tmp_path / "curves.csv"), pd.read_csv(tmp_path / "summary.csv")
     assert list(c.columns) == O.CURVE_COLUMNS and list(s.columns) == O.SUMMARY_COLUMNS
     assert len(c) == 6 * 3 and len(s) == 6 and (tmp_path / "setup.json").is_file()
@@ -89,7 +91,9 @@ def test_a_tiny_study_writes_both_tables(tmp_path):
     assert (learned["steps"] == 150).all() and (learned["learning_us_mean"] > 0).all()
     assert (s["compute_us_p99"] >= s["compute_us_median"]).all() and s["unseen_mse"].notna().all()
     exact = s.set_index("controller").loc["exact"]
-    assert exact["t_reach_s"] == pytest.approx(0.1) and exact["unseen_ratio_to_pd"] < 1e-2
+    assert exact["t_reach_s"] == pytest.approx(0.1) and exact["t_first_cross_s"] == pytest.approx(0.1)
+    assert exact["unseen_ratio_to_pd"] < 1e-2 and (s["sustain"] == 0.2).all()
+    assert json.loads((tmp_path / "setup.json").read_text())["sustain"] == 0.2
 
 
 def test_the_command_runs_and_refuses_bad_options(tmp_path, capsys, monkeypatch):
@@ -102,7 +106,8 @@ def test_the_command_runs_and_refuses_bad_options(tmp_path, capsys, monkeypatch)
     capsys.readouterr()
     for bad, option in ((["--every", "0"], "--every"), (["--seconds", "-1"], "--seconds"),
                         (["--frameworks", "tf"], "--frameworks"), (["--seeds", "a"], "--seeds"),
-                        (["--threshold", "0"], "--threshold"), (["--models", "lnn"], "--models")):
+                        (["--threshold", "0"], "--threshold"), (["--models", "lnn"], "--models"),
+                        (["--sustain", "-1"], "--sustain")):
         assert main(["online", "--out", str(tmp_path / "bad"), *bad, "--quiet"]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and option in err

@@ -1,0 +1,54 @@
+"""An HNN on canonical (q, p) rolled out by its own Hamiltonian, for every system.
+
+`canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momentum_kw=None) -> (q, qdot, p)`
+  time_derivative(q, p, extra) -> (dH/dp, -dH/dq), each (B, dof) NumPy: the learned H's flow (a model
+  adapter's `time_derivative`, `replication.evaluation.adapters`, or any callable of that form).
+  s           the `systems.System` the model learned; it gives only the initial momentum,
+              p0 = dL/dqdot(q0, qdot0) (`System.canonical_momentum`: exact for every Lagrangian, m gamma qdot
+              for the relativistic particle, M(q) qdot where the kinetic energy is quadratic).
+  q0, qdot0   (B, dof) float64 initial states; t (T,) the output times (t[0] the start); dt the RK4 step bound.
+  extra       (B, k) or None: the model's extra inputs (e.g. the relativistic field g), constant along a
+              trajectory (they ride in the integrated state with rate 0).
+  momentum_kw the system's per-sample parameters for p0 (each (B,)), e.g. {"g": g}; None for none.
+  The suite's RK4 (`rollout.rollout`, float64 state, each output interval in equal steps of at most dt)
+  integrates Hamilton's equations of the learned H, dq/dt = dH/dp, dp/dt = -dH/dq. The velocity the metrics
+  read is the learned H's own dH/dp at each output sample (`velocity`); M(q)^-1 p is never used: it is the
+  velocity only where the kinetic energy is quadratic in qdot (not for the relativistic particle, where
+  the system has no mass matrix).
+  Returns q, qdot, p, each (B, T, dof) float64; a trajectory whose state turns non-finite is NaN from then on.
+
+`velocity(time_derivative, q, p, extra=None) -> qdot`: dH/dp at states q, p (B, T, dof), extra (B, k) or
+  None; NaN where the state is non-finite (the model is not called there).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from replication.evaluation.rollout import rollout
+
+
+def canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momentum_kw=None):
+    q0, qdot0 = np.asarray(q0, np.float64), np.asarray(qdot0, np.float64)
+    d = q0.shape[1]
+    p0 = s.canonical_momentum(q0, qdot0, backend="numpy", **(momentum_kw or {}))
+    rest = np.zeros((len(q0), 0)) if extra is None else np.asarray(extra, np.float64).reshape(len(q0), -1)
+    k = rest.shape[1]
+
+    def field(z):   # z = (q, p, extra): (dH/dp, -dH/dq, 0)
+        qdot, pdot = time_derivative(z[:, :d], z[:, d:2 * d], z[:, 2 * d:] if extra is not None else None)
+        return np.concatenate([qdot, pdot, np.zeros((len(z), k))], 1)
+
+    z = rollout(field, np.concatenate([q0, p0, rest], 1), t, dt)
+    q, p = z[..., :d], z[..., d:2 * d]
+    return q, velocity(time_derivative, q, p, extra), p
+
+
+def velocity(time_derivative, q, p, extra=None):
+    b, n, d = q.shape
+    qf, pf = q.reshape(b * n, d), p.reshape(b * n, d)
+    ef = None if extra is None else np.repeat(np.asarray(extra, np.float64).reshape(b, -1), n, axis=0)
+    ok = np.all(np.isfinite(qf), 1) & np.all(np.isfinite(pf), 1)
+    out = np.full((b * n, d), np.nan)
+    if ok.any():
+        out[ok] = time_derivative(qf[ok], pf[ok], None if ef is None else ef[ok])[0]
+    return out.reshape(b, n, d)
