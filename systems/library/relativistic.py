@@ -21,7 +21,6 @@ import sympy as sp
 from systems.definition import Definition, coordinates, param
 from systems.library._sampling import unknown
 
-
 SPEED = 0.99999   # the original code's velocity scale
 
 
