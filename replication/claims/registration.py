@@ -2,10 +2,10 @@
 
 `fingerprint(claim, profile) -> dict`: everything that decides the claim's numbers and its verdict under
 the profile: the frameworks it is decided in (the profile's), per model that runs, its model spec fields,
-widths and protocol; the evaluation config; the
-seed count; the competence bars; the parts (the models they read and control, their rule, the rule's
-parameters and a hash of the rule's code with every rule and statistics function it reaches); the
-variants; the metric.
+widths and protocol; the evaluation config and the evaluation routines' version
+(`replication.evaluation.version`); the seed count; the competence bars; the parts (the models they read
+and control, their rule, the rule's parameters and a hash of the rule's code with every rule and
+statistics function it reaches); the variants; the metric.
 `protocol_hash(claim, profile) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its canonical JSON).
 `registrations()`: the committed records (`registrations.json`): {claim id: [line, ...]} oldest first, a
 line {"profile", "protocol_hash", "frozen" (the date it was frozen), "tuned_on" (the split its choices
@@ -28,6 +28,7 @@ from pathlib import Path
 
 from replication.claims import bars, stats
 from replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
+from replication.evaluation.version import EVALUATION_VERSION
 from replication.training.protocol import canonical_hash
 
 FILE = Path(__file__).with_name("registrations.json")
@@ -87,7 +88,7 @@ def fingerprint(claim, profile: str) -> dict:
                         "protocol": m.protocol(base, profile).to_dict()}
               for m in claim.models if m.runs_in(profile)}
     return {"claim": claim.id, "profile": profile, "frameworks": list(PROFILE_FRAMEWORKS[profile]), "models": models,
-            "eval": claim.evaluation_config(profile),
+            "eval": claim.evaluation_config(profile), "evaluation_version": EVALUATION_VERSION,
             "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
             "bars_code": canonical_hash({"source": inspect.getsource(bars), "share": bars.SHARE}, 16),
             "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],

@@ -19,6 +19,15 @@
 
 `velocity(time_derivative, q, p, extra=None) -> qdot`: dH/dp at states q, p (B, T, dof), extra (B, k) or
   None; NaN where the state is non-finite (the model is not called there).
+`state_velocity(s, q, p, momentum_kw=None) -> qdot`: the true system's velocity at the canonical state (q, p)
+  (..., dof): the qdot with dL/dqdot(q, qdot) = p, by Newton's method on the momentum map with the system's
+  velocity Hessian from qdot = 0 (exact in one step where the kinetic energy is quadratic: M(q)^-1 p), each
+  step halved until the speed stays below the system's `max_speed` (the relativistic particle); NaN where the
+  state is non-finite or the iteration does not converge. momentum_kw: per-sample parameters, each aligned
+  with q's leading axes ((B,) for q (B, T, dof)).
+  Quantities of the true system at a predicted canonical state (its energy H_true(q, p), as the HNN paper
+  measures it, and the velocity an error against the true trajectory reads) use this velocity; the learned
+  dH/dp is the model's own and drives its rollout.
 """
 from __future__ import annotations
 
@@ -52,3 +61,31 @@ def velocity(time_derivative, q, p, extra=None):
     if ok.any():
         out[ok] = time_derivative(qf[ok], pf[ok], None if ef is None else ef[ok])[0]
     return out.reshape(b, n, d)
+
+
+def state_velocity(s, q, p, momentum_kw=None, iterations: int = 60, tol: float = 1e-13):
+    q, p = np.asarray(q, np.float64), np.asarray(p, np.float64)
+    shape, d = q.shape, q.shape[-1]
+    qf, pf = q.reshape(-1, d), p.reshape(-1, d)
+    kw = {k: np.broadcast_to(np.asarray(v, np.float64)[(...,) + (None,) * (q.ndim - 1 - np.ndim(v))],
+                             shape[:-1]).reshape(-1) for k, v in (momentum_kw or {}).items()}
+    ok = np.all(np.isfinite(qf), 1) & np.all(np.isfinite(pf), 1)
+    out = np.full(qf.shape, np.nan)
+    if not ok.any():
+        return out.reshape(shape)
+    qo, po, kwo = qf[ok], pf[ok], {k: v[ok] for k, v in kw.items()}
+    cap = s.definition.max_speed
+    v = np.zeros_like(qo)
+    done = np.zeros(len(qo), bool)
+    for _ in range(iterations):
+        r = s.canonical_momentum(qo, v, backend="numpy", **kwo) - po
+        done = np.all(np.abs(r) <= tol * (1.0 + np.abs(po)), 1)
+        if done.all():
+            break
+        step = np.linalg.solve(s.velocity_hessian(qo, v, backend="numpy", **kwo), r[..., None])[..., 0]
+        new = v - step
+        while cap is not None and (far := np.linalg.norm(new, axis=1) >= cap).any():   # stay inside |qdot| < c
+            new[far] = v[far] - 0.5 * (v[far] - new[far])
+        v = np.where(done[:, None], v, new)
+    out[ok] = np.where(done[:, None], v, np.nan)
+    return out.reshape(shape)

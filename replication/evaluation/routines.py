@@ -18,7 +18,7 @@ import pandas as pd
 
 import systems
 import systems.trajectories
-from replication.evaluation.canonical import canonical_rollout
+from replication.evaluation.canonical import canonical_rollout, state_velocity
 from replication.evaluation.metrics import (
     bounded_relative_error,
     energy_errors,
@@ -177,9 +177,11 @@ def _float32_truth(name, params, cfg_items):
 
 def _model_rollout(ctx, s, q0, qd0, t):
     p, m, d = ctx.protocol, ctx.model, s.dof
-    if p.task == "hamiltonian" and p.data.coords == "qp":   # in (q, p) by its own H; qdot = dH/dp
-        q, qd, _ = canonical_rollout(m.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
-        return q, qd
+    if p.task == "hamiltonian" and p.data.coords == "qp":
+        # in (q, p) by its own H; the true system's velocity at each predicted state (q, p), so that its energy
+        # is H_true(q, p), as the HNN paper measures it
+        q, _, pp = canonical_rollout(m.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
+        return q, state_velocity(s, q, pp)
     if p.task == "hamiltonian":
         f = hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d)
     else:

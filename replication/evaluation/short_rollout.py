@@ -6,15 +6,15 @@ system's declared distribution with the rollout seed of the unit's split. A per-
 the integrated state with rate 0, so the suite's RK4 (`replication.evaluation.rollout`) keeps it with its
 trajectory. Model and truth are integrated by the same RK4 (the truth at the exact equations of motion,
 at step `dt`); a model on (q, qdot) by its q-double-dot as the verdict reads it (`qddot_of_prediction`),
-an HNN on canonical (q, p) in (q, p) by its own H from the true initial momentum, its velocity dH/dp
-(`replication.evaluation.canonical`). Adds `arrays.npz`: t, q_true, qdot_true, q_pred, qdot_pred
+an HNN on canonical (q, p) in (q, p) by its own H from the true initial momentum, its velocity the true
+system's at each predicted state (q, p) (`replication.evaluation.canonical.state_velocity`). Adds `arrays.npz`: t, q_true, qdot_true, q_pred, qdot_pred
 (n_ics, n_t, d); nothing a verdict reads.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.canonical import canonical_rollout
+from replication.evaluation.canonical import canonical_rollout, state_velocity
 from replication.evaluation.rollout import rollout
 from replication.evaluation.routines import Evaluation, eval_heldout, qddot_of_prediction, system_of
 from replication.training import data as datamod
@@ -84,11 +84,11 @@ def eval_heldout_trajectories(ctx) -> Evaluation:
 def _model_rollout(ctx, s, q0, qd0, names, inputs, t):
     """(q, qdot) (n_ics, n_t, d) of the trained model from (q0, qd0) and the per-sample system inputs."""
     p, d = ctx.protocol, q0.shape[1]
-    if p.task == "hamiltonian" and p.data.coords == "qp":
-        q, qdot, _ = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"],
-                                       extra=np.concatenate(inputs, 1) if names else None,
-                                       momentum_kw={k: inputs[i][:, 0] for i, k in enumerate(names)})
-        return q, qdot
+    if p.task == "hamiltonian" and p.data.coords == "qp":   # in (q, p) by its own H; the true velocity there
+        kw = {k: inputs[i][:, 0] for i, k in enumerate(names)}
+        q, _, pp = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"],
+                                     extra=np.concatenate(inputs, 1) if names else None, momentum_kw=kw)
+        return q, state_velocity(s, q, pp, kw)
     z0 = np.concatenate([q0, qd0, *inputs], 1)
     zp = rollout(_field(model_qddot(ctx, s, names), d, len(names)), z0, t, ctx.cfg["dt"])
     return zp[..., :d], zp[..., d:2 * d]

@@ -2,14 +2,16 @@
 the 'learned' one it retraces the truth on the relativistic particle, where M^-1 p is not the velocity (the
 particle has no mass matrix; its rest mass gives gamma qdot, past c at high speed), and on a quadratic
 kinetic energy, where dH/dp and M(q)^-1 p agree. Through both routines that roll it out: the energy
-rollout (`routines._model_rollout`, claim 10's pendulum) and the short rollouts (claim 3's `hnn_qp`)."""
+rollout (`routines._model_rollout`, claim 10's pendulum) and the short rollouts (claim 3's `hnn_qp`), which
+read the true system's velocity at each predicted state (q, p) (`state_velocity`), so that an energy is
+H_true(q, p) whatever the learned dH/dp."""
 import numpy as np
 import pytest
 
 import systems
 import systems.trajectories
 from replication.claims import CLAIMS
-from replication.evaluation.canonical import canonical_rollout
+from replication.evaluation.canonical import canonical_rollout, state_velocity
 from replication.evaluation.registry import EVALUATIONS
 from replication.evaluation.routines import Context, system_of
 from replication.run.runner import plan
@@ -132,3 +134,42 @@ def test_claim_10s_energy_rollout_from_an_exact_h_conserves_energy():
     assert out.metrics["energy_err_max"] < 1e-6
     assert out.metrics["rollout_gmean_err"] < 1e-6
     np.testing.assert_allclose(out.arrays["q_pred"], out.arrays["q_true"], atol=1e-6)
+
+
+@pytest.mark.parametrize("name, kw", [("relativistic", {"g": G}), ("relativistic_standard", {"g": G}),
+                                      ("double_pendulum", {}), ("pendulum", {})])
+def test_the_state_velocity_inverts_the_momentum_map(name, kw):
+    s = systems.get(name)
+    if s.dof == 1:
+        q, qdot = Q0, V0
+    else:
+        st = s.sample_states(3, np.random.default_rng(0))
+        q, qdot = st["q"], st["qdot"]
+    p = s.canonical_momentum(q, qdot, backend="numpy", **kw)
+    np.testing.assert_allclose(state_velocity(s, q, p, kw), qdot, rtol=1e-10, atol=1e-12)
+    # (B, T, dof) along trajectories, a per-sample parameter (B,) of each
+    np.testing.assert_allclose(state_velocity(s, q[:, None].repeat(2, 1), p[:, None].repeat(2, 1), kw),
+                               qdot[:, None].repeat(2, 1), rtol=1e-10, atol=1e-12)
+    bad = p.copy()
+    bad[0] = np.nan
+    assert np.isnan(state_velocity(s, q, bad, kw)[0]).all()
+
+
+class TwiceTheVelocity(PendulumH):
+    """The pendulum's H with the mass halved: dH/dp = 2 p, twice the true velocity of the state."""
+
+    def time_derivative(self, q, p, extra=None):
+        return 2.0 * p, -3.0 * np.sin(q)
+
+
+def test_the_energy_rollout_reads_the_true_energy_of_the_predicted_state_not_the_learned_velocity():
+    from replication.evaluation.routines import _model_rollout
+
+    ctx = _context("hnn_energy", "hnn_pendulum", TwiceTheVelocity)
+    s = system_of(ctx.protocol)
+    q0, qd0, t = np.array([[0.3], [-1.0]]), np.array([[1.0], [0.5]]), np.linspace(0.0, 1.0, 11)
+    q, qd = _model_rollout(ctx, s, q0, qd0, t)
+    _, _, p = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
+    np.testing.assert_allclose(qd, p, rtol=1e-12)    # m = l = 1: the true velocity of (q, p) is p, not 2 p
+    energy = s.energy(q, qd, backend="numpy")
+    np.testing.assert_allclose(energy, p[..., 0] ** 2 / 2 - 3.0 * np.cos(q[..., 0]), rtol=1e-12)   # H_true(q, p)
