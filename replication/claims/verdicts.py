@@ -2,7 +2,8 @@
 
 ``units`` is the table of summary/units.csv (``frame(records)`` builds it from result.json records):
 one row per unit with claim, framework, model, seed, status, its metrics and ``final_train_loss``.
-Each part of the claim (``claims.parts``) is decided per framework, on the units whose status is "ok":
+Each part of the claim (``claims.parts``) is decided per framework (its rule reads the units whose status is
+"ok"; a failed unit is never dropped silently):
 
 1. a model the part reads (or controls) with a failed unit makes the part "inconclusive" (a failed seed is
    a failing seed, never dropped; the reason names it); a model with no unit at all, "not run";
