@@ -1,6 +1,6 @@
 """An HNN on canonical (q, p) rolled out by its own Hamiltonian, for every system.
 
-`canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momentum_kw=None) -> (q, qdot, p)`
+`canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momentum_kw=None) -> (q, p)`
   time_derivative(q, p, extra) -> (dH/dp, -dH/dq), each (B, dof) NumPy: the learned H's flow (a model
   adapter's `time_derivative`, `replication.evaluation.adapters`, or any callable of that form).
   s           the `systems.System` the model learned; it gives only the initial momentum,
@@ -11,14 +11,13 @@
               trajectory (they ride in the integrated state with rate 0).
   momentum_kw the system's per-sample parameters for p0 (each (B,)), e.g. {"g": g}; None for none.
   The suite's RK4 (`rollout.rollout`, float64 state, each output interval in equal steps of at most dt)
-  integrates Hamilton's equations of the learned H, dq/dt = dH/dp, dp/dt = -dH/dq. The velocity the metrics
-  read is the learned H's own dH/dp at each output sample (`velocity`); M(q)^-1 p is never used: it is the
-  velocity only where the kinetic energy is quadratic in qdot (not for the relativistic particle, where
-  the system has no mass matrix).
-  Returns q, qdot, p, each (B, T, dof) float64; a trajectory whose state turns non-finite is NaN from then on.
+  integrates Hamilton's equations of the learned H, dq/dt = dH/dp, dp/dt = -dH/dq.
+  Returns q, p, each (B, T, dof) float64; a trajectory whose state turns non-finite is NaN from then on. No
+  velocity is computed here: the evaluations read the true one at each state (`state_velocity`), and the
+  learned H's own, where wanted, is `velocity`.
 
-`velocity(time_derivative, q, p, extra=None) -> qdot`: dH/dp at states q, p (B, T, dof), extra (B, k) or
-  None; NaN where the state is non-finite (the model is not called there).
+`velocity(time_derivative, q, p, extra=None) -> qdot`: the learned dH/dp at states q, p (B, T, dof), extra
+  (B, k) or None; NaN where the state is non-finite (the model is not called there).
 `state_velocity(s, q, p, momentum_kw=None) -> qdot`: the true system's velocity at the canonical state (q, p)
   (..., dof): the qdot with dL/dqdot(q, qdot) = p, by Newton's method on the momentum map with the system's
   velocity Hessian from qdot = 0 (exact in one step where the kinetic energy is quadratic: M(q)^-1 p), each
@@ -48,8 +47,7 @@ def canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momen
         return np.concatenate([qdot, pdot, np.zeros((len(z), k))], 1)
 
     z = rollout(field, np.concatenate([q0, p0, rest], 1), t, dt)
-    q, p = z[..., :d], z[..., d:2 * d]
-    return q, velocity(time_derivative, q, p, extra), p
+    return z[..., :d], z[..., d:2 * d]
 
 
 def velocity(time_derivative, q, p, extra=None):

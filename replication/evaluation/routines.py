@@ -180,7 +180,7 @@ def _model_rollout(ctx, s, q0, qd0, t):
     if p.task == "hamiltonian" and p.data.coords == "qp":
         # in (q, p) by its own H; the true system's velocity at each predicted state (q, p), so that its energy
         # is H_true(q, p), as the HNN paper measures it
-        q, _, pp = canonical_rollout(m.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
+        q, pp = canonical_rollout(m.time_derivative, s, q0, qd0, t, ctx.cfg["dt"])
         return q, state_velocity(s, q, pp)
     if p.task == "hamiltonian":
         f = hamiltonian_field(lambda x, y: m.time_derivative(x, y, None), d)

@@ -86,7 +86,7 @@ def _model_rollout(ctx, s, q0, qd0, names, inputs, t):
     p, d = ctx.protocol, q0.shape[1]
     if p.task == "hamiltonian" and p.data.coords == "qp":   # in (q, p) by its own H; the true velocity there
         kw = {k: inputs[i][:, 0] for i, k in enumerate(names)}
-        q, _, pp = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"],
+        q, pp = canonical_rollout(ctx.model.time_derivative, s, q0, qd0, t, ctx.cfg["dt"],
                                      extra=np.concatenate(inputs, 1) if names else None, momentum_kw=kw)
         return q, state_velocity(s, q, pp, kw)
     z0 = np.concatenate([q0, qd0, *inputs], 1)
