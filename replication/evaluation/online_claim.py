@@ -49,8 +49,7 @@ DEFAULTS = {"seconds": 30.0, "every": O.EVERY, "steps": O.STEPS, "batch": O.BATC
             "window": O.WINDOW, "threshold": O.THRESHOLD, "sustain": O.SUSTAIN, "n_unseen": O.N_UNSEEN,
             "unseen_duration": C.DURATION, "tail": 0.25}
 LEARNERS = {"delan": "delan", "baseline": "ff"}   # model kind -> the online learner's kind
-TIMES = ("t_reach_s", "t_first_cross_s", "t_settle_s")   # NaN in the study's summary (never) -> +inf here
-SUMMARY = (*TIMES, "first_window_mse", "final_window_mse", "final_ratio_to_pd",
+SUMMARY = (*O.TIMES, "first_window_mse", "final_window_mse", "final_ratio_to_pd",
            "inference_us_mean", "learning_us_mean", "compute_us_mean", "compute_us_p99")
 
 
@@ -130,7 +129,7 @@ def eval_online(ctx) -> Evaluation:
     bad = scores["unseen_diverged"] > 0
     out = Evaluation()
     m = out.metrics
-    m.update({k: math.inf if k in TIMES and math.isnan(row[k]) else row[k] for k in SUMMARY})
+    m.update({k: math.inf if k in O.TIMES and math.isnan(row[k]) else row[k] for k in SUMMARY})
     m["null_final_window_mse"] = float(pd_w["track_mse"].iloc[-1])
     tail = max(1, math.ceil(s["tail"] * len(w) - 1e-9))
     m["tail_mse"] = float(w["track_mse"].iloc[-tail:].mean())

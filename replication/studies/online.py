@@ -57,6 +57,7 @@ SUSTAIN = 5.0       # seconds the bar must hold to count as reached: 10 windows,
 N_UNSEEN = 8
 PERIOD_US = 1e6 / C.RATE
 KEY = ["controller", "framework", "seed"]
+TIMES = ("t_reach_s", "t_first_cross_s", "t_settle_s")   # the summary's times to the bar (NaN: never)
 CURVE_COLUMNS = [*KEY, "t_start", "track_mse", "ratio_to_pd", "n_diverged", "inference_us_per_tick",
                  "learning_us_per_tick", "steps"]
 SUMMARY_COLUMNS = [*KEY, "threshold", "sustain", "t_reach_s", "t_first_cross_s", "t_settle_s", "first_window_mse",

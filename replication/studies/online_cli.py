@@ -75,11 +75,10 @@ def cmd_online(args):
         _, summary = O.write_study(folder, settings={"threads": threads}, progress=bar.update, **kw)
     finally:
         bar.close()
-    times = ("t_reach_s", "t_first_cross_s", "t_settle_s")
-    cols = ["controller", "framework", "seed", *times, "final_ratio_to_pd", "unseen_ratio_to_pd",
+    cols = ["controller", "framework", "seed", *O.TIMES, "final_ratio_to_pd", "unseen_ratio_to_pd",
             "inference_us_mean", "learning_us_mean", "compute_us_p99", "fits_period_mean", "fits_period_p99"]
     table = summary[cols].astype(object)
-    for c in times:
+    for c in O.TIMES:
         table[c] = ["never" if math.isnan(x) else f"{x:g}" for x in summary[c]]
     print(table.to_string(index=False, float_format=lambda x: f"{x:.3g}", na_rep="-"))
     print(f"the bar: a window's tracking MSE at most {kw['threshold']:g} x PD alone's. t_reach_s: the end of the "
