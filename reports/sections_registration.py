@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from replication.tuning.search import SIZE as SEARCH_SIZE
 from reports.document import Section, Table
 from reports.fmt import cell
 from reports.load import Results
@@ -57,10 +58,15 @@ def tuning_table(res: Results) -> pd.DataFrame | None:
         if not most:
             continue
         for model, t in tuning.items():
+            confirmed = t.get("confirm_seeds") or []
+            flags = ["LESS TUNING than a rival"] * (t["configs_tried"] < most)
+            searched = t["configs_tried"] > 0   # 0: by hand
+            flags += [f"partial search ({t['configs_tried']} of {SEARCH_SIZE})"] * (0 < t["configs_tried"] < SEARCH_SIZE)
+            flags += ["unconfirmed: one seed"] * (searched and len(confirmed) < 2)
             rows.append({"claim": claim["id"], "model": model, "configurations": t["configs_tried"],
                          "scored on": cell(t["scored_on"]), "dev seeds": ", ".join(map(str, t["seeds"])) or "-",
-                         "chosen": _knobs(t["knobs"]),
-                         "flag": "LESS TUNING than a rival" if t["configs_tried"] < most else ""})
+                         "confirmed on": ", ".join(map(str, confirmed)) or "-", "chosen": _knobs(t["knobs"]),
+                         "flag": "; ".join(flags)})
     return pd.DataFrame(rows) if rows else None
 
 
@@ -96,8 +102,11 @@ def add_to(s: Section, res: Results) -> None:
                          "configurations for every model, scored on the development split) or by hand."))
     ledger = tuning_table(res)
     if ledger is not None:
-        s.add(Table("Tuning ledger", ledger, ["replication/claims/tuned.json", "docs/lab/tuning/*/ledger.json"],
+        s.add(Table("Tuning ledger", ledger, ["replication/claims/tuned.json", "docs/lab/search/*/ledger.json"],
                     note="Per model of a tuned claim: how many configurations of the declared search (peak rate "
-                         "x 1/3, 1, 3; hidden widths x 1/2, 1, 2; the registered setting among them) it was "
-                         "chosen among, on which split and seeds, and the choice as multiples of the registered "
-                         "setting. Claims not listed were tuned by hand."))
+                         f"x 1/3, 1, 3 by hidden widths x 1/2, 1, 2: {SEARCH_SIZE}, the registered setting among them, "
+                         "one step further where a model's best lies on an edge) it was chosen among, on which "
+                         "split and seeds, the development seeds its choice was confirmed on against the "
+                         "registered setting, and the choice as multiples of the registered setting. A partial "
+                         "search (fewer configurations) or an unconfirmed choice is flagged. Claims not listed "
+                         "were tuned by hand."))

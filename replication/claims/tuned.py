@@ -3,7 +3,8 @@
 `tuned.json` (beside this file): {claim id: {profile: record}}, a record being {"ledger_hash" (the
 `canonical_hash` of the adopted ledger.json), "split" ("dev", the only split a choice may read), "seeds",
 "frameworks", "configs" (configurations tried per model), "search" (the knobs and their values), "adopted"
-(the date), "models": {label: {"knobs", "configs_tried", "score"}}}. Written by
+(the date), "ledger" (its file, where the adopted search names it), "models": {label: {"knobs",
+"configs_tried", "score", "confirm_seeds"}}}. Written by
 `python -m replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
 
 `with_knobs(entry, base, profile, knobs) -> ModelEntry`: the entry with the knob values applied under
@@ -128,8 +129,10 @@ def tuning(claim, profile: str) -> dict:
         rec, names = _serving(written, entry, profile)
         chosen = _chosen(claim, rec, names, m.label)
         out[m.label] = ({"configs_tried": chosen["configs_tried"], "scored_on": rec["split"], "knobs": chosen["knobs"],
-                         "seeds": rec["seeds"], "ledger_hash": rec["ledger_hash"]} if chosen else
-                        {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": [], "ledger_hash": None})
+                         "seeds": rec["seeds"], "confirm_seeds": chosen.get("confirm_seeds", []),
+                         "ledger_hash": rec["ledger_hash"]} if chosen else
+                        {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": [], "confirm_seeds": [],
+                         "ledger_hash": None})
     return out
 
 

@@ -4,37 +4,58 @@ from __future__ import annotations
 from replication.claims.base import PROFILES
 
 
+def _num(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
 def cmd_tune(args):
     from replication.tuning.tune import tune
 
     frameworks = tuple(x.strip() for x in args.frameworks.split(",") if x.strip()) or ("jax",)
     ledger = tune(args.claim, profile=args.profile, n_configs=args.configs, n_seeds=args.seeds,
-                  frameworks=frameworks, out=args.out or f"results/tune/{args.claim}", progress=not args.quiet,
+                  frameworks=frameworks, out=args.out or f"results/tune/{args.claim}_{args.profile}",
+                  progress=not args.quiet, record=args.record, confirm=args.confirm, dry_run=args.dry_run,
                   widths=[x for x in args.widths.split(",") if x.strip()] if args.widths else None)
+    if ledger is None:
+        return 0
     for label, m in ledger["models"].items():
-        scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in m["scores"].items())
-        print(f"{label:<22} chose config {m['chosen']} {m['chosen_knobs']} of {m['configs_tried']} ({scores})")
+        scores = ", ".join(f"{k}: {_num(v)}" for k, v in m["scores"].items())
+        confirmed = ("" if not m["confirmation"] else " confirmed on seeds "
+                     + ",".join(map(str, m["confirm_seeds"])) + " ("
+                     + ", ".join(f"{k}: {_num(v)}" for k, v in m["confirmation"].items()) + ")")
+        print(f"{label:<22} chose config {m['chosen']} {m['chosen_knobs']} of {m['configs_tried']} "
+              f"({scores}){confirmed}")
+    c = ledger["compute"]
+    print(f"compute: {c['units']} units, {c['train_s'] / 3600:.2f} h of training")
     return 0
 
 
 def add_command(sub) -> None:
     s = sub.add_parser("tune", help="search every model of a claim alike on the development split",
-                       description="Train every model of a claim under the same declared search (peak rate x 1/3, "
-                       "1, 3; widths x 1/2, 1, 2; the registered setting first, then other combinations; budget, "
-                       "restarts and input scaling as registered) on the development seeds and draws, score each "
-                       "by its development held-out error, and write OUT/ledger.json and OUT/ledger.csv "
-                       "(configurations tried and chosen per model). It never reads the test split and never "
-                       "changes a claim: a ledger's choices become the claim's protocol when adopted "
-                       "(python -m replication.tuning.adopt OUT/ledger.json) and registered.")
+                       description="The declared search for every model of a claim, on the development seeds and "
+                       "draws: every combination of peak rate x 1/3, 1, 3 and widths x 1/2, 1, 2 (budget, restarts "
+                       "and input scaling as registered), one step further where a model's best lies on an edge "
+                       "(tried by every model alike), then the best and the registered setting confirmed on 3 "
+                       "development seeds; scored by the metric the claim's verdict reads (a pace study: by its "
+                       "pace, one configuration for all its arms). Writes OUT/ledger.json and OUT/ledger.csv. It "
+                       "never reads the test split and never changes a claim: a ledger's choices become the "
+                       "claim's protocol when adopted (python -m replication.tuning.adopt OUT/ledger.json) and "
+                       "registered.")
     s.add_argument("--claim", required=True, help="a claim id (see `lagbench list`)")
     s.add_argument("--profile", default="quick", choices=PROFILES, help="the budget to tune at (default: quick)")
-    s.add_argument("--configs", type=int, default=4,
-                   help="configurations per model, the same for every model (default: 4)")
-    s.add_argument("--widths", help="a width sweep instead of the search: comma-separated multipliers of the "
-                   "registered widths (e.g. 2,4,8), each at the registered rate, the registered setting first, "
-                   "every model alike (--configs is then unused)")
-    s.add_argument("--seeds", type=int, default=1, help="development seeds per configuration (default: 1)")
+    s.add_argument("--record", help="a CSV file of finished units (one small row each): appended to as units "
+                   "finish and read back on a rerun, so a search resumes from it on any machine (default: none)")
+    s.add_argument("--configs", type=int, help="a partial search for trials: the first N configurations only, no "
+                   "edge step and no confirmation; no claim may adopt it (default: the whole search)")
+    s.add_argument("--widths", help="a width sweep for trials instead of the search: comma-separated multipliers "
+                   "of the registered widths (e.g. 2,4,8), each at the registered rate, every model alike")
+    s.add_argument("--seeds", type=int, help="development seeds per configuration (default: 1; a pace study: its "
+                   "cohort of 8)")
+    s.add_argument("--confirm", type=int, default=3,
+                   help="development seeds the chosen and the registered configuration are compared on (default: 3)")
     s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")
-    s.add_argument("--out", help="results folder (default: results/tune/<claim>)")
+    s.add_argument("--out", help="results folder (default: results/tune/<claim>_<profile>)")
+    s.add_argument("--dry-run", action="store_true", help="print the first stage's trainings and their estimated "
+                   "time, and stop")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.set_defaults(func=cmd_tune)

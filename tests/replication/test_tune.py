@@ -10,7 +10,8 @@ from replication.claims.registration import protocol_hash
 from replication.cli import main
 from replication.run import splits
 from replication.training import data as datamod
-from replication.tuning import search
+from replication.tuning import choose, records, search
+from replication.tuning import tune as tune_module
 from replication.tuning.tune import tune
 
 
@@ -20,6 +21,73 @@ def test_configs_start_from_the_registered_setting_and_are_distinct():
     assert search.configs(5) == c   # the same list every time, for every model
     with pytest.raises(ValueError, match="--configs"):
         search.configs(0)
+
+
+def test_the_grid_is_every_combination_with_the_registered_setting_first():
+    g = search.grid()
+    assert len(g) == search.SIZE == 9 and g[0] == search.REGISTERED
+    assert {(c["lr"], c["width"]) for c in g} == {(a, b) for a in search.KNOBS["lr"] for b in search.KNOBS["width"]}
+
+
+def test_a_choice_on_an_edge_is_extended_one_step_in_that_direction_only():
+    g = search.grid()
+    inner = {"lr": 1.0, "width": 1.0}
+    assert search.extensions(g, [inner]) == []   # inside the grid: nothing to extend
+    assert search.extensions(g, [{"lr": 1.0, "width": 2.0}]) == [{"lr": 1.0, "width": 4.0}]
+    corner = search.extensions(g, [{"lr": 1 / 3, "width": 0.5}])
+    assert corner == [{"lr": 1 / 9, "width": 0.5}, {"lr": 1 / 3, "width": 0.25}]
+    # two models choosing the same edge add it once; the union is what every model tries
+    both = search.extensions(g, [{"lr": 1.0, "width": 2.0}, {"lr": 1.0, "width": 2.0}, {"lr": 3.0, "width": 1.0}])
+    assert both == [{"lr": 1.0, "width": 4.0}, {"lr": 9.0, "width": 1.0}]
+
+
+def _fake_search(monkeypatch, score):
+    """The search's stages on a made-up score(model, knobs, seed): no training, the choices and the record only."""
+    monkeypatch.setattr(tune_module, "run_units", lambda *a, **k: None)
+
+    def row(self, u, k, knobs):
+        return {"key": records.unit_key(u), "claim": self.claim.id, "profile": self.profile, "model": u.entry.label,
+                "config": k, "knob_lr": knobs["lr"], "knob_width": knobs["width"], "framework": u.framework,
+                "seed": u.seed, "split": u.split, "status": "ok", "metric": choose.PACE if self.claim.pooled else "heldout_l1",
+                "score": score(u.entry.label, knobs, u.seed), "train_time_s": 1.0, "train_samples": 10, "cpu": "x"}
+    monkeypatch.setattr(tune_module._Runner, "_row", row)
+
+
+def test_the_whole_search_extends_an_edge_for_every_model_and_confirms_on_three_seeds(tmp_path, monkeypatch):
+    def score(label, knobs, seed):
+        if label == "lnn":   # best at the largest width: an edge, so width x 4 is tried (by both models)
+            return 1.0 / knobs["width"] + 0.01 * abs(knobs["lr"] - 1)
+        # the baseline: config (lr 3, width 1) best on seed 0 by luck, the registered one on seeds 1 and 2
+        lucky = knobs == {"lr": 3.0, "width": 1.0}
+        return (0.5 if seed == 0 else 3.0) if lucky else 1.0 + 0.1 * seed
+    _fake_search(monkeypatch, score)
+    record = tmp_path / "record" / "units.csv"
+    ledger = tune("dp_loss", profile="smoke", out=tmp_path / "out", progress=False, record=record)
+    assert ledger["kind"] == "search" and ledger["stages"] == ["grid", "edge", "confirmation"]
+    lnn, base = ledger["models"]["lnn"], ledger["models"]["baseline"]
+    assert lnn["configs_tried"] == base["configs_tried"] == 11   # the grid, width x 4 and lr x 9 for both
+    assert ledger["configs"][9] == {"lr": 1.0, "width": 4.0} and ledger["configs"][10] == {"lr": 9.0, "width": 1.0}
+    assert lnn["chosen_knobs"] == {"lr": 1.0, "width": 4.0} and lnn["confirm_seeds"] == [0, 1, 2]
+    assert set(lnn["confirmation"]) == {9, 0}
+    assert base["first_choice"] == 7 and base["chosen"] == 0   # the lucky seed is overruled by the confirmation
+    assert base["confirmation"][7] == pytest.approx((0.5 + 3 + 3) / 3)
+    assert ledger["compute"]["units"] == len(records.read(record))
+    # a fresh machine with the committed record: nothing trained again, the same ledger
+    monkeypatch.setattr(tune_module._Runner, "_row", lambda *a: pytest.fail("a recorded unit was redone"))
+    again = tune("dp_loss", profile="smoke", out=tmp_path / "fresh", progress=False, record=record)
+    assert again["models"] == ledger["models"]
+
+
+def test_an_ablation_gives_every_arm_one_configuration(tmp_path, monkeypatch):
+    prefer = {"lnn_init-cranmer2020": 2.0, "lnn_init-xavier": 1.0, "lnn_init-kaiming": 1.0, "lnn_init-pytorch_default": 0.5}
+
+    def score(label, knobs, seed):   # each arm's own best width differs; most arms prefer width x 1
+        return 1000.0 * (1 + abs(knobs["width"] - prefer[label])) * (1 + abs(knobs["lr"] - 1)) + seed
+    _fake_search(monkeypatch, score)
+    ledger = tune("init_study", profile="smoke", n_seeds=2, out=tmp_path, progress=False)
+    chosen = {m["chosen"] for m in ledger["models"].values()}
+    assert len(chosen) == 1 and ledger["configs"][chosen.pop()] == {"lr": 1.0, "width": 1.0}
+    assert "mean_rank" in ledger["joint"] and all(m["confirm_seeds"] == [0, 1] for m in ledger["models"].values())
 
 
 def test_apply_changes_only_the_knobs():
@@ -49,9 +117,12 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
         return real(protocol, seed, **kw)
     monkeypatch.setattr(datamod, "heldout", heldout)
     before = protocol_hash(get("dp_loss"), "smoke")
-    ledger = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
+    ledger = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False,
+                  record=tmp_path / "units.csv")
     assert set(seen) == {splits.DEV.heldout_seed}   # never the test draw
-    assert ledger["split"] == "dev" and ledger["seeds"] == [0]
+    assert ledger["split"] == "dev" and ledger["seeds"] == [0] and ledger["kind"] == "partial search"
+    rows = records.read(tmp_path / "units.csv")
+    assert len(rows) == 4 and {r["metric"] for r in rows.values()} == {"heldout_l1"}
     models = ledger["models"]
     assert set(models) == {"lnn", "baseline"}
     for m in models.values():
@@ -66,6 +137,13 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
     monkeypatch.setattr("replication.tuning.tune.run_units", lambda units, *a, **k: ran.append(units))
     again = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
     assert ran == [] and again["models"] == ledger["models"]
+    # a changed protocol is another unit: its recorded row is not reused
+    u = tune_module._Runner(untuned("dp_loss"), "smoke", ["lnn"], ("jax",), tmp_path, None, False).units(
+        search.REGISTERED, ["lnn"], [0])[0]
+    assert records.unit_key(u) in rows
+    import dataclasses
+    other = dataclasses.replace(u, entry=search.apply(u.entry, u.claim.protocol("smoke"), "smoke", {"lr": 1.0, "width": 1.5}))
+    assert records.unit_key(other) not in rows
 
 
 def test_tune_command_refuses_a_bad_count_in_one_line(tmp_path, capsys):
@@ -92,7 +170,8 @@ def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_p
     assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
     widths = [{u.entry.label: u.entry.widths("smoke") for u in units} for units in trained]
     base = untuned("dp_loss").entry("lnn").widths("smoke")
-    assert widths == [{"lnn": base, "baseline": base}, {"lnn": tuple(2 * w for w in base), "baseline": tuple(2 * w for w in base)}]
+    double = tuple(2 * w for w in base)   # each model's units of a configuration run as one (the record grows per model)
+    assert widths == [{"lnn": base}, {"baseline": base}, {"lnn": double}, {"baseline": double}]
 
 
 def test_a_pace_study_is_tuned_by_its_pace_over_a_sample_of_seeds(tmp_path):

@@ -15,13 +15,15 @@ from replication.tuning import adopt
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _ledger(claim_id="hnn_energy", profile="quick", split="dev", tried=4, knobs=None, drop=()):
+def _ledger(claim_id="hnn_energy", profile="quick", split="dev", tried=9, knobs=None, drop=(), kind="search",
+            confirm=(0, 1, 2), first=9):
     claim = untuned(claim_id)
     labels = [m.label for m in claim.models if m.train and m.runs_in(profile) and m.label not in drop]
     knobs = knobs or {"lr": 1 / 3, "width": 2.0}
     return {"claim": claim_id, "profile": profile, "split": split, "search": {"lr": [1 / 3, 1, 3], "width": [0.5, 1, 2]},
-            "seeds": [0], "frameworks": ["jax"],
-            "models": {x: {"configs_tried": tried if i else 4, "scored_on": split, "chosen": 1, "chosen_knobs": knobs,
+            "seeds": [0], "frameworks": ["jax"], "kind": kind,
+            "models": {x: {"configs_tried": tried if i else first, "scored_on": split, "chosen": 1, "chosen_knobs": knobs,
+                           "confirm_seeds": list(confirm), "confirmation": {"0": 2.5, "1": 1.5},
                            "scores": {"0": 2.0, "1": 1.0}} for i, x in enumerate(labels)}}
 
 
@@ -41,7 +43,8 @@ def _write(tmp_path, ledger) -> Path:
 
 def test_adopt_applies_the_choice_under_its_profile_only(record_file):
     rec = adopt.adopt(_write(record_file, _ledger()), today="2026-01-01")
-    assert rec["split"] == "dev" and rec["configs"] == 4 and rec["adopted"] == "2026-01-01"
+    assert rec["split"] == "dev" and rec["configs"] == 9 and rec["adopted"] == "2026-01-01"
+    assert all(m["score"] == 1.5 and m["confirm_seeds"] == [0, 1, 2] for m in rec["models"].values())
     claim = tuned.apply(untuned("hnn_energy"))
     written = untuned("hnn_energy")
     for m, w in zip(claim.models, written.models, strict=True):
@@ -54,7 +57,7 @@ def test_adopt_applies_the_choice_under_its_profile_only(record_file):
         assert m.widths("full") == m.widths("quick")
         assert m.protocol(claim.protocol("full"), "full") == m.protocol(claim.protocol("quick"), "quick")
     t = tuned.tuning(claim, "quick")
-    assert all(x["configs_tried"] == 4 and x["scored_on"] == "dev" for x in t.values()) and tuned.equal(t)
+    assert all(x["configs_tried"] == 9 and x["scored_on"] == "dev" for x in t.values()) and tuned.equal(t)
     assert tuned.tuning(claim, "full") == t
     assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuned.tuning(claim, "paper").values())
 
@@ -69,7 +72,11 @@ def test_a_profile_that_runs_otherwise_than_quick_keeps_its_own_setting(record_f
 
 @pytest.mark.parametrize("ledger, says", [
     (_ledger(split="test"), "development split"),
-    (_ledger(tried=2), "unequal"),
+    (_ledger(tried=10), "unequal"),
+    (_ledger(tried=4, first=4), "the search has 9"),
+    (_ledger(kind="partial search"), "not the whole declared search"),
+    (_ledger(kind="width sweep"), "not the whole declared search"),
+    (_ledger(confirm=(0,)), "not confirmed on 3"),
     (_ledger(drop=("baseline_spring",)), "baseline_spring"),
     ({"models": {}}, "not a ledger"),
 ])
@@ -108,17 +115,19 @@ def test_a_claim_that_trains_under_another_profiles_protocol_takes_that_profiles
         assert (m.protocol(precision.protocol("full"), "full").schedule
                 == loss.entry("baseline").protocol(loss.protocol("quick"), "quick").schedule)
     assert loss.entry("baseline").widths("full") == tuple(x // 2 for x in untuned("dp_loss").entry("baseline").widths("full"))
-    assert all(x["configs_tried"] == 4 for x in tuned.tuning(precision, "full").values())
+    assert all(x["configs_tried"] == 9 for x in tuned.tuning(precision, "full").values())
 
 
 def test_every_adopted_choice_is_its_committed_ledgers():
-    """Each record of tuned.json names the ledger it came from by hash; that ledger is committed under
-    docs/lab/tuning/<claim>/ (quick's) or docs/lab/tuning/<claim>_<profile>/ and chose exactly those knobs, on
-    the development split, for every model alike."""
+    """Each record of tuned.json names the ledger it came from by hash; that ledger is committed (at the
+    record's `ledger` path; an earlier search's under docs/lab/tuning/<claim>/ for quick or
+    docs/lab/tuning/<claim>_<profile>/) and chose exactly those knobs, on the development split, for every
+    model alike."""
     for claim_id, per in tuned.records().items():
         for profile, rec in per.items():
             folder = claim_id if profile == "quick" else f"{claim_id}_{profile}"
-            ledger = json.loads((ROOT / "docs" / "lab" / "tuning" / folder / "ledger.json").read_text())
+            path = ROOT / rec["ledger"] if "ledger" in rec else ROOT / "docs" / "lab" / "tuning" / folder / "ledger.json"
+            ledger = json.loads(path.read_text())
             assert canonical_hash(ledger, 16) == rec["ledger_hash"] and ledger["profile"] == profile
             assert ledger["split"] == rec["split"] == "dev"
             for label, m in rec["models"].items():
@@ -136,18 +145,22 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
 
     def prereg(tuning):
         return {"protocol_hash": "x", "registered": True, "frozen": "2026-01-01", "registrations": 1, "tuning": tuning}
-    t = {"configs_tried": 4, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0]}
+    t = {"configs_tried": 9, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0], "confirm_seeds": [0, 1, 2]}
     hand = {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": []}
-    res = SimpleNamespace(claims=[{"id": "a"}, {"id": "b"}, {"id": "c"}], run={"profile": "quick"}, verdict_profile="quick",
+    partial = {**t, "configs_tried": 4, "confirm_seeds": []}   # an earlier search: 4 configurations, one seed
+    res = SimpleNamespace(claims=[{"id": "a"}, {"id": "b"}, {"id": "c"}, {"id": "d"}], run={"profile": "quick"},
+                          verdict_profile="quick",
                           verdicts={"a": {"preregistration": prereg({"lnn": t, "baseline": hand})},
                                     "b": {"preregistration": prereg({"hnn": t, "baseline": t})},
-                                    "c": {"preregistration": prereg({"lgn": hand})}})
+                                    "c": {"preregistration": prereg({"lgn": hand})},
+                                    "d": {"preregistration": prereg({"lgn": partial})}})
     reg = sr.registration_table(res).set_index("claim")["tuning"]
-    assert reg["a"].startswith("UNEQUAL") and "4 configurations per model (dev)" in reg["b"] and reg["c"] == "by hand, no search"
-    ledger = sr.tuning_table(res)
-    flagged = ledger[ledger["flag"] != ""]
-    assert list(zip(flagged["claim"], flagged["model"], strict=True)) == [("a", "baseline")]
-    assert set(ledger["claim"]) == {"a", "b"}
+    assert reg["a"].startswith("UNEQUAL") and "9 configurations per model (dev)" in reg["b"] and reg["c"] == "by hand, no search"
+    ledger = sr.tuning_table(res).set_index(["claim", "model"])
+    assert ledger.loc[("a", "baseline"), "flag"] == "LESS TUNING than a rival"
+    assert ledger.loc[("d", "lgn"), "flag"] == "partial search (4 of 9); unconfirmed: one seed"
+    assert ledger.loc[("b", "hnn"), "flag"] == "" and ledger.loc[("b", "hnn"), "confirmed on"] == "0, 1, 2"
+    assert set(ledger.index.get_level_values(0)) == {"a", "b", "d"}
 
 
 def test_the_scorecard_says_in_one_paragraph_how_each_claim_was_chosen():
