@@ -18,7 +18,8 @@ each finished unit is also appended to that CSV as one small row (`records`): a 
 committed record trains only what is missing, on any machine. Before each stage `lagbench tune` prints the
 trainings left and their estimated time (`replication.run.estimate`); `dry_run` prints the first stage's
 and stops. The ledger goes to OUT/ledger.json and OUT/ledger.csv: per model the configurations tried, their
-scores, the confirmation, the chosen one, and the compute the search took.
+scores, the confirmation, the chosen one, and the compute the search took; with `record`, beside the record
+too (the folder to commit and adopt from).
 What it does not do: change a claim. A ledger's choices reach the claim only when adopted
 (`python -m replication.tuning.adopt OUT/ledger.json`) and registered (a new dated line).
 """
@@ -175,9 +176,10 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
         if not claim.pooled and confirm > n_seeds:
             confirmation = _confirm(runner, claim, configs, first, seeds, splits.DEV.seeds(confirm))
     df = pd.DataFrame(runner.rows)
-    R.write_csv(out / "ledger.csv", df.drop(columns=["key"]))
     ledger = _ledger(claim, profile, kind, configs, seeds, frameworks, df, first, ranks, confirmation, labels)
-    R.write_json(out / "ledger.json", ledger)
+    for folder in dict.fromkeys([out, *([record.parent] if record is not None else [])]):
+        R.write_csv(folder / "ledger.csv", df.drop(columns=["key"]))
+        R.write_json(folder / "ledger.json", ledger)
     return ledger
 
 

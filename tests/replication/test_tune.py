@@ -76,6 +76,10 @@ def test_the_whole_search_extends_an_edge_for_every_model_and_confirms_on_three_
     monkeypatch.setattr(tune_module._Runner, "_row", lambda *a: pytest.fail("a recorded unit was redone"))
     again = tune("dp_loss", profile="smoke", out=tmp_path / "fresh", progress=False, record=record)
     assert again["models"] == ledger["models"]
+    assert json.loads((record.parent / "ledger.json").read_text())["models"] == json.loads(json.dumps(ledger["models"]))
+    from replication.tuning import summary
+    text = summary.table([record.parent / "ledger.json"])
+    assert "| dp_loss | smoke | lnn | 11 | lr x1, width x4 |" in text and "| dp_loss | smoke | baseline | 11 | lr x1, width x1 |" in text
 
 
 def test_an_ablation_gives_every_arm_one_configuration(tmp_path, monkeypatch):
