@@ -1,7 +1,8 @@
 """The framework-neutral model spec: one frozen dataclass both frameworks build from.
 
 `ModelSpec(kind, dof, hidden, activation, init, dtype, extra_inputs, formulation, n_out,
-angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius, lorentz_factor, dissipation, periodic)` is
+angle_wrap, input_scale, delan_eps, delan_diag_offset, lgn_radius, lorentz_factor, dissipation, periodic, factory,
+factory_source, scale_q_before_grad)` is
 validated on creation (unknown names and bad sizes raise ValueError listing what is valid) and round-trips
 through `to_dict()` / `from_dict()` (plain JSON types).
 
@@ -114,6 +115,12 @@ class ModelSpec:
     factory, factory_source: kind "user" only: "module:function" (or "path/file.py:function") returning
         the torch.nn.Module or equinox Module, and the sha256 (16 hex digits) of the file that defines it, so an edited
         module is a new spec and never reuses a cached training (`models.user`). Left out while None.
+    scale_q_before_grad: lnn with an input_scale: the original LNN code's convention (its relativistic notebook
+        forms q / 10 before jax.grad): the Euler-Lagrange equation takes L's q-derivatives with respect to the
+        scaled q part x_q = s_q f(q), not q, so neither dL/dq = (df/dq)^T dL/dx_q nor the mixed term's tangent
+        (df/dq) qdot carries the chain-rule factor s_q; H, qdot and the velocity side are unchanged. With s_q the
+        same on every slot, qddot is the differentiated-through one divided by s_q. The model's `lagrangian` has the
+        same value; its q-derivative is dL/dx_q chained through f only. Left out of `to_dict` while False.
     """
 
     kind: str
@@ -135,6 +142,7 @@ class ModelSpec:
     periodic: tuple = ()
     factory: str | None = None
     factory_source: str | None = None
+    scale_q_before_grad: bool = False
 
     def __post_init__(self):
         _choices("kind", self.kind, (*KINDS, USER_KIND))
@@ -182,6 +190,11 @@ class ModelSpec:
                 raise ValueError(f"input_scale needs {self.mlp_sizes()[0]} entries (the MLP input width), "
                                  f"got {len(scale)}")
             object.__setattr__(self, "input_scale", scale)
+        if not isinstance(self.scale_q_before_grad, bool):
+            raise ValueError(f"scale_q_before_grad must be True or False, got {self.scale_q_before_grad!r}")
+        if self.scale_q_before_grad and (self.kind != "lnn" or self.input_scale is None):
+            raise ValueError(f"scale_q_before_grad is for kind 'lnn' with an input_scale, not {self.kind!r} "
+                             f"(input_scale {self.input_scale})")
 
     def _check_periodic(self):
         periodic = self.periodic
@@ -215,7 +228,7 @@ class ModelSpec:
         d["hidden"] = list(self.hidden)
         d["input_scale"] = None if self.input_scale is None else list(self.input_scale)
         d["periodic"] = list(self.periodic)
-        for k in ("lorentz_factor", "dissipation", "periodic"):
+        for k in ("lorentz_factor", "dissipation", "periodic", "scale_q_before_grad"):
             if not d[k]:
                 del d[k]
         for k in ("factory", "factory_source"):

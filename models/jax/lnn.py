@@ -113,6 +113,14 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
     return hess.reshape(*q.shape, d)
 
 
+def _scaled_q_part(x, f, nq):
+    """x's q slots with their value s_q f(q) (exactly x's) but the q-derivative df/dq, for
+    `ModelSpec.scale_q_before_grad`: the original LNN code forms q / 10 before jax.grad, so its dL/dq and mixed
+    term are those in the scaled q, without the factor s_q. f - stop_gradient(f) is exactly 0 and carries f's
+    derivatives."""
+    return lax.stop_gradient(x[..., :nq]) + (f - lax.stop_gradient(f))
+
+
 class LNN(Model):
     """L = MLP([f(q), qdot, extra]) (f: `q_features`); q, qdot (..., dof), extra (..., extra_inputs) or None.
 
@@ -121,8 +129,11 @@ class LNN(Model):
     (XLA's forward-over-reverse also pushes the d + 1 tangents back through the network)."""
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [q_features(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
-        return mlp(self.params, x, self.spec)[..., 0]
+        spec, f = self.spec, q_features(self.spec, q)
+        x = mlp_input(spec, [f, *velocity_parts(spec, qdot), *self._parts(extra)])
+        if spec.scale_q_before_grad:   # the original's convention: q-derivatives in the scaled x_q = s_q f(q)
+            x = jnp.concatenate([_scaled_q_part(x, f, spec.q_width()), x[..., spec.q_width():]], axis=-1)
+        return mlp(self.params, x, spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
@@ -131,12 +142,15 @@ class LNN(Model):
         s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has
         no qdot in it: H needs none of its curvature). With the Lorentz factor, x = scale * [f(q), qdot,
         gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k) in the gamma slot k, and H gains the
-        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma'')."""
+        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma''). With spec.scale_q_before_grad both q-side
+        factors s_q are 1: the q-derivatives are taken in the scaled x_q, as the original code does."""
         spec, (n, d) = self.spec, q.shape
         x = mlp_input(spec, [q_features(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype)
         nq = spec.q_width()
         s_q, s_qd, s_g = scale[:nq], scale[nq:nq + d], scale[nq + d:nq + 2 * d]
+        if spec.scale_q_before_grad:   # q-derivatives in the scaled x_q (the original's convention): no factor s_q
+            s_q = jnp.ones_like(s_q)
         tangents = jnp.zeros((n, d + 1, x.shape[-1]), dtype=x.dtype)
         tangents = tangents.at[:, :d, nq:nq + d].set(jnp.diag(s_qd))
         tangents = tangents.at[:, d, :nq].set(q_features_jvp(spec, q, qdot) * s_q)

@@ -165,6 +165,14 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
     return hess.reshape(*q.shape, d)
 
 
+def _scaled_q_part(x, f, nq):
+    """x's q slots with their value s_q f(q) (exactly x's) but the q-derivative df/dq, for
+    `ModelSpec.scale_q_before_grad`: the original LNN code forms q / 10 before jax.grad, so its dL/dq and mixed
+    term are those in the scaled q, without the factor s_q. f - f.detach() is exactly 0 and carries f's
+    derivatives (detach stops the gradient under torch.func's transforms too)."""
+    return x[..., :nq].detach() + (f - f.detach())
+
+
 class LNN(Model):
     """L = MLP([f(q), qdot, extra]) (f: `q_features`); q, qdot (..., dof), extra (..., extra_inputs) or None.
 
@@ -177,8 +185,11 @@ class LNN(Model):
         return spec.formulation == "fast"
 
     def _lagrangian(self, q, qdot, extra=None):
-        x = mlp_input(self.spec, [q_features(self.spec, q), *velocity_parts(self.spec, qdot), *self._parts(extra)])
-        return mlp(self.params, x, self.spec)[..., 0]
+        spec, f = self.spec, q_features(self.spec, q)
+        x = mlp_input(spec, [f, *velocity_parts(spec, qdot), *self._parts(extra)])
+        if spec.scale_q_before_grad:   # the original's convention: q-derivatives in the scaled x_q = s_q f(q)
+            x = torch.cat([_scaled_q_part(x, f, spec.q_width()), x[..., spec.q_width():]], dim=-1)
+        return mlp(self.params, x, spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
         """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
@@ -187,12 +198,15 @@ class LNN(Model):
         s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has
         no qdot in it: H needs none of its curvature). With the Lorentz factor, x = scale * [f(q), qdot,
         gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k) in the gamma slot k, and H gains the
-        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma'')."""
+        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma''). With spec.scale_q_before_grad both q-side
+        factors s_q are 1: the q-derivatives are taken in the scaled x_q, as the original code does."""
         spec, lead, d = self.spec, q.shape[:-1], q.shape[-1]   # lead: (B,), or (K, B) for stacked members
         x = mlp_input(spec, [q_features(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         nq = spec.q_width()
         s_q, s_qd, s_g = scale[:nq], scale[nq:nq + d], scale[nq + d:nq + 2 * d]
+        if spec.scale_q_before_grad:   # q-derivatives in the scaled x_q (the original's convention): no factor s_q
+            s_q = torch.ones_like(s_q)
         width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
         used = nq + (2 * d if spec.lorentz_factor else d)
         zeros = torch.zeros((d, width - used), dtype=x.dtype, device=x.device)

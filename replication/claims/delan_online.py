@@ -7,9 +7,9 @@ model (claim 9's DeLaN or feed-forward net, at claim 9's widths) starts untraine
 seed, and learns while it gives the feed-forward torque of the computed-torque controller of the two-link arm
 at 500 Hz, one optimiser step of 64 samples of its replay buffer every tick, for `seconds` of simulated time
 on the training family's references (`replication.evaluation.online_claim`). Nothing is trained offline
-(`train=False`): both models take the online learner's fixed settings (claim 9's optimiser: Adam at 1e-3,
-torque MSE plus L2 1e-5; the protocol below records them, its steps being the loop's ticks), none searched by
-`lagbench tune`, so the two are tuned alike. The part reads a sustained crossing, `t_reach_s`: the end of the
+(`train=False`): both models learn with their protocol's settings (claim 9's optimiser: Adam at 1e-3, torque
+MSE plus L2 1e-5; its steps are the loop's ticks) at their widths, and `lagbench tune` searches that rate and
+those widths for both alike, as it searches a training's (`tuned.LEARNS_IN_EVALUATION`). The part reads a sustained crossing, `t_reach_s`: the end of the
 first window of the first run of consecutive 0.5 s windows whose tracking MSE is at most `THRESHOLD` (0.1) x
 PD alone's in the same window and that lasts at least `SUSTAIN` seconds (+inf: never; a run that the end of
 the run cuts short does not count; a diverged window is above the line); neither model getting there in any

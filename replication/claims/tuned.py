@@ -39,6 +39,17 @@ SHARED = {"dp_energy": ("dp_loss", {}, {}), "delan_tracking": ("delan_arm", {}, 
                         {"full": "quick"})}
 
 
+# claims whose models learn inside their evaluation (claim 13's online learners, `train=False`): the learning
+# rate and widths they learn with are their protocol's and their spec's, searched and adopted as a training's
+LEARNS_IN_EVALUATION = ("online",)
+
+
+def searched(claim, entry, profile: str) -> bool:
+    """Whether the entry is one of the claim's searched models under the profile: one that trains (offline, or
+    online inside its evaluation)."""
+    return entry.runs_in(profile) and (entry.train or claim.evaluate in LEARNS_IN_EVALUATION)
+
+
 def scaled_widths(widths, factor: float) -> tuple:
     """Every hidden width times the width knob, rounded, at least 1."""
     return tuple(max(1, int(round(w * factor))) for w in widths)
@@ -109,7 +120,7 @@ def apply(claim):
         for i, m in enumerate(models):
             rec, names = _serving(claim, claim.models[i], profile)   # judged on the claim as written
             chosen = _chosen(claim, rec, names, m.label)
-            if chosen and m.train and m.runs_in(profile):
+            if chosen and searched(claim, m, profile):
                 models[i] = with_knobs(m, base, profile, chosen["knobs"])
     return dataclasses.replace(claim, models=tuple(models))
 
@@ -123,7 +134,7 @@ def tuning(claim, profile: str) -> dict:
         written = claim
     out = {}
     for m in claim.models:
-        if not (m.train and m.runs_in(profile)):
+        if not searched(claim, m, profile):
             continue
         entry = next((w for w in written.models if w.label == m.label), m)
         rec, names = _serving(written, entry, profile)

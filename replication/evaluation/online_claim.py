@@ -95,7 +95,9 @@ def _controller(ctx, s: dict):
 
     if ctx.spec.kind not in LEARNERS:
         raise ValueError(f"online learning: model kind {ctx.spec.kind!r}; valid {', '.join(LEARNERS)}")
-    return learner(LEARNERS[ctx.spec.kind], ctx.framework, int(ctx.seed), tuple(ctx.spec.hidden)), s["steps"]
+    # the learner learns at the unit's protocol's rate and widths (claim 9's unless a search chose otherwise)
+    return (learner(LEARNERS[ctx.spec.kind], ctx.framework, int(ctx.seed), tuple(ctx.spec.hidden),
+                    lr=ctx.protocol.schedule.lr), s["steps"])
 
 
 def _windows(windows: list, pd_windows: pd.DataFrame) -> pd.DataFrame:

@@ -8,7 +8,8 @@ A *recipe* (`RECIPES[name]`) turns (system, n, rng) into a batch dict of float64
   "weight"     optional per-sample loss weight (N,)
   "qddot"      the true acceleration (N, dof), kept for evaluation
 `BatchStream` draws the pools and the batch order once from the seed, so the JAX and the PyTorch
-loop given the same protocol and seed see the same batches in the same order.
+loop given the same protocol and seed see the same batches in the same order. With `data.resample` a pool is
+drawn every epoch; the state entries `data.fixed` names are those of the epoch-0 draw in every epoch.
 """
 from __future__ import annotations
 
@@ -88,11 +89,14 @@ def sample_inputs(states: dict, system_params) -> list:
     return sorted(k for k in states if k not in ("q", "qdot") and k not in fixed)
 
 
-def recipe_iid(protocol, n, rng):
-    """i.i.d. states from the system's declared distribution, exact targets."""
+def recipe_iid(protocol, n, rng, held=None):
+    """i.i.d. states from the system's declared distribution, exact targets. held: state entries (n, ...) that
+    replace the drawn ones before the targets are computed (`Data.fixed`, from `held_states`)."""
     name = protocol.data.recipe.removesuffix("_iid")
     params = tuple(sorted(protocol.data.system_params))
     s, st = _states(name, params, n, rng)
+    if held:
+        st = {**st, **held}
     kw = {k: st[k] for k in sample_inputs(st, params)}
     st = {k: v for k, v in st.items() if k in ("q", "qdot") or k in kw}
     qddot = s.acceleration(st["q"], st["qdot"], backend="numpy", **kw)
@@ -146,6 +150,17 @@ def heldout(protocol, seed: int = HELDOUT_SEED, **kw) -> dict:
     return recipe_for(protocol)(protocol, protocol.data.n_heldout, np.random.default_rng(seed), **kw)
 
 
+def held_states(protocol, n, rng) -> dict:
+    """The entries `protocol.data.fixed` names of the system's n states drawn from rng (ValueError for a name
+    the system does not draw)."""
+    params = tuple(sorted(protocol.data.system_params))
+    _, st = _states(protocol.data.recipe.removesuffix("_iid"), params, n, rng)
+    unknown = sorted(set(protocol.data.fixed) - set(st))
+    if unknown:
+        raise ValueError(f"data fixed {', '.join(unknown)}: not a state the system draws; valid: {', '.join(sorted(st))}")
+    return {k: st[k] for k in protocol.data.fixed}
+
+
 class BatchStream:
     """Batches for step k of a protocol and seed: `stream.batch(k) -> dict of float64 arrays`."""
 
@@ -157,11 +172,17 @@ class BatchStream:
         self._pool = None
         self._order = None
         self._fixed = None
+        self._held = None
 
     def _load_epoch(self, epoch):
         if self.p.data.resample or self._fixed is None:
             rng = np.random.default_rng([self.seed, 7919, epoch if self.p.data.resample else 0])
-            self._pool = recipe_for(self.p)(self.p, self.p.data.n_train, rng)
+            kw = {}
+            if self.p.data.fixed:   # the epoch-0 draw's entries (its generator), in every epoch
+                if self._held is None:
+                    self._held = held_states(self.p, self.p.data.n_train, np.random.default_rng([self.seed, 7919, 0]))
+                kw["held"] = self._held
+            self._pool = recipe_for(self.p)(self.p, self.p.data.n_train, rng, **kw)
             if not self.p.data.resample:
                 self._fixed = self._pool
         self._order = np.random.default_rng([self.seed, 104729, epoch]).permutation(self.p.data.n_train)

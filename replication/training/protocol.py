@@ -9,7 +9,8 @@ see the same numbers in the same order. The optional parts, each `None` when the
 `guard` (`Guard`), `scouting` (`Scouting`), `cohort` (seeds trained side by side) and `tracking`
 (`Tracking`).
 
-`to_dict()` is the canonical form: every field, records as nested dicts, and `version` (`KEY_VERSION`), so
+`to_dict()` is the canonical form: every field (but `data.fixed` while empty and `tracking.keep` while off, so
+the protocols without them keep their keys), records as nested dicts, and `version` (`KEY_VERSION`), so
 every cache key built from it changes when the form does; `from_dict` reads it, and the forms of earlier
 versions (`replication.training.protocol_versions`), so that older result folders still load.
 """
@@ -119,7 +120,10 @@ class Protocol:
 
     def to_dict(self) -> dict:
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        d["data"] = {**dataclasses.asdict(self.data), "system_params": [list(p) for p in self.data.system_params]}
+        d["data"] = {**dataclasses.asdict(self.data), "system_params": [list(p) for p in self.data.system_params],
+                     "fixed": list(self.data.fixed)}
+        if not d["data"]["fixed"]:
+            del d["data"]["fixed"]   # only a protocol that keeps entries stores them: other protocols keep their keys
         d["optimiser"] = dataclasses.asdict(self.optimiser)
         d["schedule"] = schedule_to_dict(self.schedule)
         for name in PARTS:

@@ -27,7 +27,11 @@ class Data:
                double-pendulum protocol), else one pool is shuffled every epoch.
     n_heldout: size of the held-out set.
     system_params: system parameter overrides as sorted (name, value) pairs.
-    coords:    the inputs: (q, qdot) "qqdot" or canonical (q, p) "qp"."""
+    coords:    the inputs: (q, qdot) "qqdot" or canonical (q, p) "qp".
+    fixed:     with `resample` and an "<system>_iid" recipe: the sampled state entries (names the system's
+               `sample_states` gives, e.g. "qdot") kept from the epoch-0 draw every epoch while the others are
+               redrawn (the original relativistic notebook draws qdot once from a fixed key and q, g every
+               epoch). Left out of the canonical form while empty, so other protocols keep their keys."""
 
     recipe: str
     n_train: int
@@ -35,6 +39,7 @@ class Data:
     resample: bool = False
     system_params: tuple = ()
     coords: str = "qqdot"
+    fixed: tuple = ()
 
     def __post_init__(self):
         check(isinstance(self.recipe, str) and self.recipe != "", f"data recipe must be a name, got {self.recipe!r}")
@@ -45,6 +50,13 @@ class Data:
         check(isinstance(self.resample, bool), f"data resample must be True or False, got {self.resample!r}")
         check(self.coords in COORDS, f"unknown coords {self.coords!r}; valid: {', '.join(COORDS)}")
         object.__setattr__(self, "system_params", tuple(tuple(p) for p in self.system_params))
+        fixed = self.fixed
+        check(isinstance(fixed, (list, tuple)) and all(isinstance(k, str) and k for k in fixed)
+              and list(fixed) == sorted(set(fixed)), f"data fixed must be sorted, unique state names, got {fixed!r}")
+        check(not fixed or (self.resample and self.recipe.endswith("_iid")),
+              f"data fixed {tuple(fixed)} needs resample and an <system>_iid recipe (got resample {self.resample}, "
+              f"recipe {self.recipe!r})")
+        object.__setattr__(self, "fixed", tuple(fixed))
 
     def replace(self, **changes) -> Data:
         return dataclasses.replace(self, **changes)

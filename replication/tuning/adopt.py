@@ -47,7 +47,7 @@ def adopt(ledger_file, today: str | None = None) -> dict:
     if ledger.get("kind") != "search":
         raise ValueError(f"{path} is a {ledger.get('kind', 'trial')}, not the whole declared search; only a search "
                          "may choose (lagbench tune without --configs or --widths)")
-    trained = [m.label for m in claim.models if m.train and m.runs_in(profile)]
+    trained = [m.label for m in claim.models if tuned.searched(claim, m, profile)]
     missing = [x for x in trained if x not in ledger["models"]]
     if missing:
         raise ValueError(f"{path} has no search for {', '.join(missing)}: every model is tuned alike or none")

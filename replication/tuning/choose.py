@@ -2,7 +2,7 @@
 
 `score_metric(result, claim)`, `score_name(result, claim)`: a unit's score, lower is better: the metric the claim's verdict reads
 (`claim.metric`; `heldout_l1` where the evaluation does not give it); a pooled claim (a pace study: claims 6
-and 7) by its pace, the samples to leave the plateau (+inf: never).
+and 7) by its pace, the samples to leave the plateau (+inf: never). +inf is the worst score; NaN none.
 `config_scores(rows, claim) -> {model: {config: score}}`: per model and configuration, the mean over seeds
 (a pooled claim: the median over its cohort of seeds, +inf kept); a configuration with a failed or unscored
 seed scores None (never chosen over one that scored).
@@ -31,10 +31,9 @@ def score_name(result: dict, claim) -> str:
 
 
 def score_metric(result: dict, claim) -> float | None:
+    """+inf (never left the plateau, never reached the line, diverged) is a score, the worst; NaN is none."""
     v = (result.get("metrics") or {}).get(score_name(result, claim))
-    if claim.pooled:   # never leaving the plateau: +inf, a score
-        return float(v) if isinstance(v, int | float) and not math.isnan(v) else None
-    return float(v) if isinstance(v, int | float) and math.isfinite(v) else None
+    return float(v) if isinstance(v, int | float) and not math.isnan(v) and v > -math.inf else None
 
 
 def scored_by(claim) -> str:

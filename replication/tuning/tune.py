@@ -31,7 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from replication import results as R
-from replication.claims import untuned
+from replication.claims import tuned, untuned
 from replication.run import splits
 from replication.run.estimate import estimate
 from replication.run.executor import run_units
@@ -151,7 +151,7 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
         raise ValueError(f"--confirm: {confirm!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     kind = "width sweep" if widths else "partial search" if n_configs else "search"
     configs = search.sweep(widths) if widths else search.configs(n_configs) if n_configs else search.grid()
-    labels = [e.label for e in claim.models if e.runs_in(profile) and e.train]
+    labels = [e.label for e in claim.models if tuned.searched(claim, e, profile)]
     if not labels:
         raise ValueError(f"--claim {claim_id}: trains no model under profile {profile!r}")
     out = R.output_folder(out, "--out")

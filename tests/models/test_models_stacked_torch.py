@@ -24,6 +24,8 @@ CASES = {
     "lnn_periodic": dict(kind="lnn", dof=3, periodic=(0, 2), extra_inputs=1, lorentz_factor=True,
                          input_scale=(0.5, 2.0, 1.5, 0.7, 1.3, 0.3, 1.1, 0.9, 0.02, 0.05, 0.01, 0.1)),
     "baseline_periodic": dict(kind="baseline", dof=2, periodic=(1,)),
+    "lnn_scale_before_grad": dict(kind="lnn", dof=2, extra_inputs=1, scale_q_before_grad=True,
+                                  input_scale=(0.1, 0.5, 1.0, 1.0, 0.1)),
 }
 
 

@@ -191,3 +191,27 @@ def test_a_pace_study_is_tuned_by_its_pace_over_a_sample_of_seeds(tmp_path):
     r = json.loads((tmp_path / "config0/units/init_study/jax/lnn_init-kaiming/seed0/result.json").read_text())
     assert rows[(rows["model"] == "lnn_init-kaiming") & (rows["config"] == 0) & (rows["seed"] == 0)]["score"].item() \
         == r["metrics"]["samples_to_leave"]
+
+
+def test_claim_13s_online_learners_are_searched_and_learn_at_their_protocols_rate(tmp_path, monkeypatch):
+    """Claim 13's models learn inside their evaluation (`train=False`): the search gives them the same grid as
+    a training's, and the online learner takes the unit's rate and widths."""
+    from types import SimpleNamespace
+
+    from replication.claims import tuned
+    from replication.evaluation import online_claim
+    from replication.studies import online_learner
+
+    claim = untuned("delan_online")
+    assert [m.label for m in claim.models if tuned.searched(claim, m, "quick")] == ["delan", "ff"]
+    _fake_search(monkeypatch, lambda label, knobs, seed: knobs["lr"] * knobs["width"])
+    ledger = tune("delan_online", profile="smoke", out=tmp_path, progress=False)
+    assert set(ledger["models"]) == {"delan", "ff"} and all(m["configs_tried"] >= 9 for m in ledger["models"].values())
+    seen = {}
+    monkeypatch.setattr(online_learner, "learner", lambda kind, fw, seed, hidden, lr=None: seen.update(lr=lr, hidden=hidden))
+    u = tune_module._Runner(claim, "smoke", ["delan"], ("jax",), tmp_path, None, False).units(
+        {"lr": 3.0, "width": 2.0}, ["delan"], [0])[0]
+    ctx = SimpleNamespace(model=None, spec=u.spec(), protocol=u.protocol(), framework="jax", seed=0)
+    online_claim._controller(ctx, {"steps": 1})
+    assert seen["lr"] == pytest.approx(3 * claim.protocol("smoke").schedule.lr)
+    assert seen["hidden"] == tuple(2 * w for w in claim.entry("delan").widths("smoke"))
