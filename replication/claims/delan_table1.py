@@ -24,15 +24,18 @@ W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (256, 
 # quick: the relativistic models (all alike) with restarts over initialisations, 8 scouts x 200 steps, the
 # best by training loss continued. The magnetic pair and DeLaN's control train without.
 _SCOUTS = Scouting(count=8, steps=200, batch=256, schedule=OneCycle(lr=1e-3, start=0.2))   # at quick's batch, rate and start
-REL = {"data.recipe": "relativistic_iid", "data.system_params": (("g", 9.8),), "quick": {"scouting": _SCOUTS},
-       "full": {"scouting": _SCOUTS}}
+# the relativistic models sample as claim 3's (the original's): velocities drawn once, q redrawn every epoch
+REL = {"data.recipe": "relativistic_iid", "data.system_params": (("g", 9.8),), "data.resample": True,
+       "data.fixed": ("qdot",), "quick": {"scouting": _SCOUTS}, "full": {"scouting": _SCOUTS}}
 MAG = {"data.recipe": "charged_magnetic_iid"}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}
 _lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020"}
+# the relativistic LNNs as claim 3's (the original's): q / 10 at the input, q-derivatives in the scaled q
+_REL_LNN = {**_lnn, "input_scale": (0.1, 1.0), "scale_q_before_grad": True}
 CONTROL = {"data.recipe": "pendulum_iid"}   # kinetic energy q-dot^2 / 2: DeLaN's form holds
 MODELS = (ModelEntry("delan_relativistic", _delan, hidden=W, overrides=REL),
-          ModelEntry("lnn_relativistic", _lnn, hidden=W, overrides=REL),
-          ModelEntry("lnn_relativistic_gamma", {**_lnn, "lorentz_factor": True, "input_scale": (1.0, 1.0, 0.01)},
+          ModelEntry("lnn_relativistic", _REL_LNN, hidden=W, overrides=REL),
+          ModelEntry("lnn_relativistic_gamma", {**_REL_LNN, "lorentz_factor": True, "input_scale": (0.1, 1.0, 0.01)},
                      hidden=W, overrides=REL),
           ModelEntry("delan_magnetic", _delan, hidden=W, overrides=MAG),
           ModelEntry("lnn_magnetic", _lnn, hidden=W, overrides=MAG),

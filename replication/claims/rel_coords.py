@@ -3,7 +3,10 @@ canonical (q, p) and an LNN on (q, qdot) succeed.
 
 Original protocol (reference §5): L = (1-qdot^2)^(-1/2) - 1 + g q, q ~ U[-10, 10], field g ~ N(0, 10^2)
 given as an input, qdot = 0.99999 tanh(2 N(0,1)); 4x500 softplus; L1 weighted by 1 + gamma; Adam with
-one-cycle, peak 1e-3; q and g divided by 10 at the input (the canonical HNN does not scale q).
+one-cycle, peak 1e-3; q and g divided by 10 at the input (the canonical HNN does not scale q), the LNN's
+q-derivatives taken in the scaled q (q / 10 is formed before differentiating: `ModelSpec.scale_q_before_grad`);
+the velocities drawn once and reused every epoch, q and g redrawn each epoch (`Data.fixed`). Every model here
+trains on that sampling and the LNNs on that parametrisation.
 The HNNs are trained on [qdot, pdot] (non-canonical: pdot := qdot-double-dot; canonical: the exact
 pdot = dL/dq from `systems`). The original code put the canonical HNN's loss on q-double-dot, not pdot
 (a finding). The verdict reads the weighted L1 of q-double-dot for all three (the canonical HNN's pdot
@@ -35,15 +38,17 @@ from replication.training.protocol import Data, Protocol, Scouting, Tracking
 from replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "full": (128, 128, 128), "paper": (500, 500, 500, 500)}
-# inputs (q, qdot[, gamma], g): the LNNs see q unscaled, the HNNs on (q, qdot) q / 10; g / 10 for all
+# inputs (q, qdot[, gamma], g): q / 10 for the LNNs and the HNNs on (q, qdot), g / 10 for all
 CANONICAL_RATE = {"schedule.lr": 3e-3, "scouting.schedule.lr": 3e-3}
 LORENTZ = {"lorentz_factor": True, "extra_inputs": 1, "activation": "softplus"}
-_lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1}
+# the LNNs as the original built them: q / 10 and g / 10 at the input, the Euler-Lagrange q-derivatives taken in
+# the scaled q (`scale_q_before_grad`: the original forms q / 10 before differentiating)
+_lnn = {"kind": "lnn", "activation": "softplus", "init": "cranmer2020", "extra_inputs": 1, "scale_q_before_grad": True}
 _hnn = {"kind": "hnn", "activation": "softplus", "init": "xavier", "extra_inputs": 1}
 QQDOT = {"task": "hamiltonian", "data.coords": "qqdot"}
 SLOW = {"data.system_params": (("speed", 0.1),)}   # the controls' particle: speeds up to 0.1 c
 MODELS = (
-    ModelEntry("lnn", {**_lnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W),
+    ModelEntry("lnn", {**_lnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W),
     ModelEntry("hnn_qqdot", {**_hnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides=QQDOT),
     ModelEntry("hnn_qp", {**_hnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W,
                overrides={"task": "hamiltonian", "data.coords": "qp", "quick": CANONICAL_RATE, "full": CANONICAL_RATE},
@@ -52,14 +57,15 @@ MODELS = (
     # exactly the paper model's spec, protocol and tuning on slower data
     ModelEntry("hnn_qqdot_slow", {**_hnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides={**QQDOT, **SLOW},
                tuned_as="hnn_qqdot"),
-    ModelEntry("lnn_slow", {**_lnn, "input_scale": (1.0, 1.0, 0.1)}, hidden=W, overrides=SLOW, tuned_as="lnn"),
+    ModelEntry("lnn_slow", {**_lnn, "input_scale": (0.1, 1.0, 0.1)}, hidden=W, overrides=SLOW, tuned_as="lnn"),
     # the variant: the models on (q, qdot) also see gamma(qdot)
-    ModelEntry("lnn_gamma", {**_lnn, "input_scale": (1.0, 1.0, 0.01, 0.1), **LORENTZ}, hidden=W),
+    ModelEntry("lnn_gamma", {**_lnn, "input_scale": (0.1, 1.0, 0.01, 0.1), **LORENTZ}, hidden=W),
     ModelEntry("hnn_qqdot_gamma", {"kind": "hnn", "init": "xavier", "input_scale": (0.1, 1.0, 0.01, 0.1), **LORENTZ},
                hidden=W, overrides=QQDOT),
 )
 
-_data = Data("relativistic_iid", n_train=640, n_heldout=512)
+# the original's sampling: one pool of velocities kept for the whole training, q and g redrawn every epoch
+_data = Data("relativistic_iid", n_train=640, n_heldout=512, resample=True, fixed=("qdot",))
 _base = Protocol(data=_data, steps=20, batch=32, loss="l1_gamma", schedule=OneCycle(lr=1e-3, start=0.3), log_every=5)
 _SRC = "original code, SpecialRelativity notebooks, weighted-L1 training loss: "
 # the original's models: 4 x 500, 100 epochs x 3000 minibatches x 512

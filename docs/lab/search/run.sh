@@ -7,7 +7,7 @@
 #   bash docs/lab/search/run.sh [PROFILE ...]     (default: quick full)
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
-quick="hnn_energy wave_lgn delan_table1 delan_arm rel_coords init_study activation_study dp_loss"
+quick="hnn_energy wave_lgn delan_table1 delan_arm rel_coords init_study activation_study dp_loss delan_online"
 full="rel_coords init_study activation_study dp_loss"
 profiles=("$@")
 [ ${#profiles[@]} -gt 0 ] || profiles=(quick full)
