@@ -8,7 +8,9 @@ JAX (`framework_of`).
 an edited module never reuses a cached training). `make_module(spec, seed)`: a fresh module of spec's
 factory. `param_shapes(spec)`: {name: shape} of its parameters (the layout `models.params` checks against).
 `init_params(spec, seed)`: its initial parameters as NumPy arrays, the factory called under
-torch.manual_seed(seed) or with jax.random.PRNGKey(seed) (same seed, same numbers). Imported only when a
+torch.manual_seed(seed) or with jax.random.PRNGKey(seed) (same seed, same numbers). Every call into the user's
+code (the factory; the module, `forward`) goes through the suite's one boundary, `replication.user_functions`:
+an exception, a wrong type or shape is one line naming the user's file and function. Imported only when a
 user names a model.
 """
 from __future__ import annotations
@@ -18,11 +20,34 @@ import inspect
 
 import numpy as np
 
+OPTION = "--add-model"
+
 
 def _factory(ref: str):
-    from replication.user_functions import import_function  # the one importer of a user's code
+    from replication.user_functions import import_function  # the one boundary with a user's code
 
-    return import_function(ref, "--add-model")
+    return import_function(ref, OPTION)
+
+
+def _boundary():
+    from replication import user_functions
+
+    return user_functions
+
+
+def files_of(spec, module) -> tuple:
+    """The user's files a call into `module` may raise from: the factory's, and its class's unless the class is
+    a library's (a torch.nn.Sequential the factory built)."""
+    b = _boundary()
+    own = type(module).__module__.split(".")[0] not in ("torch", "equinox")
+    return tuple(dict.fromkeys(f for f in (b.source_file(_factory(spec.factory)), own and b.source_file(module)) if f))
+
+
+def forward(spec, module, fn, *args):
+    """fn(*args), a call of `module` (an equinox module itself, or torch's `functional_call` of it): any exception
+    is the boundary's one line naming the module's forward (`replication.user_functions.call`)."""
+    name = f"{type(module).__name__}.{'forward' if hasattr(module, 'forward') else '__call__'}(q, qdot)"
+    return _boundary().call(OPTION, spec.factory, name, fn, *args, files=lambda: files_of(spec, module))
 
 
 def factory_source(ref: str) -> str:
@@ -48,21 +73,22 @@ def make_module(spec, seed: int = 0):
     """A fresh module of spec's factory: PyTorch's in spec.dtype (under the caller's torch seed), equinox's
     from jax.random.PRNGKey(seed)."""
     fn = _factory(spec.factory)   # imported once: a file named by its path runs on each import
+    b, name = _boundary(), getattr(fn, "__name__", "factory")
     if _framework(fn) == "jax":
         import equinox as eqx
         import jax
 
-        module = fn(spec.dof, key=jax.random.PRNGKey(seed))
+        module = b.call(OPTION, spec.factory, f"the factory {name}(dof, key)", fn, spec.dof, key=jax.random.PRNGKey(seed))
         if not isinstance(module, eqx.Module):
-            raise ValueError(f"--add-model {spec.factory}: the factory takes a key but returned "
-                             f"{type(module).__name__}, not an equinox Module")
+            raise b.wrong(OPTION, spec.factory, f"the factory takes a key but returned {type(module).__name__}, not "
+                          f"an equinox Module")
         return module
     import torch
 
-    module = fn(spec.dof)
+    module = b.call(OPTION, spec.factory, f"the factory {name}(dof)", fn, spec.dof)
     if not isinstance(module, torch.nn.Module):
-        raise ValueError(f"--add-model {spec.factory}: the factory returned {type(module).__name__}, not a "
-                         f"torch.nn.Module (an equinox factory takes a key: factory(dof, key))")
+        raise b.wrong(OPTION, spec.factory, f"the factory returned {type(module).__name__}, not a torch.nn.Module "
+                      f"(an equinox factory takes a key: factory(dof, key))")
     return module.to(getattr(torch, spec.dtype))
 
 
@@ -103,7 +129,8 @@ def returns(module) -> str:
     "hamiltonian" (a scalar H(q, p) per sample: Hamilton's equations, trained where the paper's HNN is)."""
     r = getattr(module, "returns", "acceleration")
     if r not in RETURNS:
-        raise ValueError(f"--add-model: {type(module).__name__}.returns is {r!r}; valid: {', '.join(RETURNS)}")
+        raise _boundary().UserCodeError(f"{OPTION}: {type(module).__name__}.returns is {r!r}; valid: "
+                                        f"{', '.join(RETURNS)}; {_boundary().NO_RERUN}")
     return r
 
 
@@ -119,13 +146,13 @@ def scalar(spec, out, like):
     if out.shape[-1:] == (1,) and out.ndim == like.ndim:
         out = out[..., 0]
     if tuple(out.shape) != tuple(like.shape[:-1]):
-        raise ValueError(f"--add-model {spec.factory}: a Lagrangian's forward(q, qdot) returned shape "
-                         f"{tuple(out.shape)}, expected {tuple(like.shape[:-1])} (one scalar per sample)")
+        raise _boundary().wrong(OPTION, spec.factory, f"a scalar module's forward(q, qdot) returned shape "
+                                f"{tuple(out.shape)}, expected {tuple(like.shape[:-1])} (one scalar per sample)")
     return out
 
 
 def check_output(spec, out, like) -> None:
     if tuple(out.shape) != tuple(like.shape):
-        raise ValueError(f"--add-model {spec.factory}: forward(q, qdot) returned shape {tuple(out.shape)}, "
-                         f"expected {tuple(like.shape)} (q-double-dot, one per coordinate)")
+        raise _boundary().wrong(OPTION, spec.factory, f"forward(q, qdot) returned shape {tuple(out.shape)}, "
+                                f"expected {tuple(like.shape)} (q-double-dot, one per coordinate)")
 

@@ -63,11 +63,27 @@ def cmd_run(args):
                   dry_run=args.dry_run, split=args.split, add_models=args.add_model)
     if summary.get("dry_run"):
         return 0
-    for c in summary["claims"]:
-        print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
-    for e in summary.get("errors", []):
-        print(f"lagbench: error in unit {e} (no result written; a rerun retries it)", file=sys.stderr)
-    return 1 if summary.get("errors") else 0
+    named = _csv(args.claims)
+    for c in summary["claims"]:   # the claims this run was asked for (the summary holds every claim)
+        if named is None or c["id"] in named:
+            print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
+    return _print_errors(summary.get("errors", []))
+
+
+def _print_errors(errors) -> int:
+    """Each unit error once, units failing with the same message on one line; the exit status: 2 where the
+    user's code failed (a rerun cannot help), 1 for other errors (a rerun retries them), 0 for none."""
+    from replication.user_functions import is_users
+
+    by_message: dict = {}
+    for e in errors:
+        unit, _, message = e.partition(": ")
+        by_message.setdefault(message, []).append(unit)
+    for message, units in by_message.items():
+        which = f"unit {units[0]}" if len(units) == 1 else f"{len(units)} units ({', '.join(units)})"
+        tail = "" if is_users(message) else " (no result written; a rerun retries it)"
+        print(f"lagbench: error in {which}: {message}{tail}", file=sys.stderr)
+    return 2 if any(is_users(m) for m in by_message) else 1 if errors else 0
 
 
 RESULT_ENTRIES = ("run.json", "claims.json", "units", "bench", "bench_gpu", "stiff", "train_target", "predict",
@@ -261,6 +277,8 @@ def main(argv=None):
             code = args.func(args)
     except (KeyError, ValueError, FileNotFoundError) as e:
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
+        if args.verbose and getattr(e, "details", ""):   # a user's code failed: its traceback, not the suite's
+            print(e.details, file=sys.stderr, end="" if e.details.endswith("\n") else "\n")
         print(f"lagbench: error: {msg}", file=sys.stderr)
         return 2
     except DiskFull as e:

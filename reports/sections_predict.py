@@ -4,7 +4,8 @@
 ``predictor_results(root) -> (rows, problems)``: each verified record (its checksum and files), one row per
 predictor; a record that fails verification is named among the problems and not used.
 ``predict_sections(root) -> list[Section]``: a table per system, every predictor beside the null predictor
-and the chaos floor, with the claim and model whose evaluation scored it; empty when none was scored.
+and the chaos floor, with the claim and model whose evaluation scored it and its status ("ok", or "failed:
+non-finite on k of n held-out states": `status_of`); empty when none was scored.
 """
 from __future__ import annotations
 
@@ -21,6 +22,12 @@ COLUMNS = {"heldout_l1": "held-out L1", "null_heldout_l1": "null's held-out L1",
            "energy_err_final": "final energy error", "vpt_s": "valid time (s)",
            "chaos_floor_vpt_s": "chaos floor's valid time (s)", "lyapunov_time_s": "Lyapunov time (s)",
            "vpt_lyapunov": "valid time (Lyapunov times)", "predict_s_per_state": "s per state"}
+
+
+def status_of(d: dict) -> str:
+    """"ok", or "failed: <why>" (a predictor with a non-finite prediction on a held-out state)."""
+    failure = d.get("failure") or {}
+    return "ok" if d.get("status", "ok") == "ok" else f"failed: {failure.get('message', 'no reason recorded')}"
 
 
 def predictor_results(root: Path) -> tuple[list[dict], list[str]]:
@@ -53,7 +60,7 @@ def predict_sections(root: Path) -> list[Section]:
         mine = [d for d in rows if d["system"] == system]
         df = pd.DataFrame([{"predictor": d["model"], "function": d.get("predictor", ""),
                             "scored as": f"{d['scored_like']['claim']} / {d['scored_like']['model']}",
-                            "profile": d.get("profile", ""),
+                            "profile": d.get("profile", ""), "status": status_of(d),
                             **{label: num(d["metrics"].get(k)) for k, label in COLUMNS.items()}} for d in mine])
         s.add(Table(f"{system}: predictors from outside the suite", df,
                     [f"predict/{system}/{d['model']}/result.json" for d in mine]))

@@ -2,7 +2,7 @@
 its seeds) and predictors scored by `lagbench evaluate --predict`.
 
 ``systems_table(root) -> DataFrame``: columns system, source ("claim" or "predictor"), claim, model,
-framework, seeds, params (the checkpoint's numbers), train_samples and train_time_s (medians over seeds), and
+framework, status ("ok"; a predictor's "failed: <why>", shown beside its numbers), seeds, params (the checkpoint's numbers), train_samples and train_time_s (medians over seeds), and
 for each of ``METRICS`` (errors, valid times against the chaos and float32 floors, rollout µs per step) its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
 NaN where the claim's evaluation does not compute it). `lagbench table` writes it to
 ``summary/systems.csv`` and prints a table per system; the report shows it (``systems_sections``).
@@ -17,7 +17,7 @@ import pandas as pd
 from reports.document import Para, Section, Table
 from reports.fmt import num
 from reports.load import load_results, protocol_of
-from reports.sections_predict import predictor_results
+from reports.sections_predict import predictor_results, status_of
 
 METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
            "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test", "rollout_us_per_step")
@@ -52,7 +52,7 @@ def systems_table(root) -> pd.DataFrame:
     rows = []
     for (system, claim, model, fw), units in sorted(groups.items()):
         r = {"system": system, "source": "claim", "claim": claim, "model": model, "framework": fw,
-             "seeds": len(units), "params": params_of(units[0]),
+             "status": "ok", "seeds": len(units), "params": params_of(units[0]),
              "train_samples": _spread([u.result.get("train_time_s", 0) * (u.result.get("train_samples_per_s") or 0)
                                        for u in units])[""],
              "train_time_s": _spread([u.result.get("train_time_s") for u in units])[""]}
@@ -61,7 +61,7 @@ def systems_table(root) -> pd.DataFrame:
         rows.append(r)
     for d in predictor_results(Path(root))[0]:
         r = {"system": d["system"], "source": "predictor", "claim": d["scored_like"]["claim"], "model": d["model"],
-             "framework": "-", "seeds": 1, "params": np.nan, "train_samples": np.nan, "train_time_s": np.nan}
+             "framework": "-", "status": status_of(d), "seeds": 1, "params": np.nan, "train_samples": np.nan, "train_time_s": np.nan}
         for m in METRICS:
             v = d["metrics"].get(m)
             r.update({m + k: (np.nan if v is None else float(v)) for k in ("", "_min", "_max")})
@@ -72,6 +72,8 @@ def systems_table(root) -> pd.DataFrame:
 def shown(df: pd.DataFrame) -> pd.DataFrame:
     """One system's rows for reading: each metric as "median [min, max]" over seeds, empty columns left out."""
     out = df[["source", "claim", "model", "framework", "seeds"]].copy()
+    if (df["status"] != "ok").any():   # a failed predictor's numbers are not scores: it says why
+        out.insert(4, "status", df["status"])
     out["params"] = [num(v) for v in df["params"]]
     out["train samples"] = [num(v) for v in df["train_samples"]]
     out["train time (s)"] = [num(v) for v in df["train_time_s"]]

@@ -22,7 +22,7 @@ def skeleton(spec):
     """(parameter names in leaf order, the arrays' treedef, the module's non-array part) of spec's factory."""
     module = user.make_module(spec)
     if not callable(module):
-        raise ValueError(f"--add-model {spec.factory}: the equinox module is not callable as module(q, qdot)")
+        raise user._boundary().wrong(user.OPTION, spec.factory, "the equinox module is not callable as module(q, qdot)")
     arrays, static = eqx.partition(module, eqx.is_inexact_array)
     paths, treedef = jax.tree_util.tree_flatten_with_path(arrays)
     return tuple(jax.tree_util.keystr(p) for p, _ in paths), treedef, static
@@ -37,8 +37,9 @@ class UserModel(Model):
         self._check_state(q, qdot, extra)
         module = self._module()
         if user.returns(module) == "lagrangian":
-            return euler_lagrange(lambda a, b: user.scalar(self.spec, module(a, b), a), q, qdot)
-        out = module(q, qdot)
+            return euler_lagrange(lambda a, b: user.scalar(self.spec, user.forward(self.spec, module, module, a, b), a),
+                                  q, qdot)
+        out = user.forward(self.spec, module, module, q, qdot)
         user.check_output(self.spec, out, q)
         return out
 
@@ -53,5 +54,6 @@ class UserModel(Model):
         if user.returns(module) != "hamiltonian":
             raise ValueError(f"--add-model {self.spec.factory}: time_derivative is for a module that returns a "
                              f"Hamiltonian (returns = 'hamiltonian')")
-        dh_dx, dh_dy = jax.grad(lambda a, b: jnp.sum(user.scalar(self.spec, module(a, b), a)), argnums=(0, 1))(x, y)
+        h = lambda a, b: jnp.sum(user.scalar(self.spec, user.forward(self.spec, module, module, a, b), a))  # noqa: E731
+        dh_dx, dh_dy = jax.grad(h, argnums=(0, 1))(x, y)
         return dh_dy, -dh_dx

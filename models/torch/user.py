@@ -19,7 +19,7 @@ class UserModel(Model):
         object.__setattr__(self, "_net", user.make_module(spec))   # held apart: its parameters are self's
 
     def _forward(self, q, qdot):
-        return functional_call(self._net, dict(self.named_parameters()), (q, qdot))
+        return user.forward(self.spec, self._net, functional_call, self._net, dict(self.named_parameters()), (q, qdot))
 
     def acceleration(self, q, qdot, extra=None):
         self._check_state(q, qdot, extra)

@@ -21,7 +21,8 @@ def _show_defaults(parser) -> None:
     """Every option's help ends with its default, unless it states one itself (flags and required ones aside)."""
     for action in parser._actions:
         text = action.help or ""
-        if "default" in text or action.required or not action.option_strings or action.nargs == 0:
+        if ("default" in text or action.required or not action.option_strings or action.nargs == 0
+                or action.help == argparse.SUPPRESS):   # a hidden option (an old spelling) stays hidden
             continue
         action.help = text + (" (default: none)" if action.default is None else " (default: %(default)s)")
 
@@ -148,6 +149,10 @@ def cmd_predict(args):
             "lyapunov_time_s")
     print(f"{d['model']} on {args.system} (scored as {d['scored_like']['claim']}'s {d['scored_like']['model']}, "
           f"test split): " + ", ".join(f"{k} {m[k]:.4g}" if m[k] is not None else f"{k} -" for k in keys if k in m) + f"; written to {d['folder']}")
+    if d["status"] != "ok":
+        print(f"lagbench: --predict {args.predict}: failed: {d['failure']['message']} (record in {d['folder']})",
+              file=sys.stderr)
+        return 1
 
 
 def cmd_evaluate(args):

@@ -96,16 +96,18 @@ def energy_function(cfg, dof):
         import systems
 
         return systems.get(cfg["system"]).energy
-    from replication.user_functions import import_function
+    from replication.user_functions import array_of, call, import_function, wrong
 
     fn = import_function(spec, "--energy")
-    probe = np.asarray(fn(np.zeros((2, dof)), np.zeros((2, dof))))
+    what = f"{getattr(fn, '__name__', 'the function')}(q, qdot)"
+    probe = array_of("--energy", spec, what, call("--energy", spec, what, fn, np.zeros((2, dof)), np.zeros((2, dof))))
     if probe.shape != (2,):
-        raise ValueError(f"--energy {spec}: must map q, qdot of shape (N, {dof}) to (N,), gave shape {probe.shape}")
+        raise wrong("--energy", spec, f"must map q, qdot of shape (N, {dof}) to (N,), gave shape {probe.shape}")
 
     def energy(q, qdot):
         q, qdot = np.asarray(q), np.asarray(qdot)
-        return np.asarray(fn(q.reshape(-1, dof), qdot.reshape(-1, dof)), np.float64).reshape(q.shape[:-1])
+        out = call("--energy", spec, what, fn, q.reshape(-1, dof), qdot.reshape(-1, dof))
+        return array_of("--energy", spec, what, out).reshape(q.shape[:-1])
     return energy
 
 

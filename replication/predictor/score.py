@@ -8,7 +8,9 @@ claim's evaluation config (rollout initial conditions, horizon, step) under `pro
 that model is, on the test split (`replication.run.splits.TEST`: its held-out draw and initial conditions):
 one-step errors beside the null predictor's, rollouts with the suite's RK4, the energy error along them,
 valid prediction time against the chaos floor (`replication.evaluation.valid_time`), and the seconds per
-state of one call. With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the
+state of one call. Its status is "failed" (its failure: "non-finite on k of n held-out states") where the
+function returns a non-finite q-double-dot on any held-out state; an exception it raises, or an output of the
+wrong type or shape, is one line (`replication.user_functions`). With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the
 evaluation's tables). `lagbench evaluate --predict module:function --system NAME` runs it.
 """
 from __future__ import annotations
@@ -24,6 +26,7 @@ from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
 from replication.evaluation.routines import Context, heldout_of, system_of
 from replication.run import environment as env
 from replication.run.splits import TEST
+from replication.user_functions import array_of, call, nonfinite_failure, nonfinite_rows, wrong
 
 SCORED_BY = ("energy_rollout", "heldout")   # the evaluations a (q, qdot) -> qddot predictor can be put through
 
@@ -53,13 +56,12 @@ class Predictor:
     def acceleration(self, q, qdot, extra=None):
         q, qdot = np.asarray(q, np.float64), np.asarray(qdot, np.float64)
         n = int(np.prod(q.shape[:-1]))
-        try:
-            out = np.asarray(self.function(q.reshape(n, self.dof), qdot.reshape(n, self.dof)), dtype=np.float64)
-        except (TypeError, ValueError) as e:
-            raise ValueError(f"--predict {self.name}: its output is not an array of numbers ({e})") from None
+        what = f"{getattr(self.function, '__name__', 'the function')}(q, qdot)"
+        out = call("--predict", self.name, what, self.function, q.reshape(n, self.dof), qdot.reshape(n, self.dof))
+        out = array_of("--predict", self.name, what, out)
         if out.shape != (n, self.dof):
-            raise ValueError(f"--predict {self.name}: must map q, qdot of shape (N, {self.dof}) to qddot of shape "
-                             f"(N, {self.dof}); for N = {n} it gave shape {out.shape}")
+            raise wrong("--predict", self.name, f"{what} must map q, qdot of shape (N, {self.dof}) to qddot of shape "
+                        f"(N, {self.dof}); for N = {n} it gave shape {out.shape}")
         return out.reshape(q.shape)
 
 
@@ -103,11 +105,12 @@ def score(function, system: str, profile: str = "quick", out=None, label: str | 
                   protocol=s.protocol, profile=profile, cfg=s.cfg, model=model, split=TEST)
     batch = heldout_of(ctx)
     t0 = time.perf_counter()
-    model.acceleration(batch["q"], batch["qdot"])
+    held = model.acceleration(batch["q"], batch["qdot"])
     per_state = (time.perf_counter() - t0) / len(batch["q"])
+    failure = nonfinite_failure(nonfinite_rows(held), len(held))   # a NaN is never scored "ok"
     ev = EVALUATIONS[s.evaluate](ctx)
     record = {"schema": R.SCHEMA, "claim": "predict", "system": system, "predictor": name or label, "model": label,
-              "split": TEST.name, "profile": profile, "status": "ok",
+              "split": TEST.name, "profile": profile, "status": "ok" if failure is None else "failed", "failure": failure,
               "scored_like": {"claim": s.claim.id, "model": s.entry.label, "evaluation": s.evaluate},
               "metrics": {**ev.metrics, "predict_s_per_state": per_state}, "counters": ev.counters,
               "protocol": s.protocol.to_dict(), "eval_config": s.cfg, "evaluation_version": EVALUATION_VERSION,

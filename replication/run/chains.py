@@ -63,11 +63,15 @@ def release_if_crowded() -> bool:
 def run_one(unit, out, on_log=None):
     """(failure or None, error or None) of running one unit."""
     from replication.run.units import run_unit
+    from replication.user_functions import UserCodeError
 
     try:
         d = run_unit(unit, out, on_log=on_log)
     except R.DiskFull:
         raise   # every later unit would fail the same way: the run stops (`runner.run`)
+    except UserCodeError as e:   # the user's model failed: its one line, and its traceback with -v
+        log.info("%s failed:\n%s", unit.name, e.details or e)
+        return None, f"{unit.name}: {e}"
     except Exception as e:  # noqa: BLE001 - one unit's error must not lose the rest of the run
         log.exception("%s failed", unit.name)
         return None, f"{unit.name}: {type(e).__name__}: {e}"

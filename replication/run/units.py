@@ -11,18 +11,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+import numpy as np
+
 from models import ModelSpec
+from models.spec import USER_KIND
 from replication import results as R
 from replication.evaluation.adapters import adapter
 from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
-from replication.evaluation.routines import Context, system_of
+from replication.evaluation.routines import Context, heldout_of, system_of
 from replication.run import environment as env
 from replication.run import splits
 from replication.training import device as dev
 from replication.training import hessian_probe
+from replication.training.objective import predict
 from replication.training.outcome import log_frame
 from replication.training.scouting import budget_samples
 from replication.training.train import train_cached
+from replication.user_functions import nonfinite_failure, nonfinite_rows
 
 
 class UnitSource(Protocol):
@@ -64,6 +69,13 @@ class Unit:
         return R.unit_dir(out, self.claim.id, self.framework, self.entry.label, self.seed)
 
 
+def _nonfinite(ctx) -> dict | None:
+    """The failure of a model whose prediction is non-finite on any of the unit's held-out states (or None)."""
+    batch = heldout_of(ctx)
+    pred = predict(ctx.model, ctx.spec.kind, ctx.protocol.task, batch, np.concatenate)
+    return nonfinite_failure(nonfinite_rows(pred), len(pred))
+
+
 def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
     """Train (or reuse the cached training), evaluate, and write the unit's files; result.json last.
     on_log(row): each training log row; on_progress(label, done, total): the evaluation's long work."""
@@ -88,6 +100,8 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
             ctx.log = outcome.log
             ctx.tracked = outcome.tracked
         ev = EVALUATIONS[unit.claim.evaluate](ctx)
+        if spec.kind == USER_KIND and failure is None:   # a user's model: a non-finite prediction is never "ok"
+            failure = _nonfinite(ctx)
     for name, df in ev.tables.items():
         files[name] = R.write_csv(folder / name, df)
     if ev.arrays:

@@ -256,3 +256,12 @@ def test_out_is_not_made_for_an_invalid_command(tmp_path, capsys, argv):
     assert main([*argv, "--out", str(out)]) == 2
     assert capsys.readouterr().err.count("\n") == 1
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", ["fit", "evaluate"])
+def test_help_leaves_the_hidden_old_spellings_out(command, capsys):
+    """Issue 85: fit's and evaluate's help printed "==SUPPRESS== (default: none)" for their old spellings."""
+    with pytest.raises(SystemExit):
+        build_parser().parse_args([command, "--help"])
+    out = capsys.readouterr().out
+    assert "SUPPRESS" not in out and "--out" in out

@@ -1,5 +1,7 @@
 """Fitted models loaded back and judged (issue 26, gaps 1, 4, 5 and 7): load_fitted in either framework,
 torques refused by an LNN / HNN and used by DeLaN, the options' defaults in --help, tiny trainings only."""
+import argparse
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -88,8 +90,8 @@ def test_the_metric_is_named_for_the_loss_and_the_rows():
 def test_every_fit_option_shows_its_default():
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     parser = sub.choices["fit"]
-    helps = {a.option_strings[-1]: a.help for a in parser._actions
-             if a.option_strings and not a.required and a.nargs != 0}
+    helps = {a.option_strings[-1]: a.help for a in parser._actions   # hidden ones (old spellings) aside
+             if a.option_strings and not a.required and a.nargs != 0 and a.help != argparse.SUPPRESS}
     assert {"--activation", "--weight-decay", "--schedule", "--lr-final", "--delan-eps", "--delan-offset",
             "--input-scale", "--holdout", "--holdout-fraction", "--test", "--window", "--polyorder"} <= set(helps)
     missing = [k for k, h in helps.items() if "default" not in h]

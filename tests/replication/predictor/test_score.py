@@ -97,3 +97,39 @@ def test_the_report_shows_verified_predictors_and_names_a_tampered_one(tmp_path)
     sections = build_sections(tmp_path, tmp_path / "report")
     texts = [b.text for s in sections if s.title == "Your predictors" for b in s.blocks if hasattr(b, "text")]
     assert any("zero: result.json checksum mismatch; not used" in t for t in texts)
+
+
+def heldout_of_predictor(system, profile):
+    """The held-out states a predictor of `system` is scored on."""
+    from replication.evaluation.routines import heldout_of
+    from replication.run.splits import TEST
+
+    class Ctx:
+        protocol, split = setup(system, profile).protocol, TEST
+    return heldout_of(Ctx)["q"]
+
+
+def test_a_function_that_raises_is_one_line_and_a_non_finite_one_is_scored_failed(tmp_path, monkeypatch, capsys):
+    (tmp_path / "odd.py").write_text("import numpy as np\n\ndef raises(q, qdot):\n    return {}['key']\n\n"
+                                     "def nan7(q, qdot):\n    out = np.zeros_like(q)\n    out[::7] = np.nan\n"
+                                     "    return out\n")
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "res"
+    common = ["--system", "pendulum", "--profile", "smoke", "--out", str(out)]
+    assert main(["evaluate", "--predict", "odd.py:raises", *common]) == 2
+    err = capsys.readouterr().err
+    assert err == ("lagbench: error: --predict odd.py:raises: raises(q, qdot) raised KeyError: 'key' (odd.py line 4, "
+                   "in raises); an error in your code: a rerun fails the same way until it is fixed\n")
+    assert main(["evaluate", "--predict", "odd.py:nan7", *common]) == 1
+    d = json.loads((out / "predict" / "pendulum" / "nan7" / "result.json").read_text())
+    n = len(heldout_of_predictor("pendulum", "smoke"))
+    why = f"non-finite on {-(-n // 7)} of {n} held-out states"
+    assert d["status"] == "failed" and d["failure"]["message"] == why and d["checksum"]   # the record is kept
+    assert f"--predict odd.py:nan7: failed: {why}" in capsys.readouterr().err
+    assert main(["table", "--results", str(out)]) == 0
+    assert f"failed: {why}" in capsys.readouterr().out   # the table says why its numbers are no scores
+    from reports.build import build_sections
+
+    table = next(b for s in build_sections(out, tmp_path / "report") if s.title == "Your predictors"
+                 for b in s.blocks if hasattr(b, "df"))
+    assert list(table.df["status"]) == [f"failed: {why}"]

@@ -1,5 +1,8 @@
 """`lagbench run --add-model` (`replication.run.added_models`, `models.user`): which claims a user's model
 enters and with what, what it is refused with, and that an edited model file is a new spec."""
+import json
+import re
+
 import numpy as np
 import pytest
 
@@ -7,9 +10,11 @@ import systems
 from models import ModelSpec, init_params
 from replication.claims import CLAIMS
 from replication.claims.bars import Bar, added_competence
+from replication.cli import main
 from replication.evaluation.adapters import adapter
 from replication.run import added_models
 from replication.run.runner import plan
+from replication.user_functions import NO_RERUN, UserCodeError
 
 MODEL = '''import torch
 
@@ -215,3 +220,125 @@ def test_a_hamiltonian_module_stands_in_for_the_hnn_and_goes_through_hamiltons_e
     np.testing.assert_allclose(xdot, y, atol=1e-12)
     np.testing.assert_allclose(ydot, -2.0 * x, atol=1e-12)
     _learns_the_springs_k("torch", spec, "k", task="hamiltonian")
+
+
+BROKEN = '''import equinox as eqx
+import jax.numpy as jnp
+import torch
+
+
+class Boom(torch.nn.Module):
+    def __init__(self, dof):
+        super().__init__()
+        raise RuntimeError("no weights here")
+
+
+class Net(torch.nn.Module):
+    def __init__(self, dof, extra=0, fail=False):
+        super().__init__()
+        self.lin, self.fail = torch.nn.Linear(2 * dof, dof + extra), fail
+
+    def forward(self, q, qdot):
+        if self.fail:
+            raise RuntimeError("forward broke")
+        out = self.lin(torch.cat([q, qdot], -1))
+        if q.shape[0] > 64:   # the held-out set, never a training batch: NaN on every seventh state
+            rows = torch.arange(q.shape[0], device=q.device)[:, None]
+            out = torch.where(rows % 7 == 0, torch.full_like(out, float("nan")), out)
+        return out
+
+
+class Eqx(eqx.Module):
+    k: jnp.ndarray
+
+    def __init__(self, dof, key):
+        self.k = jnp.ones(dof)
+
+    def __call__(self, q, qdot):
+        return q.reshape(-1)   # the wrong shape
+
+
+def boom(dof):
+    return Boom(dof)
+
+
+def wide(dof):
+    return Net(dof, extra=1)
+
+
+def raises(dof):
+    return Net(dof, fail=True)
+
+
+def nan_held_out(dof):
+    return Net(dof)
+
+
+def eqx_flat(dof, key):
+    return Eqx(dof, key)
+'''
+
+
+@pytest.fixture
+def broken(tmp_path, monkeypatch):
+    (tmp_path / "broken_net.py").write_text(BROKEN, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def test_a_factory_that_raises_is_one_line_naming_its_file_and_v_shows_the_users_traceback(broken, capsys):
+    argv = ["run", "--profile", "smoke", "--claims", "dp_loss", "--add-model", "b=broken_net.py:boom", "--dry-run",
+            "--out", str(broken / "res")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert ("--add-model broken_net.py:boom: the factory boom(dof) raised RuntimeError: no weights here "
+            "(broken_net.py line 9, in __init__); an error in your code: a rerun fails the same way") in err
+    assert main(["-v", *argv]) == 2
+    err = capsys.readouterr().err
+    shown = err.split("Traceback (your code):", 1)[1]
+    assert 'broken_net.py", line 38, in boom' in shown and "replication" not in shown.split("lagbench: error")[0]
+
+
+@pytest.mark.parametrize("factory, words", [
+    ("raises", "Net.forward(q, qdot) raised RuntimeError: forward broke (broken_net.py line 19, in forward)"),
+    ("wide", "forward(q, qdot) returned shape (4, 3), expected (4, 2)"),
+    ("eqx_flat", "forward(q, qdot) returned shape (8,), expected (4, 2)"),
+])
+def test_a_forward_that_raises_or_returns_the_wrong_shape_is_the_users_error(broken, factory, words):
+    (a,) = added_models.parse([f"x=broken_net.py:{factory}"])
+    spec = ModelSpec(kind="user", dof=2, factory=a.ref, factory_source=a.source, dtype="float64")
+    with pytest.raises(UserCodeError) as e:
+        adapter(a.framework, spec, init_params(spec, 0)).acceleration(np.ones((4, 2)), np.zeros((4, 2)), None)
+    assert words in str(e.value) and str(e.value).endswith("a rerun fails the same way until it is fixed")
+
+
+def test_a_run_says_once_that_a_rerun_cannot_help_and_a_non_finite_model_fails(broken, capsys):
+    """One unit's forward returns the wrong shape (an error: no result, exit 2, no traceback, and no "a rerun
+    retries it"); the other's is NaN on held-out states (a result: failed, never ok). Only the claim named is
+    listed."""
+    out = broken / "res"
+    argv = ["run", "--profile", "smoke", "--claims", "dp_loss", "--add-model", "w=broken_net.py:wide",
+            "--add-model", "n=broken_net.py:nan_held_out", "--models", "w,n", "--quiet", "--out", str(out)]
+    assert main(argv) == 2
+    std = capsys.readouterr()
+    assert [line.split()[0] for line in std.out.splitlines()] == ["dp_loss"]
+    (line,) = std.err.splitlines()
+    assert line.startswith("lagbench: error in unit dp_loss/torch/w/seed1000: --add-model broken_net.py:wide: "
+                           "forward(q, qdot) returned shape (16, 3), expected (16, 2)")
+    assert line.endswith("a rerun fails the same way until it is fixed")
+    (result,) = (out / "units" / "dp_loss" / "torch" / "n").glob("seed*/result.json")
+    d = json.loads(result.read_text())
+    assert d["status"] == "failed" and d["failure"]["kind"] == "non_finite_prediction"
+    assert re.fullmatch(r"non-finite on (\d+) of (\d+) held-out states", d["failure"]["message"])
+
+
+def test_unit_errors_are_printed_once_per_message_with_the_exit_status_they_call_for(capsys):
+    from replication.cli import _print_errors
+
+    mine = "--add-model m.py:f: the factory f(dof) raised KeyError: 'a' (m.py line 2, in f); " + NO_RERUN
+    assert _print_errors([f"a/torch/m/seed1: {mine}", f"b/torch/m/seed1: {mine}", "c/jax/lnn/seed1: OSError: gone"]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert lines == [f"lagbench: error in 2 units (a/torch/m/seed1, b/torch/m/seed1): {mine}",
+                     "lagbench: error in unit c/jax/lnn/seed1: OSError: gone (no result written; a rerun retries it)"]
+    assert _print_errors(["c/jax/lnn/seed1: OSError: gone"]) == 1 and _print_errors([]) == 0
