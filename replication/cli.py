@@ -107,19 +107,28 @@ def cmd_report(args):
     out = Path(args.out) if args.out else Path("report") / (results.resolve().name or "results")
     paths = reports.build_report(results, out, pdf=not args.no_pdf)
     for k, v in paths.items():
-        print(f"{k}: {len(v)} files in {out / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
+        if k == "not_rebuilt":
+            print(f"lagbench report: note: {', '.join(p.name for p in v)} in {out} not from this build (changed since "
+                  f"written, or not on record): left as is", file=sys.stderr)
+        else:
+            print(f"{k}: {len(v)} files in {out / 'figures'}" if isinstance(v, list) else f"{k}: {v}")
 
 
 def cmd_table(args):
     from replication.results import output_folder, write_csv
-    from reports.systems_table import shown, systems_table
+    from reports.load import load_results
+    from reports.systems_table import excluded, shown, systems_table
 
     results = _results_folder(Path(args.results))
-    df = systems_table(results)
+    res = load_results(results)
+    df = systems_table(results, res)
     if args.system:
         df = df[df["system"] == args.system]
     if df.empty:
         raise ValueError(f"--results {results}: no model of {args.system or 'any system'} in it")
+    left_out = excluded(results, res)
+    if left_out:   # the units and records the numbers leave out, as the report names them
+        print("lagbench table: " + "\n".join(left_out), file=sys.stderr)
     for system, g in df.groupby("system", sort=True):
         print(f"{system}\n{shown(g).to_string(index=False)}\n")
     path = output_folder(results / "summary", "--results") / "systems.csv"
@@ -245,7 +254,9 @@ RESUME = {"run": "finished units are kept; run the same command again to resume"
           "bench": "run it again with --resume to keep the finished stages",
           "train-target": "the log up to the last evaluation is in {out}/train_target/train_target_log.csv",
           "fit": "no result was written; run the same command again",
-          "evaluate": "no result was written; run the same command again"}
+          "evaluate": "no result was written; run the same command again",
+          "report": "the previous report is left whole (this build was written aside and discarded); run the "
+                    "same command again"}
 
 
 class Terminated(KeyboardInterrupt):

@@ -20,14 +20,22 @@ UserCodeError.
 `nonfinite_rows(out) -> int`: rows of an (N, ...) output with any non-finite entry; `nonfinite_failure(k, n)`:
 a result's failure record when k of n held-out states got a non-finite prediction (None when k is 0).
 `is_users(error)`: whether an error line is a UserCodeError's (the command line says no rerun retries it).
+`time_limit(seconds, error)`: a block (one call into a user's code) under a limit of `seconds` (None: none); past
+it, `error()` (a UserCodeError) is raised: at once where a timer can interrupt the call (SIGALRM, in the main
+thread; the timer's exception is a BaseException, so the user's `except Exception` lets it through), else when
+the call returns.
 """
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
 import inspect
 import os
+import signal
 import sys
+import threading
+import time
 import traceback
 from pathlib import Path
 
@@ -185,3 +193,38 @@ def nonfinite_failure(k: int, n: int) -> dict | None:
     if k == 0:
         return None
     return {"kind": "non_finite_prediction", "step": None, "message": f"non-finite on {k} of {n} held-out states"}
+
+
+class _PastLimit(BaseException):
+    """Raised into a user's call by `time_limit`'s timer."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float | None, error):
+    if seconds is None:
+        yield
+        return
+    timer = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
+    if timer and 0 < signal.getitimer(signal.ITIMER_REAL)[0] < seconds:
+        timer = False   # a timer of the caller's runs out first: it is left alone, the call checked when it returns
+    if timer:
+        def alarm(signum, frame):
+            raise _PastLimit
+        old = signal.signal(signal.SIGALRM, alarm)
+        previous = signal.setitimer(signal.ITIMER_REAL, seconds)
+    t0 = time.perf_counter()
+    try:
+        try:
+            yield
+        finally:
+            if timer:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+    except _PastLimit:
+        raise error() from None
+    finally:
+        if timer:
+            signal.signal(signal.SIGALRM, old)
+            if previous[0] > 0:   # a caller's timer goes on with what it had left
+                signal.setitimer(signal.ITIMER_REAL, max(previous[0] - (time.perf_counter() - t0), 1e-6), previous[1])
+    if time.perf_counter() - t0 > seconds:   # a call the timer could not interrupt
+        raise error()

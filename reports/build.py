@@ -2,7 +2,10 @@
 
 Reads only the result files of ``docs/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
 training code. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
-``figures/*.png``. Returns ``{"markdown": Path, "typst": Path, "pdf": Path, "figures": [Path, ...]}``.
+``figures/*.png``, built aside and moved in as a whole (``reports.output``). Returns ``{"markdown": Path,
+"typst": Path, "pdf": Path, "figures": [Path, ...]}``, and ``"not_rebuilt": [Path, ...]`` where a
+``--no-pdf`` build leaves a REPORT.pdf or REPORT.typ it did not write and may not remove (not on record,
+or changed since).
 An empty or missing results folder still yields a report that says nothing was run (the command line
 refuses one that holds no results). Writes go through ``reports.output``: atomic, never through a
 symlink, and only files an earlier build recorded are ever removed.
@@ -11,6 +14,7 @@ symlink, and only files an earlier build recorded are ever removed.
 from __future__ import annotations
 
 import datetime as dt
+import os
 from pathlib import Path
 
 from replication.results import writes
@@ -71,13 +75,32 @@ def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = N
 
 @writes
 def build_report(results_dir: str | Path, out_dir: str | Path, *, pdf: bool = True) -> dict:
-    """Build REPORT.md (and REPORT.pdf unless ``pdf=False``) from ``results_dir`` into ``out_dir``."""
-    out_dir = output.prepare(out_dir)
-    sections = build_sections(Path(results_dir), out_dir)
-    md = output.write(out_dir / "REPORT.md", render_markdown(TITLE, sections))
-    figures = [out_dir / b.path for b in tables_and_figures(sections) if isinstance(b, Figure)]
-    paths: dict = {"markdown": md, "figures": figures}
+    """Build REPORT.md (and REPORT.pdf unless ``pdf=False``) from ``results_dir`` into ``out_dir``: written
+    aside (``reports.output``'s staging folder), then moved in as a whole. Without typst, the Markdown and
+    figures are moved in and the previous build's PDF removed before the error is raised."""
+    stage = output.prepare(out_dir)
+    out_dir = Path(out_dir)
+    failure = None
+    try:
+        sections = build_sections(Path(results_dir), stage)
+        built = [output.write(stage / "REPORT.md", render_markdown(TITLE, sections))]
+        built += list(dict.fromkeys(stage / b.path for b in tables_and_figures(sections) if isinstance(b, Figure)))
+        if pdf:
+            try:
+                built += write_pdf(TITLE, sections, stage)
+            except ValueError as e:   # typst missing: what is built is kept, never beside the old PDF
+                failure = e
+        moved, removed = output.finish(out_dir, built)
+    finally:
+        output.discard()   # a build that failed or was interrupted: the previous report stays whole
+    if failure is not None:
+        gone = sorted(p.name for p in removed if p.name in ("REPORT.pdf", "REPORT.typ"))
+        note = f"; the previous build's {' and '.join(gone)} removed" if gone else ""
+        raise ValueError(f"{failure} (REPORT.md and its figures were written{note})") from failure
+    paths: dict = {"markdown": moved[0], "figures": [p for p in moved if p.parent.name == "figures"]}
     if pdf:
-        paths["typst"], paths["pdf"] = write_pdf(TITLE, sections, out_dir)
-    output.finish(out_dir, [md, *figures, *([paths["typst"], paths["pdf"]] if pdf else [])])
+        paths["typst"], paths["pdf"] = out_dir / "REPORT.typ", out_dir / "REPORT.pdf"
+    stale = [out_dir / n for n in ("REPORT.typ", "REPORT.pdf") if not pdf and os.path.lexists(out_dir / n)]
+    if stale:   # not this build's and not on record as an unchanged earlier output: left as it is, and said so
+        paths["not_rebuilt"] = stale
     return paths

@@ -21,7 +21,14 @@ from reports.document import NOT_RUN, Figure, Para, Section, Table
 from reports.fmt import cell, num
 from reports.load import Results
 from reports.scorecard import competence_table, parts_table
-from reports.tables import claim_table, metrics_table, problem_units_table, status_table
+from reports.tables import (
+    PROBLEM_UNITS,
+    claim_table,
+    excluded_note,
+    metrics_table,
+    problem_units_table,
+    status_table,
+)
 from reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
@@ -58,9 +65,8 @@ def summary_sections(res: Results) -> list[Section]:
     st.add(Table("Units per claim and framework", status_table(res), ["units/*/*/*/seed*/result.json"]))
     bad = problem_units_table(res)
     if bad is not None:
-        st.add(Para("Corrupt units failed checksum or schema checks and are excluded from every number "
-                    "in this report; failed units (the runner's status) are excluded too."))
-        st.add(Table("Failed, corrupt and missing units", bad, ["units/*/*/*/seed*/result.json",
+        st.add(Para(excluded_note("report")))
+        st.add(Table(PROBLEM_UNITS, bad, ["units/*/*/*/seed*/result.json",
                                                                  "summary/units.csv"]))
     elif res.unfinished:
         st.add(Para("The run is unfinished (run.json records no end), though every unit it planned is present."))

@@ -6,6 +6,8 @@ framework, status ("ok"; a predictor's "failed: <why>", shown beside its numbers
 for each of ``METRICS`` (errors, valid times against the chaos and float32 floors, rollout µs per step) its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
 NaN where the claim's evaluation does not compute it). `lagbench table` writes it to
 ``summary/systems.csv`` and prints a table per system; the report shows it (``systems_sections``).
+``excluded(root) -> [str]``: what the table leaves out (failed, corrupt and missing units; predictor records
+that fail verification), in the words the report uses; `lagbench table` prints it.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ from reports.document import Para, Section, Table
 from reports.fmt import num
 from reports.load import load_results, protocol_of
 from reports.sections_predict import predictor_results, status_of
+from reports.tables import PROBLEM_UNITS, excluded_note, problem_units_table
 
 METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
            "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test", "rollout_us_per_step")
@@ -42,8 +45,9 @@ def _spread(values) -> dict:
     return {"": float(np.median(v)), "_min": float(np.min(v)), "_max": float(np.max(v))}
 
 
-def systems_table(root) -> pd.DataFrame:
-    res, groups = load_results(root), {}
+def systems_table(root, res=None) -> pd.DataFrame:
+    """The table of the module doc; `res`, the folder's `load_results` where the caller has it already."""
+    res, groups = res if res is not None else load_results(root), {}
     for u in res.usable():
         p = protocol_of(u.result)
         if p is None or p.data.recipe.startswith("file:"):
@@ -67,6 +71,15 @@ def systems_table(root) -> pd.DataFrame:
             r.update({m + k: (np.nan if v is None else float(v)) for k in ("", "_min", "_max")})
         rows.append(r)
     return pd.DataFrame(rows)
+
+
+def excluded(root, res=None) -> list[str]:
+    """What the table leaves out, in the report's words: the note and the table of failed, corrupt and missing
+    units of its "Run status", then each predictor record that fails verification ("...; not used")."""
+    res = res if res is not None else load_results(root)
+    bad = problem_units_table(res)
+    lines = [] if bad is None else [excluded_note("table"), f"{PROBLEM_UNITS}:", bad.to_string(index=False)]
+    return lines + predictor_results(Path(root))[1]
 
 
 def shown(df: pd.DataFrame) -> pd.DataFrame:

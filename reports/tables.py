@@ -151,6 +151,15 @@ def status_table(res: Results) -> pd.DataFrame:
     return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN]})
 
 
+PROBLEM_UNITS = "Failed, corrupt and missing units"
+
+
+def excluded_note(reader: str) -> str:
+    """What every reader of a results folder says of the units it leaves out (`reader`: "report", "table")."""
+    return (f"Corrupt units failed checksum or schema checks and are excluded from every number in this {reader}; "
+            f"failed units (the runner's status) are excluded too.")
+
+
 def problem_units_table(res: Results) -> pd.DataFrame | None:
     rows = [
         {"unit": u.rel, "status": u.status, "reason": cell(u.reason, "unknown")}

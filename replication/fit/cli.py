@@ -137,13 +137,29 @@ def cmd_predict(args):
     from replication.user_functions import import_function
 
     given = [o for o, v in (("--data", args.data), ("--fitted", args.fitted or args.fitted_old), ("--energy", args.energy),
-                            ("--framework", args.framework)) if v is not None]
+                            ("--framework", args.framework), ("--time-unit", args.time_unit)) if v is not None]
     if given:
         raise ValueError(f"{given[0]}: not used with --predict (the predictor is scored on --system's own states)")
     if not args.system:
         raise ValueError("--system: required with --predict; see `lagbench list` for the systems")
     fn = import_function(args.predict, "--predict")
-    d = score(fn, args.system, profile=args.profile, out=args.out, label=args.label, name=args.predict)
+    bar = []   # made at the first call: a refused option or import prints one line and nothing else
+
+    def on_call(done, total):
+        from tqdm.auto import tqdm
+
+        if not bar:
+            bar.append(tqdm(total=total, desc=f"lagbench evaluate --predict {args.label or args.predict}", unit="call",
+                            disable=args.quiet))
+        bar[0].total = total
+        bar[0].update(done - bar[0].n)
+
+    try:
+        d = score(fn, args.system, profile=args.profile, out=args.out, label=args.label, name=args.predict,
+                  call_limit=args.call_limit, on_call=on_call)
+    finally:
+        for b in bar:
+            b.close()
     m = d["metrics"]
     keys = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
             "lyapunov_time_s")
@@ -160,6 +176,8 @@ def cmd_evaluate(args):
 
     if args.predict is not None:
         return cmd_predict(args)
+    if args.call_limit is not None:
+        raise ValueError("--call-limit: with --predict only (a fitted model is the suite's own code)")
     if args.data is None:
         raise ValueError("--data: required; give the trajectory file to evaluate on (or --predict to score a function)")
     fitted = _fitted_folder(args)
@@ -167,7 +185,7 @@ def cmd_evaluate(args):
     try:
         done = evaluate(fitted, args.data, out=args.out, framework=args.framework, system=args.system,
                         substeps=args.substeps, window=args.window, polyorder=args.polyorder, energy=args.energy,
-                        device=args.device, horizon=args.horizon, on_progress=rollouts)
+                        device=args.device, horizon=args.horizon, on_progress=rollouts, time_unit=args.time_unit)
     finally:
         rollouts.close()
     from replication.fit.competence import competence, describe
@@ -245,6 +263,9 @@ def add_commands(sub) -> None:
     s.add_argument("--profile", default="quick", choices=PROFILES,
                    help="with --predict: whose held-out set and rollouts to score on")
     s.add_argument("--label", help="with --predict: the name of its results folder (default: the function's name)")
+    s.add_argument("--call-limit", type=float, metavar="SECONDS", help="with --predict: the most seconds one call of "
+                   "the function may take; a call past it stops the scoring with one line (the progress bar's "
+                   "estimate, from the first calls, shows the whole; default: no limit)")
     s.add_argument("--out", default="results/evaluate", help="results folder")
     s.add_argument("--framework", choices=("jax", "torch"), help="default: the one each model was trained in")
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system); with "
@@ -256,5 +277,7 @@ def add_commands(sub) -> None:
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")
+    s.add_argument("--time-unit", choices=tuple(fit_options.TIME_UNITS), help="the unit of --data's t column: s or "
+                   "ms (default: the fit's)")
     s.set_defaults(func=cmd_evaluate)
     _show_defaults(s)

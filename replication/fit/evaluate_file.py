@@ -1,12 +1,13 @@
 """`lagbench evaluate --fitted DIR --data FILE`: fitted models judged on a new data file.
 
 `evaluate(model, data, out, framework=None, system=None, substeps=None, window=None, polyorder=None,
-energy=None, device="auto", horizon=None, on_progress=None)`
+energy=None, device="auto", horizon=None, on_progress=None, time_unit=None)`
 -> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
 in it, side by side). Each model is loaded by `load.load_fitted` (checksums verified; in `framework`,
 default the one it was trained in: parameters load in either), the data file is prepared as a test file
 (`rows.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
-polyorder unless given) and evaluated by the fit routine (`evaluate.eval_fit`: one-step errors per
+polyorder and time unit unless given; with a system, the step checked against its time scale,
+`replication.fit.time_base`) and evaluated by the fit routine (`evaluate.eval_fit`: one-step errors per
 component, rollouts, energies with `system` or `energy` ("module:function"), DeLaN's decomposition). Written as units of a claim
 "evaluate": `OUT/units/evaluate/<framework>/<model>/seed<k>/` (result.json, one_step.csv, rollouts.csv,
 timeseries.csv, arrays.npz; `lagbench report` renders them) and OUT/data/ (the prepared rows). A verified
@@ -21,14 +22,14 @@ from replication import results as R
 from replication.claims.base import Claim, ModelEntry
 from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
-from replication.fit import trajectories, userdata
+from replication.fit import time_base, trajectories, userdata
 from replication.fit.load import fitted_folders, load_fitted
 from replication.fit.task import LOSS_NAMES
 from replication.run.units import Unit, run_unit
 
 
-def _check(framework, system, substeps, window, polyorder, horizon):
-    given = {"framework": framework, "substeps": substeps, "system": system, "horizon": horizon}
+def _check(framework, system, substeps, window, polyorder, horizon, time_unit):
+    given = {"framework": framework, "substeps": substeps, "system": system, "horizon": horizon, "time_unit": time_unit}
     fit_options.check({k: v for k, v in given.items() if v is not None})
     if window is not None or polyorder is not None:
         trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
@@ -36,11 +37,16 @@ def _check(framework, system, substeps, window, polyorder, horizon):
 
 @R.writes
 def evaluate(model, data, out="results/evaluate", framework=None, system=None, substeps=None, window=None,
-             polyorder=None, energy=None, device="auto", horizon=None, on_progress=None) -> list[dict]:
-    _check(framework, system, substeps, window, polyorder, horizon)
+             polyorder=None, energy=None, device="auto", horizon=None, on_progress=None, time_unit=None) -> list[dict]:
+    _check(framework, system, substeps, window, polyorder, horizon, time_unit)
     path = str(Path(data).resolve())
-    has_tau = "tau" in userdata.read(path)[1]
+    raw = userdata.read(path)[1]
+    has_tau = "tau" in raw
     fits = [load_fitted(f) for f in fitted_folders(model)]
+    for f in fits:   # the time base of each fit's evaluation, before anything is written
+        fcfg = f.result.get("eval_config") or {}
+        unit = time_unit or (fcfg.get("derivatives") or {}).get("time_unit", "s")
+        time_base.check_unit(f"--data {data}", raw, system or fcfg.get("system"), unit)
     if energy:
         from replication.fit.evaluate import energy_function
 
@@ -62,7 +68,9 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         w = window or deriv.get("window", trajectories.WINDOW)
         p = polyorder or deriv.get("polyorder", trajectories.POLYORDER)
         g = deriv.get("gaps", "interpolate")
-        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test", gaps=g)
+        unit = time_unit or deriv.get("time_unit", "s")
+        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test", gaps=g,
+                                time_unit=unit)
         if prep.dof != f.spec.dof:
             raise ValueError(f"--data {data}: has {prep.dof} degrees of freedom, the model in {f.folder} {f.spec.dof}")
         fields = {k: v for k, v in r["model_spec"].items() if k not in ("hidden", "dtype")}
@@ -71,7 +79,8 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         cfg = {"heldout": False, "test": prep.reference, "system": system or fcfg.get("system"),
                "energy": energy or fcfg.get("energy"),
                "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
-               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p, **({"gaps": g} if g != "interpolate" else {})},
+               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p, **({"gaps": g} if g != "interpolate" else {}),
+                                                                     **({"time_unit": unit} if unit != "s" else {})},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
         if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys
             cfg["horizon"] = float(horizon or fcfg["horizon"])

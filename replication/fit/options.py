@@ -16,6 +16,7 @@ from types import SimpleNamespace
 
 from models import ACTIVATIONS
 from replication.fit.rows import HELDOUT, SPLITS
+from replication.fit.time_base import TIME_UNITS
 from replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
 from replication.renamed import renamed
 
@@ -105,6 +106,9 @@ OPTIONS = (
     Option("gaps", "interpolate", f"dropped frames in a trajectory file: interpolate (up to {MAX_GAP} in a row, cubic "
            "spline; the filled rows are not trained on), split (each piece its own trajectory) or refuse",
            one_of(GAPS), f"one of {', '.join(GAPS)}"),
+    Option("time_unit", "s", "the unit of a trajectory file's t column: s (seconds) or ms (milliseconds, read as "
+           "t / 1000); with --system, a time step longer than the system's time scale is refused, naming the unit "
+           "it looks like", one_of(TIME_UNITS), f"one of {', '.join(TIME_UNITS)}"),
     Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
     Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
     Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),

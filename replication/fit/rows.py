@@ -1,7 +1,7 @@
 """The rows `lagbench fit` trains and evaluates on: derivatives, the split, and the prepared file.
 
-`prepare(out, path, split, heldout, window, polyorder, dtype, kind, gaps)` reads the user's file
-(`replication.fit.userdata`), turns a trajectory file into state samples (`replication.fit.trajectories`),
+`prepare(out, path, split, heldout, window, polyorder, dtype, kind, gaps, time_unit)` reads the user's file
+(`replication.fit.userdata`), reads its times in `time_unit` (`replication.fit.time_base`), turns a trajectory file into state samples (`replication.fit.trajectories`),
 assigns every row to "train" or "heldout" (kind "fit") or to "test" (kind "test", a `--test` or
 `lagbench evaluate --data` file), and writes the rows to `OUT/data/<name>-<kind>-<hash>.csv` (columns
 split, [traj, t,] q0.., qdot0.., qddot0..[, tau0..]; loadable with `pandas.read_csv`). The hash covers
@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from replication import results as R
-from replication.fit import trajectories, userdata
+from replication.fit import time_base, trajectories, userdata
 
 SPLITS = ("by-trajectory", "random", "none")
 HELDOUT = 0.1
@@ -85,11 +85,12 @@ def _frame(d: dict, labels) -> pd.DataFrame:
 
 
 def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, polyorder=trajectories.POLYORDER,
-            dtype="float32", kind="fit", gaps="interpolate") -> Prepared:
+            dtype="float32", kind="fit", gaps="interpolate", time_unit="s") -> Prepared:
     path = str(Path(path).resolve())
     digest, d = userdata.read(path)
     is_traj = "t" in d
     if is_traj:
+        d = time_base.in_seconds(d, time_unit)
         d = trajectories.with_derivatives(d, path, window, polyorder, gaps)
     userdata.check_range(path, d, dtype)
     if kind == "test":
@@ -106,6 +107,8 @@ def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, 
         options.update(window=window, polyorder=polyorder)
         if gaps != "interpolate":   # a file without dropped frames gives the same rows under any
             options["gaps"] = gaps
+        if time_unit != "s":   # named only when not seconds: the files prepared in seconds keep their names
+            options["time_unit"] = time_unit
     tag = hashlib.sha256(json.dumps({"source": digest, "kind": kind, **options}, sort_keys=True).encode())
     target = Path(out) / "data" / f"{Path(path).stem}-{kind}-{tag.hexdigest()[:12]}.csv"
     prepared_digest = R.write_csv(target, _frame(d, labels))

@@ -32,7 +32,7 @@ import numpy as np
 
 from replication import results as R
 from replication.claims.base import ModelEntry
-from replication.fit import kind_defaults, trajectories, userdata
+from replication.fit import kind_defaults, time_base, trajectories, userdata
 from replication.fit import options as fit_options
 from replication.fit import rows as fit_data
 from replication.run.units import Unit, run_unit
@@ -94,9 +94,10 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     o, task, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
-    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps)
+    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps,
+                            time_unit=o.time_unit)
     tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test",
-                             gaps=o.gaps) if o.test else None
+                             gaps=o.gaps, time_unit=o.time_unit) if o.test else None
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     n_train = prep.counts["train"]
@@ -113,7 +114,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
            "derivatives": {"window": o.window, "polyorder": o.polyorder,
-                           **({"gaps": o.gaps} if o.gaps != "interpolate" else {})}, "rows": prep.counts,
+                           **({"gaps": o.gaps} if o.gaps != "interpolate" else {}),
+                           **({"time_unit": o.time_unit} if o.time_unit != "s" else {})}, "rows": prep.counts,
            "trajectories": prep.trajectories}
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
@@ -148,6 +150,7 @@ def resolved(data, options: dict) -> Resolved:
         fit_data.check_options(o.split, o.heldout)
     trajectories.check_options(o.window, o.polyorder)
     raw = userdata.read(path)[1]
+    time_base.check_unit(path, raw, o.system, o.time_unit)
     task, recording = task_of(o.model, "tau" in raw, path), "traj" in raw
     o = kind_defaults.fill(o, task, recording=recording)
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
@@ -170,7 +173,9 @@ def resolved(data, options: dict) -> Resolved:
 
         energy_function({"energy": o.energy}, raw["q"].shape[1])
     if o.test is not None:
-        test_tau = "tau" in userdata.read(str(Path(o.test).resolve()))[1]
+        test_raw = userdata.read(str(Path(o.test).resolve()))[1]
+        time_base.check_unit(o.test, test_raw, o.system, o.time_unit)
+        test_tau = "tau" in test_raw
         if test_tau != (task == "inverse_dynamics"):
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "

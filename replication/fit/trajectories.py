@@ -61,7 +61,10 @@ def derivative(x, h: float, order: int, window: int = WINDOW, polyorder: int = P
 
 def grid(t, where: str, gaps: str = "refuse") -> tuple[float, np.ndarray]:
     """(h, frame): the step of the times t (T,) and each sample's frame on the grid t[0] + frame x h; a
-    ValueError naming `where` if they are not on one (see the module doc), or hold a gap `gaps` refuses."""
+    ValueError naming `where` if they are not on one (see the module doc), or hold a gap `gaps` refuses. A lone
+    sample has no step (h NaN)."""
+    if len(t) < 2:   # no step to take a median of (NumPy would warn on the empty slice)
+        return float("nan"), np.zeros(len(t), dtype=int)
     dt = np.diff(t)
     if not np.all(dt > 0):
         raise ValueError(f"{where}: times are not strictly increasing")
@@ -140,7 +143,8 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
         long_enough = [p for p in pieces if not estimate or p["t"].size >= window + 1]
         if not long_enough:
             n = max(p["t"].size for p in pieces)
-            raise ValueError(f"{where} has {n} samples{' in its longest piece between gaps' if len(pieces) > 1 else ''}; "
+            raise ValueError(f"{where} has {n} sample{'s' if n != 1 else ''}"
+                             f"{' in its longest piece between gaps' if len(pieces) > 1 else ''}; "
                              f"estimating its derivatives needs at least {window + 1} (--window {window}, whose first "
                              f"and last {window // 2} are dropped)")
         parts += [_derivatives(p, h, window, polyorder, estimate) for p in long_enough]

@@ -2,12 +2,14 @@
 
 Accepted: `.npz` with arrays q, qdot, qddot (each (N, d)) and optionally tau (N, d); or `.csv` with
 columns q0..q{d-1}, qdot0.., qddot0.. and optionally tau0... (spaces around header names are
-ignored). A *trajectory file* has a time column `t` (and optionally `traj`, the trajectory id): then
+ignored; separated by commas, semicolons or tabs: the commonest of them in the header line, and a file
+separated by semicolons or tabs whose rows hold commas has decimal commas). A *trajectory file* has a time column `t` (and optionally `traj`, the trajectory id): then
 only q is required and the missing derivatives are estimated (`replication.fit.trajectories`). A prepared
 file (`replication.fit.rows`, written by `lagbench fit`) adds a `split` column (train, heldout, test).
 Every problem (unknown suffix, missing columns or a gap in their numbering, mismatched
 lengths, non-finite values or values beyond the training dtype's range, too few rows) raises a
-ValueError that names it. Rows are split by the file's `split` column; a file without one (a state
+ValueError that names it; a row with a NaN or infinite value is named by its line in a CSV file (its
+index in an .npz file) and its trajectory. Rows are split by the file's `split` column; a file without one (a state
 file given straight to `split_rows`) by a fixed random 10 % held out (seed 0), the same for every model.
 
 Content addressing: a file is read once into bytes, hashed (sha256) and parsed from those bytes;
@@ -30,6 +32,7 @@ REQUIRED = ("q", "qdot", "qddot")
 ARRAYS = (*REQUIRED, "tau")
 COLUMNS = ("traj", "t", "split")  # single columns: trajectory id, time, and a prepared file's split
 _MARK = "#sha256="
+_LINES = "_lines"    # a CSV file's line number of each row, for naming a bad row
 _PARSED: dict = {}  # (suffix, sha256) -> parsed arrays; a few entries
 
 
@@ -72,14 +75,39 @@ def _columns(path, df, name) -> list:
     return cols
 
 
+SEPARATORS = {",": "comma", ";": "semicolon", "\t": "tab"}
+
+
+def _dialect(raw: bytes) -> tuple[str, str]:
+    """(separator, decimal mark) of a CSV file, from its header line: the commonest of comma, semicolon and
+    tab there (the header's names hold none of them); a file separated by semicolons or tabs whose rows
+    hold commas writes decimal commas ("1,5")."""
+    text = raw.decode("utf-8", errors="replace")
+    header = next((line for line in text.splitlines() if line.strip()), "")
+    counts = {sep: header.count(sep) for sep in SEPARATORS}
+    sep = max(counts, key=lambda k: (counts[k], k == ","))
+    if not counts[sep]:
+        sep = ","
+    body = text[text.find(header) + len(header):]
+    return sep, "," if sep != "," and "," in body else "."
+
+
+def _lines(raw: bytes) -> np.ndarray:
+    """The line number (1-based) of each data row, as pandas reads them (blank lines skipped, header first)."""
+    text = raw.decode("utf-8", errors="replace")
+    numbers = [i for i, line in enumerate(text.splitlines(), 1) if line.strip()]
+    return np.asarray(numbers[1:], dtype=np.int64)
+
+
 def _from_csv(path, raw: bytes):
     import pandas as pd
 
+    sep, decimal = _dialect(raw)
     try:
-        df = pd.read_csv(io.BytesIO(raw))
+        df = pd.read_csv(io.BytesIO(raw), sep=sep, decimal=decimal)
     except Exception as e:
-        raise ValueError(f"{path}: cannot read as CSV ({e})") from e
-    header = [str(c).strip() for c in pd.read_csv(io.BytesIO(raw), header=None, nrows=1).iloc[0]]
+        raise ValueError(f"{path}: cannot read as CSV separated by {SEPARATORS[sep]}s ({e})") from e
+    header = [str(c).strip() for c in pd.read_csv(io.BytesIO(raw), sep=sep, header=None, nrows=1).iloc[0]]
     twice = sorted({c for c in header if header.count(c) > 1})
     if twice:   # pandas would rename the second one ("q1.1") and read the first alone
         raise ValueError(f"{path}: column{'s' if len(twice) > 1 else ''} {', '.join(twice)} named more than once; "
@@ -92,7 +120,11 @@ def _from_csv(path, raw: bytes):
             try:
                 out[name] = df[cols].to_numpy(dtype=np.float64)
             except (TypeError, ValueError) as e:
-                raise ValueError(f"{path}: columns {', '.join(cols)} are not all numbers ({e})") from e
+                how = f" (read as separated by {SEPARATORS[sep]}s, decimal mark {decimal!r})" if sep != "," else ""
+                raise ValueError(f"{path}: columns {', '.join(cols)} are not all numbers{how} ({e})") from e
+    lines = _lines(raw)
+    if lines.size == len(df):
+        out[_LINES] = lines
     return out
 
 
@@ -145,8 +177,41 @@ def check_range(path, d: dict, dtype: str) -> None:
             raise ValueError(f"{path}: {k} has {bad} rows with values beyond the {dtype} range (|x| > {big:.3g})")
 
 
+def _first_bad(path: str, d: dict, cols: dict, lines) -> None:
+    """A ValueError naming how many rows hold a NaN or infinite value, in which arrays, and the first of them:
+    its line in a CSV file (its row in an .npz file) and its trajectory."""
+    numeric = {**d, **{k: cols[k] for k in ("traj", "t") if k in cols}}
+    masks = {}
+    for k, v in numeric.items():
+        try:
+            finite = np.isfinite(np.asarray(v, dtype=np.float64))
+        except (TypeError, ValueError):
+            continue   # a column of text: refused as such further on
+        masks[k] = ~(finite.reshape(len(finite), -1).all(axis=1))
+    if not masks:
+        return
+    bad = np.any(np.stack(list(masks.values())), axis=0)
+    if not bad.any():
+        return
+    i = int(np.argmax(bad))
+    where = f"line {int(lines[i])}" if lines is not None else f"row {i} (counting from 0)"
+    traj = cols.get("traj")
+    if traj is not None:
+        try:
+            where += f", trajectory {float(traj[i]):g}"
+        except (TypeError, ValueError):
+            where += f", trajectory {traj[i]}"
+    if "t" in cols and not masks.get("t", bad)[i]:
+        where += f", t = {float(cols['t'][i]):g}"
+    names = ", ".join(k for k, m in masks.items() if m.any())
+    n = int(bad.sum())
+    raise ValueError(f"{path}: {n} row{'s' if n > 1 else ''} with NaN or infinite values (in {names}), the first at "
+                     f"{where}; remove or fill {'them' if n > 1 else 'it'}")
+
+
 def _validate(p: Path, d: dict) -> dict:
     path = str(p)
+    lines = d.pop(_LINES, None)
     cols = {k: d.pop(k) for k in COLUMNS if k in d}
     trajectories = "t" in cols and "split" not in cols
     missing = [k for k in (("q",) if trajectories else REQUIRED) if k not in d]
@@ -161,9 +226,6 @@ def _validate(p: Path, d: dict) -> dict:
             d[k] = v = v[:, None]
         if v.ndim != 2:
             raise ValueError(f"{path}: {k} must be (N, d), got shape {v.shape}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.sum(~np.all(np.isfinite(v), axis=1)))
-            raise ValueError(f"{path}: {k} has {bad} rows with NaN or infinite values")
     shapes = {k: v.shape for k, v in d.items()}
     if len(set(shapes.values())) != 1:
         raise ValueError(f"{path}: mismatched shapes {shapes}; every array must be (N, d) with the same N and d")
@@ -171,6 +233,8 @@ def _validate(p: Path, d: dict) -> dict:
     for k, v in cols.items():
         if v.shape != (n,):
             raise ValueError(f"{path}: {k} must be one column of {n} values (as q), got shape {v.shape}")
+    _first_bad(path, d, cols, lines)
+    for k, v in cols.items():
         if k == "split":
             cols[k] = v.astype(str)
             continue
@@ -178,8 +242,6 @@ def _validate(p: Path, d: dict) -> dict:
             cols[k] = v = v.astype(np.float64)
         except (TypeError, ValueError):
             raise ValueError(f"{path}: column {k} is not all numbers") from None
-        if not np.all(np.isfinite(v)):
-            raise ValueError(f"{path}: {k} has {int(np.sum(~np.isfinite(v)))} NaN or infinite values")
     if not cols and n < 20:
         raise ValueError(f"{path}: only {n} rows; need at least 20 (10 % are held out)")
     d.update(cols)

@@ -10,11 +10,13 @@ one-step errors beside the null predictor's, rollouts with the suite's RK4, the 
 valid prediction time against the chaos floor (`replication.evaluation.valid_time`), and the seconds per
 state of one call. Its status is "failed" (its failure: "non-finite on k of n held-out states") where the
 function returns a non-finite q-double-dot on any held-out state; an exception it raises, or an output of the
-wrong type or shape, is one line (`replication.user_functions`). With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the
-evaluation's tables). `lagbench evaluate --predict module:function --system NAME` runs it.
+wrong type or shape, is one line (`replication.user_functions`), and so is a call that runs past
+`call_limit` seconds. `on_call(done, total)` follows every call (`calls_of(setup)`: how many scoring makes).
+With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the evaluation's tables). `lagbench evaluate --predict module:function --system NAME` runs it.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,10 +25,19 @@ import numpy as np
 
 from replication import results as R
 from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
-from replication.evaluation.routines import Context, heldout_of, system_of
+from replication.evaluation.rollout import steps
+from replication.evaluation.routines import Context, _floor, _truth, heldout_of, system_of, truth_key
 from replication.run import environment as env
 from replication.run.splits import TEST
-from replication.user_functions import array_of, call, nonfinite_failure, nonfinite_rows, wrong
+from replication.user_functions import (
+    UserCodeError,
+    array_of,
+    call,
+    nonfinite_failure,
+    nonfinite_rows,
+    time_limit,
+    wrong,
+)
 
 SCORED_BY = ("energy_rollout", "heldout")   # the evaluations a (q, qdot) -> qddot predictor can be put through
 
@@ -48,16 +59,29 @@ class External:
 
 
 class Predictor:
-    """A user's function as the evaluation routines call a model: float64 (..., d) arrays in and out."""
+    """A user's function as the evaluation routines call a model: float64 (..., d) arrays in and out. Each call
+    runs under `limit` seconds (None: no limit) and is counted (`calls`); `on_call(calls)` follows each one."""
 
-    def __init__(self, function, dof: int, name: str):
-        self.function, self.dof, self.name = function, dof, name
+    def __init__(self, function, dof: int, name: str, limit: float | None = None, on_call=None):
+        self.function, self.dof, self.name, self.limit, self.on_call = function, dof, name, limit, on_call
+        self.calls, self.seconds = 0, 0.0
+
+    def _past_limit(self, what: str, n: int) -> UserCodeError:
+        done = (f"; the {self.calls} before it took {self.seconds / self.calls:.3g} s on average" if self.calls
+                else "")
+        return UserCodeError(f"--predict {self.name}: {what} on {n} states ran past --call-limit {self.limit:g} s "
+                             f"(call {self.calls + 1}{done}); make the function faster, or give a larger --call-limit")
 
     def acceleration(self, q, qdot, extra=None):
         q, qdot = np.asarray(q, np.float64), np.asarray(qdot, np.float64)
         n = int(np.prod(q.shape[:-1]))
         what = f"{getattr(self.function, '__name__', 'the function')}(q, qdot)"
-        out = call("--predict", self.name, what, self.function, q.reshape(n, self.dof), qdot.reshape(n, self.dof))
+        t0 = time.perf_counter()
+        with time_limit(self.limit, lambda: self._past_limit(what, n)):
+            out = call("--predict", self.name, what, self.function, q.reshape(n, self.dof), qdot.reshape(n, self.dof))
+        self.calls, self.seconds = self.calls + 1, self.seconds + time.perf_counter() - t0
+        if self.on_call is not None:
+            self.on_call(self.calls)
         out = array_of("--predict", self.name, what, out)
         if out.shape != (n, self.dof):
             raise wrong("--predict", self.name, f"{what} must map q, qdot of shape (N, {self.dof}) to qddot of shape "
@@ -91,8 +115,23 @@ def setup(system: str, profile: str = "quick") -> Setup:
     return found[system]
 
 
-def score(function, system: str, profile: str = "quick", out=None, label: str | None = None, name: str = "") -> dict:
-    """The predictor's record (see the module's doc); `name` is how errors name it (its module:function)."""
+def calls_of(s: Setup) -> int:
+    """How many calls scoring makes into the function: the held-out set twice (its time per state, then the
+    evaluation), and for "energy_rollout" four per RK4 step of the rollouts (batched over initial conditions)."""
+    if s.evaluate != "energy_rollout":
+        return 2
+    t = np.linspace(0.0, s.cfg["t_end"], s.cfg["n_t"])
+    return 2 + 4 * sum(steps(b - a, s.cfg["dt"], "split", np.float64)[0] for a, b in zip(t[:-1], t[1:], strict=True))
+
+
+def score(function, system: str, profile: str = "quick", out=None, label: str | None = None, name: str = "",
+          call_limit: float | None = None, on_call=None) -> dict:
+    """The predictor's record (see the module's doc); `name` is how errors name it (its module:function).
+    `call_limit`: seconds one call may take (`time_limit`; None: no limit); `on_call(done, total)` after each
+    call, `total` from `calls_of` (for a progress bar)."""
+    if call_limit is not None and not (isinstance(call_limit, int | float) and math.isfinite(call_limit)
+                                       and call_limit > 0):
+        raise ValueError(f"--call-limit: {call_limit!r} is not valid; expected a number of seconds > 0")
     s = setup(system, profile)
     named = getattr(function, "__name__", "")
     label = label or (named if named.isidentifier() else "predictor")   # a lambda's "<lambda>" names no folder
@@ -100,10 +139,15 @@ def score(function, system: str, profile: str = "quick", out=None, label: str | 
         raise ValueError(f"--label {label}: use letters, digits, - and _ only (it names a folder)")
     folder = R.output_folder(out) / "predict" / system / label if out is not None else None
     dof = system_of(s.protocol).dof
-    model = Predictor(function, dof, name or label)
+    total = calls_of(s)
+    model = Predictor(function, dof, name or label, call_limit,
+                      None if on_call is None else lambda done: on_call(done, max(done, total)))
     ctx = Context(claim=s.claim, entry=s.entry, framework="numpy", spec=External(dof), params=None,
                   protocol=s.protocol, profile=profile, cfg=s.cfg, model=model, split=TEST)
     batch = heldout_of(ctx)
+    if s.evaluate == "energy_rollout":   # the truth first (cached): the progress bar's estimate times the calls alone
+        _truth(*truth_key(ctx))
+        _floor(*truth_key(ctx))
     t0 = time.perf_counter()
     held = model.acceleration(batch["q"], batch["qdot"])
     per_state = (time.perf_counter() - t0) / len(batch["q"])

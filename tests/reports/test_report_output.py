@@ -55,21 +55,22 @@ def test_report_refuses_a_results_folder_that_is_not_one(tmp_path, capsys, make,
     assert not (tmp_path / "out").exists()
 
 
-def test_a_killed_builds_temporaries_and_figures_are_cleaned_by_the_next(results_dir, tmp_path):
-    """A build killed part-way (issue 58, item 7): its half-written temporaries go at the next build, and
-    the figures it wrote are on record, so the next build removes those it does not write again."""
+def test_a_killed_builds_temporaries_and_staging_folder_are_cleaned_by_the_next(tmp_path):
+    """A build killed part-way (issue 58, item 7; issue 85, item 5): its half-written temporaries go at the next
+    build, and so does its staging folder with what it wrote there; nothing of it reached the report."""
     from replication.results import writing
     from reports import output
 
     out = tmp_path / "out"
     with writing():   # the killed build's process: its lock goes with it
-        output.prepare(out)
-        stray = output.write(out / "figures" / "gone_claim_energy.png", b"from the killed build")
+        stage = output.prepare(out)
+        stray = output.write(stage / "figures" / "gone_claim_energy.png", b"from the killed build")
+    assert stage.parent == out and not (out / "figures" / stray.name).exists()
     (out / ".REPORT.md.ab12cd34.tmp").write_bytes(b"half")
     (out / "figures" / ".x_energy.png.zz99yy88.tmp").write_bytes(b"half")
     (out / "figures" / ".notes.tmp").write_text("a user's own file")      # not our pattern: kept
     build_report(tmp_path / "empty", out, pdf=False)                      # the next build, no figures
-    assert not stray.exists()
+    assert not stage.exists() and not list(out.glob(output.STAGE + "*"))
     assert not (out / ".REPORT.md.ab12cd34.tmp").exists() and not (out / "figures" / ".x_energy.png.zz99yy88.tmp").exists()
     assert (out / "figures" / ".notes.tmp").read_text() == "a user's own file"
 
@@ -120,3 +121,104 @@ def test_no_pdf_writes_the_markdown_alone_and_a_missing_typst_says_what_to_do(sm
     err = capsys.readouterr().err.strip()
     assert err.startswith("lagbench: error: the PDF report needs typst") and "--no-pdf" in err and "\n" not in err
     assert (tmp_path / "nopdf" / "REPORT.md").is_file()   # written before the PDF: nothing computed is lost
+
+
+def _fake_pdf(label: bytes):
+    """A stand-in for `write_pdf` (typst's compile is not what these tests are about): REPORT.typ and REPORT.pdf
+    marked with `label`, written where the build asks."""
+    from reports import output
+
+    def write_pdf(title, sections, out_dir):
+        return output.write(out_dir / "REPORT.typ", label), output.write(out_dir / "REPORT.pdf", b"%PDF " + label)
+    return write_pdf
+
+
+def _files(out) -> dict:
+    """Every file of a report folder and its bytes (the folder locks, which name the time, aside)."""
+    return {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file() and p.name != ".lagbench.lock"}
+
+
+def _other_results(small_results_dir, tmp_path):
+    """The small results less one claim's units: a report that reads differently."""
+    import shutil
+
+    other = tmp_path / "other"
+    shutil.copytree(small_results_dir, other)
+    shutil.rmtree(other / "units" / "dp_energy")
+    return other
+
+
+def test_an_interrupted_rebuild_leaves_the_previous_report_whole(small_results_dir, tmp_path, monkeypatch, capsys):
+    """Issue 85, item 5: never a new REPORT.md beside the previous build's REPORT.pdf."""
+    import reports.build
+    from reports import output
+
+    out = tmp_path / "out"
+    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    assert main(["report", "--results", str(small_results_dir), "--out", str(out)]) in (0, None)
+    before = _files(out)
+
+    def interrupted(title, sections, out_dir):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(reports.build, "write_pdf", interrupted)
+    capsys.readouterr()
+    assert main(["report", "--results", str(_other_results(small_results_dir, tmp_path)), "--out", str(out)]) == 130
+    assert "the previous report is left whole" in capsys.readouterr().err
+    assert _files(out) == before and not list(out.glob(output.STAGE + "*"))
+
+
+def test_without_typst_the_previous_pdf_goes_and_the_error_says_so(small_results_dir, tmp_path, monkeypatch, capsys):
+    import reports.build
+
+    out = tmp_path / "out"
+    real = reports.build.write_pdf
+    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    first = build_report(small_results_dir, out)["markdown"].read_text()
+    monkeypatch.setattr(reports.build, "write_pdf", real)
+    monkeypatch.setitem(sys.modules, "typst", None)   # `import typst` raises ImportError
+    capsys.readouterr()
+    assert main(["report", "--results", str(_other_results(small_results_dir, tmp_path)), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the previous build's REPORT.pdf and REPORT.typ removed" in err, err
+    assert (out / "REPORT.md").read_text() != first   # the new Markdown, alone
+    assert not (out / "REPORT.pdf").exists() and not (out / "REPORT.typ").exists()
+
+
+def test_a_signal_while_the_report_moves_in_arrives_after_it_is_whole(small_results_dir, tmp_path, monkeypatch):
+    import os
+    import signal
+    import threading
+
+    import reports.build
+    import reports.output
+    from reports import output
+
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signal handlers are set in the main thread only")
+    out = tmp_path / "out"
+    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    first = build_report(small_results_dir, out)["markdown"].read_text()
+    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"second"))
+    replace, sent = os.replace, []
+
+    def replace_then_stop(src, dst):   # SIGTERM right after the first output is moved into the report's folder
+        replace(src, dst)
+        if not sent and output.STAGE in str(src) and output.STAGE not in str(dst):
+            sent.append(dst)
+            os.kill(os.getpid(), signal.SIGTERM)
+
+    class Stopped(Exception):
+        pass
+
+    def stop(signum, frame):
+        raise Stopped
+
+    monkeypatch.setattr(reports.output.os, "replace", replace_then_stop)
+    old = signal.signal(signal.SIGTERM, stop)
+    try:
+        with pytest.raises(Stopped):
+            build_report(_other_results(small_results_dir, tmp_path), out)
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert sent and (out / "REPORT.pdf").read_bytes() == b"%PDF second" and (out / "REPORT.typ").read_bytes() == b"second"
+    assert (out / "REPORT.md").read_text() != first and not list(out.glob(output.STAGE + "*"))

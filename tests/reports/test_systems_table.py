@@ -34,3 +34,28 @@ def test_one_row_per_claim_model_and_framework_with_its_seeds_spread(results_dir
 def test_the_report_has_the_table(built):
     text = built["markdown"].read_text()
     assert "## Results by system" in text and "**double_pendulum**" in text
+
+
+def test_the_table_names_what_it_leaves_out_in_the_reports_words(small_results_dir, tmp_path, capsys):
+    """Issue 85, item 5: a unit whose checksum fails is flagged by `lagbench table` as the report flags it."""
+    import json
+
+    from reports.load import load_results
+    from reports.tables import excluded_note, problem_units_table
+
+    root = tmp_path / "r"
+    shutil.copytree(small_results_dir, root)
+    unit = sorted(root.glob("units/*/*/*/seed*/result.json"))[0]
+    d = json.loads(unit.read_text())
+    d["metrics"]["heldout_l1"] = 1e-9   # a better number than was computed: the checksum no longer matches
+    unit.write_text(json.dumps(d))
+    score(lambda q, qd: np.zeros_like(q), "double_pendulum", "smoke", out=root, label="zero")
+    record = root / "predict" / "double_pendulum" / "zero" / "result.json"
+    record.write_text(record.read_text().replace('"zero"', '"zeros"', 1))
+    assert main(["table", "--results", str(root)]) == 0
+    err = capsys.readouterr().err
+    rel = unit.parent.relative_to(root).as_posix()
+    assert excluded_note("table") in err and rel in err and "checksum mismatch" in err, err
+    assert problem_units_table(load_results(root)).to_string(index=False) in err   # the report's table, as is
+    assert "predict/double_pendulum/zero: " in err and "; not used" in err, err
+    assert excluded_note("report") == excluded_note("table").replace("this table", "this report")
