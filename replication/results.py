@@ -135,6 +135,28 @@ def _lock(path: Path, option: str) -> None:
     _LOCKS[key] = fd
 
 
+def refuse_if_locked(path, option: str = "--out") -> None:
+    """The ValueError `_lock` would give when another process holds the folder's lock, asked before a command's
+    long planning, so that a second writer hears it at once; nothing is created or held."""
+    import fcntl
+
+    path = Path(path)
+    if path.is_symlink() or not (path / LOCK_NAME).is_file() or str(path.resolve()) in _LOCKS:
+        return
+    try:
+        fd = os.open(path / LOCK_NAME, os.O_RDONLY | os.O_NOFOLLOW)
+    except OSError:
+        return   # unreadable: `output_folder` says why when the command takes the folder
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
+        raise ValueError(f"{option} {path}: another lagbench command is writing into this folder ({holder}); "
+                         "wait for it to end, or give another folder") from None
+    finally:
+        os.close(fd)
+
+
 @contextmanager
 def writing():
     """The folders locked (by `output_folder`) inside the block are let go at its end; a block inside

@@ -197,6 +197,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
+    if not dry_run:   # a folder another command is writing into is refused before the planning, not after it
+        R.refuse_if_locked(out, "--out")
     added = added_models.parse(add_models, {e.label for c in CLAIMS.values() for e in c.models})
     units = plan(profile, claims, frameworks, seeds, models, split, added)
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)

@@ -68,3 +68,29 @@ def test_two_fits_into_one_folder_at_once_never_both_report_success(tmp_path):
     assert first.returncode == 0, stderr
     assert second.returncode == 2 and f"pid {first.pid}" in second.stderr, second.stderr
     assert len(list(out.glob("units/fit/*/*/seed*/result.json"))) == 1
+
+
+def test_a_run_into_a_locked_folder_is_refused_before_it_plans(tmp_path, monkeypatch):
+    """`lagbench run` plans every claim's units before it takes its folder; a folder another command holds
+    is refused first, with the same line, and planning never starts."""
+    from replication.run import runner
+
+    out = tmp_path / "out"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from replication import results as R\n"
+                               "with R.writing():\n    R.output_folder(sys.argv[1]); print('held', flush=True); "
+                               "time.sleep(60)", str(out)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        monkeypatch.setattr(runner, "plan", lambda *a, **k: (_ for _ in ()).throw(AssertionError("planned")))
+        try:
+            runner.run("smoke", out=out, claims=["dp_loss"], progress=False)
+            raise AssertionError("not refused")
+        except ValueError as e:
+            assert "another lagbench command is writing into this folder" in str(e) and f"pid {holder.pid}" in str(e)
+        R.refuse_if_locked(tmp_path / "absent")   # no folder, or no lock file: nothing to refuse, nothing made
+        assert not (tmp_path / "absent").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()
+    R.refuse_if_locked(out)   # let go: no refusal
