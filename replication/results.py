@@ -11,7 +11,6 @@ both and raises `CorruptResult` on any mismatch; the runner then reruns the unit
 from __future__ import annotations
 
 import errno
-import functools
 import hashlib
 import io
 import json
@@ -19,10 +18,12 @@ import math
 import os
 import stat
 import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+
+# the folder locks: `output_folder` takes one; every command runs inside `writing` (re-exported for callers)
+from replication.folder_lock import _LOCKS, LOCK_NAME, lock, refuse_if_locked, writes, writing  # noqa: F401
 
 SCHEMA = 1
 
@@ -105,80 +106,6 @@ def make_own_folder(path) -> str | None:
     return f"{path} is not a folder of this user's that no one else may write"
 
 
-LOCK_NAME = ".lagbench.lock"
-_LOCKS: dict = {}   # resolved folder -> the open lock file this process holds on it
-
-
-def _lock(path: Path, option: str) -> None:
-    """Hold the folder's exclusive lock (an flock on its LOCK_NAME, released when this process lets go or
-    ends); a ValueError naming the holder if another process holds it. Reentrant within a process."""
-    import fcntl
-
-    key = str(path.resolve())
-    if key in _LOCKS:
-        return
-    try:
-        fd = os.open(path / LOCK_NAME, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
-    except OSError as e:
-        raise ValueError(f"{option} {path}: cannot make its lock file {LOCK_NAME} ({e.strerror or e})") from None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
-        os.close(fd)
-        raise ValueError(f"{option} {path}: another lagbench command is writing into this folder ({holder}); "
-                         "wait for it to end, or give another folder") from None
-    os.ftruncate(fd, 0)
-    from replication.run.environment import now  # imports the standard library only
-
-    os.write(fd, f"pid {os.getpid()}, since {now()}".encode())
-    _LOCKS[key] = fd
-
-
-def refuse_if_locked(path, option: str = "--out") -> None:
-    """The ValueError `_lock` would give when another process holds the folder's lock, asked before a command's
-    long planning, so that a second writer hears it at once; nothing is created or held."""
-    import fcntl
-
-    path = Path(path)
-    if path.is_symlink() or not (path / LOCK_NAME).is_file() or str(path.resolve()) in _LOCKS:
-        return
-    try:
-        fd = os.open(path / LOCK_NAME, os.O_RDONLY | os.O_NOFOLLOW)
-    except OSError:
-        return   # unreadable: `output_folder` says why when the command takes the folder
-    try:
-        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another process"
-        raise ValueError(f"{option} {path}: another lagbench command is writing into this folder ({holder}); "
-                         "wait for it to end, or give another folder") from None
-    finally:
-        os.close(fd)
-
-
-@contextmanager
-def writing():
-    """The folders locked (by `output_folder`) inside the block are let go at its end; a block inside
-    another lets go only of its own. Every command, and every library call that writes a folder, runs in
-    one: two commands never write into one folder at once."""
-    before = set(_LOCKS)
-    try:
-        yield
-    finally:
-        for key in set(_LOCKS) - before:
-            os.close(_LOCKS.pop(key))
-
-
-def writes(fn):
-    """`fn` run inside `writing`: the folders it locks are let go when it returns."""
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        with writing():
-            return fn(*args, **kwargs)
-    return wrapper
-
-
 def output_folder(path, option: str = "--out") -> Path:
     """`path` as a folder this process can write into, created if absent, and locked for this process
     (`writing`); else a ValueError naming `option` (checked before any work starts, so no computation is
@@ -192,7 +119,7 @@ def output_folder(path, option: str = "--out") -> Path:
         raise ValueError(f"{option} {path}: cannot create the folder ({e.strerror or e})") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise ValueError(f"{option} {path}: the folder is not writable; give a writable folder")
-    _lock(path, option)
+    lock(path, option)
     return path
 
 

@@ -71,9 +71,9 @@ class _Runner:
         return self.out / f"config{k}"
 
     def tell(self, stage: str, plan) -> None:
-        todo = self.todo(plan)
         if not self.progress:
             return
+        todo = self.todo(plan)
         if not todo:
             print(f"{self.claim.id} {stage}: every unit finished", flush=True)
             return
@@ -86,27 +86,24 @@ class _Runner:
         self.tell(stage, plan)
         for k, knobs, labels, seeds in plan:
             for label in labels:   # one model at a time, so that the record grows as each one finishes
-                units = self.units(knobs, [label], seeds)
-                new = []
-                todo = [u for u in units if records.unit_key(u) not in self.known]
-                train = [u for u in todo if not is_current(u, self.folder(k))]
+                keyed = [(records.unit_key(u), u) for u in self.units(knobs, [label], seeds)]
+                todo = [(key, u) for key, u in keyed if key not in self.known]
+                train = [u for _, u in todo if not is_current(u, self.folder(k))]
                 if train:
                     run_units(train, self.folder(k), self.profile, self.progress, jobs=1)
-                for u in todo:
-                    new.append(self._row(u, k, knobs))
+                new = [self._row(key, u, k, knobs) for key, u in todo]
                 if self.record:
                     records.append(self.record, new)
                 self.known.update({r["key"]: r for r in new})
-                for u in units:
-                    self.rows.append({**self.known[records.unit_key(u)], "stage": stage, "config": k})
+                self.rows += [{**self.known[key], "stage": stage, "config": k} for key, _ in keyed]
 
-    def _row(self, u: Unit, k: int, knobs: dict) -> dict:
+    def _row(self, key: str, u: Unit, k: int, knobs: dict) -> dict:
         try:
             r = R.load_result(u.folder(self.folder(k)))
         except R.CorruptResult:
             r = {}
         ok = r.get("status") == "ok"
-        return {"key": records.unit_key(u), "claim": self.claim.id, "profile": self.profile, "model": u.entry.label,
+        return {"key": key, "claim": self.claim.id, "profile": self.profile, "model": u.entry.label,
                 "config": k, "knob_lr": knobs["lr"], "knob_width": knobs["width"], "framework": u.framework,
                 "seed": u.seed, "split": u.split, "status": r.get("status", "failed"),
                 "metric": choose.score_name(r, self.claim),

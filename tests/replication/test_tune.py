@@ -45,8 +45,8 @@ def _fake_search(monkeypatch, score):
     """The search's stages on a made-up score(model, knobs, seed): no training, the choices and the record only."""
     monkeypatch.setattr(tune_module, "run_units", lambda *a, **k: None)
 
-    def row(self, u, k, knobs):
-        return {"key": records.unit_key(u), "claim": self.claim.id, "profile": self.profile, "model": u.entry.label,
+    def row(self, key, u, k, knobs):
+        return {"key": key, "claim": self.claim.id, "profile": self.profile, "model": u.entry.label,
                 "config": k, "knob_lr": knobs["lr"], "knob_width": knobs["width"], "framework": u.framework,
                 "seed": u.seed, "split": u.split, "status": "ok", "metric": choose.PACE if self.claim.pooled else "heldout_l1",
                 "score": score(u.entry.label, knobs, u.seed), "train_time_s": 1.0, "train_samples": 10, "cpu": "x"}
