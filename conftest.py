@@ -7,8 +7,8 @@ import tempfile
 
 import pytest
 
-from replication.run import jax_cache
-from replication.run.environment import one_thread_env
+from lagbench.replication.run import jax_cache
+from lagbench.replication.run.environment import one_thread_env
 
 # Under pytest-xdist the workers share the machine's cores, so each computes on one thread (JAX's XLA,
 # PyTorch, OpenMP, MKL), as the replication's own worker processes do. Set here, before any test module

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.params import layer_table
-from models.spec import USER_KIND, ModelSpec
+from lagbench.models.params import layer_table
+from lagbench.models.spec import USER_KIND, ModelSpec
 
 
 def _cranmer_std(role: str, index: int, shape: tuple) -> float:
@@ -54,7 +54,7 @@ DISSIPATION_INIT = 0.01   # the Rayleigh coefficients' start, b = softplus(raw):
 def init_params(spec: ModelSpec, seed: int = 0) -> dict:
     """Fresh parameters in the `models.params` layout, dtype spec.dtype. Same seed, same numbers."""
     if spec.kind == USER_KIND:
-        from models import user
+        from lagbench.models import user
 
         return user.init_params(spec, seed)
     rng = np.random.default_rng(seed)

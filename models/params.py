@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.spec import USER_KIND, ModelSpec
+from lagbench.models.spec import USER_KIND, ModelSpec
 
 
 def layer_table(spec: ModelSpec) -> list:
@@ -37,7 +37,7 @@ def layer_table(spec: ModelSpec) -> list:
 def param_shapes(spec: ModelSpec) -> dict:
     """{key: shape} of the layout, in drawing order (a user's model: its module's parameters, `models.user`)."""
     if spec.kind == USER_KIND:
-        from models import user
+        from lagbench.models import user
 
         return user.param_shapes(spec)
     out = {}

@@ -17,7 +17,7 @@ eager PyTorch gained nothing reliable).
 """
 from __future__ import annotations
 
-from models.graph import banded_supported
+from lagbench.models.graph import banded_supported
 
 BLOCK_ROWS = 1024
 

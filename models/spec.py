@@ -24,7 +24,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from models.activations import ACTIVATIONS
+from lagbench.models.activations import ACTIVATIONS
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ an edited module never reuses a cached training). `make_module(spec, seed)`: a f
 factory. `param_shapes(spec)`: {name: shape} of its parameters (the layout `models.params` checks against).
 `init_params(spec, seed)`: its initial parameters as NumPy arrays, the factory called under
 torch.manual_seed(seed) or with jax.random.PRNGKey(seed) (same seed, same numbers). Every call into the user's
-code (the factory; the module, `forward`) goes through the suite's one boundary, `replication.user_functions`:
+code (the factory; the module, `forward`) goes through the suite's one boundary, `lagbench.files.user_functions`:
 an exception, a wrong type or shape is one line naming the user's file and function. Imported only when a
 user names a model.
 """
@@ -24,13 +24,13 @@ OPTION = "--add-model"
 
 
 def _factory(ref: str):
-    from replication.user_functions import import_function  # the one boundary with a user's code
+    from lagbench.files.user_functions import import_function  # the one boundary with a user's code
 
     return import_function(ref, OPTION)
 
 
 def _boundary():
-    from replication import user_functions
+    from lagbench.files import user_functions
 
     return user_functions
 
@@ -45,7 +45,7 @@ def files_of(spec, module) -> tuple:
 
 def forward(spec, module, fn, *args):
     """fn(*args), a call of `module` (an equinox module itself, or torch's `functional_call` of it): any exception
-    is the boundary's one line naming the module's forward (`replication.user_functions.call`)."""
+    is the boundary's one line naming the module's forward (`lagbench.files.user_functions.call`)."""
     name = f"{type(module).__name__}.{'forward' if hasattr(module, 'forward') else '__call__'}(q, qdot)"
     return _boundary().call(OPTION, spec.factory, name, fn, *args, files=lambda: files_of(spec, module))
 
@@ -136,7 +136,7 @@ def returns(module) -> str:
 
 def returns_of(ref: str) -> str:
     """`returns` of the module the factory `ref` builds (built once, for one coordinate)."""
-    from models.spec import USER_KIND, ModelSpec
+    from lagbench.models.spec import USER_KIND, ModelSpec
 
     return returns(make_module(ModelSpec(kind=USER_KIND, dof=1, factory=ref, factory_source="-")))
 

@@ -7,6 +7,6 @@ diffrax, the suite's ``systems`` or ``models``, or its training and evaluation c
 so that its verdicts are the runner's own rule applied to the unit files it reads.
 """
 
-from reports.build import build_report
+from lagbench.reports.build import build_report
 
 __all__ = ["build_report"]

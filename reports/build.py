@@ -17,26 +17,26 @@ import datetime as dt
 import os
 from pathlib import Path
 
-from replication.results import writes
-from reports import output
-from reports.document import Figure, Para, Section, tables_and_figures
-from reports.environment import environment_sections, sources_sections
-from reports.findings import findings_sections
-from reports.load import load_results
-from reports.markdown import render_markdown
-from reports.pdf import write_pdf
-from reports.scorecard import scorecard_appendix, scorecard_section
-from reports.sections_claims import claim_details, metrics_appendix, summary_sections, theme_sections
-from reports.sections_control import control_sections
-from reports.sections_fit import fit_sections, is_fit_results
-from reports.sections_frameworks import frameworks_sections
-from reports.sections_hessian import hessian_sections
-from reports.sections_online import online_sections
-from reports.sections_predict import predict_sections
-from reports.sections_robustness import robustness_sections
-from reports.sections_speed import speed_appendix, speed_sections
-from reports.sections_stiff import stiff_sections
-from reports.systems_table import systems_sections
+from lagbench.files.results import writes
+from lagbench.reports import output
+from lagbench.reports.document import Figure, Para, Section, tables_and_figures
+from lagbench.reports.environment import environment_sections, sources_sections
+from lagbench.reports.findings import findings_sections
+from lagbench.reports.load import load_results
+from lagbench.reports.markdown import render_markdown
+from lagbench.reports.pdf import write_pdf
+from lagbench.reports.scorecard import scorecard_appendix, scorecard_section
+from lagbench.reports.sections_claims import claim_details, metrics_appendix, summary_sections, theme_sections
+from lagbench.reports.sections_control import control_sections
+from lagbench.reports.sections_fit import fit_sections, is_fit_results
+from lagbench.reports.sections_frameworks import frameworks_sections
+from lagbench.reports.sections_hessian import hessian_sections
+from lagbench.reports.sections_online import online_sections
+from lagbench.reports.sections_predict import predict_sections
+from lagbench.reports.sections_robustness import robustness_sections
+from lagbench.reports.sections_speed import speed_appendix, speed_sections
+from lagbench.reports.sections_stiff import stiff_sections
+from lagbench.reports.systems_table import systems_sections
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 

@@ -21,10 +21,10 @@ import math
 
 import pandas as pd
 
-from reports.document import NOT_RUN
-from reports.fmt import num, summarise
-from reports.load import Results
-from reports.tables import claim_models, values
+from lagbench.reports.document import NOT_RUN
+from lagbench.reports.fmt import num, summarise
+from lagbench.reports.load import Results
+from lagbench.reports.tables import claim_models, values
 
 TOLERANCE = 2.0
 

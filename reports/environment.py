@@ -8,9 +8,9 @@ import datetime as dt
 
 import pandas as pd
 
-from reports.document import NOT_RUN, Figure, Para, Section, Table
-from reports.fmt import cell
-from reports.load import Results
+from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
+from lagbench.reports.fmt import cell
+from lagbench.reports.load import Results
 
 
 def flatten(d, prefix: str = "") -> dict[str, str]:

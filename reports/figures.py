@@ -20,8 +20,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from reports.load import Unit
-from reports.output import write
+from lagbench.reports.load import Unit
+from lagbench.reports.output import write
 
 DPI = 130
 LINESTYLES = ["-", "--", ":", "-."]

@@ -8,8 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
-from reports.figures import LINESTYLES, MARKERS, _groups, model_colours, new_figure, save, style_index
-from reports.load import Unit
+from lagbench.reports.figures import (
+    LINESTYLES,
+    MARKERS,
+    _groups,
+    model_colours,
+    new_figure,
+    save,
+    style_index,
+)
+from lagbench.reports.load import Unit
 
 DECOMPOSITION = [("M", r"inertia $M(q)$"), ("c", r"Coriolis/centrifugal $c(q, \dot q)$"),
                  ("g", r"gravity $g(q)$"), ("tau", r"torque $\tau$")]

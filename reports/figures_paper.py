@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reports.figures import (
+from lagbench.reports.figures import (
     DIVERGED,
     LINESTYLES,
     _first_with,
@@ -22,7 +22,7 @@ from reports.figures import (
     save,
     style_index,
 )
-from reports.load import Unit
+from lagbench.reports.load import Unit
 
 
 def model_panels(units: list[Unit], path: Path, models: list[str]) -> bool:

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.ticker import NullFormatter
 
-from reports.figures import LINESTYLES, _groups, model_colours, new_figure, save, style_index
-from reports.load import Unit
+from lagbench.reports.figures import LINESTYLES, _groups, model_colours, new_figure, save, style_index
+from lagbench.reports.load import Unit
 
 COLUMNS = {"samples", "train_s", "heldout_loss"}
 

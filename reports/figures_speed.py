@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from reports.figures import (
+from lagbench.reports.figures import (
     MARKERS,
     colour,
     log_if_spread,
@@ -28,7 +28,7 @@ from reports.figures import (
     style_index,
     ticks_at,
 )
-from reports.load import Unit
+from lagbench.reports.load import Unit
 
 SIZE_METRIC = re.compile(r"^(?P<base>.+)_n(?P<n>\d+)$")
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import pandas as pd
 
-from replication.claims.findings import FINDINGS, Finding
-from reports.document import NOT_RUN, Para, Section, Table
-from reports.load import Results
+from lagbench.replication.claims.findings import FINDINGS, Finding
+from lagbench.reports.document import NOT_RUN, Para, Section, Table
+from lagbench.reports.load import Results
 
 
 def _lookup(d, keys: set[str], prefix: str = "") -> dict[str, str]:

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from reports.document import NOT_RUN
+from lagbench.reports.document import NOT_RUN
 
 
 def is_number(x) -> bool:

@@ -8,7 +8,7 @@ Canonical form of a ``result.json`` checksum (the writer must match it byte for 
 
 Only the top-level ``"checksum"`` key is dropped; nested keys are sorted too (``sort_keys`` is recursive).
 Every entry of ``result["files"]`` maps a path relative to the unit folder to the lowercase hex sha256
-of that file's bytes. The code that computes both is the writer's own (`replication.results`: `canonical`,
+of that file's bytes. The code that computes both is the writer's own (`lagbench.files.results`: `canonical`,
 `result_checksum`, `sha256_file`; NumPy only, no training code); this module adds the report's
 verification, which names what is wrong instead of raising.
 """
@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from replication.results import canonical, result_checksum
-from replication.results import sha256_file as file_sha256
+from lagbench.files.results import canonical, result_checksum
+from lagbench.files.results import sha256_file as file_sha256
 
 __all__ = ["canonical_json", "result_checksum", "file_sha256", "verify_unit"]
 

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from replication.training.protocol import Protocol
-from reports.integrity import verify_unit
+from lagbench.replication.training.protocol import Protocol
+from lagbench.reports.integrity import verify_unit
 
 BENCH_COLUMNS = {
     "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
@@ -273,8 +273,8 @@ def load_results(root: str | Path) -> Results:
 
 def _recompute_verdicts(res: Results) -> None:
     """Verdicts from the verified unit files, by the runner's own function; stored ones only compared."""
-    from replication.claims import CLAIMS
-    from replication.claims.verdicts import frame, judge, of_split
+    from lagbench.replication.claims import CLAIMS
+    from lagbench.replication.claims.verdicts import frame, judge, of_split
 
     profile = (res.run or {}).get("profile") or res.verdict_profile
     df = of_split(frame([u.result for u in res.units if u.status in ("ok", "failed")]), res.split)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from reports.document import NOT_RUN, Bullets, Figure, Para, Section, Table
+from lagbench.reports.document import NOT_RUN, Bullets, Figure, Para, Section, Table
 
 
 def _escape(text) -> str:

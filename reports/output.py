@@ -7,7 +7,7 @@ removes what a killed build left (its temporaries, its staging folder) and retur
 folder inside ``out_dir`` (``.lagbench-build-<random>/``, with ``figures/``): the build writes every output
 there, so an interrupted or failed build leaves the previous report as it was, never a new REPORT.md
 beside the previous build's REPORT.pdf. Every output is written with
-``replication.results.atomic_write_bytes`` (a temporary file and a rename).
+``lagbench.files.results.atomic_write_bytes`` (a temporary file and a rename).
 
 ``finish(out_dir, paths)`` moves this build's outputs (``paths``, inside the staging folder) into
 ``out_dir``, each by a rename (a symlink at a name is replaced, never written through), with SIGINT and
@@ -31,7 +31,7 @@ import tempfile
 import threading
 from pathlib import Path
 
-from replication.results import atomic_write_bytes, output_folder, read_nofollow
+from lagbench.files.results import atomic_write_bytes, output_folder, read_nofollow
 
 MANIFEST = ".lagbench-report.json"
 STAGE = ".lagbench-build-"   # the staging folder's name prefix

@@ -11,8 +11,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from reports.document import Bullets, Figure, Para, Section, Table
-from reports.output import write
+from lagbench.reports.document import Bullets, Figure, Para, Section, Table
+from lagbench.reports.output import write
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

@@ -3,7 +3,7 @@
 `table(claims, verdicts) -> str`: one Markdown row per paper claim, then per check: number, title, where in
 the paper, the verdict, each counted part with its verdict, the key model's metric in JAX and PyTorch (the
 seed mean) and the published value with what kind of number it is; below it, one line per variant.
-`python -m reports.readme_table FOLDER` prints it from FOLDER/claims.json and FOLDER/verdicts.json (a
+`python -m lagbench.reports.readme_table FOLDER` prints it from FOLDER/claims.json and FOLDER/verdicts.json (a
 sample-report folder) or FOLDER/summary/verdicts.json (a results folder). The README holds the output of
 the verdict-of-record run between the markers BEGIN and END; `tests/reports/test_readme_table.py` keeps
 it equal to this function's output on the committed `docs/sample_report/`.
@@ -14,7 +14,7 @@ import json
 import sys
 from pathlib import Path
 
-BEGIN = "<!-- claims table: made by `python -m reports.readme_table docs/sample_report`; do not edit by hand -->"
+BEGIN = "<!-- claims table: made by `python -m lagbench.reports.readme_table docs/sample_report`; do not edit by hand -->"
 END = "<!-- end of the claims table -->"
 FRAMEWORKS = (("jax", "JAX"), ("torch", "PyTorch"))
 
@@ -102,5 +102,5 @@ def block(folder) -> str:
 
 if __name__ == "__main__":
     if len(sys.argv) != 2:
-        raise SystemExit("usage: python -m reports.readme_table FOLDER (a results or sample-report folder)")
+        raise SystemExit("usage: python -m lagbench.reports.readme_table FOLDER (a results or sample-report folder)")
     print(block(sys.argv[1]))

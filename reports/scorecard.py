@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import pandas as pd
 
-from reports import sections_registration
-from reports.document import NOT_RUN, Para, Section, Table
-from reports.fmt import cell, num, stat, summarise
-from reports.load import Results
-from reports.tables import published_cell, published_entry, verdict_text
+from lagbench.reports import sections_registration
+from lagbench.reports.document import NOT_RUN, Para, Section, Table
+from lagbench.reports.fmt import cell, num, stat, summarise
+from lagbench.reports.load import Results
+from lagbench.reports.tables import published_cell, published_entry, verdict_text
 
 REASON_CHARS = 120
 FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}

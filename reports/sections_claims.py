@@ -12,16 +12,16 @@ from pathlib import Path
 
 import pandas as pd
 
-from reports import figures as F
-from reports import figures_delan as FD
-from reports import figures_paper as FL
-from reports import figures_precision as FP
-from reports import figures_speed as FS
-from reports.document import NOT_RUN, Figure, Para, Section, Table
-from reports.fmt import cell, num
-from reports.load import Results
-from reports.scorecard import competence_table, parts_table
-from reports.tables import (
+from lagbench.reports import figures as F
+from lagbench.reports import figures_delan as FD
+from lagbench.reports import figures_paper as FL
+from lagbench.reports import figures_precision as FP
+from lagbench.reports import figures_speed as FS
+from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
+from lagbench.reports.fmt import cell, num
+from lagbench.reports.load import Results
+from lagbench.reports.scorecard import competence_table, parts_table
+from lagbench.reports.tables import (
     PROBLEM_UNITS,
     claim_table,
     excluded_note,
@@ -29,7 +29,7 @@ from reports.tables import (
     problem_units_table,
     status_table,
 )
-from reports.themes import THEMES, assign
+from lagbench.reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
 REASON_CHARS = 400   # a verdict's reason on a claim's page

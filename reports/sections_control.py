@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from reports import figures as F
-from reports.document import Figure, Para, Section, Table
-from reports.fmt import num
-from reports.load import Results
+from lagbench.reports import figures as F
+from lagbench.reports.document import Figure, Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import Results
 
 FAMILIES = {"test": "unseen shapes (the test family)", "train_x2": "training family, twice as fast"}
 GAINS = "gains KP 20, KD 2 sqrt(20)"

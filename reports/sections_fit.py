@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from reports import figures as F
-from reports import figures_delan as FD
-from reports.document import Figure, Para, Section, Table
-from reports.fmt import cell, num
-from reports.load import Results, protocol_of
-from reports.tables import problem_units_table
+from lagbench.reports import figures as F
+from lagbench.reports import figures_delan as FD
+from lagbench.reports.document import Figure, Para, Section, Table
+from lagbench.reports.fmt import cell, num
+from lagbench.reports.load import Results, protocol_of
+from lagbench.reports.tables import problem_units_table
 
 CLAIMS = ("fit", "evaluate")
 SETS = {"train": "train", "heldout": "held-out", "test": "test"}
@@ -72,7 +72,7 @@ def _models_table(units) -> pd.DataFrame:
 
 def _competence(u) -> dict | None:
     """`replication.fit.competence.competence` of the unit on the set it reports: the test file's, else held-out."""
-    from replication.fit.competence import competence
+    from lagbench.replication.fit.competence import competence
 
     m, loss = u.result.get("metrics") or {}, (u.result.get("protocol") or {}).get("loss", "l1")
     return next((c for c in (competence(m, f"{s}_{loss}") for s in ("test", "heldout")) if c is not None), None)
@@ -80,7 +80,7 @@ def _competence(u) -> dict | None:
 
 def _competence_para(units) -> Para | None:
     """The fits and evaluations not clearly better than the null predictor on the set they report, named."""
-    from replication.fit.competence import describe
+    from lagbench.replication.fit.competence import describe
 
     flagged = [f"{_name(u)} ({u.claim}), {c['metric']}: {describe(c)}" for u in units
                if (c := _competence(u)) is not None and not c["learned"]]
@@ -95,7 +95,7 @@ RECOMMEND_WITHIN = 2.0   # the recommendation: the fewest parameters among the f
 def _recommendation_para(units) -> Para | None:
     """The fit to use on this data: among the fits that learned, the one with the fewest parameters whose
     rollout error (test file, else held-out) is within RECOMMEND_WITHIN x the best; None with fewer than two."""
-    from reports.systems_table import params_of
+    from lagbench.reports.systems_table import params_of
 
     cands = []
     for u in units:

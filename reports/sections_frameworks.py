@@ -23,12 +23,12 @@ import math
 import numpy as np
 import pandas as pd
 
-from reports.compare import cross_framework_table
-from reports.document import NOT_RUN, Bullets, Para, Section, Table
-from reports.fmt import cell, num
-from reports.load import Results, Unit
-from reports.sections_speed import _bench_table
-from reports.tables import claim_models
+from lagbench.reports.compare import cross_framework_table
+from lagbench.reports.document import NOT_RUN, Bullets, Para, Section, Table
+from lagbench.reports.fmt import cell, num
+from lagbench.reports.load import Results, Unit
+from lagbench.reports.sections_speed import _bench_table
+from lagbench.reports.tables import claim_models
 
 START_TOL = 1e-4   # relative difference of the first logged training loss from identical weights
 PART = 1e-2        # relative difference of the training losses from which two curves count as parted

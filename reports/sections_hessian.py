@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import pandas as pd
 
-from reports.document import Para, Section, Table
-from reports.fmt import num
-from reports.load import Results
+from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import Results
 
 INTRO = ("The Euler-Lagrange step solves (d2L/dqdot2) qddot = rhs. Indefinite: the Hessian has eigenvalues "
          "of both signs (solvable, but the learned kinetic energy is not convex). Singular: its smallest "

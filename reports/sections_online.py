@@ -18,9 +18,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from reports.document import Para, Section, Table
-from reports.fmt import num
-from reports.load import Results
+from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import Results
 
 FOLDER = "online_four_joint_arm"
 LABELS = {"pd": "PD alone", "exact": "true inverse dynamics"}

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from reports.document import Para, Section, Table
-from reports.fmt import num
-from reports.integrity import verify_unit
+from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.integrity import verify_unit
 
 COLUMNS = {"heldout_l1": "held-out L1", "null_heldout_l1": "null's held-out L1", "rollout_gmean_err": "rollout error",
            "energy_err_final": "final energy error", "vpt_s": "valid time (s)",

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import pandas as pd
 
-from replication.tuning.search import SIZE as SEARCH_SIZE
-from reports.document import Section, Table
-from reports.fmt import cell
-from reports.load import Results
+from lagbench.replication.tuning.search import SIZE as SEARCH_SIZE
+from lagbench.reports.document import Section, Table
+from lagbench.reports.fmt import cell
+from lagbench.reports.load import Results
 
 
 def _prereg(res: Results, claim: dict) -> dict:

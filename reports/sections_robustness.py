@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from reports.document import Figure, Para, Section, Table
-from reports.fmt import num
-from reports.load import Results
+from lagbench.reports.document import Figure, Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import Results
 
 FIGURE = "figures/robustness_advantage.png"
 
@@ -50,7 +50,7 @@ def _references(df: pd.DataFrame) -> str:
 
 def _figure(df: pd.DataFrame, path: Path) -> bool:
     """The study's figure drawn from the table; False (the section goes on without it) where it cannot be."""
-    from replication.studies.robustness_figure import advantage_figure
+    from lagbench.replication.studies.robustness_figure import advantage_figure
 
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -61,7 +61,7 @@ def _figure(df: pd.DataFrame, path: Path) -> bool:
 
 
 def robustness_sections(res: Results, out_dir: Path) -> list[Section]:
-    from replication.studies.robustness_summary import summary_frame
+    from lagbench.replication.studies.robustness_summary import summary_frame
 
     folder = res.root / "robustness"
     try:

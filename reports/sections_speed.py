@@ -12,17 +12,17 @@ from pathlib import Path
 
 import pandas as pd
 
-from reports import figures_speed as FS
-from reports.compare import (
+from lagbench.reports import figures_speed as FS
+from lagbench.reports.compare import (
     TOLERANCE,
     bench_cheapest_table,
     cheapest_table,
     gpu_vs_cpu_table,
 )
-from reports.document import NOT_RUN, Figure, Para, Section, Table
-from reports.fmt import cell
-from reports.load import Results
-from reports.sections_claims import slug
+from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
+from lagbench.reports.fmt import cell
+from lagbench.reports.load import Results
+from lagbench.reports.sections_claims import slug
 
 BENCH_TABLE_ROWS = 40
 

@@ -10,9 +10,9 @@ import json
 
 import pandas as pd
 
-from reports.document import Para, Section, Table
-from reports.fmt import num
-from reports.load import Results
+from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import Results
 
 COLS = ["solver", "rtol", "dt", "wall_s", "n_steps", "state_err", "energy_err", "picked"]
 

@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from reports.document import Para, Section, Table
-from reports.fmt import num
-from reports.load import load_results, protocol_of
-from reports.sections_predict import predictor_results, status_of
-from reports.tables import PROBLEM_UNITS, excluded_note, problem_units_table
+from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
+from lagbench.reports.load import load_results, protocol_of
+from lagbench.reports.sections_predict import predictor_results, status_of
+from lagbench.reports.tables import PROBLEM_UNITS, excluded_note, problem_units_table
 
 METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_final", "vpt_s", "chaos_floor_vpt_s",
            "float32_truth_vpt_s", "lyapunov_time_s", "torque_mse_test", "rollout_us_per_step")

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import pandas as pd
 
-from replication.claims.published import Published
-from reports.document import NOT_RUN
-from reports.fmt import cell, num, stat, summarise
-from reports.load import Results, Unit
+from lagbench.replication.claims.published import Published
+from lagbench.reports.document import NOT_RUN
+from lagbench.reports.fmt import cell, num, stat, summarise
+from lagbench.reports.load import Results, Unit
 
 
 def claim_models(res: Results, claim: dict) -> list[str]:

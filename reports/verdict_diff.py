@@ -4,7 +4,7 @@ decides the same, and how far each part's interval lies from its threshold.
 `rows(a, b, claims=None) -> pandas.DataFrame`: one row per claim, part and framework judged in either
 `summary/verdicts.json`: the verdict in each run, whether they agree, each run's interval (point [lo, hi])
 and the distance of its nearer end from the threshold (a factor >= 1; `verdicts.json`'s `distance`).
-`python -m reports.verdict_diff A/summary/verdicts.json B/summary/verdicts.json [--claims dp_loss,dp_energy]`
+`python -m lagbench.reports.verdict_diff A/summary/verdicts.json B/summary/verdicts.json [--claims dp_loss,dp_energy]`
 prints the table; exit status 0 when every verdict agrees, 1 otherwise.
 """
 from __future__ import annotations
@@ -50,7 +50,7 @@ def rows(a: dict, b: dict, claims=None) -> pd.DataFrame:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m reports.verdict_diff", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m lagbench.reports.verdict_diff", description=__doc__.split("\n\n")[0])
     ap.add_argument("a", type=Path, help="a run's summary/verdicts.json")
     ap.add_argument("b", type=Path, help="another run's summary/verdicts.json")
     ap.add_argument("--claims", default="", help="claim ids, comma-separated (default: all)")

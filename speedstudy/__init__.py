@@ -57,6 +57,6 @@ __all__ = ["run_bench"]
 
 def run_bench(*args, **kwargs):
     """`speedstudy.bench.run_bench`: imported when called, so that importing the package imports no framework."""
-    from speedstudy.bench import run_bench as run
+    from lagbench.speedstudy.bench import run_bench as run
 
     return run(*args, **kwargs)

@@ -12,9 +12,9 @@ import pandas as pd
 import torch
 from tqdm.auto import tqdm
 
-from replication.results import write_csv, write_json
-from replication.run import environment
-from speedstudy import (
+from lagbench.files.results import write_csv, write_json
+from lagbench.replication.run import environment
+from lagbench.speedstudy import (
     control_rate,
     device,
     latency,
@@ -28,10 +28,10 @@ from speedstudy import (
     train_target,
     training,
 )
-from speedstudy import inference as INF
-from speedstudy import targets as TG
-from speedstudy.resume import StageCache
-from speedstudy.timing import FULL, GPU, GPU_TINY, QUICK, STAGES, TINY, TORCH_THREADS, Sizes
+from lagbench.speedstudy import inference as INF
+from lagbench.speedstudy import targets as TG
+from lagbench.speedstudy.resume import StageCache
+from lagbench.speedstudy.timing import FULL, GPU, GPU_TINY, QUICK, STAGES, TINY, TORCH_THREADS, Sizes
 
 
 def machine(sizes) -> dict:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 
 def cmd_bench(args):
-    from replication.results import output_folder
-    from speedstudy import run_bench
-    from speedstudy.device import NoGPUError
+    from lagbench.files.results import output_folder
+    from lagbench.speedstudy import run_bench
+    from lagbench.speedstudy.device import NoGPUError
 
     output_folder(Path(args.out), "--out")   # made and checked before any work
     try:

@@ -14,7 +14,7 @@ its timing is the trained model's.
 Threads: one, as the online study holds them (`online.one_thread()`: XLA without its Eigen pool, intra-op
 parallelism 1, JAX's CPU programs run inline; PyTorch at 1 intra-op thread). `one_thread()` acts only before
 JAX's backend starts, so the bench stage (`control_rate_stage`) measures in a fresh process
-(`python -m speedstudy.control_rate`), whose environment also holds OpenMP and MKL to one thread.
+(`python -m lagbench.speedstudy.control_rate`), whose environment also holds OpenMP and MKL to one thread.
 
 `control_rate_rows(models, frameworks, seconds, warmup, ...) -> rows`: one row per model, framework and mode:
 model, framework, mode, ticks (the ticks measured: the run's first `warmup` ticks, WARMUP = 50 (0.1 s) by
@@ -65,9 +65,9 @@ def control_rate_rows(models=MODELS, frameworks=FRAMEWORKS, seconds: float = 2.0
     `every`, `steps`, `buffer`: default the online study's (claim 9's widths; one Adam step on 64 samples at every
     tick, drawn from the last 10 s of samples). Runs in this process, at the thread settings that
     `online.one_thread()` can still set (all of them before JAX's backend starts)."""
-    from replication.run.environment import torch_threads
-    from replication.studies import online as O
-    from replication.studies import online_learner as OL
+    from lagbench.replication.run.environment import torch_threads
+    from lagbench.replication.studies import online as O
+    from lagbench.replication.studies import online_learner as OL
 
     hidden = tuple(hidden or OL.HIDDEN)
     batch, every = batch or O.BATCH, every or O.EVERY
@@ -100,13 +100,13 @@ def control_rate_rows(models=MODELS, frameworks=FRAMEWORKS, seconds: float = 2.0
 def control_rate_stage(sizes, notes: list | None = None) -> list[dict]:
     """The bench stage: `control_rate_rows` at `sizes.control_s` simulated seconds per run, in a fresh process
     held to one thread. A failed process adds a note (or raises, without `notes`) and gives no rows."""
-    from replication.run.environment import one_thread_env
+    from lagbench.replication.run.environment import one_thread_env
 
     arg = json.dumps({"seconds": sizes.control_s})
     root = str(Path(__file__).resolve().parents[1])   # the project root, for an uninstalled checkout
     env = {**os.environ, **one_thread_env(os.environ),
            "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)}
-    proc = subprocess.run([sys.executable, "-m", "speedstudy.control_rate", arg], env=env, capture_output=True,
+    proc = subprocess.run([sys.executable, "-m", "lagbench.speedstudy.control_rate", arg], env=env, capture_output=True,
                           text=True, timeout=1800)
     if proc.returncode != 0:
         msg = (proc.stderr.strip().splitlines() or ["no output"])[-1][:200]

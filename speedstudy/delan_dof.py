@@ -19,7 +19,7 @@ DeLaN's one trunk pass carries the d forward tangents dh/dq_k beside h, so its M
 model adds a d x d solve.
 
 `write(rows, path)` writes the rows as CSV (atomically). Run it:
-`python -m speedstudy.delan_dof --out delan_dof.csv [--dofs 2,4,7] [--batch 1024] [--hidden 64,64]
+`python -m lagbench.speedstudy.delan_dof --out delan_dof.csv [--dofs 2,4,7] [--batch 1024] [--hidden 64,64]
 [--seconds 1.0] [--frameworks jax,torch]`; it prints the ratios. Not a stage of `lagbench bench`.
 """
 from __future__ import annotations
@@ -50,9 +50,9 @@ def _inputs(dof: int, batch: int, seed: int = 0) -> tuple:
 
 def _call(framework: str, method: str, dof: int, batch: int, hidden: tuple):
     """A no-argument call that runs `method` of a DeLaN on one batch and blocks, made ready (and compiled)."""
-    from models import init_params
-    from speedstudy.inference import model_spec
-    from speedstudy.timing import jax_ready, torch_ready
+    from lagbench.models import init_params
+    from lagbench.speedstudy.inference import model_spec
+    from lagbench.speedstudy.timing import jax_ready, torch_ready
 
     spec = model_spec("delan", "-", dof, hidden, "float32")
     params = init_params(spec, seed=0)
@@ -60,14 +60,14 @@ def _call(framework: str, method: str, dof: int, batch: int, hidden: tuple):
     if framework == "jax":
         import jax.numpy as jnp
 
-        from models.jax.build import build
+        from lagbench.models.jax.build import build
 
         model = build(spec, params)
         fn = jax_ready(getattr(model, method), *(jnp.asarray(x) for x in arrays))
     else:
         import torch
 
-        from models.torch.build import build
+        from lagbench.models.torch.build import build
 
         model = build(spec, params)
         fn = torch_ready(getattr(model, method), *(torch.as_tensor(x) for x in arrays))
@@ -78,7 +78,7 @@ def _call(framework: str, method: str, dof: int, batch: int, hidden: tuple):
 def delan_dof_rows(dofs=DOFS, batch: int = BATCH, hidden=HIDDEN, seconds: float = SECONDS,
                    frameworks=FRAMEWORKS) -> list[dict]:
     """The rows of the module docstring, for every framework x method x dof."""
-    from speedstudy.timing import TORCH_THREADS, interleaved_best, torch_threads
+    from lagbench.speedstudy.timing import TORCH_THREADS, interleaved_best, torch_threads
 
     dofs, hidden = tuple(int(d) for d in dofs), tuple(int(h) for h in hidden)
     if not dofs or min(dofs) < 1 or batch < 1:
@@ -103,7 +103,7 @@ def delan_dof_rows(dofs=DOFS, batch: int = BATCH, hidden=HIDDEN, seconds: float 
 def write(rows: list[dict], path) -> Path:
     import pandas as pd
 
-    from replication.results import write_csv
+    from lagbench.files.results import write_csv
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -116,7 +116,7 @@ def _ints(text: str) -> tuple:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m speedstudy.delan_dof", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m lagbench.speedstudy.delan_dof", description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, help="the CSV file to write")
     ap.add_argument("--dofs", type=_ints, default=DOFS, help="comma-separated degrees of freedom (default 2,4,7)")
     ap.add_argument("--batch", type=int, default=BATCH)

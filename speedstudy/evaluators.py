@@ -12,13 +12,13 @@ and counted here is the speed study's own program of that call. JAX calls are `j
 an argument (the weights are inputs of the compiled program, not folded constants), lowered and
 compiled ahead of time on the first call per shape (the same object serves `flops` and `ops`); PyTorch
 runs eagerly under `torch.no_grad()` (torch.func inside still differentiates), or with mode="aoti"
-through `models.torch.compiled.compile_batched` (torch.export + AOTInductor: one library for every
+through `lagbench.models.torch.compiled.compile_batched` (torch.export + AOTInductor: one library for every
 batch size, compiled when the evaluator is made, 10-25 s, once per intra-op thread count the rows are
 timed at: inductor fixes a kernel's thread count when it compiles, `per_thread_count`). Not every model
 exports: what differentiates with torch.func (the paper-formulation LNN's hessian, the dense LGN's
 forward-over-reverse) fails inside torch.export (torch 2.13), which raises. The fast LNN, the HNN, DeLaN
 and the banded LGN differentiate their MLPs by hand and export. Those two go through mode="traced" (`TorchTracedEvaluator`): make_fx traces the call
-into plain ATen operators first (`models.torch.compiled.trace_flat`), which exports and compiles, one
+into plain ATen operators first (`lagbench.models.torch.compiled.trace_flat`), which exports and compiles, one
 library per batch size. `ev.mode`: "jit", "eager", "aoti", "traced", "numpy".
 `ev.ops(args)`: kernels per call, for the ratio notes: JAX the compiled program's top-level kernels
 (fusions, dots, custom calls, ... in the optimised HLO's entry computation), PyTorch the ATen operators
@@ -34,12 +34,12 @@ import jax.numpy as jnp
 import numpy as np
 import torch
 
-import models.jax  # noqa: F401 - float64 enabled on import (the evaluators' arrays may be float64)
-from models.row_blocks import rows_per_sample
-from models.torch.compiled import compile_batched
-from replication.evaluation.adapters import adapter, qddot
-from speedstudy.device import sync, to_numpy
-from speedstudy.timing import torch_thread_choices, torch_threads
+import lagbench.models.jax  # noqa: F401 - float64 enabled on import (the evaluators' arrays may be float64)
+from lagbench.models.row_blocks import rows_per_sample
+from lagbench.models.torch.compiled import compile_batched
+from lagbench.replication.evaluation.adapters import adapter, qddot
+from lagbench.speedstudy.device import sync, to_numpy
+from lagbench.speedstudy.timing import torch_thread_choices, torch_threads
 
 
 def median_rel_error(pred, true) -> float:
@@ -54,7 +54,7 @@ def _model(framework: str, spec, params):
     return adapter(framework, spec, params).model
 
 
-FLOPS_ROWS = 16  # at most 2 * the smallest block (`models.jax.blocking.block_size` >= 8): one block
+FLOPS_ROWS = 16  # at most 2 * the smallest block (`lagbench.models.jax.blocking.block_size` >= 8): one block
 
 _NOT_KERNELS = {"parameter", "constant", "bitcast", "tuple", "get-tuple-element"}
 
@@ -111,7 +111,7 @@ class JaxEvaluator:
 
     def flops(self, args) -> float | None:
         """FLOPs of one call from XLA's compiled cost analysis (None if unavailable). The analysis
-        counts a loop body once, and large batches run in row blocks (`models.jax.blocking`), so the
+        counts a loop body once, and large batches run in row blocks (`lagbench.models.jax.blocking`), so the
         call is costed on its first FLOPS_ROWS samples (never blocked) and scaled to the batch."""
         n = args[0].shape[0]
         m = min(n, FLOPS_ROWS)
@@ -184,7 +184,7 @@ def for_threads(libraries: dict):
 class TorchAotEvaluator(TorchEvaluator):
     """PyTorch through `compile_batched`: one library for every batch size, compiled when made, at each
     thread count the rows are timed at (`per_thread_count`). rows: large batches are called in row blocks
-    where the JAX model computes them so (`models.row_blocks.rows_per_sample`)."""
+    where the JAX model computes them so (`lagbench.models.row_blocks.rows_per_sample`)."""
     mode = "aoti"
 
     def __init__(self, fn, width, dtype, kind, rows=None):

@@ -29,11 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
-import systems
-from models import ModelSpec, init_params
-from models.spec import CAPABILITIES
-from speedstudy.evaluators import make_evaluator, median_rel_error
-from speedstudy.timing import (  # noqa: F401 - TORCH_THREAD_CHOICES is read as inference.*
+from lagbench import systems
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.spec import CAPABILITIES
+from lagbench.speedstudy.evaluators import make_evaluator, median_rel_error
+from lagbench.speedstudy.timing import (  # noqa: F401 - TORCH_THREAD_CHOICES is read as inference.*
     PAIRED_ROUNDS,
     TORCH_THREAD_CHOICES,
     TORCH_THREADS,
@@ -107,8 +107,8 @@ def inference_cases(sizes) -> list[Case]:
 
 def trained_cases(out: Path, batches: tuple) -> list[Case]:
     """Double-pendulum checkpoints of a previous `lagbench run` in OUT/units (seed 0 only)."""
-    from replication.results import load_npz
-    from replication.training.protocol import Protocol
+    from lagbench.files.results import load_npz
+    from lagbench.replication.training.protocol import Protocol
 
     cases = []
     for res_path in sorted(Path(out).glob("units/*/*/*/seed0/result.json")):

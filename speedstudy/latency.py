@@ -5,13 +5,13 @@ pendulum.
 evals_per_s, max_abs_diff, ops}`: evaluations per second of ONE sample (inputs of shape (dof,), results
 blocked on), for method "inverse_dynamics" (q, qdot, qddot) -> tau and "acceleration" (q, qdot) -> qddot.
 Modes: JAX "method" (the model's eqx.filter_jit method, as a user calls it), "compile_single" and
-"compile_single_frozen" (`models.jax.compiled.compile_single`, parameters as arguments / as constants);
+"compile_single_frozen" (`lagbench.models.jax.compiled.compile_single`, parameters as arguments / as constants);
 PyTorch "eager" (the method under torch.no_grad) and, where `sizes.torch_compile` (not the tiny preset: 15-40 s
-of compiling per method), "compile_single" (`models.torch.compiled.compile_single`: torch.export +
+of compiling per method), "compile_single" (`lagbench.models.torch.compiled.compile_single`: torch.export +
 AOTInductor, parameters as constants; ops None). max_abs_diff: largest |difference| against the model
 method on the same sample (0 for the method itself); ops: XLA kernels of the compiled program, or the
 ATen operators of one PyTorch call (None for the eqx method).
-Each dispatch setting runs in a fresh Python process (`python -m speedstudy.latency`), because
+Each dispatch setting runs in a fresh Python process (`python -m lagbench.speedstudy.latency`), because
 JAX's CPU client fixes it when it starts: "async" (JAX's default: programs run on a worker thread) and
 "sync" (`use_sync_dispatch()`: inline in the caller). Both processes run on one core's worth of threads
 (XLA: no multi-threaded Eigen, intra-op parallelism 1; PyTorch: 1 thread); PyTorch is measured once, in
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from replication.run.environment import one_thread_env
-from speedstudy.evaluators import torch_ops, xla_kernels
+from lagbench.replication.run.environment import one_thread_env
+from lagbench.speedstudy.evaluators import torch_ops, xla_kernels
 
 METHODS = ("inverse_dynamics", "acceleration")
 CALLS = 50
@@ -68,10 +68,10 @@ def _jax_fns(spec, params, method, x):
     import jax
     import jax.numpy as jnp
 
-    import models.jax
-    from models.jax.compiled import compile_single
+    import lagbench.models.jax
+    from lagbench.models.jax.compiled import compile_single
 
-    m = models.jax.build(spec, params)
+    m = lagbench.models.jax.build(spec, params)
     xs = [jnp.asarray(v, spec.dtype) for v in x]
     call = getattr(m, method)
     ref = np.asarray(call(*xs), np.float64)
@@ -87,10 +87,10 @@ def _jax_fns(spec, params, method, x):
 def _torch_fns(spec, params, method, x, aot: bool):
     import torch
 
-    import models.torch
-    from models.torch.compiled import compile_single
+    import lagbench.models.torch
+    from lagbench.models.torch.compiled import compile_single
 
-    m = models.torch.build(spec, params)
+    m = lagbench.models.torch.build(spec, params)
     xs = [torch.as_tensor(v, dtype=getattr(torch, spec.dtype)) for v in x]
     call = getattr(m, method)
 
@@ -108,14 +108,14 @@ def _torch_fns(spec, params, method, x, aot: bool):
 def measure(hidden: tuple, dtypes: tuple, seconds: float, sync: bool, methods: tuple = METHODS,
             torch_aot: bool = False) -> list[dict]:
     """The rows of one process (call with a fresh interpreter: `sync` must be set before JAX starts)."""
-    from models.jax.compiled import async_dispatch, use_sync_dispatch
+    from lagbench.models.jax.compiled import async_dispatch, use_sync_dispatch
 
     if sync and not use_sync_dispatch():
         raise RuntimeError("JAX's backend had started before the latency study could set sync dispatch")
     import torch
 
-    from models import init_params
-    from speedstudy.inference import model_spec
+    from lagbench.models import init_params
+    from lagbench.speedstudy.inference import model_spec
 
     torch.set_num_threads(1)
     rng = np.random.default_rng(0)
@@ -149,7 +149,7 @@ def latency_rows(sizes, notes: list | None = None) -> list[dict]:
         root = str(Path(__file__).resolve().parents[1])  # the project root, for an uninstalled checkout
         env = {**os.environ, **one_thread_env(os.environ),
                "PYTHONPATH": os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)}
-        proc = subprocess.run([sys.executable, "-m", "speedstudy.latency", arg], env=env,
+        proc = subprocess.run([sys.executable, "-m", "lagbench.speedstudy.latency", arg], env=env,
                               capture_output=True, text=True, timeout=600)
         if proc.returncode != 0:
             msg = (proc.stderr.strip().splitlines() or ["no output"])[-1][:200]

@@ -21,9 +21,9 @@ from pathlib import Path
 import jax.numpy as jnp
 import numpy as np
 
-import models.jax
-from models import ModelSpec
-from speedstudy.rollout import MAX_STEPS, field_solver, timed_solve
+import lagbench.models.jax
+from lagbench.models import ModelSpec
+from lagbench.speedstudy.rollout import MAX_STEPS, field_solver, timed_solve
 
 LABELS = ("lnn", "baseline")
 TINY_STEPS = {"tiny": 10, "quick": 600, "full": 3000}
@@ -31,8 +31,8 @@ TINY_STEPS = {"tiny": 10, "quick": 600, "full": 3000}
 
 def find_trained(folder) -> dict:
     """{label: (spec, params, source)} from folder/trained/jax/*; the entry with the most steps per label."""
-    from replication.results import load_npz
-    from replication.training.protocol import Protocol
+    from lagbench.files.results import load_npz
+    from lagbench.replication.training.protocol import Protocol
 
     found: dict = {}
     for res in sorted(Path(folder).glob("trained/jax/*/result.json")) if folder else []:
@@ -54,10 +54,10 @@ def find_trained(folder) -> dict:
 
 def tiny_models(sizes, labels=LABELS) -> dict:
     """The claim's models at sizes.target_hidden, trained briefly with the suite's `train_jax.train`."""
-    from models import init_params
-    from replication.claims.double_pendulum import MODELS, PLAIN_QUICK
-    from replication.training.data import BatchStream
-    from replication.training.train_jax import train
+    from lagbench.models import init_params
+    from lagbench.replication.claims.double_pendulum import MODELS, PLAIN_QUICK
+    from lagbench.replication.training.data import BatchStream
+    from lagbench.replication.training.train_jax import train
 
     steps = TINY_STEPS.get(sizes.name, 300)
     proto = PLAIN_QUICK.replace(steps=steps, data=PLAIN_QUICK.data.replace(n_train=128 * 50, n_heldout=256),
@@ -81,7 +81,7 @@ def learned_rollout_rows(sizes, q0, qd0, errors, base, folder=None, notes=None, 
     for label in LABELS:
         spec, params, source = models_[label]
         spec64 = dataclasses.replace(spec, dtype="float64")
-        model = models.jax.build(spec64, params)
+        model = lagbench.models.jax.build(spec64, params)
         row_kind = "learned_tiny" if source.startswith("learned_tiny") else "learned"
         for solver in sizes.rollout_solvers:
             fn = field_solver(model.acceleration, solver)

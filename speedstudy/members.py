@@ -21,10 +21,10 @@ per framework, is checked in `speedstudy.targets`.
 """
 from __future__ import annotations
 
-from models import ModelSpec, init_params
-from replication.claims.double_pendulum import MODELS, RESTARTS
-from replication.training import compile_torch, loop, scouting, train_jax, train_torch
-from replication.training.data import BatchStream
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.claims.double_pendulum import MODELS, RESTARTS
+from lagbench.replication.training import compile_torch, loop, scouting, train_jax, train_torch
+from lagbench.replication.training.data import BatchStream
 
 MEMBERS = 8
 MODES = {"jax": ("jit",), "torch": ("eager", "compiled")}   # "compiled": only where `sizes.torch_compile`

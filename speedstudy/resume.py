@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from replication.results import atomic_write_bytes
+from lagbench.files.results import atomic_write_bytes
 
 __all__ = ["StageCache"]
 

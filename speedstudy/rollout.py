@@ -27,11 +27,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-import systems
-from replication.claims.double_pendulum import ENERGY_SCALE
-from replication.evaluation.rollout import rk4_scan
-from speedstudy.timing import best_time
-from systems.trajectories import SOLVERS, integrate
+from lagbench import systems
+from lagbench.replication.claims.double_pendulum import ENERGY_SCALE
+from lagbench.replication.evaluation.rollout import rk4_scan
+from lagbench.speedstudy.timing import best_time
+from lagbench.systems.trajectories import SOLVERS, integrate
 
 REF_RTOL = 1e-13
 MAX_STEPS = 4096  # per adaptive solve of a learned model (a non-smooth learned field can need far more)

@@ -24,11 +24,11 @@ import jax.numpy as jnp
 import numpy as np
 import torch
 
-from models import init_params
-from speedstudy.device import sync
-from speedstudy.evaluators import make_evaluator
-from speedstudy.inference import model_spec, torch_thread_choices
-from speedstudy.timing import interleaved_best, torch_threads
+from lagbench.models import init_params
+from lagbench.speedstudy.device import sync
+from lagbench.speedstudy.evaluators import make_evaluator
+from lagbench.speedstudy.inference import model_spec, torch_thread_choices
+from lagbench.speedstudy.timing import interleaved_best, torch_threads
 
 COMPILED_MODES = (("fast", "aoti"), ("paper", "traced"))  # PyTorch compiled rows where sizes.torch_compile
 

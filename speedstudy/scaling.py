@@ -20,10 +20,10 @@ import time
 
 import numpy as np
 
-from models import init_params
-from speedstudy.evaluators import make_evaluator
-from speedstudy.inference import model_spec
-from speedstudy.timing import interleaved_best
+from lagbench.models import init_params
+from lagbench.speedstudy.evaluators import make_evaluator
+from lagbench.speedstudy.inference import model_spec
+from lagbench.speedstudy.timing import interleaved_best
 
 MAX_DENSE_N = 2048
 FRAMEWORKS = ("jax", "torch")

@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-import systems
-from models import init_params
-from speedstudy.evaluators import make_evaluator
-from speedstudy.inference import model_spec
-from speedstudy.timing import best_time
+from lagbench import systems
+from lagbench.models import init_params
+from lagbench.speedstudy.evaluators import make_evaluator
+from lagbench.speedstudy.inference import model_spec
+from lagbench.speedstudy.timing import best_time
 
 
 def _throughput(kind, dof, sizes):

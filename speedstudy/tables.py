@@ -22,8 +22,8 @@ import os
 
 import numpy as np
 
-from speedstudy.bounds import TARGETS
-from speedstudy.timing import TORCH_THREADS
+from lagbench.speedstudy.bounds import TARGETS
+from lagbench.speedstudy.timing import TORCH_THREADS
 
 KINDS = ("latency", "inference", "training", "scaling", "fast_paper", "fast_over_paper", "matmul", "achieved",
          "roofline_fraction", "note")

@@ -37,11 +37,11 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from replication.results import write_csv, write_json
-from replication.run import splits
-from replication.training.protocol import canonical_hash
-from speedstudy import train_target
-from speedstudy.train_target_run import run_study
+from lagbench.files.results import write_csv, write_json
+from lagbench.replication.run import splits
+from lagbench.replication.training.protocol import canonical_hash
+from lagbench.speedstudy import train_target
+from lagbench.speedstudy.train_target_run import run_study
 
 TARGET = train_target.CODE_HELDOUT_L1
 DIST_COLUMNS = ["protocol", "run", "init_seed", "chosen_seed", "split", "threshold", "reached", "samples_to_reach",

@@ -15,13 +15,13 @@ import equinox as eqx
 import jax.numpy as jnp
 import numpy as np
 
-import models.jax
-from models import ModelSpec, init_params
-from replication.training import data as datamod
-from replication.training import loop, scouting, train_jax
-from replication.training.data import HELDOUT_SEED, BatchStream
-from replication.training.objective import loss_value, predict
-from replication.training.schedules import learning_rate
+import lagbench.models.jax
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training import loop, scouting, train_jax
+from lagbench.replication.training.data import HELDOUT_SEED, BatchStream
+from lagbench.replication.training.objective import loss_value, predict
+from lagbench.replication.training.schedules import learning_rate
 
 N_EVALS = 20
 
@@ -61,7 +61,7 @@ class _Loop:
         row of the log."""
         every, losses = max(protocol.steps // n_evals, 1), []
         steps0, wall0, skipped0 = self.steps, self.wall, self.skipped
-        stepper = train_jax.Stepper(self.spec, models.jax.to_params(model), protocol, step=self.step)
+        stepper = train_jax.Stepper(self.spec, lagbench.models.jax.to_params(model), protocol, step=self.step)
 
         def evaluate(k, st, info):
             self.steps, self.wall = steps0 + k + 1, wall0 + info["step_seconds"]
@@ -96,25 +96,25 @@ def run_protocol(name: str, spec: ModelSpec, protocol, seed: int = 0, on_eval=No
     scouts' wall time is the one program's."""
     loop = _Loop(name, spec, protocol, on_eval, heldout_seed)
     if not protocol.scouting:
-        model = models.jax.build(spec, init_params(spec, seed=seed))
+        model = lagbench.models.jax.build(spec, init_params(spec, seed=seed))
         loop.row(model, "train", seed, learning_rate(protocol, 0), np.nan)
         return loop.log, loop.phase(model, protocol, seed, "train", seed, N_EVALS)[0]
     seeds, scout = list(range(seed, seed + protocol.scouting.count)), scouting.scout_protocol(protocol)
-    loop.row(models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
+    loop.row(lagbench.models.jax.build(spec, init_params(spec, seed=seed)), "scout", seed, learning_rate(scout, 0), np.nan)
     outcomes, tails = scouting.scout(train_jax, spec, protocol, seeds)
     loop.wall += max(o.step_seconds for o in outcomes)   # the kept scouts' time runs on past a cut
     steps, extra = divmod(scouting.scouting_samples(protocol), protocol.batch)
     loop.steps, loop.extra = loop.steps + steps, loop.extra + extra
     for s, out, tail in zip(seeds, outcomes, tails, strict=True):
         loop.skipped += out.skipped_steps
-        model = models.jax.build(spec, out.params)
+        model = lagbench.models.jax.build(spec, out.params)
         if out.failure is None:
             loop.row(model, "scout", s, learning_rate(scout, out.steps_done - 1), out.log[-1]["loss"])   # a cut scout: at the cut
         else:
             loop.row(model, "scout (stopped: non-finite loss)", s, learning_rate(scout, out.failure["step"]), np.nan)
         loop.log[-1]["scout_loss"] = tail
     best = scouting.choose(tails) or 0
-    model = models.jax.build(spec, outcomes[best].params)
+    model = lagbench.models.jax.build(spec, outcomes[best].params)
     rest = scouting.continuation_protocol(protocol)
     return loop.log, loop.phase(model, rest, seeds[best] + scouting.CONTINUATION_STREAM, "continue", seeds[best],
                                 N_EVALS)[0]

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from speedstudy.bounds import TARGETS
-from speedstudy.members import MEMBERS, MODES
-from speedstudy.tables import fastest_per_batch, row_value
-from speedstudy.train_target import ORIGINAL_SAMPLES, PAPER_L1, TARGET_SAMPLES
+from lagbench.speedstudy.bounds import TARGETS
+from lagbench.speedstudy.members import MEMBERS, MODES
+from lagbench.speedstudy.tables import fastest_per_batch, row_value
+from lagbench.speedstudy.train_target import ORIGINAL_SAMPLES, PAPER_L1, TARGET_SAMPLES
 
 
 def members_target(rows) -> dict:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import jax
 
-from replication.run.environment import torch_threads  # noqa: F401 - read as timing.torch_threads
+from lagbench.replication.run.environment import torch_threads  # noqa: F401 - read as timing.torch_threads
 
 LONG_CALL_S = 5.0  # a call this long is timed once: other processes' noise is small against it
 
@@ -173,6 +173,6 @@ PAIRED_ROUNDS = 5  # interleaved rounds (at least) of a PyTorch row and its JAX 
 def torch_thread_choices() -> tuple:
     """The intra-op thread counts a PyTorch row is timed at: TORCH_THREAD_CHOICES on the CPU; on a GPU only
     TORCH_THREADS (the host threads only launch kernels there)."""
-    from speedstudy.device import on_gpu
+    from lagbench.speedstudy.device import on_gpu
 
     return (TORCH_THREADS,) if on_gpu() else TORCH_THREAD_CHOICES

@@ -76,15 +76,15 @@ from typing import NamedTuple
 import jax.numpy as jnp
 import numpy as np
 
-import systems
-from models import ModelSpec
-from replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
-from replication.training import data as datamod
-from replication.training import scouting
-from replication.training.data import HELDOUT_SEED
-from replication.training.protocol import Guard, Scouting
-from replication.training.schedules import OneCycle
-from speedstudy.target_loop import N_EVALS, run_protocol
+from lagbench import systems
+from lagbench.models import ModelSpec
+from lagbench.replication.claims.double_pendulum import MODELS, PLAIN_QUICK, PROTOCOLS
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training import scouting
+from lagbench.replication.training.data import HELDOUT_SEED
+from lagbench.replication.training.protocol import Guard, Scouting
+from lagbench.replication.training.schedules import OneCycle
+from lagbench.speedstudy.target_loop import N_EVALS, run_protocol
 
 PAPER_L1, ORIGINAL_SAMPLES = 7.3e-2, 3e8  # the paper's number (a training loss; held-out 6.9e-2); the code's samples
 CODE_HELDOUT_L1 = 6.9e-2                  # the original code's held-out L1 (reference §7): the like-for-like target

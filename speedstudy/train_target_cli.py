@@ -10,18 +10,18 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from replication.renamed import renamed
-from replication.training.device import HELP as DEVICE_HELP
+from lagbench.replication.renamed import renamed
+from lagbench.replication.training.device import HELP as DEVICE_HELP
 
 HELDOUT_STATES = 4096
 
 
 def cmd_train_target(args):
-    from replication.fit.options import widths
-    from replication.run import splits
-    from speedstudy import target_distribution as dist
-    from speedstudy.train_target import protocols
-    from speedstudy.train_target_run import check_names, run_study
+    from lagbench.replication.fit.options import widths
+    from lagbench.replication.run import splits
+    from lagbench.speedstudy import target_distribution as dist
+    from lagbench.speedstudy.train_target import protocols
+    from lagbench.speedstudy.train_target_run import check_names, run_study
 
     heldout = renamed("train-target", args.heldout_states, args.heldout_old, HELDOUT_STATES, "--heldout-states", "--heldout",
                       "in `fit`, --holdout-fraction is a fraction of the rows")
@@ -34,8 +34,8 @@ def cmd_train_target(args):
         raise ValueError(f"the train-target budget must be at least 1 sample, got {args.budget!r}")
     split = splits.get(args.split)
     seeds = dist.init_seeds(names or list(protocols(1000, 1)), split, args.seed, args.runs)   # checks --runs
-    from replication.results import output_folder
-    from replication.training import device
+    from lagbench.files.results import output_folder
+    from lagbench.replication.training import device
 
     where = device.apply(args.device, ("jax",))["jax"]   # the study trains in JAX
     folder = output_folder(Path(args.out) / "train_target", "--out")

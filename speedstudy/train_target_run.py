@@ -15,9 +15,9 @@ from pathlib import Path
 import pandas as pd
 from tqdm.auto import tqdm
 
-from replication.results import write_csv, write_json, write_npz
-from replication.training.data import HELDOUT_SEED
-from speedstudy import train_target
+from lagbench.files.results import write_csv, write_json, write_npz
+from lagbench.replication.training.data import HELDOUT_SEED
+from lagbench.speedstudy import train_target
 
 
 def check_names(names) -> None:
@@ -42,9 +42,9 @@ def run_study(folder: Path, budget: int, hidden, n_heldout: int, names=None, see
         bar.set_postfix_str(f"{log[-1]['protocol']}: held-out L1 {log[-1]['heldout_l1']:.4g}")
 
     def on_model(name, spec, model):
-        import models.jax
+        import lagbench.models.jax
 
-        write_npz(folder / f"{name}.npz", models.jax.to_params(model))
+        write_npz(folder / f"{name}.npz", lagbench.models.jax.to_params(model))
         write_json(folder / f"{name}.spec.json", spec.to_dict())
 
     rows, log = train_target.study(budget, hidden, n_heldout, names=names, on_eval=on_eval, seed=seed,

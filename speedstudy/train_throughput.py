@@ -8,7 +8,7 @@ compiles), the step mode (JAX jit; PyTorch compiled where the protocol's trainin
 the reason if a compile failed), and where it computed. It says nothing of
 accuracy: the steps are a few of the protocol's.
 
-`python -m speedstudy.train_throughput --device gpu --out FILE.csv` (defaults: the double-pendulum LNN of
+`python -m lagbench.speedstudy.train_throughput --device gpu --out FILE.csv` (defaults: the double-pendulum LNN of
 the `paper` profile, 3 x 600, batch 512, both frameworks, 200 steps) writes the rows as CSV and prints them.
 """
 from __future__ import annotations
@@ -18,15 +18,15 @@ import sys
 
 import pandas as pd
 
-from replication.claims import get as get_claim
-from replication.training import compile_torch
-from replication.training import device as dev
-from replication.training.train import run_training
+from lagbench.replication.claims import get as get_claim
+from lagbench.replication.training import compile_torch
+from lagbench.replication.training import device as dev
+from lagbench.replication.training.train import run_training
 
 
 def measure(claim: str = "dp_loss", model: str = "lnn", profile: str = "paper", frameworks=("jax", "torch"),
             device: str = "auto", steps: int = 200) -> pd.DataFrame:
-    from replication.run.units import Unit
+    from lagbench.replication.run.units import Unit
 
     c = get_claim(claim)
     entry = c.entry(model)
@@ -52,7 +52,7 @@ def measure(claim: str = "dp_loss", model: str = "lnn", profile: str = "paper", 
 
 
 def main(argv=None) -> int:
-    a = argparse.ArgumentParser(prog="python -m speedstudy.train_throughput", description=__doc__.split("\n\n")[0])
+    a = argparse.ArgumentParser(prog="python -m lagbench.speedstudy.train_throughput", description=__doc__.split("\n\n")[0])
     a.add_argument("--claim", default="dp_loss")
     a.add_argument("--model", default="lnn")
     a.add_argument("--profile", default="paper")

@@ -6,7 +6,7 @@ samples_per_s, hidden}` for the claim's LNN (fast formulation) and baseline, wit
 Adam, l2 penalty) at batch `sizes.train_batch` (and each of `sizes.train_extra_batches`). One optimiser
 step is timed (fastest of `sizes.train_steps` after one warm-up/compile step) with the training loops' own step functions:
 `train_jax.make_step` (eqx.filter_jit) and `train_torch.make_loss` + torch.optim.Adam.
-mode "compile" wraps the PyTorch loss in `torch.compile` (generated code in `models.torch.inductor_cache`);
+mode "compile" wraps the PyTorch loss in `torch.compile` (generated code in `lagbench.models.torch.inductor_cache`);
 where that fails or is disabled, no row is written and the reason goes to `notes` (shown in ratios.csv).
 """
 from __future__ import annotations
@@ -16,14 +16,14 @@ import time
 import jax.numpy as jnp
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
-from models.torch import inductor_cache
-from replication.claims.double_pendulum import MODELS, PROTOCOLS
-from replication.training import train_jax, train_torch
-from replication.training.data import BatchStream
-from speedstudy.timing import best_time
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.torch import inductor_cache
+from lagbench.replication.claims.double_pendulum import MODELS, PROTOCOLS
+from lagbench.replication.training import train_jax, train_torch
+from lagbench.replication.training.data import BatchStream
+from lagbench.speedstudy.timing import best_time
 
 COMPILE_BUDGET_S = 240.0
 
@@ -33,7 +33,7 @@ def _spec(entry, hidden, dtype):
 
 
 def _jax_step_time(spec, params, protocol, batch, reps):
-    model = models.jax.build(spec, params)
+    model = lagbench.models.jax.build(spec, params)
     opt, step = train_jax.make_step(spec, protocol)
     import equinox as eqx
 
@@ -50,7 +50,7 @@ def _jax_step_time(spec, params, protocol, batch, reps):
 
 
 def _torch_step_time(spec, params, protocol, batch, reps, compile_=False):
-    model = models.torch.build(spec, params)
+    model = lagbench.models.torch.build(spec, params)
     loss_fn = train_torch.make_loss(spec, protocol)
     if compile_:
         if not inductor_cache.private():

@@ -51,8 +51,8 @@ def arm_dataset(kind: str = "train", n_traj: int = 16, n_points: int = 200, seed
                 duration: float = 4.0, cache: bool = True, system: str = "two_link_arm", **params) -> dict:
     """Trajectory family ``kind`` ("train" | "test") of arm ``system`` with exact torques; see the module
     docstring."""
-    from systems.dataset_cache import _key, cached
-    from systems.registry import get
+    from lagbench.systems.dataset_cache import _key, cached
+    from lagbench.systems.registry import get
 
     if kind not in FAMILIES:
         raise ValueError(f"unknown arm trajectory family {kind!r}; valid: {', '.join(FAMILIES)}")

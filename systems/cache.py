@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from replication.results import atomic_write_bytes, read_nofollow  # light: NumPy only
-from systems import cache_key
+from lagbench.files.results import atomic_write_bytes, read_nofollow  # light: NumPy only
+from lagbench.systems import cache_key
 
 log = logging.getLogger(__name__)
 

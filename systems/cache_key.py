@@ -29,7 +29,7 @@ import stat
 import tempfile
 from pathlib import Path
 
-from replication.results import make_own_folder
+from lagbench.files.results import make_own_folder
 
 log = logging.getLogger(__name__)
 

@@ -23,7 +23,7 @@ import linecache
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
-from systems import backends
+from lagbench.systems import backends
 
 CODEGEN_VERSION = "1"
 

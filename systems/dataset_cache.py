@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from systems import cache as _cache
-from systems.system import System
+from lagbench.systems import cache as _cache
+from lagbench.systems.system import System
 
 DATASET_VERSION = "1"
 

@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from systems import cache as _cache
-from systems.arm_data import arm_dataset
-from systems.dataset_cache import DATASET_VERSION, _key, cached
-from systems.registry import get
-from systems.trajectories import integrate
+from lagbench.systems import cache as _cache
+from lagbench.systems.arm_data import arm_dataset
+from lagbench.systems.dataset_cache import DATASET_VERSION, _key, cached
+from lagbench.systems.registry import get
+from lagbench.systems.trajectories import integrate
 
 _STATE_KEYS = ("q", "qdot")
 

@@ -23,7 +23,7 @@ import functools
 
 import sympy as sp
 
-from systems.definition import Definition
+from lagbench.systems.definition import Definition
 
 
 class NotQuadraticError(ValueError):

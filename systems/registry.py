@@ -12,9 +12,9 @@ from __future__ import annotations
 import functools
 import inspect
 
-from systems.definition import Definition
-from systems.library import arm, arm4, magnetic, mechanics, relativistic, stiff, wave
-from systems.system import System
+from lagbench.systems.definition import Definition
+from lagbench.systems.library import arm, arm4, magnetic, mechanics, relativistic, stiff, wave
+from lagbench.systems.system import System
 
 _BUILDERS = {
     "free_fall": mechanics.build_free_fall,

@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from systems.system import System
+from lagbench.systems.system import System
 
 STIFF = 100.0        # stiffness ratio above which a system counts as stiff
 DISSIPATIVE = 0.1    # fast modes decay if -Re(lambda) >= DISSIPATIVE * |lambda|

@@ -26,9 +26,9 @@ import json
 import numpy as np
 import sympy as sp
 
-from systems import backends, cache, codegen
-from systems.definition import Definition
-from systems.derive import Derivation, NotQuadraticError
+from lagbench.systems import backends, cache, codegen
+from lagbench.systems.definition import Definition
+from lagbench.systems.derive import Derivation, NotQuadraticError
 
 _SOURCES: dict = {}
 _FUNCS: dict = {}

@@ -24,8 +24,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from systems import backends  # noqa: F401  (x64)
-from systems.system import System
+from lagbench.systems import backends  # noqa: F401  (x64)
+from lagbench.systems.system import System
 
 SOLVERS = {"tsit5": diffrax.Tsit5, "dopri5": diffrax.Dopri5, "dopri8": diffrax.Dopri8,
            "kvaerno5": diffrax.Kvaerno5}

@@ -4,14 +4,15 @@ import ast
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("systems", "models", "replication", "reports", "speedstudy")
+FOLDERS = ("lagbench", "systems", "models", "replication", "reports", "speedstudy")   # all under `lagbench`
 
 
 def _modules() -> dict[str, Path]:
     mods = {}
-    for pkg in PACKAGES:
-        for p in (ROOT / pkg).rglob("*.py"):
-            name = ".".join(p.relative_to(ROOT).with_suffix("").parts)
+    for folder in FOLDERS:
+        for p in (ROOT / folder).rglob("*.py"):
+            parts = p.relative_to(ROOT).with_suffix("").parts
+            name = ".".join(parts if folder == "lagbench" else ("lagbench", *parts))
             mods[name.removesuffix(".__init__")] = p
     return mods
 

@@ -5,7 +5,7 @@ import sys
 
 
 def test_packages_import_no_framework():
-    code = ("import sys, replication, reports, speedstudy; "
+    code = ("import sys, lagbench.replication, lagbench.reports, lagbench.speedstudy; "
             "print(','.join(m for m in ('torch', 'jax') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert out == ""

@@ -7,6 +7,6 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from models.jax.build import build, to_params  # noqa: E402
+from lagbench.models.jax.build import build, to_params  # noqa: E402
 
 __all__ = ["build", "to_params"]

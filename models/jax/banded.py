@@ -15,7 +15,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from models.graph import band_columns
+from lagbench.models.graph import band_columns
 
 
 def _gather(band, triple):

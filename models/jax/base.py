@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import equinox as eqx
 
-from models.checks import check_input, check_state
-from models.spec import ModelSpec
+from lagbench.models.checks import check_input, check_state
+from lagbench.models.spec import ModelSpec
 
 
 class Model(eqx.Module):

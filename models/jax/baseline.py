@@ -9,8 +9,8 @@ from __future__ import annotations
 import equinox as eqx
 import jax.numpy as jnp
 
-from models.jax.base import Model
-from models.jax.mlp import mlp, mlp_input, q_features
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.mlp import mlp, mlp_input, q_features
 
 
 class Baseline(Model):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from models.row_blocks import block_plan, block_size  # noqa: F401 - block_size re-exported
+from lagbench.models.row_blocks import block_plan, block_size  # noqa: F401 - block_size re-exported
 
 
 def _pad(a, pad):

@@ -10,17 +10,17 @@ import importlib
 import jax.numpy as jnp
 import numpy as np
 
-from models.params import check_params
-from models.spec import CAPABILITIES, USER_KIND, ModelSpec
+from lagbench.models.params import check_params
+from lagbench.models.spec import CAPABILITIES, USER_KIND, ModelSpec
 
-CLASSES = {kind: getattr(importlib.import_module(f"models.jax.{kind}"), cap.model_class)
+CLASSES = {kind: getattr(importlib.import_module(f"lagbench.models.jax.{kind}"), cap.model_class)
            for kind, cap in CAPABILITIES.items()}
 
 
 def model_class(kind: str):
     """CLASSES[kind], or a user's model (`models.user`), imported when one is built."""
     if kind == USER_KIND:
-        return importlib.import_module("models.jax.user").UserModel
+        return importlib.import_module("lagbench.models.jax.user").UserModel
     return CLASSES[kind]
 
 

@@ -35,7 +35,7 @@ import dataclasses
 import jax
 import jax.numpy as jnp
 
-from models.checks import n_required_inputs
+from lagbench.models.checks import n_required_inputs
 
 __all__ = ["CompiledMethod", "async_dispatch", "compile_single", "use_sync_dispatch"]
 

@@ -17,9 +17,18 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from models.jax.base import Model
-from models.jax.mlp import ACT, act_and_slope, input_scale, linear, mlp, mlp_input, q_features, q_features_jvp
-from models.params import n_layers, tril_selection
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.mlp import (
+    ACT,
+    act_and_slope,
+    input_scale,
+    linear,
+    mlp,
+    mlp_input,
+    q_features,
+    q_features_jvp,
+)
+from lagbench.models.params import n_layers, tril_selection
 
 
 def _mv(m, v):

@@ -10,9 +10,9 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from models.jax.base import Model
-from models.jax.mlp import mlp, mlp_input, q_features
-from models.lorentz import velocity_parts
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.mlp import mlp, mlp_input, q_features
+from lagbench.models.lorentz import velocity_parts
 
 
 class HNN(Model):

@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax import lax
 
-from models.graph import (
+from lagbench.models.graph import (
     band_coloring,
     band_columns,
     band_from_colours,
@@ -33,11 +33,11 @@ from models.graph import (
     cyclic_band_layout,
     identity_band,
 )
-from models.jax.banded import solve_cyclic_banded
-from models.jax.base import Model
-from models.jax.lnn import euler_lagrange_info, pinv_solve
-from models.jax.mlp import input_scale, mlp, mlp_input, wrap_angles
-from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
+from lagbench.models.jax.banded import solve_cyclic_banded
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.lnn import euler_lagrange_info, pinv_solve
+from lagbench.models.jax.mlp import input_scale, mlp, mlp_input, wrap_angles
+from lagbench.models.jax.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 def banded_terms(L_fn, q, qdot, r):

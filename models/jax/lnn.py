@@ -26,12 +26,12 @@ import jax
 import jax.numpy as jnp
 from jax import lax
 
-from models.jax.base import Model
-from models.jax.blocking import in_row_blocks
-from models.jax.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
-from models.jax.mlp_derivatives import input_grad_and_tangent_hessian
-from models.lorentz import lorentz_slopes, velocity_parts
-from models.numerics import pinv_rtol, rcond_min
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.blocking import in_row_blocks
+from lagbench.models.jax.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
+from lagbench.models.jax.mlp_derivatives import input_grad_and_tangent_hessian
+from lagbench.models.lorentz import lorentz_slopes, velocity_parts
+from lagbench.models.numerics import pinv_rtol, rcond_min
 
 
 def _call(L_fn, q, qdot, extra):

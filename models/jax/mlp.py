@@ -15,7 +15,7 @@ import math
 import jax
 import jax.numpy as jnp
 
-from models.params import n_layers
+from lagbench.models.params import n_layers
 
 ACT = {
     "softplus": lambda x: jnp.logaddexp(x, 0.0),

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from models.jax.mlp import act_derivs
-from models.params import n_layers
+from lagbench.models.jax.mlp import act_derivs
+from lagbench.models.params import n_layers
 
 
 def input_grad_and_tangent_hessian(params: dict, x, tangents, spec, prefix: str = "mlp", rows=None):

@@ -12,9 +12,9 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 
-from models import user
-from models.jax.base import Model
-from models.jax.lnn import euler_lagrange
+from lagbench.models import user
+from lagbench.models.jax.base import Model
+from lagbench.models.jax.lnn import euler_lagrange
 
 
 @lru_cache(maxsize=16)

@@ -5,6 +5,6 @@
     build_stacked(spec, params_list) -> one Model of K stacked members, for the specs where stacks(spec)
     compiles(spec) -> whether a training loss of spec's model may run under torch.compile
 """
-from models.torch.build import build, build_stacked, compiles, stacks, to_params
+from lagbench.models.torch.build import build, build_stacked, compiles, stacks, to_params
 
 __all__ = ["build", "build_stacked", "compiles", "stacks", "to_params"]

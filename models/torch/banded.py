@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import torch
 
-from models.graph import band_columns
+from lagbench.models.graph import band_columns
 
 
 def _gather(band, triple):

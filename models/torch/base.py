@@ -13,8 +13,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from models.checks import check_input, check_state
-from models.spec import ModelSpec
+from lagbench.models.checks import check_input, check_state
+from lagbench.models.spec import ModelSpec
 
 
 class Model(nn.Module):

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import torch
 
-from models.torch.base import Model
-from models.torch.mlp import mlp, mlp_input, q_features
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.mlp import mlp, mlp_input, q_features
 
 
 class Baseline(Model):

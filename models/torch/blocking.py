@@ -14,7 +14,7 @@ from __future__ import annotations
 import torch
 from torch.utils._pytree import tree_flatten, tree_unflatten
 
-from models.row_blocks import block_plan, block_size  # noqa: F401 - block_size re-exported
+from lagbench.models.row_blocks import block_plan, block_size  # noqa: F401 - block_size re-exported
 
 
 def _pad(x, pad):

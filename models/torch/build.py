@@ -12,17 +12,17 @@ import importlib
 
 import numpy as np
 
-from models.params import check_params
-from models.spec import CAPABILITIES, USER_KIND, ModelSpec
+from lagbench.models.params import check_params
+from lagbench.models.spec import CAPABILITIES, USER_KIND, ModelSpec
 
-CLASSES = {kind: getattr(importlib.import_module(f"models.torch.{kind}"), cap.model_class)
+CLASSES = {kind: getattr(importlib.import_module(f"lagbench.models.torch.{kind}"), cap.model_class)
            for kind, cap in CAPABILITIES.items()}
 
 
 def model_class(kind: str):
     """CLASSES[kind], or a user's model (`models.user`), imported when one is built."""
     if kind == USER_KIND:
-        return importlib.import_module("models.torch.user").UserModel
+        return importlib.import_module("lagbench.models.torch.user").UserModel
     return CLASSES[kind]
 
 

@@ -36,10 +36,10 @@ import torch
 from torch.fx.experimental.proxy_tensor import make_fx
 from torch.utils._pytree import tree_flatten, tree_unflatten
 
-from models.checks import n_required_inputs
-from models.row_blocks import block_plan
-from models.torch import inductor_cache
-from models.torch.blocking import in_row_blocks
+from lagbench.models.checks import n_required_inputs
+from lagbench.models.row_blocks import block_plan
+from lagbench.models.torch import inductor_cache
+from lagbench.models.torch.blocking import in_row_blocks
 
 __all__ = ["BlockedMethod", "CompiledMethod", "compile_batched", "compile_single"]
 

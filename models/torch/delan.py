@@ -19,11 +19,11 @@ from __future__ import annotations
 import torch
 from torch.nn.functional import linear as _lin
 
-from models.params import n_layers, tril_selection
-from models.torch.base import Model
-from models.torch.export_paths import pick
-from models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, q_features, q_features_jvp
-from models.torch.mlp_derivatives import ACT_DERIVS
+from lagbench.models.params import n_layers, tril_selection
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.export_paths import pick
+from lagbench.models.torch.mlp import ACT, input_scale, linear, mlp, mlp_input, q_features, q_features_jvp
+from lagbench.models.torch.mlp_derivatives import ACT_DERIVS
 
 
 def _mv(m, v):

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import torch
 
-from models.lorentz import lorentz_slopes, velocity_parts
-from models.torch.base import Model
-from models.torch.mlp import mlp, mlp_input, q_features, q_features_vjp
-from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
+from lagbench.models.lorentz import lorentz_slopes, velocity_parts
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.mlp import mlp, mlp_input, q_features, q_features_vjp
+from lagbench.models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 class HNN(Model):

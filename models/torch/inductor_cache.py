@@ -20,8 +20,8 @@ import os
 import tempfile
 from pathlib import Path
 
-from replication.results import make_own_folder
-from systems.cache import cache_dir
+from lagbench.files.results import make_own_folder
+from lagbench.systems.cache import cache_dir
 
 log = logging.getLogger("lagbench")
 

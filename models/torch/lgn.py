@@ -24,7 +24,7 @@ import numpy as np
 import torch
 from torch.func import grad, jvp, vmap
 
-from models.graph import (
+from lagbench.models.graph import (
     band_coloring,
     band_columns,
     band_from_colours,
@@ -33,12 +33,12 @@ from models.graph import (
     cyclic_band_layout,
     identity_band,
 )
-from models.torch.banded import solve_cyclic_banded
-from models.torch.base import Model
-from models.torch.export_paths import pick, vmapped
-from models.torch.lnn import euler_lagrange_info, pinv_solve
-from models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
-from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
+from lagbench.models.torch.banded import solve_cyclic_banded
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.export_paths import pick, vmapped
+from lagbench.models.torch.lnn import euler_lagrange_info, pinv_solve
+from lagbench.models.torch.mlp import input_scale, mlp, mlp_input, wrap_angles
+from lagbench.models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 def banded_terms(L_fn, q, qdot, r):

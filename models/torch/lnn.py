@@ -15,12 +15,12 @@ from __future__ import annotations
 import torch
 from torch.func import grad, hessian, jacfwd, jacrev, jvp, vmap
 
-from models.lorentz import lorentz_slopes, velocity_parts
-from models.numerics import pinv_rtol, rcond_min
-from models.torch.base import Model
-from models.torch.export_paths import pick, replace_bad_rows
-from models.torch.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
-from models.torch.mlp_derivatives import input_grad_and_tangent_hessian
+from lagbench.models.lorentz import lorentz_slopes, velocity_parts
+from lagbench.models.numerics import pinv_rtol, rcond_min
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.export_paths import pick, replace_bad_rows
+from lagbench.models.torch.mlp import input_scale, mlp, mlp_input, q_features, q_features_jvp, q_features_vjp
+from lagbench.models.torch.mlp_derivatives import input_grad_and_tangent_hessian
 
 
 def _dtype_name(x) -> str:

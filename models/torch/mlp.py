@@ -14,8 +14,8 @@ import math
 
 import torch
 
-from models.params import n_layers
-from models.torch.export_paths import pick
+from lagbench.models.params import n_layers
+from lagbench.models.torch.export_paths import pick
 
 
 class _Softplus(torch.autograd.Function):

@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import torch
 
-from models.params import n_layers
-from models.torch.mlp import linear, softplus_given_sigmoid
+from lagbench.models.params import n_layers
+from lagbench.models.torch.mlp import linear, softplus_given_sigmoid
 
 
 def _softplus(a):

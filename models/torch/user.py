@@ -8,9 +8,9 @@ from __future__ import annotations
 import torch
 from torch.func import functional_call, grad
 
-from models import user
-from models.torch.base import Model
-from models.torch.lnn import euler_lagrange
+from lagbench.models import user
+from lagbench.models.torch.base import Model
+from lagbench.models.torch.lnn import euler_lagrange
 
 
 class UserModel(Model):

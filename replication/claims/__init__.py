@@ -3,7 +3,7 @@ DeLaN paper's control experiments (12: delan_tracking; 13: delan_online, learnin
 
 `CLAIMS` holds each claim as it runs: its models with the protocols `lagbench tune` chose where a choice is
 adopted (`tuned.py`); `untuned(id)` the claim as its file writes it, the base every tuning searches around."""
-from replication.claims import (
+from lagbench.replication.claims import (
     activation_study,
     appendix_b,
     delan_arm,
@@ -19,7 +19,7 @@ from replication.claims import (
     tuned,
     wave_lgn,
 )
-from replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
+from lagbench.replication.claims.base import PROFILES, VERDICTS, Claim, ModelEntry
 
 _ALL = (dp_loss, dp_energy, rel_coords, wave_lgn, appendix_b, init_study, activation_study, delan_table1,
         delan_arm, hnn_energy, precision, delan_tracking, delan_online)

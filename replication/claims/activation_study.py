@@ -10,11 +10,11 @@ softplus ends it half trained (held-out 20-27 against the null's 46.6 in quick),
 measure the budget, not the claim; its bar asks only that softplus ends off the plateau (held-out L1 at most
 half the null's). ReLU's held-out L1 there is the null's, 46.6 in every seed.
 """
-from replication.claims import double_pendulum as dp
-from replication.claims import pace_study as pace
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.rules import faster, never
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.claims import pace_study as pace
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.rules import faster, never
 
 ACTS = ("softplus", "relu2", "relu3", "tanh", "sigmoid", "relu")
 SMOKE_ACTS = ("softplus", "tanh", "relu")   # smoke: the reference, one smooth rival and plain ReLU

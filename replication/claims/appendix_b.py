@@ -3,10 +3,10 @@
 No training: the exact Lagrangian of `systems.get("free_fall")` is written as a model and passed
 through each framework's Euler-Lagrange routine, in both formulations, in float64.
 """
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.published import Published
-from replication.claims.rules import bound
-from replication.training.protocol import Data, Protocol
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.published import Published
+from lagbench.replication.claims.rules import bound
+from lagbench.replication.training.protocol import Data, Protocol
 
 MODELS = (ModelEntry("lnn_exact_paper", {"kind": "lnn", "formulation": "paper"}, train=False),
           ModelEntry("lnn_exact_fast", {"kind": "lnn", "formulation": "fast"}, train=False))

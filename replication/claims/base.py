@@ -14,10 +14,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from replication.claims import seed_rule
-from replication.claims.parts import Part, Variant
-from replication.claims.rules import VERDICTS
-from replication.training.protocol import Protocol
+from lagbench.replication.claims import seed_rule
+from lagbench.replication.claims.parts import Part, Variant
+from lagbench.replication.claims.rules import VERDICTS
+from lagbench.replication.training.protocol import Protocol
 
 PROFILES = ("smoke", "quick", "full", "paper")
 # a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`

@@ -7,11 +7,11 @@ trajectories and tested on another ("test" family); data efficiency reads the sm
 bar asks every model, the small-pool ones included, to have learned the training family (torque MSE on its
 held-out states at most a tenth of the null's).
 """
-from replication.claims import two_link_arm as arm
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, Part
-from replication.claims.published import Published
-from replication.claims.rules import better_by, bound
+from lagbench.replication.claims import two_link_arm as arm
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, Part
+from lagbench.replication.claims.published import Published
+from lagbench.replication.claims.rules import better_by, bound
 
 MODELS, PROTOCOLS, SIZES = arm.MODELS, arm.PROTOCOLS, arm.SIZES
 METRIC = "torque_mse_test"

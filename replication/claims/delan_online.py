@@ -27,12 +27,12 @@ not decided (timings on a shared machine).
 """
 import dataclasses
 
-from replication.claims import two_link_arm as arm
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, Part
-from replication.claims.rules import sooner
-from replication.studies import control as C
-from replication.studies import online as O
+from lagbench.replication.claims import two_link_arm as arm
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, Part
+from lagbench.replication.claims.rules import sooner
+from lagbench.replication.studies import control as C
+from lagbench.replication.studies import online as O
 
 MODELS = tuple(dataclasses.replace(m, train=False) for m in arm.MODELS if m.label in ("delan", "ff"))
 METRIC = "t_reach_s"

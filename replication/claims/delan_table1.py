@@ -13,12 +13,12 @@ factor gamma(qdot) as well (`ModelSpec.lorentz_factor`, scaled by 0.01; claim 3 
 own verdict line and never decides. DeLaN's kinetic energy is quadratic in qdot by construction, whatever
 its inputs: it gets no such feature.
 """
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part, Variant
-from replication.claims.rules import better_by
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Protocol, Scouting
-from replication.training.schedules import OneCycle
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part, Variant
+from lagbench.replication.claims.rules import better_by
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Protocol, Scouting
+from lagbench.replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (256, 256, 256)}
 # quick: the relativistic models (all alike) with restarts over initialisations, 8 scouts x 200 steps, the

@@ -11,10 +11,10 @@ that did not learn its inverse dynamics decides nothing. The true inverse dynami
 model gives) is recorded beside every unit. The paper prints tracking only as figures on its own
 trajectories: no number to compare with.
 """
-from replication.claims import two_link_arm as arm
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, Part
-from replication.claims.rules import better_by
+from lagbench.replication.claims import two_link_arm as arm
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, Part
+from lagbench.replication.claims.rules import better_by
 
 MODELS = tuple(m for m in arm.MODELS if m.label in ("delan", "ff"))
 METRIC = "tracking_mse_test"

@@ -11,12 +11,12 @@ before they are compared. These are the claims as written, the setting every tun
 `quick` both models run with what `lagbench tune` chose for them (3 x 128 at these rates:
 `replication/claims/tuned.json`, `docs/lab/tuning/dp_loss/`).
 """
-from replication.claims.bars import Bar
-from replication.claims.base import ModelEntry
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Guard, Protocol, Scouting, Tracking
-from replication.training.schedules import OneCycle, StepDecay
-from replication.training.scouting import scouting_samples
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import ModelEntry
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Guard, Protocol, Scouting, Tracking
+from lagbench.replication.training.schedules import OneCycle, StepDecay
+from lagbench.replication.training.scouting import scouting_samples
 
 PAPER_W, QUICK_W, SMOKE_W = (600, 600, 600), (64, 64, 64), (16, 16)
 FULL_W = (128, 128, 128)          # full: the train-to-target study's width that reached held-out 0.069

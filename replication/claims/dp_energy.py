@@ -15,12 +15,12 @@ nearest a registered held-out level (`evaluation.matched`), the level being the 
 held-out error under the profile's protocol, fixed before any test-split run (MATCH_LEVEL). The part is
 decided only where the two checkpoints' held-out errors on the run's split are within 1.5x of each other.
 """
-from replication.claims import double_pendulum as dp
-from replication.claims import tuned
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, Part
-from replication.claims.published import Published
-from replication.claims.rules import better_by, matched_better_by
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.claims import tuned
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, Part
+from lagbench.replication.claims.published import Published
+from lagbench.replication.claims.rules import better_by, matched_better_by
 
 _PAPER_HORIZON = (("n_ics", 40), ("t_end", 100.0))
 # the rollouts also give the float32 floor of the valid prediction time (the exact model in float32); no

@@ -10,10 +10,10 @@ Published like for like: held-out per-sample L1 on i.i.d. states. The paper prin
 but that is its late-epoch training loss (0.0731, code cell 30); the same code's held-out value is
 6.89e-2 (cell 66). The baseline's 7.4e-2 is its held-out 0.0739 (Baseline cell 58).
 """
-from replication.claims import double_pendulum as dp
-from replication.claims.base import Claim, Part
-from replication.claims.published import Published
-from replication.claims.rules import similar
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.claims.base import Claim, Part
+from lagbench.replication.claims.published import Published
+from lagbench.replication.claims.rules import similar
 
 # the tolerance of "similar" (module docstring): the original's own gap is a ratio of 0.93
 SIMILAR_WITHIN = 1.5

@@ -1,12 +1,12 @@
 """Claim 10 (HNN, as compared in both papers): an HNN conserves energy better than a baseline on the
 mass-spring and the pendulum. HNN on canonical (q, p) with targets (qdot, pdot); baseline MLP
 (q, qdot) -> qdd. Metric: max over the rollout of |E_pred - E_true| / scale, mean over initial states."""
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.rules import better_by
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Protocol
-from replication.training.schedules import OneCycle
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.rules import better_by
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128), "full": (128, 128), "paper": (200, 200)}
 _hnn = {"kind": "hnn", "activation": "tanh", "init": "xavier"}

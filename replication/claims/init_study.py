@@ -12,11 +12,11 @@ interval, and the share that reached the competence bar are reported beside.
 quick: 8 seeds of the claims 1-2 scouts' protocol (3 x 64, batch 32, peak 1e-3, velocity inputs x 0.3,
 the spike guard) for `pace_study.PACE_STEPS` steps; full: 16 seeds for the scouts' whole 15 625 steps.
 """
-from replication.claims import double_pendulum as dp
-from replication.claims import pace_study as pace
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.rules import faster
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.claims import pace_study as pace
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.rules import faster
 
 INITS = ("cranmer2020", "xavier", "kaiming", "pytorch_default")
 SMOKE_INITS = ("cranmer2020", "kaiming")   # smoke: two cohorts of two seeds, to keep the test run short

@@ -1,8 +1,8 @@
 """The settings claims 6 and 7 share (the training-pace studies on the double pendulum): widths, protocols,
 seeds, the end-state bar's level and what the reported share counts. Shared constants, not a claim."""
-from replication.claims import double_pendulum as dp
-from replication.training.protocol import Tracking
-from replication.training.scouting import scout_protocol
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.training.protocol import Tracking
+from lagbench.replication.training.scouting import scout_protocol
 
 WIDTHS = {"smoke": dp.SMOKE_W, "quick": dp.QUICK_W, "full": dp.QUICK_W, "paper": dp.PAPER_W}
 # quick: 1.6e5 samples a seed at batch 32, sized to the 45-minute budget. Measured (8 seeds, 3 x 64, JAX and

@@ -17,11 +17,11 @@ alone: a float64 LNN would cost about 3x its float32 training in JAX. The LNN jo
 The reference's 0.10 % float32 truth drift is measured on the original code, not published: it is
 context in the module docstring, not a published value.
 """
-from replication.claims import double_pendulum as dp
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.rules import better_by, similar
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.claims import double_pendulum as dp
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.rules import better_by, similar
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
 
 L1_CHANGE = 0.5   # learned-model held-out L1 may change by less than this fraction between dtypes
 

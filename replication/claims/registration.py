@@ -14,7 +14,7 @@ read), "note" (how it was chosen)}.
 line's date, else None), "tuned_on", "note", "registrations" (lines of this profile: more than one means the
 protocol was changed after an earlier registration, each change disclosed)}. A protocol that matches no
 line is unregistered: the tests forbid it, so a changed protocol is a new, dated line, never a silent edit.
-`python -m replication.claims.registration --note "..."` appends a line for every claim and profile whose
+`python -m lagbench.replication.claims.registration --note "..."` appends a line for every claim and profile whose
 current protocol matches none (nothing else changes).
 """
 from __future__ import annotations
@@ -22,18 +22,26 @@ from __future__ import annotations
 import argparse
 import inspect
 import json
+import re
 from datetime import date
 from functools import lru_cache
 from pathlib import Path
 
-from replication.claims import bars, stats
-from replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
-from replication.evaluation.version import EVALUATION_VERSION
-from replication.training.protocol import canonical_hash
+from lagbench.replication.claims import bars, stats
+from lagbench.replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
+from lagbench.replication.evaluation.version import EVALUATION_VERSION
+from lagbench.replication.training.protocol import canonical_hash
 
 FILE = Path(__file__).with_name("registrations.json")
 _SIMPLE = (str, int, float, bool, tuple, type(None))
-_RULE_MODULES = ("replication.claims.rules", "replication.claims.stats")
+_RULE_MODULES = ("lagbench.replication.claims.rules", "lagbench.replication.claims.stats")
+_PACKAGE = re.compile(r"\blagbench\.")
+
+
+def _relative(text: str) -> str:
+    """Module names in a rule's code as the package names them inside (`replication.claims.rules`), so that the
+    hash follows what a rule compares and not the name it is installed under."""
+    return _PACKAGE.sub("", text)
 
 
 def _code(fn, seen: set) -> list:
@@ -49,7 +57,7 @@ def _code(fn, seen: set) -> list:
         text = inspect.getsource(fn)
     except (OSError, TypeError):
         text = code.co_code.hex()
-    out = [f"{fn.__module__}.{fn.__qualname__}:\n{text}"]
+    out = [_relative(f"{fn.__module__}.{fn.__qualname__}:\n{text}")]
     for c in getattr(fn, "__closure__", None) or ():
         v = c.cell_contents
         if inspect.isfunction(v):
@@ -61,7 +69,7 @@ def _code(fn, seen: set) -> list:
             out += _code(g, seen)
         elif inspect.isclass(g) and g.__module__ in _RULE_MODULES:
             try:
-                out.append(f"{g.__module__}.{g.__qualname__}:\n{inspect.getsource(g)}")
+                out.append(_relative(f"{g.__module__}.{g.__qualname__}:\n{inspect.getsource(g)}"))
             except (OSError, TypeError):
                 pass
     return out
@@ -90,7 +98,7 @@ def fingerprint(claim, profile: str) -> dict:
     return {"claim": claim.id, "profile": profile, "frameworks": list(PROFILE_FRAMEWORKS[profile]), "models": models,
             "eval": claim.evaluation_config(profile), "evaluation_version": EVALUATION_VERSION,
             "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
-            "bars_code": canonical_hash({"source": inspect.getsource(bars), "share": bars.SHARE}, 16),
+            "bars_code": canonical_hash({"source": _relative(inspect.getsource(bars)), "share": bars.SHARE}, 16),
             "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],
             "variants": [v.describe() for v in claim.variants]}
 
@@ -114,7 +122,7 @@ def status(claim, profile: str) -> dict:
 
 def register(note: str, tuned_on: str = "dev", today: str | None = None) -> list[str]:
     """Append a line for each claim and profile whose current protocol matches none; the names added."""
-    from replication.claims import CLAIMS
+    from lagbench.replication.claims import CLAIMS
 
     data = json.loads(FILE.read_text()) if FILE.is_file() else {}
     added = []
@@ -132,7 +140,7 @@ def register(note: str, tuned_on: str = "dev", today: str | None = None) -> list
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m replication.claims.registration",
+    p = argparse.ArgumentParser(prog="python -m lagbench.replication.claims.registration",
                                 description="Register (freeze) every claim protocol that matches no registration.")
     p.add_argument("--note", required=True, help="how the protocols were chosen")
     p.add_argument("--tuned-on", default="dev", choices=("dev",), help="the split the choices read")

@@ -28,14 +28,14 @@ The variant beside the claim feeds the models on (q, qdot) also the Lorentz fact
 zero while the velocity Hessian must grow like (1 - qdot^2)^(-5/2) (`docs/relativistic_lnn_trials.md`).
 It is a departure from the paper and has its own verdict line.
 """
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part, Variant
-from replication.claims.parts import Budget
-from replication.claims.published import Published
-from replication.claims.rules import fails
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Protocol, Scouting, Tracking
-from replication.training.schedules import OneCycle
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part, Variant
+from lagbench.replication.claims.parts import Budget
+from lagbench.replication.claims.published import Published
+from lagbench.replication.claims.rules import fails
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Protocol, Scouting, Tracking
+from lagbench.replication.training.schedules import OneCycle
 
 W = {"smoke": (16, 16), "quick": (128, 128, 128), "full": (128, 128, 128), "paper": (500, 500, 500, 500)}
 # inputs (q, qdot[, gamma], g): q / 10 for the LNNs and the HNNs on (q, qdot), g / 10 for all

@@ -36,7 +36,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from replication.claims.stats import Interval, Stat, hodges_lehmann, ratio_interval, separated, wilson
+from lagbench.replication.claims.stats import (
+    Interval,
+    Stat,
+    hodges_lehmann,
+    ratio_interval,
+    separated,
+    wilson,
+)
 
 VERDICTS = ("reproduced", "partly", "not reproduced", "inconclusive", "not run")
 PART_VERDICTS = ("reproduced", "not reproduced", "inconclusive", "not run")

@@ -18,7 +18,7 @@ import math
 
 from scipy.stats import t as student_t
 
-from replication.claims.stats import LEVEL, seeds_needed
+from lagbench.replication.claims.stats import LEVEL, seeds_needed
 
 RECORD_PROFILES = ("full", "paper")
 RECORD_HALFWIDTH = 1.25

@@ -5,7 +5,7 @@
 "frameworks", "configs" (configurations tried per model), "search" (the knobs and their values), "adopted"
 (the date), "ledger" (its file, where the adopted search names it), "models": {label: {"knobs",
 "configs_tried", "score", "confirm_seeds"}}}. Written by
-`python -m replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
+`python -m lagbench.replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
 
 `with_knobs(entry, base, profile, knobs) -> ModelEntry`: the entry with the knob values applied under
 `profile` only (peak rate, the scouting round's with it, as a multiple of the entry's own; every hidden
@@ -28,7 +28,7 @@ import json
 from functools import lru_cache
 from pathlib import Path
 
-from replication.claims.base import PROFILES, per_profile
+from lagbench.replication.claims.base import PROFILES, per_profile
 
 FILE = Path(__file__).with_name("tuned.json")
 # claim -> (the claim whose tuning it takes, {its label: that claim's label}, {its profile: that claim's
@@ -126,7 +126,7 @@ def apply(claim):
 
 
 def tuning(claim, profile: str) -> dict:
-    from replication.claims import untuned
+    from lagbench.replication.claims import untuned
 
     try:
         written = untuned(claim.id)   # whether a profile runs as quick is judged on the claim as written

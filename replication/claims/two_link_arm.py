@@ -6,10 +6,10 @@ Adam lr 5e-4, weight decay 1e-5 (as an L2 term), torque MSE; trained on one fami
 trajectories. Data efficiency: the same models on smaller pools (`SIZES`), each a few points along several
 trajectories (`replication.training.data.arm_trajectories`), trained for as many steps as the full pool.
 """
-from replication.claims.base import ModelEntry
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Protocol
-from replication.training.schedules import Constant
+from lagbench.replication.claims.base import ModelEntry
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.replication.training.schedules import Constant
 
 W = {"smoke": (16, 16), "quick": (64, 64), "full": (64, 64), "paper": (64, 64)}
 _delan = {"kind": "delan", "activation": "softplus", "init": "xavier"}

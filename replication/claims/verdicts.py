@@ -27,11 +27,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication import results as R
-from replication.claims import CLAIMS, registration, tuned
-from replication.claims.bars import added_competence, competence
-from replication.claims.parts import claim_verdict, combine_frameworks
-from replication.claims.rules import Outcome, Stat
+from lagbench.files import results as R
+from lagbench.replication.claims import CLAIMS, registration, tuned
+from lagbench.replication.claims.bars import added_competence, competence
+from lagbench.replication.claims.parts import claim_verdict, combine_frameworks
+from lagbench.replication.claims.rules import Outcome, Stat
 
 KEYS = ("claim", "framework", "model", "seed", "status")
 

@@ -5,12 +5,12 @@ Original protocol (reference §6): periodic grid, the code's coefficient (second
 dx = 0.1); density MLP on 3 neighbours, 3x400 softplus, empirical init; i.i.d. white-noise states on
 10 points; L1; batch 1; Adam one-cycle peak 1e-3. Evaluation: a Gaussian pulse on 100 points.
 """
-from replication.claims.bars import Bar
-from replication.claims.base import Claim, ModelEntry, Part
-from replication.claims.rules import below_null, bound
-from replication.claims.seed_rule import PRELIMINARY_SEEDS
-from replication.training.protocol import Data, Protocol, Scouting
-from replication.training.schedules import OneCycle, StepDecay
+from lagbench.replication.claims.bars import Bar
+from lagbench.replication.claims.base import Claim, ModelEntry, Part
+from lagbench.replication.claims.rules import below_null, bound
+from lagbench.replication.claims.seed_rule import PRELIMINARY_SEEDS
+from lagbench.replication.training.protocol import Data, Protocol, Scouting
+from lagbench.replication.training.schedules import OneCycle, StepDecay
 
 W = {"smoke": (16, 16), "quick": (64, 64, 64), "full": (64, 64, 64), "paper": (400, 400, 400)}
 MODELS = (ModelEntry("lgn", {"kind": "lgn", "activation": "softplus", "init": "cranmer2020",

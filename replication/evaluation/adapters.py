@@ -5,7 +5,7 @@
 `acceleration_info`, ...) taking and returning float64 NumPy arrays. Inputs are cast to the
 model's dtype; large batches are evaluated in chunks. JAX methods are jit-compiled once per method.
 So evaluation code (metrics, rollouts) is written once and judges both frameworks alike.
-`view.model` is the framework's model object (`models.jax.build` / `models.torch.build`).
+`view.model` is the framework's model object (`lagbench.models.jax.build` / `lagbench.models.torch.build`).
 
 `qddot(model, kind, q, qdot)`: q-double-dot of any model kind, on a framework model or on a view: the
 acceleration, or for an HNN ("hnn") the second half of its time derivative on the non-canonical (q, qdot);
@@ -83,10 +83,10 @@ class JaxAdapter(_Adapter):
         super().__init__(spec, params)
         import jax.numpy as jnp
 
-        import models.jax
+        import lagbench.models.jax
 
         self._jnp = jnp
-        self.model = models.jax.build(spec, params)
+        self.model = lagbench.models.jax.build(spec, params)
 
     def _compile(self, name):
         jnp, dtype = self._jnp, self._jnp.dtype(self.spec.dtype)
@@ -104,10 +104,10 @@ class TorchAdapter(_Adapter):
         super().__init__(spec, params)
         import torch
 
-        import models.torch
+        import lagbench.models.torch
 
         self._torch = torch
-        self.model = models.torch.build(spec, params)
+        self.model = lagbench.models.torch.build(spec, params)
 
     def _compile(self, name):
         torch, dtype = self._torch, getattr(self._torch, self.spec.dtype)

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.metrics import null_errors
-from replication.evaluation.routines import Evaluation, heldout_of, system_of
-from replication.training.objective import predict
+from lagbench.replication.evaluation.metrics import null_errors
+from lagbench.replication.evaluation.routines import Evaluation, heldout_of, system_of
+from lagbench.replication.training.objective import predict
 
 
 def _mse(a, b):

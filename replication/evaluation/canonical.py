@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.rollout import rollout
+from lagbench.replication.evaluation.rollout import rollout
 
 
 def canonical_rollout(time_derivative, s, q0, qdot0, t, dt, *, extra=None, momentum_kw=None):

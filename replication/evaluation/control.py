@@ -23,9 +23,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from replication.evaluation.routines import Evaluation
-from replication.studies import control
-from replication.training.objective import predict
+from lagbench.replication.evaluation.routines import Evaluation
+from lagbench.replication.studies import control
+from lagbench.replication.training.objective import predict
 
 FAMILIES = ("train", "test", "train_x2")
 N_REFS, DURATION = control.N_REFS, control.DURATION
@@ -49,7 +49,7 @@ def _family(d: dict, rows: slice) -> dict:
 @lru_cache(maxsize=8)
 def _floors(n_refs: int, duration: float, seed: int) -> dict:
     """family -> (PD alone's scores, the true inverse dynamics' scores) on the family's references."""
-    import systems
+    from lagbench import systems
 
     (refs, rows), plant = _references(n_refs, duration, seed), systems.get("two_link_arm")
     pd = control.track(None, refs)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from replication.evaluation.routines import Evaluation, system_of
+from lagbench.replication.evaluation.routines import Evaluation, system_of
 
 
 def lagrangian_callable(s):
@@ -29,12 +29,12 @@ def eval_exact_lagrangian(ctx) -> Evaluation:
     if ctx.framework == "jax":
         import jax.numpy as jnp
 
-        from models.jax.lnn import euler_lagrange
+        from lagbench.models.jax.lnn import euler_lagrange
         qdd = np.asarray(euler_lagrange(L, jnp.asarray(q), jnp.asarray(qdot), form))
     else:
         import torch
 
-        from models.torch.lnn import euler_lagrange
+        from lagbench.models.torch.lnn import euler_lagrange
         qdd = euler_lagrange(L, torch.as_tensor(q), torch.as_tensor(qdot), form).detach().cpu().numpy()
     truth = s.acceleration(q, qdot, backend="numpy")
     expected = np.broadcast_to(np.array([-float(s.params["g"]), 0.0]), qdd.shape)

@@ -15,8 +15,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from replication.evaluation.adapters import adapter
-from replication.training.tracking import unstack
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.training.tracking import unstack
 
 
 def nearest(losses, level: float) -> int | None:

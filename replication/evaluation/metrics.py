@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.training.objective import loss_value
+from lagbench.replication.training.objective import loss_value
 
 
 def _same_shape(what: str, a, b, ndim: int, min_len=(1,)):

@@ -40,10 +40,10 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
-from replication.evaluation.routines import Evaluation
-from replication.studies import control as C
-from replication.studies import online as O
-from replication.training.objective import predict
+from lagbench.replication.evaluation.routines import Evaluation
+from lagbench.replication.studies import control as C
+from lagbench.replication.studies import online as O
+from lagbench.replication.training.objective import predict
 
 DEFAULTS = {"seconds": 30.0, "every": O.EVERY, "steps": O.STEPS, "batch": O.BATCH, "buffer": O.BUFFER,
             "window": O.WINDOW, "threshold": O.THRESHOLD, "sustain": O.SUSTAIN, "n_unseen": O.N_UNSEEN,
@@ -91,7 +91,7 @@ def _controller(ctx, s: dict):
     """(controller, optimiser steps per learning tick): a fixed model (no steps), else a fresh learner."""
     if ctx.model is not None:
         return Fixed(ctx.model, ctx.spec.kind, ctx.protocol.task), 0
-    from replication.studies.online_learner import learner
+    from lagbench.replication.studies.online_learner import learner
 
     if ctx.spec.kind not in LEARNERS:
         raise ValueError(f"online learning: model kind {ctx.spec.kind!r}; valid {', '.join(LEARNERS)}")
@@ -109,7 +109,7 @@ def _windows(windows: list, pd_windows: pd.DataFrame) -> pd.DataFrame:
 
 
 def eval_online(ctx) -> Evaluation:
-    from replication.run.environment import torch_threads
+    from lagbench.replication.run.environment import torch_threads
 
     s, seed = settings(ctx.cfg), C.SEED + ctx.split.draw_offset
     refs, pd_w = _references(s["seconds"], seed), _pd_alone(s["seconds"], s["window"], seed)

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 
-from replication.claims.bars import FRACTION
-from replication.evaluation.routines import eval_heldout
+from lagbench.replication.claims.bars import FRACTION
+from lagbench.replication.evaluation.routines import eval_heldout
 
 PLATEAU = 0.5   # off the plateau: at most half the null predictor's error (the plateau sits at the null's)
 LEVELS = {"left_plateau": ("samples_to_leave", PLATEAU), "reached_bar": ("samples_to_bar", FRACTION)}

@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from replication.evaluation.routines import _truth, eval_energy_rollout, truth_key, truth_rk4
+from lagbench.replication.evaluation.routines import _truth, eval_energy_rollout, truth_key, truth_rk4
 
 
 @lru_cache(maxsize=8)

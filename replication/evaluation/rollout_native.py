@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.adapters import padded_size
-from replication.evaluation.rollout import rk4_step, steps
+from lagbench.replication.evaluation.adapters import padded_size
+from lagbench.replication.evaluation.rollout import rk4_step, steps
 
 BLOCK = 256   # intervals a compiled JAX call advances; the progress bar moves once a block
 COMPILE_CALLS = 40_000   # model calls from which a PyTorch rollout compiles its RK4 step (eager ~1 ms a call)
@@ -211,7 +211,7 @@ def _compiled(step, k, forced, batch):
     where it cannot be built: the rollout then runs eagerly."""
     import torch
 
-    from replication.training.compile_torch import compiler
+    from lagbench.replication.training.compile_torch import compiler
 
     if torch.get_default_device().type == "cpu" and compiler() is None:
         import warnings
@@ -220,7 +220,7 @@ def _compiled(step, k, forced, batch):
                       stacklevel=2)
         return None
     try:
-        from models.torch.compiled import compile_batched
+        from lagbench.models.torch.compiled import compile_batched
 
         dof = (k - forced) // 2
         return compile_batched(step, 1, k + 3 + 2 * dof * forced, "float64", batch=batch, name="rk4 step",

@@ -16,27 +16,27 @@ from functools import lru_cache
 import numpy as np
 import pandas as pd
 
-import systems
-import systems.trajectories
-from replication.evaluation.canonical import canonical_rollout, state_velocity
-from replication.evaluation.metrics import (
+import lagbench.systems.trajectories
+from lagbench import systems
+from lagbench.replication.evaluation.canonical import canonical_rollout, state_velocity
+from lagbench.replication.evaluation.metrics import (
     bounded_relative_error,
     energy_errors,
     geometric_mean_over_time,
     heldout_errors,
     null_errors,
 )
-from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout, steps
-from replication.evaluation.valid_time import (
+from lagbench.replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout, steps
+from lagbench.replication.evaluation.valid_time import (
     PERTURBATION,
     VPT_NRMSE,
     normalised_rmse,
     valid_time,
     valid_times,
 )
-from replication.run.splits import DEV
-from replication.training import data as datamod
-from replication.training.objective import predict
+from lagbench.replication.run.splits import DEV
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training.objective import predict
 
 
 @dataclass
@@ -148,8 +148,8 @@ def _truth(name, params, cfg_items):
     rng = np.random.default_rng(cfg.get("ic_seed", 0))
     q0, qd0 = _initial_states(s, cfg, rng)
     t = np.linspace(0.0, cfg["t_end"], cfg["n_t"])
-    q, qd = systems.trajectories.integrate(s, q0, qd0, t)
-    qc, qdc = systems.trajectories.integrate(s, q0 + 1e-4, qd0, t)
+    q, qd = lagbench.systems.trajectories.integrate(s, q0, qd0, t)
+    qc, qdc = lagbench.systems.trajectories.integrate(s, q0 + 1e-4, qd0, t)
     return s, t, q, qd, qc, qdc
 
 
@@ -157,7 +157,7 @@ def _truth(name, params, cfg_items):
 def _floor(name, params, cfg_items):
     """The truth from the truth's initial states with PERTURBATION added to every angle: the chaos floor."""
     s, t, q, qd, _, _ = _truth(name, params, cfg_items)
-    return systems.trajectories.integrate(s, q[:, 0] + PERTURBATION, qd[:, 0], t)
+    return lagbench.systems.trajectories.integrate(s, q[:, 0] + PERTURBATION, qd[:, 0], t)
 
 
 def truth_rk4(name, params, cfg_items, dtype: str, step: str = "split"):
@@ -230,7 +230,7 @@ def eval_energy_rollout(ctx) -> Evaluation:
         **vpt_columns})
     out.arrays = {"t": t, "q_true": q[:3], "q_pred": qp[:3]}
     if cfg.get("match_heldout_l1"):   # the same evaluation at the checkpoint nearest a registered accuracy
-        from replication.evaluation.matched import at_level
+        from lagbench.replication.evaluation.matched import at_level
 
         plain = {k: v for k, v in cfg.items() if k not in ("match_heldout_l1", "float32_truth")}
         out.metrics.update(at_level(ctx, cfg["match_heldout_l1"],

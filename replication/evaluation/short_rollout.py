@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.canonical import canonical_rollout, state_velocity
-from replication.evaluation.rollout import rollout
-from replication.evaluation.routines import Evaluation, eval_heldout, qddot_of_prediction, system_of
-from replication.training import data as datamod
-from replication.training.objective import predict
+from lagbench.replication.evaluation.canonical import canonical_rollout, state_velocity
+from lagbench.replication.evaluation.rollout import rollout
+from lagbench.replication.evaluation.routines import Evaluation, eval_heldout, qddot_of_prediction, system_of
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training.objective import predict
 
 
 def _states(ctx, s):

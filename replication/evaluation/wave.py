@@ -5,9 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from replication.evaluation.metrics import bounded_relative_error, geometric_mean_over_time, heldout_errors
-from replication.evaluation.rollout import lagrangian_field, rollout
-from replication.evaluation.routines import Evaluation, eval_heldout, heldout_of, system_of
+from lagbench.replication.evaluation.metrics import (
+    bounded_relative_error,
+    geometric_mean_over_time,
+    heldout_errors,
+)
+from lagbench.replication.evaluation.rollout import lagrangian_field, rollout
+from lagbench.replication.evaluation.routines import Evaluation, eval_heldout, heldout_of, system_of
 
 
 def eval_wave(ctx) -> Evaluation:
@@ -27,7 +31,7 @@ def eval_wave(ctx) -> Evaluation:
     q0 = np.exp(-((x - 0.5) ** 2) / (2 * 0.05**2))[None]
     qd0 = np.zeros_like(q0)
     t = np.linspace(0.0, cfg["t_end"], cfg["n_t"])
-    import systems.trajectories as tr
+    import lagbench.systems.trajectories as tr
 
     q, qd = tr.integrate(s, q0, qd0, t)
     z = rollout(lagrangian_field(lambda a, v: m.acceleration(a, v, None), n_big),

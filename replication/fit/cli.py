@@ -1,5 +1,5 @@
 """The command line of bringing your own data: `lagbench simulate`, `fit` and `evaluate` (registered on
-`replication.cli`'s parser by `add_commands`). Every option shows its default in `--help`; bad input is
+`lagbench.cli`'s parser by `add_commands`). Every option shows its default in `--help`; bad input is
 one line naming the option (raised as ValueError, printed by `cli.main`)."""
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from replication.claims.base import PROFILES
-from replication.fit import options as fit_options
-from replication.renamed import renamed
-from replication.training.device import HELP as DEVICE_HELP
+from lagbench.replication.claims.base import PROFILES
+from lagbench.replication.fit import options as fit_options
+from lagbench.replication.renamed import renamed
+from lagbench.replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
@@ -28,8 +28,8 @@ def _show_defaults(parser) -> None:
 
 
 def cmd_simulate(args):
-    from replication.fit.simulate import simulate
-    from replication.results import write_csv
+    from lagbench.files.results import write_csv
+    from lagbench.replication.fit.simulate import simulate
 
     path = Path(args.out)
     if path.suffix != ".csv":
@@ -66,9 +66,9 @@ class RolloutBars:
 def cmd_fit(args):
     from tqdm.auto import tqdm
 
-    from replication.fit import kind_defaults
-    from replication.fit.task import LOSS_NAMES, fit, resolved
-    from replication.training import device
+    from lagbench.replication.fit import kind_defaults
+    from lagbench.replication.fit.task import LOSS_NAMES, fit, resolved
+    from lagbench.replication.training import device
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
@@ -93,7 +93,7 @@ def cmd_fit(args):
 
     try:
         if args.tune:
-            from replication.fit.tune import tune_fit
+            from lagbench.replication.fit.tune import tune_fit
 
             d, ledger = tune_fit(args.data, out=args.out, n_configs=args.tune, on_log=on_log, on_progress=rollouts,
                                  **fit_options.from_args(args))
@@ -112,7 +112,7 @@ def cmd_fit(args):
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
         return 1
-    from replication.fit.competence import competence, describe
+    from lagbench.replication.fit.competence import competence, describe
 
     again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
     value = d.get("final_train_loss") if d["metric"] == "final_train_loss" else d["metrics"].get(d["metric"])
@@ -133,8 +133,8 @@ def _fitted_folder(args) -> str:
 
 def cmd_predict(args):
     """`evaluate --predict module:function --system NAME`: a predictor from outside scored on a system."""
-    from replication.predictor.score import score
-    from replication.user_functions import import_function
+    from lagbench.files.user_functions import import_function
+    from lagbench.replication.predictor.score import score
 
     given = [o for o, v in (("--data", args.data), ("--fitted", args.fitted or args.fitted_old), ("--energy", args.energy),
                             ("--framework", args.framework), ("--time-unit", args.time_unit)) if v is not None]
@@ -172,7 +172,7 @@ def cmd_predict(args):
 
 
 def cmd_evaluate(args):
-    from replication.fit.evaluate_file import evaluate
+    from lagbench.replication.fit.evaluate_file import evaluate
 
     if args.predict is not None:
         return cmd_predict(args)
@@ -188,7 +188,7 @@ def cmd_evaluate(args):
                         device=args.device, horizon=args.horizon, on_progress=rollouts, time_unit=args.time_unit)
     finally:
         rollouts.close()
-    from replication.fit.competence import competence, describe
+    from lagbench.replication.fit.competence import competence, describe
 
     for d in done:
         m, loss = d["metrics"], f"test_{d['protocol']['loss']}"

@@ -7,10 +7,10 @@ import dataclasses
 
 import numpy as np
 
-from replication.evaluation.adapters import adapter
-from replication.evaluation.metrics import heldout_errors
-from replication.fit.competence import competence
-from replication.fit.load import Padded
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.evaluation.metrics import heldout_errors
+from lagbench.replication.fit.competence import competence
+from lagbench.replication.fit.load import Padded
 
 KEEP = 2000   # states of the set (at most) the velocity Hessian is compared on
 

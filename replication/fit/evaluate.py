@@ -2,7 +2,7 @@
 `lagbench fit` (its held-out rows and its `--test` file) and `lagbench evaluate` run.
 
 ctx.cfg: {"heldout": bool (evaluate the protocol file's held-out rows), "test": a prepared file's
-`userdata.reference` or None, "system": a `systems` name or None, "energy": "module:function" (a user's
+`user_data.reference` or None, "system": a `systems` name or None, "energy": "module:function" (a user's
 E(q, qdot), in place of the system's) or None, "substeps": RK4 steps per sample
 interval, "horizon": seconds of each trajectory rolled out (absent: all), "model": a fit's unit folder (evaluate: the model is loaded from it by `load.load_fitted`)}.
 Every evaluation set S ("heldout", "test") gives, as NumPy arrays and alike for both frameworks:
@@ -40,19 +40,19 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from replication.evaluation.metrics import (
+from lagbench.files import user_data
+from lagbench.replication.evaluation.metrics import (
     bounded_relative_error,
     energy_errors,
     geometric_mean_over_time,
     heldout_errors,
     null_errors,
 )
-from replication.evaluation.routines import Evaluation
-from replication.evaluation.valid_time import VPT_NMSE, VPT_NRMSE, normalised_rmse, valid_time
-from replication.fit import userdata
-from replication.fit.dissipation import dissipation_metrics
-from replication.fit.load import Fitted, Padded, load_fitted
-from replication.fit.trajectories import starts
+from lagbench.replication.evaluation.routines import Evaluation
+from lagbench.replication.evaluation.valid_time import VPT_NMSE, VPT_NRMSE, normalised_rmse, valid_time
+from lagbench.replication.fit.dissipation import dissipation_metrics
+from lagbench.replication.fit.load import Fitted, Padded, load_fitted
+from lagbench.replication.fit.trajectories import starts
 
 KEEP = 2000   # rows kept for the parity and decomposition figures
 
@@ -93,10 +93,10 @@ def energy_function(cfg, dof):
     if not spec:
         if not cfg.get("system"):
             return None
-        import systems
+        from lagbench import systems
 
         return systems.get(cfg["system"]).energy
-    from replication.user_functions import array_of, call, import_function, wrong
+    from lagbench.files.user_functions import array_of, call, import_function, wrong
 
     fn = import_function(spec, "--energy")
     what = f"{getattr(fn, '__name__', 'the function')}(q, qdot)"
@@ -232,7 +232,7 @@ def _decomposition(f: Fitted, r, name, system, out: Evaluation):
 
 
 def eval_fit(ctx) -> Evaluation:
-    import systems
+    from lagbench import systems
 
     cfg = ctx.cfg
     if ctx.model is not None:
@@ -246,9 +246,9 @@ def eval_fit(ctx) -> Evaluation:
     true_energy = energy_function(cfg, f.spec.dof)
     sets = {}
     if cfg.get("heldout"):
-        sets["heldout"] = userdata.rows(ctx.protocol.data.recipe, "heldout")
+        sets["heldout"] = user_data.rows(ctx.protocol.data.recipe, "heldout")
     if cfg.get("test"):
-        sets["test"] = userdata.rows(cfg["test"], "test")
+        sets["test"] = user_data.rows(cfg["test"], "test")
     sets = {k: v for k, v in sets.items() if len(v["q"])}
     out = Evaluation()
     cfg = {**cfg, "primary": "test" if "test" in sets else "heldout", "progress": ctx.progress}

@@ -18,14 +18,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from replication import results as R
-from replication.claims.base import Claim, ModelEntry
-from replication.fit import options as fit_options
-from replication.fit import rows as fit_data
-from replication.fit import time_base, trajectories, userdata
-from replication.fit.load import fitted_folders, load_fitted
-from replication.fit.task import LOSS_NAMES
-from replication.run.units import Unit, run_unit
+from lagbench.files import results as R
+from lagbench.files import user_data
+from lagbench.replication.claims.base import Claim, ModelEntry
+from lagbench.replication.fit import options as fit_options
+from lagbench.replication.fit import rows as fit_data
+from lagbench.replication.fit import time_base, trajectories
+from lagbench.replication.fit.load import fitted_folders, load_fitted
+from lagbench.replication.fit.task import LOSS_NAMES
+from lagbench.replication.run.units import Unit, run_unit
 
 
 def _check(framework, system, substeps, window, polyorder, horizon, time_unit):
@@ -40,7 +41,7 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
              polyorder=None, energy=None, device="auto", horizon=None, on_progress=None, time_unit=None) -> list[dict]:
     _check(framework, system, substeps, window, polyorder, horizon, time_unit)
     path = str(Path(data).resolve())
-    raw = userdata.read(path)[1]
+    raw = user_data.read(path)[1]
     has_tau = "tau" in raw
     fits = [load_fitted(f) for f in fitted_folders(model)]
     for f in fits:   # the time base of each fit's evaluation, before anything is written
@@ -48,18 +49,18 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         unit = time_unit or (fcfg.get("derivatives") or {}).get("time_unit", "s")
         time_base.check_unit(f"--data {data}", raw, system or fcfg.get("system"), unit)
     if energy:
-        from replication.fit.evaluate import energy_function
+        from lagbench.replication.fit.evaluate import energy_function
 
         energy_function({"energy": energy}, fits[0].spec.dof)
     for f in fits:
         if (f.task == "inverse_dynamics") != has_tau:
             raise ValueError(f"--data {data}: {'has' if has_tau else 'lacks'} tau columns, but the fit in {f.folder} "
                              f"was trained {'with' if f.task == 'inverse_dynamics' else 'without'} them")
-    from replication.training import device as dev
+    from lagbench.replication.training import device as dev
 
     dev.apply(device, sorted({framework or f.result["framework"] for f in fits}))   # before anything is written
     out = R.output_folder(out, "--out")
-    from replication.run.runner import is_current
+    from lagbench.replication.run.runner import is_current
 
     done = []
     for f in fits:

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from functools import cache
 
-from replication.training.schedules import OneCycle
+from lagbench.replication.training.schedules import OneCycle
 
 PROFILE = "quick"
 SOURCES = {("lnn", "acceleration"): ("dp_loss", "lnn"), ("baseline", "acceleration"): ("dp_loss", "baseline"),
@@ -40,8 +40,8 @@ FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr
 
 
 def _entry(kind: str, task: str):
-    from replication.claims import get
-    from replication.claims.base import per_profile
+    from lagbench.replication.claims import get
+    from lagbench.replication.claims.base import per_profile
 
     claim_id, label = SOURCES[(kind, task)]
     claim = get(claim_id)
@@ -95,7 +95,7 @@ def fill(o, task: str, recording: bool = False):
     peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
     from types import SimpleNamespace
 
-    from replication.fit import options as fit_options
+    from lagbench.replication.fit import options as fit_options
 
     d, v = defaults(o.model, task, recording), dict(vars(o))
     given = {k for k, x in v.items() if x is not fit_options.BY_KIND}

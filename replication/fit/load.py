@@ -32,11 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
-from models import ModelSpec
-from replication import results as R
-from replication.evaluation.adapters import adapter, padded_size
-from replication.evaluation.rollout_native import native_rollout
-from replication.training.protocol import Protocol
+from lagbench.files import results as R
+from lagbench.models import ModelSpec
+from lagbench.replication.evaluation.adapters import adapter, padded_size
+from lagbench.replication.evaluation.rollout_native import native_rollout
+from lagbench.replication.training.protocol import Protocol
 
 ENERGY_STEP = 1e-4   # in float64: truncation ~1e-8 relative, round-off ~1e-12 x |L|
 
@@ -97,10 +97,10 @@ class Fitted:
 
     def one_step(self, rows: dict) -> tuple[dict, np.ndarray]:
         """(the batch of `rows` for this model's task, the model's prediction of its target on it)."""
-        from replication.fit import userdata
-        from replication.training.objective import predict
+        from lagbench.files import user_data
+        from lagbench.replication.training.objective import predict
 
-        b = userdata.batch_of(rows, self.task)
+        b = user_data.batch_of(rows, self.task)
         return b, predict(self.model, self.spec.kind, self.task, b, np.concatenate)
 
     def acceleration(self, q, qdot, tau=None):

@@ -14,11 +14,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
 
-from models import ACTIVATIONS
-from replication.fit.rows import HELDOUT, SPLITS
-from replication.fit.time_base import TIME_UNITS
-from replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
-from replication.renamed import renamed
+from lagbench.models import ACTIVATIONS
+from lagbench.replication.fit.rows import HELDOUT, SPLITS
+from lagbench.replication.fit.time_base import TIME_UNITS
+from lagbench.replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
+from lagbench.replication.renamed import renamed
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
 FRAMEWORKS = ("jax", "torch")
@@ -204,7 +204,7 @@ def check(values: dict) -> None:
                          "function); the baseline's q-double-dot is free-form already")
     system = values.get("system")
     if system is not None:
-        import systems
+        from lagbench import systems
 
         if system not in systems.names():
             raise ValueError(f"--system: unknown {system!r}; valid: {', '.join(systems.names())}")

@@ -1,12 +1,12 @@
 """The rows `lagbench fit` trains and evaluates on: derivatives, the split, and the prepared file.
 
 `prepare(out, path, split, heldout, window, polyorder, dtype, kind, gaps, time_unit)` reads the user's file
-(`replication.fit.userdata`), reads its times in `time_unit` (`replication.fit.time_base`), turns a trajectory file into state samples (`replication.fit.trajectories`),
+(`lagbench.files.user_data`), reads its times in `time_unit` (`replication.fit.time_base`), turns a trajectory file into state samples (`replication.fit.trajectories`),
 assigns every row to "train" or "heldout" (kind "fit") or to "test" (kind "test", a `--test` or
 `lagbench evaluate --data` file), and writes the rows to `OUT/data/<name>-<kind>-<hash>.csv` (columns
 split, [traj, t,] q0.., qdot0.., qddot0..[, tau0..]; loadable with `pandas.read_csv`). The hash covers
 the source file's sha256 and every option, and the file's bytes follow from them, so the prepared file
-(and with it the training cache key: the protocol records `userdata.reference` of the prepared file)
+(and with it the training cache key: the protocol records `user_data.reference` of the prepared file)
 changes exactly when the data or an option does. Returns a `Prepared` record.
 
 Splits (`SPLITS`):
@@ -28,8 +28,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from replication import results as R
-from replication.fit import time_base, trajectories, userdata
+from lagbench.files import results as R
+from lagbench.files import user_data
+from lagbench.replication.fit import time_base, trajectories
 
 SPLITS = ("by-trajectory", "random", "none")
 HELDOUT = 0.1
@@ -37,12 +38,12 @@ HELDOUT = 0.1
 
 @dataclass(frozen=True)
 class Prepared:
-    reference: str          # userdata.reference of the prepared file
+    reference: str          # user_data.reference of the prepared file
     dof: int
     counts: dict            # split -> rows
     trajectories: dict      # split -> whole trajectories (0 for a state file)
     has_tau: bool
-    source: str             # userdata.reference of the user's own file
+    source: str             # user_data.reference of the user's own file
 
 
 def check_options(split, heldout) -> None:
@@ -78,7 +79,7 @@ def _frame(d: dict, labels) -> pd.DataFrame:
     for k in ("traj", "t"):
         if k in d:
             cols[k] = d[k]
-    for k in userdata.ARRAYS:
+    for k in user_data.ARRAYS:
         if k in d:
             cols.update({f"{k}{j}": d[k][:, j] for j in range(d[k].shape[1])})
     return pd.DataFrame(cols)
@@ -87,12 +88,12 @@ def _frame(d: dict, labels) -> pd.DataFrame:
 def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, polyorder=trajectories.POLYORDER,
             dtype="float32", kind="fit", gaps="interpolate", time_unit="s") -> Prepared:
     path = str(Path(path).resolve())
-    digest, d = userdata.read(path)
+    digest, d = user_data.read(path)
     is_traj = "t" in d
     if is_traj:
         d = time_base.in_seconds(d, time_unit)
         d = trajectories.with_derivatives(d, path, window, polyorder, gaps)
-    userdata.check_range(path, d, dtype)
+    user_data.check_range(path, d, dtype)
     if kind == "test":
         labels = np.full(len(d["q"]), "test", dtype=object)
         options = {}
@@ -114,6 +115,6 @@ def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, 
     prepared_digest = R.write_csv(target, _frame(d, labels))
     names, counts = np.unique(labels, return_counts=True)
     traj = {str(s): int(np.unique(d["traj"][labels == s]).size) if is_traj else 0 for s in names}
-    return Prepared(userdata.reference(str(target.resolve()), prepared_digest), d["q"].shape[1],
+    return Prepared(user_data.reference(str(target.resolve()), prepared_digest), d["q"].shape[1],
                     {str(s): int(c) for s, c in zip(names, counts, strict=True)}, traj, "tau" in d,
-                    userdata.reference(path, digest))
+                    user_data.reference(path, digest))

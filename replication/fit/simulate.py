@@ -20,7 +20,7 @@ import pandas as pd
 
 
 def check_options(system, trajectories, duration, rate, noise, seed, dropped=0.0, decimals=None) -> None:
-    import systems
+    from lagbench import systems
 
     if system not in systems.names():
         raise ValueError(f"--system: unknown {system!r}; valid: {', '.join(systems.names())}")
@@ -59,8 +59,9 @@ def parse_settings(settings) -> dict:
 
 def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0.0, seed=0,
              velocities=False, dropped=0.0, decimals=None, settings=()) -> pd.DataFrame:
-    import systems
-    import systems.trajectories
+
+    import lagbench.systems.trajectories
+    from lagbench import systems
 
     check_options(system, trajectories, duration, rate, noise, seed, dropped, decimals)
     try:
@@ -70,7 +71,7 @@ def simulate(system="pendulum", trajectories=8, duration=5.0, rate=50.0, noise=0
     rng = np.random.default_rng(seed)
     st = s.sample_states(trajectories, rng)
     t = np.arange(int(math.floor(duration * rate + 1e-9)) + 1) / rate
-    q, qd = systems.trajectories.integrate(s, st["q"], st["qdot"], t)
+    q, qd = lagbench.systems.trajectories.integrate(s, st["q"], st["qdot"], t)
     q = q + noise * rng.standard_normal(q.shape)
     qd = qd + noise * rng.standard_normal(qd.shape)
     b, n, d = q.shape

@@ -5,7 +5,7 @@ per component, rollouts of whole held-out or test trajectories, energies, DeLaN'
 folder (`OUT/units/fit/<framework>/<model>/seed<k>/`) has result.json, train_log.csv, checkpoint.npz and
 the evaluation's tables like every other unit; `replication.fit.load.load_fitted` loads the model back.
 
-Data: a state file or a trajectory file (`replication.fit.userdata`); derivatives a trajectory file lacks are
+Data: a state file or a trajectory file (`lagbench.files.user_data`); derivatives a trajectory file lacks are
 estimated (`replication.fit.trajectories`), rows are split into train / held-out (`replication.fit.rows`:
 `split` by-trajectory, the default for trajectory files, random, the default for state files, or none;
 fraction `heldout`), and an optional `test` file is evaluated as a whole. The prepared rows are written
@@ -30,14 +30,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from replication import results as R
-from replication.claims.base import ModelEntry
-from replication.fit import kind_defaults, time_base, trajectories, userdata
-from replication.fit import options as fit_options
-from replication.fit import rows as fit_data
-from replication.run.units import Unit, run_unit
-from replication.training.protocol import Data, Guard, Protocol, Scouting
-from replication.training.schedules import Constant, OneCycle
+from lagbench.files import results as R
+from lagbench.files import user_data
+from lagbench.replication.claims.base import ModelEntry
+from lagbench.replication.fit import kind_defaults, time_base, trajectories
+from lagbench.replication.fit import options as fit_options
+from lagbench.replication.fit import rows as fit_data
+from lagbench.replication.run.units import Unit, run_unit
+from lagbench.replication.training.protocol import Data, Guard, Protocol, Scouting
+from lagbench.replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
 SET_NAMES = {"heldout": "held-out", "test": "test"}
@@ -55,7 +56,7 @@ def task_of(model: str, has_tau: bool, path) -> str:
 def auto_scale(reference: str, task: str, kind: str, periodic: tuple = ()) -> tuple:
     """1 / the standard deviation of each MLP input over the training rows (1 where it is 0), 6 digits; the
     periodic coordinates' inputs are their cos and sin, in the MLP's layout (`models.spec`)."""
-    b = userdata.batch_of(userdata.rows(reference, "train"), task)
+    b = user_data.batch_of(user_data.rows(reference, "train"), task)
     q = np.concatenate([np.stack([np.cos(c), np.sin(c)], 1) if k in periodic else c[:, None]
                         for k, c in enumerate(b["q"].T)], 1)
     x = q if kind == "delan" else np.concatenate([q, *(b[k] for k in ("qdot", "extra") if k in b)], 1)
@@ -124,7 +125,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     # a dissipative fit has its own folder beside the conservative one of the same kind: the two compare
     entry = ModelEntry(o.model + ("_dissipative" if o.dissipation else ""), _model_spec(o, prep, task), hidden=o.hidden)
     unit = Unit(FitSource(protocol, cfg), entry, o.framework, o.seed, "quick")
-    from replication.run.runner import is_current
+    from lagbench.replication.run.runner import is_current
 
     if is_current(unit, out):
         return dict(R.load_result(unit.folder(out)), reused=True, metric=metric, metric_label=label)
@@ -149,12 +150,12 @@ def resolved(data, options: dict) -> Resolved:
     if o.split is not None:
         fit_data.check_options(o.split, o.heldout)
     trajectories.check_options(o.window, o.polyorder)
-    raw = userdata.read(path)[1]
+    raw = user_data.read(path)[1]
     time_base.check_unit(path, raw, o.system, o.time_unit)
     task, recording = task_of(o.model, "tau" in raw, path), "traj" in raw
     o = kind_defaults.fill(o, task, recording=recording)
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
-        from models import ModelSpec
+        from lagbench.models import ModelSpec
         try:
             ModelSpec(kind=o.model, dof=raw["q"].shape[1], periodic=tuple(o.periodic), angle_wrap=bool(o.angle_wrap))
         except ValueError as e:
@@ -169,11 +170,11 @@ def resolved(data, options: dict) -> Resolved:
             raise ValueError(f"--input-scale: {len(o.input_scale)} numbers given; this {o.model}'s MLP takes {width} "
                              f"inputs ({names}, {dof} each{periodic})")
     if o.energy:  # importable and of the right shape, before any work
-        from replication.fit.evaluate import energy_function
+        from lagbench.replication.fit.evaluate import energy_function
 
         energy_function({"energy": o.energy}, raw["q"].shape[1])
     if o.test is not None:
-        test_raw = userdata.read(str(Path(o.test).resolve()))[1]
+        test_raw = user_data.read(str(Path(o.test).resolve()))[1]
         time_base.check_unit(o.test, test_raw, o.system, o.time_unit)
         test_tau = "tau" in test_raw
         if test_tau != (task == "inverse_dynamics"):

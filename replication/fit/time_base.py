@@ -45,7 +45,7 @@ def step(d: dict) -> float | None:
 @lru_cache(maxsize=16)
 def time_scale(system: str) -> float:
     """sqrt(rms(q - mean q) / rms(q̈)) in seconds over 256 of the system's own states."""
-    import systems
+    from lagbench import systems
 
     s = systems.get(system)
     st = s.sample_states(256, np.random.default_rng(0))

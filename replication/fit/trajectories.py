@@ -1,6 +1,6 @@
 """Trajectory input for `lagbench fit` / `evaluate`: derivatives estimated from sampled positions.
 
-A trajectory file (see `replication.fit.userdata`) holds rows of (traj, t, q[, qdot][, qddot][, tau]): one
+A trajectory file (see `lagbench.files.user_data`) holds rows of (traj, t, q[, qdot][, qddot][, tau]): one
 or more trajectories, each sampled on its own uniform time grid. `with_derivatives(d, window,
 polyorder)` returns the rows as state samples (q, qdot, qddot[, tau], traj, t), each trajectory sorted
 by time. What the file gives is used as is; what it lacks is estimated, trajectory by trajectory:

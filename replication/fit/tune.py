@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication import results as R
-from replication.tuning import search
+from lagbench.files import results as R
+from lagbench.replication.tuning import search
 
 
 def _score(record: dict) -> float | None:
@@ -25,7 +25,7 @@ def _score(record: dict) -> float | None:
 
 
 def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progress=None, **options):
-    from replication.fit.task import fit, resolved
+    from lagbench.replication.fit.task import fit, resolved
 
     o = resolved(data, options)[0]   # the model kind's defaults where not given
     if not o.heldout or o.split == "none":

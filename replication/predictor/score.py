@@ -10,7 +10,7 @@ one-step errors beside the null predictor's, rollouts with the suite's RK4, the 
 valid prediction time against the chaos floor (`replication.evaluation.valid_time`), and the seconds per
 state of one call. Its status is "failed" (its failure: "non-finite on k of n held-out states") where the
 function returns a non-finite q-double-dot on any held-out state; an exception it raises, or an output of the
-wrong type or shape, is one line (`replication.user_functions`), and so is a call that runs past
+wrong type or shape, is one line (`lagbench.files.user_functions`), and so is a call that runs past
 `call_limit` seconds. `on_call(done, total)` follows every call (`calls_of(setup)`: how many scoring makes).
 With `out`, the record is written to OUT/predict/<system>/<label>/ (result.json and the evaluation's tables). `lagbench evaluate --predict module:function --system NAME` runs it.
 """
@@ -23,13 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from replication import results as R
-from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
-from replication.evaluation.rollout import steps
-from replication.evaluation.routines import Context, _floor, _truth, heldout_of, system_of, truth_key
-from replication.run import environment as env
-from replication.run.splits import TEST
-from replication.user_functions import (
+from lagbench.files import results as R
+from lagbench.files.user_functions import (
     UserCodeError,
     array_of,
     call,
@@ -38,6 +33,11 @@ from replication.user_functions import (
     time_limit,
     wrong,
 )
+from lagbench.replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
+from lagbench.replication.evaluation.rollout import steps
+from lagbench.replication.evaluation.routines import Context, _floor, _truth, heldout_of, system_of, truth_key
+from lagbench.replication.run import environment as env
+from lagbench.replication.run.splits import TEST
 
 SCORED_BY = ("energy_rollout", "heldout")   # the evaluations a (q, qdot) -> qddot predictor can be put through
 
@@ -90,7 +90,7 @@ class Predictor:
 
 
 def _candidates(profile: str):
-    from replication.claims import CLAIMS
+    from lagbench.replication.claims import CLAIMS
 
     for c in CLAIMS.values():
         if c.evaluate not in SCORED_BY:

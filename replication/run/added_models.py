@@ -16,8 +16,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from models.spec import USER_KIND
-from replication.claims.base import ModelEntry
+from lagbench.models.spec import USER_KIND
+from lagbench.replication.claims.base import ModelEntry
 
 SCORES_QDDOT = ("heldout", "energy_rollout", "heldout_trajectories")   # evaluations a q-double-dot model fits
 NAME = re.compile(r"[A-Za-z][A-Za-z0-9-]{0,31}")
@@ -33,7 +33,7 @@ class Added:
 
 
 def parse(values, suite_labels=()) -> list[Added]:
-    from models.user import factory_source, framework_of, returns_of
+    from lagbench.models.user import factory_source, framework_of, returns_of
 
     out = []
     for v in values or ():
@@ -95,6 +95,6 @@ def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
 
 def framework(entry: ModelEntry) -> str:
     """The framework a user's entry runs in."""
-    from models.user import framework_of
+    from lagbench.models.user import framework_of
 
     return framework_of(entry.spec["factory"])

@@ -19,8 +19,8 @@ import gc
 import logging
 import sys
 
-from models.spec import USER_KIND
-from replication import results as R
+from lagbench.files import results as R
+from lagbench.models.spec import USER_KIND
 
 log = logging.getLogger("lagbench")
 TORCH_COST = 3.0   # PyTorch's eager LNN step against JAX's compiled one, per sample (measured, 3 x 64 and 3 x 128)
@@ -62,8 +62,8 @@ def release_if_crowded() -> bool:
 
 def run_one(unit, out, on_log=None):
     """(failure or None, error or None) of running one unit."""
-    from replication.run.units import run_unit
-    from replication.user_functions import UserCodeError
+    from lagbench.files.user_functions import UserCodeError
+    from lagbench.replication.run.units import run_unit
 
     try:
         d = run_unit(unit, out, on_log=on_log)
@@ -82,7 +82,7 @@ def run_one(unit, out, on_log=None):
 
 def chains(todo) -> list[list]:
     """The units grouped by the model they train (untrained units alone), longest chain first."""
-    from replication.training.train import group_key
+    from lagbench.replication.training.train import group_key
 
     groups: dict = {}
     for u in todo:   # a cohort's seeds (`Protocol.cohort`) train in one program: one chain
@@ -92,7 +92,7 @@ def chains(todo) -> list[list]:
 
 
 def cost(chain) -> float:
-    from replication.training.scouting import budget_samples
+    from lagbench.replication.training.scouting import budget_samples
 
     u = chain[0]
     if not u.entry.train:
@@ -109,8 +109,8 @@ def ref(u) -> tuple:
 
 
 def unit_of(r):
-    from replication.claims import get as get_claim
-    from replication.run.units import Unit
+    from lagbench.replication.claims import get as get_claim
+    from lagbench.replication.run.units import Unit
 
     claim_id, label, framework, seed, profile, user = r
     claim = get_claim(claim_id)

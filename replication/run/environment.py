@@ -1,7 +1,6 @@
 """What a result was computed with: package versions, hardware, commit, time."""
 from __future__ import annotations
 
-import datetime as _dt
 import importlib.metadata
 import os
 import platform
@@ -9,6 +8,8 @@ import subprocess
 from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
+
+from lagbench.files.clock import now  # noqa: F401  (the time results record)
 
 PACKAGES = ("numpy", "sympy", "jax", "jaxlib", "equinox", "optax", "diffrax", "torch", "pandas")
 ONE_CORE_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
@@ -148,5 +149,3 @@ def commit() -> str | None:
         return None
 
 
-def now() -> str:
-    return _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -28,15 +28,15 @@ from pathlib import Path
 
 import numpy as np
 
-from replication import results as R
-from replication.run import environment as env
-from replication.run.chains import chains
-from replication.run.environment import torch_threads as threads_of_torch
-from replication.training import compile_torch
-from replication.training import device as dev
-from replication.training.schedules import Constant
-from replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
-from replication.training.train import group_key, run_training, train_cohort, train_key
+from lagbench.files import results as R
+from lagbench.replication.run import environment as env
+from lagbench.replication.run.chains import chains
+from lagbench.replication.run.environment import torch_threads as threads_of_torch
+from lagbench.replication.training import compile_torch
+from lagbench.replication.training import device as dev
+from lagbench.replication.training.schedules import Constant
+from lagbench.replication.training.scouting import continuation_protocol, scout_parts, scout_protocol
+from lagbench.replication.training.train import group_key, run_training, train_cohort, train_key
 
 PROBE_STEPS = 8   # the first is discarded (compilation); the median of the other seven steps' times
 

@@ -28,14 +28,14 @@ from multiprocessing import get_context
 
 from tqdm.auto import tqdm
 
-from replication.results import DiskFull
-from replication.run.chains import TORCH_COST, chains, release_compiled  # noqa: F401 - TORCH_COST, release_compiled: re-exported
-from replication.run.chains import cost as _cost  # noqa: F401 - re-exported for the tests
-from replication.run.chains import ref as _ref
-from replication.run.chains import run_chain as _run_chain
-from replication.run.chains import run_one as _one
-from replication.run.environment import one_thread_children, worker_start
-from replication.training.scouting import progress_steps
+from lagbench.files.results import DiskFull
+from lagbench.replication.run.chains import TORCH_COST, chains, release_compiled  # noqa: F401 - TORCH_COST, release_compiled: re-exported
+from lagbench.replication.run.chains import cost as _cost  # noqa: F401 - re-exported for the tests
+from lagbench.replication.run.chains import ref as _ref
+from lagbench.replication.run.chains import run_chain as _run_chain
+from lagbench.replication.run.chains import run_one as _one
+from lagbench.replication.run.environment import one_thread_children, worker_start
+from lagbench.replication.training.scouting import progress_steps
 
 
 def _serial(todo, out, profile, progress):

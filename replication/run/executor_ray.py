@@ -30,8 +30,8 @@ import warnings
 
 from tqdm.auto import tqdm
 
-from replication.run.chains import chains, ref
-from replication.run.environment import commit, one_thread_env
+from lagbench.replication.run.chains import chains, ref
+from lagbench.replication.run.environment import commit, one_thread_env
 
 INSTALL = "pip install 'lagbench[ray]'"
 RETRIES = 2          # retries of a task whose worker died, before the unit is recorded as an error
@@ -70,7 +70,7 @@ def resources(unit, cluster_gpus: float, device: str = "auto") -> dict:
 @functools.cache
 def _remote(ray):
     """The Ray task and the progress board actor (defined here: Ray is an optional dependency)."""
-    from replication.run.ray_task import Board, run_unit_task
+    from lagbench.replication.run.ray_task import Board, run_unit_task
 
     return ray.remote(run_unit_task), ray.remote(num_cpus=0)(Board)
 
@@ -135,7 +135,7 @@ class _Bar:
 
 def _submit(ray, todo, out, retries, board):
     """Every unit's task, chain by chain -> {ObjectRef: (unit, the unit before it in its chain or None)}."""
-    from replication.run.unit_files import trained_entry
+    from lagbench.replication.run.unit_files import trained_entry
 
     task, _ = _remote(ray)
     gpus = ray.cluster_resources().get("GPU", 0)
@@ -160,8 +160,8 @@ def _started(ray, board) -> list:
 
 
 def run_units_ray(todo, out, profile, progress=True, address=None, retries=None):
-    from replication.results import CorruptResult
-    from replication.run.unit_files import write
+    from lagbench.files.results import CorruptResult
+    from lagbench.replication.run.unit_files import write
 
     retries = RETRIES if retries is None else retries
     ray = require_ray()

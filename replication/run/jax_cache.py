@@ -28,8 +28,8 @@ import platform
 import sys
 from pathlib import Path
 
-from replication.results import make_own_folder
-from replication.run.environment import cpu_description
+from lagbench.files.results import make_own_folder
+from lagbench.replication.run.environment import cpu_description
 
 log = logging.getLogger("lagbench")
 

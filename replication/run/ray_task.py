@@ -23,8 +23,8 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from replication.run import unit_files
-from replication.run.chains import run_one, unit_of
+from lagbench.replication.run import unit_files
+from lagbench.replication.run.chains import run_one, unit_of
 
 
 class Board:

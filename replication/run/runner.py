@@ -16,20 +16,20 @@ import logging
 import time
 from pathlib import Path
 
-from models.spec import USER_KIND
-from replication import results as R
-from replication.claims import CLAIMS, PROFILES
-from replication.claims import get as get_claim
-from replication.claims.base import FRAMEWORKS, run_frameworks
-from replication.claims.verdicts import write_summary
-from replication.evaluation.registry import EVALUATION_VERSION
-from replication.fit.userdata import content_only
-from replication.run import added_models, splits
-from replication.run import environment as env
-from replication.run.estimate import PROBES, describe, estimate
-from replication.run.executor import run_units
-from replication.run.units import Unit
-from replication.training import device as dev
+from lagbench.files import results as R
+from lagbench.files.user_data import content_only
+from lagbench.models.spec import USER_KIND
+from lagbench.replication.claims import CLAIMS, PROFILES
+from lagbench.replication.claims import get as get_claim
+from lagbench.replication.claims.base import FRAMEWORKS, run_frameworks
+from lagbench.replication.claims.verdicts import write_summary
+from lagbench.replication.evaluation.registry import EVALUATION_VERSION
+from lagbench.replication.run import added_models, splits
+from lagbench.replication.run import environment as env
+from lagbench.replication.run.estimate import PROBES, describe, estimate
+from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.units import Unit
+from lagbench.replication.training import device as dev
 
 log = logging.getLogger("lagbench")
 LONG_PROFILES = ("full", "paper")   # profiles that print their units and an estimated duration first
@@ -178,7 +178,7 @@ def executor_of(executor, jobs, address):
             raise ValueError("--address is for --executor ray; the local executor runs on this machine")
         return lambda todo, out, profile, progress: run_units(todo, out, profile, progress, jobs)
     if executor == "ray":
-        from replication.run.executor_ray import check_address, require_ray, run_units_ray
+        from lagbench.replication.run.executor_ray import check_address, require_ray, run_units_ray
 
         if jobs != 1:
             raise ValueError("--jobs is for the local executor; with --executor ray every unit is a task on "

@@ -2,7 +2,7 @@
 refactor changed no result (rows matched on claim, framework, model and seed; the timing columns, which
 differ from run to run, reported apart).
 
-`python -m replication.run.same_numbers A/summary/units.csv B/summary/units.csv` prints the rows and
+`python -m lagbench.replication.run.same_numbers A/summary/units.csv B/summary/units.csv` prints the rows and
 columns compared and the columns that differ; exit status 0 when only timing columns differ, 1 otherwise.
 """
 from __future__ import annotations
@@ -41,7 +41,7 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m replication.run.same_numbers",
+    p = argparse.ArgumentParser(prog="python -m lagbench.replication.run.same_numbers",
                                 description="Compare two runs' summary/units.csv column by column.")
     p.add_argument("a", help="the first run's summary/units.csv")
     p.add_argument("b", help="the second run's summary/units.csv")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from replication.training.data import HELDOUT_SEED
+from lagbench.replication.training.data import HELDOUT_SEED
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 from pathlib import Path, PurePosixPath
 
-from replication import results as R
+from lagbench.files import results as R
 
 
 def collect(root, skip=()) -> dict:
@@ -35,7 +35,7 @@ def collect(root, skip=()) -> dict:
 def trained_entry(out, unit) -> dict:
     if not unit.entry.train:
         return {}
-    from replication.training.train import train_key
+    from lagbench.replication.training.train import train_key
 
     rel = f"trained/{unit.framework}/{train_key(unit.framework, unit.spec(), unit.protocol(), unit.seed)}"
     folder = Path(out) / rel

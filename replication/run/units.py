@@ -13,21 +13,21 @@ from typing import Protocol
 
 import numpy as np
 
-from models import ModelSpec
-from models.spec import USER_KIND
-from replication import results as R
-from replication.evaluation.adapters import adapter
-from replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
-from replication.evaluation.routines import Context, heldout_of, system_of
-from replication.run import environment as env
-from replication.run import splits
-from replication.training import device as dev
-from replication.training import hessian_probe
-from replication.training.objective import predict
-from replication.training.outcome import log_frame
-from replication.training.scouting import budget_samples
-from replication.training.train import train_cached
-from replication.user_functions import nonfinite_failure, nonfinite_rows
+from lagbench.files import results as R
+from lagbench.files.user_functions import nonfinite_failure, nonfinite_rows
+from lagbench.models import ModelSpec
+from lagbench.models.spec import USER_KIND
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.evaluation.registry import EVALUATION_VERSION, EVALUATIONS
+from lagbench.replication.evaluation.routines import Context, heldout_of, system_of
+from lagbench.replication.run import environment as env
+from lagbench.replication.run import splits
+from lagbench.replication.training import device as dev
+from lagbench.replication.training import hessian_probe
+from lagbench.replication.training.objective import predict
+from lagbench.replication.training.outcome import log_frame
+from lagbench.replication.training.scouting import budget_samples
+from lagbench.replication.training.train import train_cached
 
 
 class UnitSource(Protocol):

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication.studies import control as C
+from lagbench.replication.studies import control as C
 
 SYSTEM = "four_joint_arm"
 MODELS = ("delan", "ff")   # names of `robustness.MODELS`: DeLaN and the feed-forward net of (q, qdot, qddot)
@@ -39,8 +39,8 @@ TRAIN_SEED = 2001          # a development draw: no claim reads the four-joint a
 
 def recording(folder, sizes=None) -> Path:
     """The training family's recording, FOLDER/data/train.npz (kept as is when its arrays are the same)."""
-    from replication.studies.robustness_scenes import Scene, write_recording
-    from systems.arm_data import arm_dataset
+    from lagbench.replication.studies.robustness_scenes import Scene, write_recording
+    from lagbench.systems.arm_data import arm_dataset
 
     z = {**SIZES, **(sizes or {})}
     d = arm_dataset("train", n_traj=z["n_train"], n_points=z["n_points"], seed=TRAIN_SEED,
@@ -54,7 +54,7 @@ def recording(folder, sizes=None) -> Path:
 def fitted_controllers(folder, framework: str = "jax", seeds=(0,), steps: int = STEPS, sizes=None,
                        progress=None) -> list:
     """(model, framework, seed, inverse) for each model of MODELS and seed, fitted into FOLDER/fits/seed<k>."""
-    from replication.studies.robustness import fit_model
+    from lagbench.replication.studies.robustness import fit_model
 
     data, out = recording(folder, sizes), []
     for seed in seeds:
@@ -77,7 +77,7 @@ def study(folder, framework: str = "jax", seeds=(0,), steps: int = STEPS, n_refs
 def settings(framework: str = "jax", seeds=(0,), steps: int = STEPS, n_refs: int = C.N_REFS,
              duration: float = C.DURATION, sizes=None) -> dict:
     """What the study ran with (FOLDER/study.json)."""
-    from replication.studies.robustness import budget
+    from lagbench.replication.studies.robustness import budget
 
     kp, kd = C.gains(4)
     return {"system": SYSTEM, "framework": framework, "seeds": [int(s) for s in seeds], "steps": int(steps),
@@ -89,7 +89,7 @@ def settings(framework: str = "jax", seeds=(0,), steps: int = STEPS, n_refs: int
 
 def write_study(folder, framework: str = "jax", seeds=(0,), steps: int = STEPS, n_refs: int = C.N_REFS,
                 duration: float = C.DURATION, sizes=None, progress=None) -> pd.DataFrame:
-    from replication import results as R
+    from lagbench.files import results as R
 
     folder = Path(folder)
     df, traces = study(folder, framework, seeds, steps, n_refs, duration, sizes, progress)

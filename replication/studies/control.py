@@ -56,7 +56,7 @@ FAMILIES = ("test", "train_x2")
 def references(family: str, n: int = N_REFS, duration: float = DURATION, rate: float = RATE, seed: int = SEED,
                system: str = SYSTEM):
     """q_d, qdot_d, qddot_d (n, T, dof) of arm `system` at the control ticks, and t (T,)."""
-    from systems.arm_data import arm_dataset
+    from lagbench.systems.arm_data import arm_dataset
 
     fast = family == "train_x2"
     k = 2.0 if fast else 1.0
@@ -97,7 +97,7 @@ def period(plant, h: float, substeps: int = SUBSTEPS, periods: int = COMPILE_FRO
     faster than NumPy's 16 calls; the states agree to rounding, `tests/replication/studies/test_control.py`),
     kept per plant by its repr, which names what it simulates; any other plant and short tracks run `hold`
     in NumPy."""
-    from systems.system import System
+    from lagbench.systems.system import System
 
     if not (isinstance(plant, System) or getattr(plant, "traceable", False)) or periods < COMPILE_FROM:
         return lambda q, v, tau: hold(plant, q, v, tau, h, substeps)
@@ -131,7 +131,7 @@ def track(inverse, refs: dict, rate: float = RATE, substeps: int = SUBSTEPS, kp=
     """Simulate the closed loop for every reference at once. `inverse(q, qdot, qddot) -> tau` on (B, dof)
     float64 arrays, or None for PD alone; `plant` anything with `.acceleration(q, qdot, tau=)` (default the
     SymPy arm `system`); kp, kd default `gains(dof)`. Returns q, tau (B, T, dof) and a diverged mask (B,)."""
-    import systems
+    from lagbench import systems
 
     plant = plant or systems.get(system)
     qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
@@ -175,7 +175,7 @@ def _learned(results) -> list:
     """(model, framework, seed, Fitted) for every usable full-data claim-9 unit in the results folder."""
     from pathlib import Path
 
-    from replication.fit.load import load_fitted
+    from lagbench.replication.fit.load import load_fitted
 
     out = []
     for model in MODELS:
@@ -190,7 +190,7 @@ def _learned(results) -> list:
 
 def references_controllers(system: str = SYSTEM) -> list:
     """(name, framework, seed, inverse) of the true inverse dynamics of arm `system` and PD alone."""
-    import systems
+    from lagbench import systems
 
     plant = systems.get(system)
     return [("exact", "numpy", "-", lambda q, v, a: plant.inverse_dynamics(q, v, a)), ("pd", "numpy", "-", None)]
@@ -230,7 +230,7 @@ def tracking_table(controllers, families=FAMILIES, n_refs: int = N_REFS, duratio
 def write_study(results, folder, **kw) -> pd.DataFrame:
     from pathlib import Path
 
-    from replication import results as R
+    from lagbench.files import results as R
 
     folder = Path(folder)
     df, traces = control_study(results, **kw)

@@ -14,8 +14,8 @@ TWO_LINK = "two_link_arm"
 
 
 def _fit_options(args) -> dict:
-    from replication.studies import arm4_control as A
-    from replication.studies.robustness_cli import _seeds, _steps
+    from lagbench.replication.studies import arm4_control as A
+    from lagbench.replication.studies.robustness_cli import _seeds, _steps
 
     framework = args.framework or "jax"
     if framework not in FRAMEWORKS:
@@ -24,7 +24,7 @@ def _fit_options(args) -> dict:
 
 
 def _check(args) -> dict:
-    from systems.arm_data import ARMS
+    from lagbench.systems.arm_data import ARMS
 
     if args.system not in ARMS:
         raise ValueError(f"--system {args.system}: expected one of {', '.join(ARMS)}")
@@ -47,7 +47,7 @@ def _check(args) -> dict:
 def cmd_control(args):
     from tqdm.auto import tqdm
 
-    from replication.results import output_folder
+    from lagbench.files.results import output_folder
 
     fit = _check(args)
     results, two_link = Path(args.results), args.system == TWO_LINK
@@ -55,12 +55,12 @@ def cmd_control(args):
     bar = tqdm(desc="lagbench control", unit="controller", disable=args.quiet)
     try:
         if two_link:
-            from replication.studies.control import write_study
+            from lagbench.replication.studies.control import write_study
 
             df = write_study(results, folder, n_refs=args.references, duration=args.duration,
                              progress=lambda _: bar.update())
         else:
-            from replication.studies.arm4_control import write_study
+            from lagbench.replication.studies.arm4_control import write_study
 
             df = write_study(folder, n_refs=args.references, duration=args.duration,
                              progress=lambda what: (bar.set_postfix_str(what), bar.update()), **fit)

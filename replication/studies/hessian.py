@@ -1,6 +1,6 @@
 """Where the paper's formulation and the fast one part ways: a freshly initialised LNN's velocity Hessians.
 
-`python -m replication.studies.hessian [N]` (or `hessian_study(n, hidden, seed)` -> DataFrame): for N
+`python -m lagbench.replication.studies.hessian [N]` (or `hessian_study(n, hidden, seed)` -> DataFrame): for N
 double-pendulum training states and a fresh 3x600 LNN (the empirical init) with softplus and with ReLU,
 in float32 and float64, one row each: the indefinite and singular fractions of d2L/dqdot2 (singular: the
 smallest |eigenvalue| at or below pinv's relative cutoff), the fast solve's fallbacks, the relative
@@ -14,15 +14,15 @@ import sys
 import numpy as np
 import pandas as pd
 
-import systems
-from models import ModelSpec, init_params
-from models.numerics import pinv_rtol
+from lagbench import systems
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.numerics import pinv_rtol
 
 
 def hessian_study(n: int = 2000, hidden=(600, 600, 600), seed: int = 0) -> pd.DataFrame:
     import jax.numpy as jnp
 
-    import models.jax
+    import lagbench.models.jax
 
     st = systems.get("double_pendulum").sample_states(n, np.random.default_rng(seed))
     rows = []
@@ -33,7 +33,7 @@ def hessian_study(n: int = 2000, hidden=(600, 600, 600), seed: int = 0) -> pd.Da
             for form in ("fast", "paper"):
                 spec = ModelSpec(kind="lnn", dof=2, hidden=tuple(hidden), dtype=dt, angle_wrap=True,
                                  formulation=form, activation=act)
-                m = models.jax.build(spec, init_params(spec, seed=seed))
+                m = lagbench.models.jax.build(spec, init_params(spec, seed=seed))
                 qdd, n_fb = m.acceleration_info(q, qd)
                 out[form] = (np.asarray(qdd, np.float64), int(n_fb))
             eig = np.linalg.eigvalsh(np.asarray(m.velocity_hessian(q, qd), np.float64))

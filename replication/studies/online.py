@@ -48,7 +48,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from replication.studies import control as C
+from lagbench.replication.studies import control as C
 
 WINDOW = 0.5        # seconds of simulated time per curve point
 EVERY, STEPS, BATCH, BUFFER = 1, 1, 64, 5000   # learn at every tick, one step of 64; 10 s of samples
@@ -76,8 +76,8 @@ def sequence(family: str, seconds: float, rate: float = C.RATE, seed: int = C.SE
 def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: int = BATCH, buffer: int = BUFFER,
                window: float = WINDOW, seed: int = 0, seconds: float | None = None, rate: float = C.RATE,
                substeps: int = C.SUBSTEPS, kp=None, kd=None, progress=None, system: str = C.SYSTEM):
-    import systems
-    from replication.studies.online_learner import ReplayBuffer
+    from lagbench import systems
+    from lagbench.replication.studies.online_learner import ReplayBuffer
 
     plant = systems.get(system)
     qd, vd, ad = refs["q"], refs["qdot"], refs["qddot"]
@@ -137,7 +137,7 @@ def run_online(ctrl, refs: dict, every: int = EVERY, steps: int = STEPS, batch: 
 
 
 def unseen(ctrl, n_unseen: int, duration: float, seed: int = C.SEED, system: str = C.SYSTEM) -> dict:
-    import systems
+    from lagbench import systems
 
     refs = C.references("test", n=n_unseen, duration=duration, seed=seed, system=system)
     if ctrl is None or isinstance(ctrl, str):
@@ -206,9 +206,9 @@ def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,)
                  unseen_duration: float = C.DURATION, progress=None, system: str = C.SYSTEM) -> tuple[pd.DataFrame, pd.DataFrame]:
     """See the module docstring. `refs`: the references to learn on (default `sequence("train", seconds)`);
     `hidden`, `lr`: the models' widths and learning rate (default claim 9's); n_unseen 0: no unseen score."""
-    import systems
-    from replication.run.environment import torch_threads
-    from replication.studies import online_learner as OL
+    from lagbench import systems
+    from lagbench.replication.run.environment import torch_threads
+    from lagbench.replication.studies import online_learner as OL
 
     refs = sequence("train", seconds, system=system) if refs is None else refs
     dof = systems.get(system).dof
@@ -244,8 +244,8 @@ def one_thread() -> dict:
     one thread by `online_study` itself."""
     import os
 
-    from models.jax.compiled import _backend_started, async_dispatch, use_sync_dispatch
-    from replication.run.environment import ONE_CORE_XLA
+    from lagbench.models.jax.compiled import _backend_started, async_dispatch, use_sync_dispatch
+    from lagbench.replication.run.environment import ONE_CORE_XLA
 
     if not _backend_started() and ONE_CORE_XLA not in os.environ.get("XLA_FLAGS", ""):
         os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip()
@@ -257,9 +257,9 @@ def one_thread() -> dict:
 def write_study(folder, settings: dict | None = None, **kw) -> tuple[pd.DataFrame, pd.DataFrame]:
     from pathlib import Path
 
-    import systems
-    from replication import results as R
-    from replication.run import environment
+    from lagbench import systems
+    from lagbench.files import results as R
+    from lagbench.replication.run import environment
 
     folder = Path(folder)
     curves, summary = online_study(**kw)

@@ -34,9 +34,9 @@ def _number(option: str, value: float, low: float, high: float = float("inf"), s
 
 
 def _check(args) -> dict:
-    from replication.studies import control as C
-    from replication.studies.online_learner import KINDS
-    from systems.arm_data import ARMS
+    from lagbench.replication.studies import control as C
+    from lagbench.replication.studies.online_learner import KINDS
+    from lagbench.systems.arm_data import ARMS
 
     if args.system not in ARMS:
         raise ValueError(f"--system {args.system}: expected one of {', '.join(ARMS)}")
@@ -62,8 +62,8 @@ def cmd_online(args):
 
     from tqdm.auto import tqdm
 
-    from replication.results import output_folder
-    from replication.studies import online as O
+    from lagbench.files.results import output_folder
+    from lagbench.replication.studies import online as O
 
     kw = _check(args)
     folder = output_folder(Path(args.out) / ("online" if "system" not in kw else f"online_{kw['system']}"), "--out")
@@ -87,7 +87,7 @@ def cmd_online(args):
 
 
 def add_command(sub) -> None:
-    from replication.studies import online as O
+    from lagbench.replication.studies import online as O
 
     s = sub.add_parser("online", help="DeLaN and the feed-forward net learning online while they track the two-link "
                                       "arm (writes OUT/online/) or the four-joint arm (OUT/online_four_joint_arm/)",

@@ -58,8 +58,8 @@ class ReplayBuffer:
 def claim_model(kind: str, hidden=HIDDEN, dof: int = 2):
     """(ModelSpec, Protocol) of claim 9's model `kind` for an arm of `dof` joints (claim 9's own: 2): its spec
     fields at `hidden` and its quick protocol (loss, L2, Adam, learning rate)."""
-    from models import ModelSpec
-    from replication.claims.delan_arm import CLAIM, PROTOCOLS
+    from lagbench.models import ModelSpec
+    from lagbench.replication.claims.delan_arm import CLAIM, PROTOCOLS
 
     if kind not in KINDS:
         raise ValueError(f"model {kind!r}: valid {', '.join(KINDS)}")
@@ -80,8 +80,8 @@ class JaxLearner(_Learner):
     framework = "jax"
 
     def __init__(self, spec, params, protocol, lr: float):
-        from models.jax.compiled import compile_single
-        from replication.training.train_jax import Stepper
+        from lagbench.models.jax.compiled import compile_single
+        from lagbench.replication.training.train_jax import Stepper
 
         self.spec, self.lr = spec, lr
         self.stepper = Stepper(spec, params, protocol)
@@ -115,8 +115,8 @@ class TorchLearner(_Learner):
     def __init__(self, spec, params, protocol, lr: float):
         import torch
 
-        from replication.training.compile_torch import setting_as
-        from replication.training.train_torch import Stepper
+        from lagbench.replication.training.compile_torch import setting_as
+        from lagbench.replication.training.train_torch import Stepper
 
         self.torch, self.spec, self.lr = torch, spec, lr
         with setting_as("off"):
@@ -145,7 +145,7 @@ class TorchLearner(_Learner):
 def learner(kind: str, framework: str, seed: int, hidden=HIDDEN, lr: float | None = None, dof: int = 2):
     """A fresh learner of claim 9's model `kind` in `framework` ("jax" or "torch") for `dof` joints, initialised
     from `seed`."""
-    from models import init_params
+    from lagbench.models import init_params
 
     spec, protocol = claim_model(kind, hidden, dof)
     lr = protocol.schedule.lr if lr is None else float(lr)

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from replication.studies.robustness_scenes import SCENES, UNITS, Plant, scene_data, write_recording
+from lagbench.replication.studies.robustness_scenes import SCENES, UNITS, Plant, scene_data, write_recording
 
 MODELS = {"delan": {"model": "delan"}, "delan_dissipation": {"model": "delan", "dissipation": True},
           "ff": {"model": "baseline"}}
@@ -63,7 +63,7 @@ def score(inverse, test: dict, refs: dict, plant) -> dict:
     """torque_nmse on the test set and the tracking scores; `inverse` None is the null (zero torque)."""
     q, v, a, tau = (test[k].reshape(-1, test[k].shape[-1]) for k in ("q", "qdot", "qddot", "tau"))
     pred = np.zeros_like(tau) if inverse is None else np.asarray(inverse(q, v, a), np.float64)
-    from replication.studies.control import scores, track
+    from lagbench.replication.studies.control import scores, track
 
     tracked = scores(track(inverse, refs, plant=plant), refs)
     return {"torque_nmse": float(np.mean((pred - tau) ** 2) / np.mean(tau ** 2)),
@@ -72,9 +72,9 @@ def score(inverse, test: dict, refs: dict, plant) -> dict:
 
 def fit_model(name: str, data, folder, framework: str, seed: int, steps: int):
     """Fit model `name` of MODELS to the recording `data` into `folder`; the loaded `Fitted`."""
-    from replication import results as R
-    from replication.fit.load import load_fitted
-    from replication.fit.task import fit
+    from lagbench.files import results as R
+    from lagbench.replication.fit.load import load_fitted
+    from lagbench.replication.fit.task import fit
 
     fit(str(data), out=str(folder), framework=framework, seed=int(seed), **budget(steps), **MODELS[name])
     return load_fitted(R.unit_dir(folder, "fit", framework, UNIT_LABEL[name], seed))
@@ -109,7 +109,7 @@ def study(out, framework: str = "jax", seeds=(0,), steps: int = STEPS, scenes=No
 
 def scene_rows(scene, out: Path, framework: str, seeds, steps: int, z: dict, progress=None) -> list[dict]:
     """One scene's rows: the null and the exact model, then every model of MODELS fitted for every seed."""
-    from replication.studies.control import references
+    from lagbench.replication.studies.control import references
 
     refs = references("test", z["n_refs"], z["ref_duration"])
     plant, rows = Plant(scene), []
@@ -142,7 +142,7 @@ def _in_workers(args, jobs: int):
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
-    from replication.run.environment import one_thread_children, worker_start
+    from lagbench.replication.run.environment import one_thread_children, worker_start
 
     with one_thread_children(), ProcessPoolExecutor(min(jobs, len(args)), mp_context=get_context("spawn"),
                                                     initializer=worker_start, initargs=(os.getpid(),)) as pool:
@@ -187,9 +187,9 @@ def recommend(df: pd.DataFrame) -> pd.DataFrame:
 def write_study(out, **kw) -> tuple[pd.DataFrame, pd.DataFrame]:
     """study(), then OUT/scenes.csv, OUT/recommendation.csv, OUT/summary.md, OUT/advantage.png and
     OUT/study.json (the framework, seeds, steps, fit options, sizes and data seeds it ran with)."""
-    from replication import results as R
-    from replication.studies.robustness_figure import advantage_figure
-    from replication.studies.robustness_summary import summary_markdown
+    from lagbench.files import results as R
+    from lagbench.replication.studies.robustness_figure import advantage_figure
+    from lagbench.replication.studies.robustness_summary import summary_markdown
 
     out = Path(out)
     df = study(out, **kw)

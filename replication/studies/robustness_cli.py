@@ -31,8 +31,8 @@ def _jobs(text: str) -> int:
 def cmd_robustness(args):
     from tqdm.auto import tqdm
 
-    from replication.results import output_folder
-    from replication.studies import robustness as R
+    from lagbench.files.results import output_folder
+    from lagbench.replication.studies import robustness as R
 
     steps, seeds, jobs = _steps(args.steps), _seeds(args.seeds), _jobs(args.jobs)
     if args.framework not in FRAMEWORKS:

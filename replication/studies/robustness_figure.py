@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from replication.results import atomic_write_bytes
-from replication.studies.robustness_scenes import KINDS, UNITS
+from lagbench.files.results import atomic_write_bytes
+from lagbench.replication.studies.robustness_scenes import KINDS, UNITS
 
 VARIANTS = {"delan": ("DeLaN / ff", "-", "o"), "delan_dissipation": ("DeLaN + dissipation / ff", "--", "s")}
 ROWS = (("torque_ratio_to_ff", "torque nMSE ratio"), ("track_ratio_to_ff", "tracking MSE ratio"))

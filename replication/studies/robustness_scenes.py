@@ -80,7 +80,7 @@ class Plant:
     """The scene's arm: the SymPy two-link arm with its viscous friction, and the Coulomb friction on top."""
 
     def __init__(self, scene: Scene):
-        import systems
+        from lagbench import systems
 
         self.scene = scene
         self.arm = systems.get("two_link_arm", friction=scene.friction)
@@ -106,7 +106,7 @@ class Plant:
 
 def scene_data(scene: Scene, family: str, n_traj: int, n_points: int, seed: int, noise_seed: int = 0,
                duration: float = 4.0) -> dict:
-    from systems.arm_data import arm_dataset
+    from lagbench.systems.arm_data import arm_dataset
 
     d = arm_dataset(family, n_traj=n_traj, n_points=n_points, seed=seed, duration=duration, cache=False,
                     friction=scene.friction)
@@ -119,7 +119,7 @@ def scene_data(scene: Scene, family: str, n_traj: int, n_points: int, seed: int,
 
 
 def write_recording(d: dict, path, scene: Scene) -> None:
-    from replication import results as R
+    from lagbench.files import results as R
 
     b, n_t, dof = d["q"].shape
     rows = {"traj": np.repeat(np.arange(b), n_t), "t": np.tile(d["t"], b), "q": d["q_rec"].reshape(-1, dof),

@@ -16,9 +16,9 @@ import time
 import numpy as np
 import pandas as pd
 
-import systems
-from systems.stiffness import pick_solver
-from systems.trajectories import integrate
+from lagbench import systems
+from lagbench.systems.stiffness import pick_solver
+from lagbench.systems.trajectories import integrate
 
 QUICK = [("tsit5", 1e-6), ("tsit5", 1e-10), ("dopri5", 1e-6), ("dopri5", 1e-10), ("dopri8", 1e-6),
          ("dopri8", 1e-8), ("dopri8", 1e-10), ("kvaerno5", 1e-6), ("kvaerno5", 1e-8), ("kvaerno5", 1e-10)]
@@ -78,7 +78,7 @@ def stiff_study(system: str = "stiff_chain", n_ics: int = 4, t_end: float = 10.0
 
 
 def write_study(folder, system: str = "stiff_chain") -> pd.DataFrame:
-    from replication.results import write_csv, write_json
+    from lagbench.files.results import write_csv, write_json
 
     df = stiff_study(system=system)
     write_csv(folder / "solvers.csv", df)

@@ -8,7 +8,7 @@ context in which every phase compiles as a phase of `protocol` would; `setting_a
 setting is `value` (the speed study's members stage times PyTorch both ways).
 
 When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
-  auto (default): where the model's loss is plain tensor ops and compiling pays (`models.torch.compiles`:
+  auto (default): where the model's loss is plain tensor ops and compiling pays (`lagbench.models.torch.compiles`:
         the fast LNN; not the feed-forward baseline, whose step is its matrix products) and the phase trains
         at least COMPILE_MIN_SAMPLES samples (steps x batch x members), so that the capture (about 26 s for
         the double pendulum's 3 x 128 LNN on a cold cache, 12 s warm) is paid back: the double pendulum's
@@ -16,7 +16,7 @@ When (`LAGBENCH_TORCH_COMPILE`, read for each training phase):
         relativistic scouts (200 steps) or the tests;
   on:   wherever the kind allows, however short (the tests);
   off:  never.
-The whole loss is captured (fullgraph): in the models, `models.torch.export_paths.compiling` picks the
+The whole loss is captured (fullgraph): in the models, `lagbench.models.torch.export_paths.compiling` picks the
 branch-free fallback solve and the plain softplus. Gradients are autograd's of the same maths, so a compiled
 phase's numbers equal the eager ones up to rounding (`tests/replication/training/test_compile_torch.py`).
 A capture or build that fails (no C++ compiler, an op dynamo cannot take) is logged, and the phase goes on
@@ -27,7 +27,7 @@ Measured, `full`'s double-pendulum LNN (3 x 128, softplus), one thread, interlea
 8.6 ms); 16 stacked scouts at batch 32 17-20 ms against 28 ms.
 
 Where: inductor's cache of generated C++ and its shared objects is `$LAGBENCH_CACHE/torchinductor`
-(`models.torch.inductor_cache`), so that workers and later runs reuse a capture; where that folder is not
+(`lagbench.models.torch.inductor_cache`), so that workers and later runs reuse a capture; where that folder is not
 this user's own, nothing is compiled.
 """
 from __future__ import annotations
@@ -38,8 +38,8 @@ import os
 
 import torch
 
-import models.torch
-from models.torch import inductor_cache
+import lagbench.models.torch
+from lagbench.models.torch import inductor_cache
 
 log = logging.getLogger("lagbench")
 
@@ -83,7 +83,7 @@ def _valid(value: str) -> str:
 def wanted(spec, protocol, members: int = 1) -> bool:
     """Whether the loss of this phase (`members` models side by side) should run under torch.compile."""
     how = setting()
-    if how == "off" or not models.torch.compiles(spec):
+    if how == "off" or not lagbench.models.torch.compiles(spec):
         return False
     return how == "on" or protocol.steps * protocol.batch * members >= COMPILE_MIN_SAMPLES
 

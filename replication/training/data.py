@@ -17,8 +17,8 @@ from functools import lru_cache
 
 import numpy as np
 
-import systems
-from systems.arm_data import ARMS  # arm recipes by name
+from lagbench import systems
+from lagbench.systems.arm_data import ARMS  # arm recipes by name
 
 HELDOUT_SEED = 1_000_000_000  # the original code's PRNGKey(int(1e9)) test set, by analogy
 
@@ -110,7 +110,7 @@ def recipe_iid(protocol, n, rng, held=None):
 def recipe_arm(protocol, n, rng, kind="train"):
     """An arm's inverse dynamics along smooth trajectories (the recipe names the arm: `two_link_arm`, or
     `four_joint_arm`): inputs q, qdot, extra=qddot, target tau, each (n, dof)."""
-    from systems.datasets import arm_dataset
+    from lagbench.systems.datasets import arm_dataset
 
     n_traj = arm_trajectories(n)
     arm = next(a for a in ARMS if protocol.data.recipe.startswith(a))
@@ -125,8 +125,8 @@ RECIPES = {"iid": recipe_iid, "arm": recipe_arm}
 
 
 def recipe_file(protocol, n, rng, kind="train"):
-    """A user's data file (see `replication.fit.userdata`): the train or held-out rows, as a batch dict."""
-    from replication.fit.userdata import split_rows
+    """A user's data file (see `lagbench.files.user_data`): the train or held-out rows, as a batch dict."""
+    from lagbench.files.user_data import split_rows
 
     return split_rows(protocol.data.recipe.removeprefix("file:"), protocol.task, kind)
 

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.numerics import pinv_rtol
-from models.spec import CAPABILITIES
+from lagbench.models.numerics import pinv_rtol
+from lagbench.models.spec import CAPABILITIES
 
 KINDS = tuple(k for k, c in CAPABILITIES.items() if c.lagrangian_hessian)
 COLUMNS = ("hessian_fallbacks", "hessian_indefinite_fraction", "hessian_singular_fraction", "qddot_max_abs")

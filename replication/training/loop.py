@@ -36,9 +36,9 @@ import time
 
 import numpy as np
 
-from replication.training.loop_state import StatefulHook, TrainState, fits
-from replication.training.outcome import TrainOutcome, nonfinite_failure
-from replication.training.schedules import learning_rate
+from lagbench.replication.training.loop_state import StatefulHook, TrainState, fits
+from lagbench.replication.training.outcome import TrainOutcome, nonfinite_failure
+from lagbench.replication.training.schedules import learning_rate
 
 log = logging.getLogger("lagbench")
 

@@ -19,7 +19,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from replication.training.spike_guard import SpikeGuard
+from lagbench.replication.training.spike_guard import SpikeGuard
 
 
 class MemberStepper(Protocol):

@@ -22,7 +22,7 @@ import json
 import math
 from dataclasses import dataclass
 
-from replication.training.protocol_parts import (
+from lagbench.replication.training.protocol_parts import (
     COORDS,
     Adam,
     Data,
@@ -33,7 +33,13 @@ from replication.training.protocol_parts import (
     integer,
     real,
 )
-from replication.training.schedules import SCHEDULES, OneCycle, Schedule, schedule_from_dict, schedule_to_dict
+from lagbench.replication.training.schedules import (
+    SCHEDULES,
+    OneCycle,
+    Schedule,
+    schedule_from_dict,
+    schedule_to_dict,
+)
 
 __all__ = ["LOSSES", "DTYPES", "TASKS", "COORDS", "KEY_VERSION", "Protocol", "Data", "Adam", "Guard", "Scouting",
            "Tracking", "canonical_hash"]
@@ -136,7 +142,7 @@ class Protocol:
 
     @classmethod
     def from_dict(cls, d: dict) -> Protocol:
-        from replication.training.protocol_versions import upgraded
+        from lagbench.replication.training.protocol_versions import upgraded
         d = upgraded(dict(d), KEY_VERSION)
         d.pop("version", None)
         d["data"] = Data(**d["data"])

@@ -12,7 +12,7 @@ import math
 import numbers
 from dataclasses import dataclass
 
-from replication.training.schedules import SCHEDULES, Schedule
+from lagbench.replication.training.schedules import SCHEDULES, Schedule
 
 COORDS = ("qqdot", "qp")
 

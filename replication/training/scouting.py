@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from replication.training.loop_state import narrow
-from replication.training.outcome import joined_modes
+from lagbench.replication.training.loop_state import narrow
+from lagbench.replication.training.outcome import joined_modes
 
 TAIL = 0.05               # the share of a scout's last steps whose mean training loss chooses
 CONTINUATION_STREAM = 1000  # the chosen init seed + this: the continuation's batch stream
@@ -158,8 +158,10 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
     keep their outcome at the cut and the tail inf (they are never chosen); `record` (a dict) gets
     {cut_step, cut_tail_loss, kept}. The callers' `hooks` see both parts; their state is not carried
     across the cut."""
-    from models import init_params  # here, not at import: claims read scout_protocol without
-    from replication.training.data import BatchStream  # the models or the data (reports import the claims)
+    from lagbench.models import init_params  # here, not at import: claims read scout_protocol without
+    from lagbench.replication.training.data import (
+        BatchStream,  # the models or the data (reports import the claims)
+    )
 
     p, half = scout_protocol(protocol), cut_step(protocol)
     keep = _Losses()
@@ -201,7 +203,7 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     offset_seconds)` may give a held-out tracking hook for the continuation (`training.tracker_for`): the
     scouts' samples and step time count. `snapshot` (`snapshots.Snapshots`): each phase snapshots under
     its own name ("scouts", "continuation"), so that a run killed in its continuation does not scout again."""
-    from replication.training.data import BatchStream
+    from lagbench.replication.training.data import BatchStream
 
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
     done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps

@@ -31,7 +31,7 @@ import logging
 import time
 from pathlib import Path
 
-from replication import results as R
+from lagbench.files import results as R
 
 log = logging.getLogger("lagbench")
 

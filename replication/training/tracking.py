@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.evaluation.adapters import adapter
-from replication.training import data as datamod
-from replication.training.objective import loss_value, predict
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training.objective import loss_value, predict
 
 TRACK_STATES = 2000
 

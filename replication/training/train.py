@@ -14,22 +14,22 @@ from pathlib import Path
 
 import pandas as pd
 
-from models import init_params
-from replication import results as R
-from replication.training import device as dev
-from replication.training.data import BatchStream, targets_version
-from replication.training.outcome import TrainOutcome, log_frame
-from replication.training.protocol import canonical_hash
-from replication.training.scouting import train_scouted
-from replication.training.snapshots import Snapshots
-from replication.training.tracking import Tracker
+from lagbench.files import results as R
+from lagbench.models import init_params
+from lagbench.replication.training import device as dev
+from lagbench.replication.training.data import BatchStream, targets_version
+from lagbench.replication.training.outcome import TrainOutcome, log_frame
+from lagbench.replication.training.protocol import canonical_hash
+from lagbench.replication.training.scouting import train_scouted
+from lagbench.replication.training.snapshots import Snapshots
+from lagbench.replication.training.tracking import Tracker
 
 log = logging.getLogger("lagbench")
 
 
 def train_key(framework, spec, protocol, seed) -> str:
     """The training's cache key: framework, spec, protocol (a user file by its content, not its path) and seed."""
-    from replication.fit.userdata import content_only
+    from lagbench.files.user_data import content_only
 
     key = {"fw": framework, "spec": spec.to_dict(), "protocol": content_only(protocol.to_dict()), "seed": seed}
     targets = targets_version(protocol)
@@ -41,9 +41,9 @@ def train_key(framework, spec, protocol, seed) -> str:
 def trainer(framework):
     """The framework's training module (`train_jax` or `train_torch`: `train`, `train_members`)."""
     if framework == "jax":
-        from replication.training import train_jax as module
+        from lagbench.replication.training import train_jax as module
     elif framework == "torch":
-        from replication.training import train_torch as module
+        from lagbench.replication.training import train_torch as module
     else:
         raise ValueError(f"unknown framework {framework!r}; valid: jax, torch")
     return module

@@ -22,10 +22,10 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-import models.jax
-from replication.training import hessian_probe, loop
-from replication.training.objective import loss_value, predict
-from replication.training.outcome import TrainOutcome
+import lagbench.models.jax
+from lagbench.replication.training import hessian_probe, loop
+from lagbench.replication.training.objective import loss_value, predict
+from lagbench.replication.training.outcome import TrainOutcome
 
 
 def _to_jax(batch: dict, dtype) -> dict:
@@ -121,7 +121,7 @@ def _load_state_arrays(stepper, arrays) -> None:
 class Stepper:
     def __init__(self, spec, params, protocol, step=None):
         self.dtype = jnp.dtype(protocol.dtype)
-        self.model = models.jax.build(spec, params)
+        self.model = lagbench.models.jax.build(spec, params)
         self.opt, self.step = step or make_step(spec, protocol)
         self.look = make_probe(spec, protocol)
         self.opt_state = self.opt.init(eqx.filter(self.model, eqx.is_inexact_array))
@@ -144,7 +144,7 @@ class Stepper:
         return None if self.look is None else self.look(self.model, self._batch)
 
     def params(self) -> dict:
-        return models.jax.to_params(self.model)
+        return lagbench.models.jax.to_params(self.model)
 
     def state_arrays(self) -> list[np.ndarray]:
         return _state_arrays(self)
@@ -171,7 +171,7 @@ def make_members_step(spec, protocol):
 class Members:
     def __init__(self, spec, params_list, protocol, step=None):
         self.dtype = jnp.dtype(protocol.dtype)
-        built = [models.jax.build(spec, p) for p in params_list]
+        built = [lagbench.models.jax.build(spec, p) for p in params_list]
         self.static = eqx.filter(built[0], eqx.is_array, inverse=True)
         self.model = eqx.combine(_stack([eqx.filter(m, eqx.is_array) for m in built]), self.static)
         self.opt, self.step = step or make_members_step(spec, protocol)
@@ -203,7 +203,7 @@ class Members:
                 for i in range(self.n)]
 
     def params(self) -> list[dict]:
-        return [models.jax.to_params(self.member(i)) for i in range(self.n)]
+        return [lagbench.models.jax.to_params(self.member(i)) for i in range(self.n)]
 
     def state_arrays(self) -> list[np.ndarray]:
         return _state_arrays(self)

@@ -9,8 +9,8 @@ Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol)`: K models of one spec trained as one program (the stepper of
 `replication.training.loop.train_members`). Where the model's maths takes stacked members
-(`models.torch.stacks(spec)`: the fast LNN, the feed-forward baseline) they are one model whose parameters
-have a leading K axis (`models.torch.build_stacked`): every product is one batched product over the members
+(`lagbench.models.torch.stacks(spec)`: the fast LNN, the feed-forward baseline) they are one model whose parameters
+have a leading K axis (`lagbench.models.torch.build_stacked`): every product is one batched product over the members
 and the K losses come out per member (`loss_value(..., axis=-1)`). Other kinds stack with
 `torch.func.stack_module_state` and map `torch.func.functional_call` under `torch.func.vmap` over parameters
 and batches. Either way one backward pass of the losses' sum (the members share nothing, so each gets its
@@ -29,11 +29,11 @@ import torch
 from torch import nn
 from torch.func import functional_call, stack_module_state, vmap
 
-import models.torch
-from replication.training import hessian_probe, loop
-from replication.training.compile_torch import compiled_loss, step_mode
-from replication.training.objective import loss_value, predict
-from replication.training.outcome import TrainOutcome
+import lagbench.models.torch
+from lagbench.replication.training import hessian_probe, loop
+from lagbench.replication.training.compile_torch import compiled_loss, step_mode
+from lagbench.replication.training.objective import loss_value, predict
+from lagbench.replication.training.outcome import TrainOutcome
 
 _ADAM_STATE = ("step", "exp_avg", "exp_avg_sq")   # torch.optim.Adam's state of one parameter (no amsgrad)
 # which torch.optim.Adam implementation trains (and the speed study times): the fused kernel, one pass over
@@ -76,7 +76,7 @@ def make_probe(spec, protocol):
 class Stepper:
     def __init__(self, spec, params, protocol):
         self.dtype = getattr(torch, protocol.dtype)
-        self.model = models.torch.build(spec, params)
+        self.model = lagbench.models.torch.build(spec, params)
         self.loss_fn = compiled_loss(make_loss(spec, protocol), spec, protocol)
         self.look = make_probe(spec, protocol)
         self.opt = torch.optim.Adam(self.model.parameters(), lr=protocol.schedule.lr, betas=(protocol.optimiser.b1, protocol.optimiser.b2),
@@ -110,7 +110,7 @@ class Stepper:
         return None if self.look is None else self.look(self.model, self._batch)
 
     def params(self) -> dict:
-        return models.torch.to_params(self.model)
+        return lagbench.models.torch.to_params(self.model)
 
     def state_arrays(self) -> list[np.ndarray]:
         """Per parameter: its values, whether Adam holds a state for it (none before its first gradient),
@@ -162,12 +162,12 @@ class Members:
     def __init__(self, spec, params_list, protocol):
         self.dtype, self.protocol = getattr(torch, protocol.dtype), protocol
         self.spec, self.n = spec, len(params_list)
-        if models.torch.stacks(spec):
-            self.model = models.torch.build_stacked(spec, params_list)
+        if lagbench.models.torch.stacks(spec):
+            self.model = lagbench.models.torch.build_stacked(spec, params_list)
             self.loss_fn = compiled_loss(make_loss(spec, protocol, True), spec, protocol, self.n)
             self.stacked = dict(self.model.named_parameters())
         else:   # no stacked model: the K losses come from vmap over the stacked parameters
-            objectives = [_Objective(models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]
+            objectives = [_Objective(lagbench.models.torch.build(spec, p), make_loss(spec, protocol)) for p in params_list]
             self.model, self.base = None, objectives[0]
             self.stacked, self.buffers = stack_module_state(objectives)
         self.moments = {k: (torch.zeros_like(p), torch.zeros_like(p)) for k, p in self.stacked.items()}
@@ -236,7 +236,7 @@ class Members:
     def probe(self):
         if self.look is None:
             return None
-        return [self.look(models.torch.build(self.spec, self._params_of(i)), {k: v[i] for k, v in self._batch.items()})
+        return [self.look(lagbench.models.torch.build(self.spec, self._params_of(i)), {k: v[i] for k, v in self._batch.items()})
                 for i in range(self.n)]
 
     def params(self) -> list[dict]:

@@ -1,11 +1,11 @@
 """Adopt a `lagbench tune` ledger: its choices become the claim's protocol under its profile.
 
-`python -m replication.tuning.adopt LEDGER.json ...` writes each ledger's choices into
+`python -m lagbench.replication.tuning.adopt LEDGER.json ...` writes each ledger's choices into
 `replication/claims/tuned.json` (read by `replication.claims.tuned`), after checking that the ledger is the
 whole declared search (`kind` "search": every configuration of the grid, a partial search or a width sweep
 is a trial), scored on the development split, that every trained model of the claim was searched alike (the
 same number of configurations), and that each choice was confirmed on at least `CONFIRM_SEEDS` development
-seeds. The record names the ledger's file (committed under `docs/lab/search/`). Register the changed protocols next (`python -m replication.claims.registration
+seeds. The record names the ledger's file (committed under `docs/lab/search/`). Register the changed protocols next (`python -m lagbench.replication.claims.registration
 --note ...`): a verdict rests on a registered protocol only.
 """
 from __future__ import annotations
@@ -15,10 +15,10 @@ import json
 from datetime import date
 from pathlib import Path
 
-from replication.claims import tuned, untuned
-from replication.training.protocol import canonical_hash
-from replication.tuning import search
-from replication.tuning.tune import CONFIRM_SEEDS
+from lagbench.replication.claims import tuned, untuned
+from lagbench.replication.training.protocol import canonical_hash
+from lagbench.replication.tuning import search
+from lagbench.replication.tuning.tune import CONFIRM_SEEDS
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -80,7 +80,7 @@ def adopt(ledger_file, today: str | None = None) -> dict:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m replication.tuning.adopt",
+    p = argparse.ArgumentParser(prog="python -m lagbench.replication.tuning.adopt",
                                 description="Adopt the choices of a `lagbench tune` ledger as the claim's protocol "
                                             "under its profile (then register it: python -m "
                                             "replication.claims.registration --note ...).")

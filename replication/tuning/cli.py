@@ -1,7 +1,7 @@
 """`lagbench tune`: its command line (the search itself is `tune.py`)."""
 from __future__ import annotations
 
-from replication.claims.base import PROFILES
+from lagbench.replication.claims.base import PROFILES
 
 
 def _num(v) -> str:
@@ -9,7 +9,7 @@ def _num(v) -> str:
 
 
 def cmd_tune(args):
-    from replication.tuning.tune import tune
+    from lagbench.replication.tuning.tune import tune
 
     frameworks = tuple(x.strip() for x in args.frameworks.split(",") if x.strip()) or ("jax",)
     ledger = tune(args.claim, profile=args.profile, n_configs=args.configs, n_seeds=args.seeds,
@@ -39,7 +39,7 @@ def add_command(sub) -> None:
                        "development seeds; scored by the metric the claim's verdict reads (a pace study: by its "
                        "pace, one configuration for all its arms). Writes OUT/ledger.json and OUT/ledger.csv. It "
                        "never reads the test split and never changes a claim: a ledger's choices become the "
-                       "claim's protocol when adopted (python -m replication.tuning.adopt OUT/ledger.json) and "
+                       "claim's protocol when adopted (python -m lagbench.replication.tuning.adopt OUT/ledger.json) and "
                        "registered.")
     s.add_argument("--claim", required=True, help="a claim id (see `lagbench list`)")
     s.add_argument("--profile", default="quick", choices=PROFILES, help="the budget to tune at (default: quick)")

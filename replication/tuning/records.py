@@ -18,9 +18,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication import results as R
-from replication.evaluation.registry import EVALUATION_VERSION
-from replication.training.protocol import canonical_hash
+from lagbench.files import results as R
+from lagbench.replication.evaluation.registry import EVALUATION_VERSION
+from lagbench.replication.training.protocol import canonical_hash
 
 COLUMNS = ["key", "claim", "profile", "model", "config", "knob_lr", "knob_width", "framework", "seed", "split",
            "status", "metric", "score", "train_time_s", "train_samples", "cpu"]

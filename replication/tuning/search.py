@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from replication.claims.tuned import scaled_widths, with_knobs
+from lagbench.replication.claims.tuned import scaled_widths, with_knobs
 
 __all__ = ["KNOBS", "REGISTERED", "SIZE", "STEP", "apply", "configs", "extensions", "grid", "scaled_widths", "sweep"]
 

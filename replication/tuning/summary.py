@@ -1,4 +1,4 @@
-"""`python -m replication.tuning.summary LEDGER.json ...`: the search ledgers as one Markdown table.
+"""`python -m lagbench.replication.tuning.summary LEDGER.json ...`: the search ledgers as one Markdown table.
 
 Per claim, profile and model: the configurations tried, the chosen one (as multiples of the registered
 rate and widths), its development score (the mean over the confirmation seeds where confirmed, else the
@@ -42,7 +42,7 @@ def table(paths) -> str:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m replication.tuning.summary",
+    p = argparse.ArgumentParser(prog="python -m lagbench.replication.tuning.summary",
                                 description="The ledgers of `lagbench tune` as one Markdown table.")
     p.add_argument("ledgers", nargs="+", metavar="LEDGER", help="ledger.json files")
     args = p.parse_args(argv)

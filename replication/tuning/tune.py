@@ -21,7 +21,7 @@ and stops. The ledger goes to OUT/ledger.json and OUT/ledger.csv: per model the 
 scores, the confirmation, the chosen one, and the compute the search took; with `record`, beside the record
 too (the folder to commit and adopt from).
 What it does not do: change a claim. A ledger's choices reach the claim only when adopted
-(`python -m replication.tuning.adopt OUT/ledger.json`) and registered (a new dated line).
+(`python -m lagbench.replication.tuning.adopt OUT/ledger.json`) and registered (a new dated line).
 """
 from __future__ import annotations
 
@@ -30,14 +30,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication import results as R
-from replication.claims import tuned, untuned
-from replication.run import splits
-from replication.run.estimate import estimate
-from replication.run.executor import run_units
-from replication.run.runner import is_current
-from replication.run.units import Unit
-from replication.tuning import choose, records, search
+from lagbench.files import results as R
+from lagbench.replication.claims import tuned, untuned
+from lagbench.replication.run import splits
+from lagbench.replication.run.estimate import estimate
+from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.runner import is_current
+from lagbench.replication.run.units import Unit
+from lagbench.replication.tuning import choose, records, search
 
 CONFIRM_SEEDS = 3   # development seeds the chosen configuration is confirmed on, against the registered one
 POOLED_SEEDS = 8    # a pooled claim's cohort of development seeds per configuration (its confirmation too)

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from systems.definition import Definition, coordinates, param, planar_kinetic, planar_position
-from systems.library._sampling import unknown
+from lagbench.systems.definition import Definition, coordinates, param, planar_kinetic, planar_position
+from lagbench.systems.library._sampling import unknown
 
 
 def build_two_link_arm() -> Definition:

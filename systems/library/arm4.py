@@ -39,9 +39,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from systems.definition import Definition, coordinates, param
-from systems.library._sampling import unknown
-from systems.spatial import body_angular_velocity, body_velocity, rotation
+from lagbench.systems.definition import Definition, coordinates, param
+from lagbench.systems.library._sampling import unknown
+from lagbench.systems.spatial import body_angular_velocity, body_velocity, rotation
 
 COULOMB_SPEED = 0.05  # rad/s, the default smoothing speed of the Coulomb friction
 

@@ -8,8 +8,8 @@ Hessian is m I. Motion: m qddot = e B (ydot, -xdot) (circles of radius m|v|/(eB)
 
 from __future__ import annotations
 
-from systems.definition import Definition, coordinates, param
-from systems.library._sampling import unknown
+from lagbench.systems.definition import Definition, coordinates, param
+from lagbench.systems.library._sampling import unknown
 
 
 def build_charged_magnetic() -> Definition:

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from systems.definition import Definition, coordinates, param, planar_kinetic, planar_position
-from systems.library._sampling import ring, unknown
+from lagbench.systems.definition import Definition, coordinates, param, planar_kinetic, planar_position
+from lagbench.systems.library._sampling import ring, unknown
 
 
 def build_free_fall() -> Definition:

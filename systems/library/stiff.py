@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from systems.definition import Definition, coordinates, param
-from systems.library._sampling import unknown
+from lagbench.systems.definition import Definition, coordinates, param
+from lagbench.systems.library._sampling import unknown
 
 
 def build_stiff_chain() -> Definition:

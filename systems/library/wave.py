@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from systems.definition import Definition, coordinates, param
-from systems.library._sampling import unknown
+from lagbench.systems.definition import Definition, coordinates, param
+from lagbench.systems.library._sampling import unknown
 
 VARIANTS = ("code", "textbook")
 

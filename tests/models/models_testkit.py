@@ -7,9 +7,9 @@ import jax.numpy as jnp
 import numpy as np
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
 
 # relative tolerance, max|a - b| / max|b|, keyed by dtype (one table for every model test)
 TOL = {"float64": 1e-10, "float32": 2e-4}
@@ -62,13 +62,13 @@ def jax_loss_and_grads(spec, params, x):
         return jnp.mean(jnp.sum(jnp.abs(pred - xj["target"]), axis=-1)), pred
 
     step = eqx.filter_jit(eqx.filter_value_and_grad(loss, has_aux=True))
-    (_, pred), grads = step(models.jax.build(spec, params), to_jax(x))
+    (_, pred), grads = step(lagbench.models.jax.build(spec, params), to_jax(x))
     return np.asarray(pred), {k: np.asarray(v) for k, v in grads.params.items()}
 
 
 def torch_loss_and_grads(spec, params, x):
     xt = to_torch(x)
-    model = models.torch.build(spec, params)
+    model = lagbench.models.torch.build(spec, params)
     pred = predict(model, spec.kind, xt, torch.cat)
     torch.mean(torch.sum(torch.abs(pred - xt["target"]), dim=-1)).backward()
     return pred.detach().numpy(), {k: np.zeros(tuple(p.shape)) if p.grad is None else p.grad.numpy()

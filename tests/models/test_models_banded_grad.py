@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-import systems
-from models import ModelSpec, init_params
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench import systems
+from lagbench.models import ModelSpec, init_params
 
 
 @pytest.mark.parametrize("dtype, rtol", [("float64", 1e-10), ("float32", 2e-3)])
@@ -20,15 +20,15 @@ def test_banded_gradients_match_dense(dtype, rtol):
     grads = {}
     for form in ("dense", "banded"):
         spec = ModelSpec(kind="lgn", dof=10, hidden=(32, 32, 32), dtype=dtype, formulation=form)
-        m = models.jax.build(spec, init_params(spec, 0))
+        m = lagbench.models.jax.build(spec, init_params(spec, 0))
         q, qd, t = (jnp.asarray(x, dtype) for x in (st["q"], st["qdot"], tgt))
         def loss(m, q=q, qd=qd, t=t):
             return jnp.mean(jnp.sum(jnp.abs(m.acceleration(q, qd) - t), -1))
 
         g = eqx.filter_grad(loss)(m)
-        grads[form] = models.jax.to_params(g)
+        grads[form] = lagbench.models.jax.to_params(g)
         if form == "banded":
-            mt = models.torch.build(spec, init_params(spec, 0))
+            mt = lagbench.models.torch.build(spec, init_params(spec, 0))
             qt, qdt, tt = (torch.as_tensor(x, dtype=getattr(torch, dtype)) for x in (st["q"], st["qdot"], tgt))
             (mt.acceleration(qt, qdt) - tt).abs().sum(-1).mean().backward()
             grads["torch"] = {k: (v.grad if v.grad is not None else torch.zeros_like(v)).numpy()

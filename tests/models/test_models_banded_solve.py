@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax.banded as jb
-import models.torch.banded as tb
+import lagbench.models.jax.banded as jb
+import lagbench.models.torch.banded as tb
 
 
 def _system(m, w=2, k=3, batch=2, seed=0):

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from models_testkit import make_inputs, spec_params, to_jax
 
-import models.jax
-import models.jax.lnn as jlnn
-from models.jax.blocking import block_size, in_row_blocks
+import lagbench.models.jax
+import lagbench.models.jax.lnn as jlnn
+from lagbench.models.jax.blocking import block_size, in_row_blocks
 
 
 def test_blocks_equal_one_call_with_padding_and_none_arguments():
@@ -27,7 +27,7 @@ def test_blocked_lnn_equals_per_block_calls(formulation):
     n = 2 * block_size(spec.dof + 1) + 18                    # 3 blocks, the last padded; halves unblocked
     assert n % 3
     x = to_jax(make_inputs(spec, batch=n, seed=3))
-    model = models.jax.build(spec, params)
+    model = lagbench.models.jax.build(spec, params)
     whole = np.asarray(model.acceleration(x["q"], x["qdot"]))
     half = n // 2
     parts = [np.asarray(model.acceleration(x["q"][s], x["qdot"][s])) for s in (slice(0, half), slice(half, n))]
@@ -43,6 +43,6 @@ def test_blocked_fallbacks_count_each_sample_once():
     n = 3 * block_size(spec.dof + 1) - 23                     # 3 blocks, the last padded
     assert n % 3
     x = to_jax(make_inputs(spec, batch=n))
-    qddot, n_bad = models.jax.build(spec, params).acceleration_info(x["q"], x["qdot"])
+    qddot, n_bad = lagbench.models.jax.build(spec, params).acceleration_info(x["q"], x["qdot"])
     assert int(n_bad) == n
     assert qddot.shape == (n, 2) and np.all(np.isfinite(np.asarray(qddot)))

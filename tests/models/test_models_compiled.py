@@ -4,16 +4,16 @@ it cannot compile."""
 import numpy as np
 import pytest
 
-import models.jax
-from models import ModelSpec, init_params
-from models.jax.compiled import async_dispatch, compile_single, use_sync_dispatch
+import lagbench.models.jax
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.jax.compiled import async_dispatch, compile_single, use_sync_dispatch
 
 RNG = np.random.default_rng(0)
 
 
 def _model(kind="delan", dtype="float64", **kw):
     spec = ModelSpec(kind=kind, dof=2, hidden=(16, 16), dtype=dtype, init="xavier", **kw)
-    return models.jax.build(spec, init_params(spec, seed=1))
+    return lagbench.models.jax.build(spec, init_params(spec, seed=1))
 
 
 @pytest.mark.parametrize("method,n,freeze", [("inverse_dynamics", 3, False), ("inverse_dynamics", 3, True),

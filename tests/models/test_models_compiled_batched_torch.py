@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 import torch
 
-import models.torch
-from models import ModelSpec, init_params
-from models.torch.compiled import compile_batched
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.torch.compiled import compile_batched
 
 RNG = np.random.default_rng(3)
 
@@ -24,7 +24,7 @@ def test_any_batch_size_and_the_singular_fallback():
     takes the pinv branch (q'' = pinv(0) rhs = 0); without that branch the guarded solve would return rhs."""
     spec, params = _lnn()
     params["mlp.0.weight"][:, 2:] = 0.0
-    m = models.torch.build(spec, params)
+    m = lagbench.models.torch.build(spec, params)
     f = compile_batched(m.acceleration, n_inputs=2, width=2, dtype="float64", name="acceleration")
     for b in (1, 5, 37):
         q, qdot = (torch.tensor(RNG.uniform(-2, 2, (b, 2))) for _ in range(2))
@@ -47,7 +47,7 @@ def test_any_batch_size_and_the_singular_fallback():
 @pytest.mark.parametrize("kind", ["delan", "lnn"])
 def test_model_acceleration_any_batch(kind):
     spec = ModelSpec(kind=kind, dof=2, hidden=(16, 16), dtype="float64", init="xavier")
-    m = models.torch.build(spec, init_params(spec, seed=2))
+    m = lagbench.models.torch.build(spec, init_params(spec, seed=2))
     f = compile_batched(m.acceleration, n_inputs=2, width=2, dtype="float64")
     for b in (1, 64):
         q, qdot = (torch.tensor(RNG.uniform(-1, 1, (b, 2))) for _ in range(2))
@@ -62,7 +62,7 @@ def test_hnn_exports_and_matches_the_autograd_gradient():
     compiled (dH/dy, -dH/dx) matches autograd's gradient of the eager Hamiltonian at any batch size."""
     spec = ModelSpec(kind="hnn", dof=2, hidden=(16, 16), dtype="float64", init="xavier", angle_wrap=True,
                      input_scale=(0.5, 2.0, 1.5, 0.1))
-    m = models.torch.build(spec, init_params(spec, seed=2))
+    m = lagbench.models.torch.build(spec, init_params(spec, seed=2))
     f = compile_batched(m.time_derivative, n_inputs=2, width=2, dtype="float64", name="time_derivative")
     for b in (1, 9):
         x, y = (torch.tensor(RNG.uniform(-4, 4, (b, 2)), requires_grad=True) for _ in range(2))
@@ -78,7 +78,7 @@ def test_banded_lgn_exports_and_keeps_its_fallback():
     takes pinv on the gathered bad samples only. A batch with one non-finite state: the good samples
     equal eager, the bad one is NaN (as in eager), also at batch 1."""
     spec = ModelSpec(kind="lgn", dof=10, hidden=(16, 16), dtype="float64", init="xavier", formulation="banded")
-    m = models.torch.build(spec, init_params(spec, seed=2))
+    m = lagbench.models.torch.build(spec, init_params(spec, seed=2))
     f = compile_batched(m.acceleration, n_inputs=2, width=10, dtype="float64", name="acceleration")
     for b in (1, 6):
         q, qdot = (torch.tensor(RNG.uniform(-1, 1, (b, 10))) for _ in range(2))

@@ -5,16 +5,16 @@ import numpy as np
 import pytest
 import torch
 
-import models.torch
-from models import ModelSpec, init_params
-from models.torch.compiled import compile_single
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.torch.compiled import compile_single
 
 RNG = np.random.default_rng(0)
 
 
 def _model(**kw):
     spec = ModelSpec(kind="delan", dof=2, hidden=(16, 16), dtype="float64", init="xavier", **kw)
-    return models.torch.build(spec, init_params(spec, seed=1))
+    return lagbench.models.torch.build(spec, init_params(spec, seed=1))
 
 
 @pytest.mark.slow   # slow: a speed-study compile path (`lagbench bench`'s quick preset); the paths verdicts use stay in the default run

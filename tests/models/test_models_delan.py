@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from models_testkit import assert_rel, spec_params
 
-import models.torch
-from models.torch.lnn import euler_lagrange
+import lagbench.models.torch
+from lagbench.models.torch.lnn import euler_lagrange
 
 
 @settings(max_examples=25, deadline=None)
@@ -17,7 +17,7 @@ from models.torch.lnn import euler_lagrange
 def test_mass_matrix_is_symmetric_positive_definite(seed, dof, scale, init):
     spec, params = spec_params(seed=seed, kind="delan", dof=dof, dtype="float64", init=init, hidden=(16, 16))
     q = torch.tensor(np.random.default_rng(seed).normal(scale=scale, size=(32, dof)))
-    m = models.torch.build(spec, params).mass_matrix(q).detach().numpy()
+    m = lagbench.models.torch.build(spec, params).mass_matrix(q).detach().numpy()
     np.testing.assert_array_equal(m, np.swapaxes(m, -1, -2))
     # eigvalsh is backward stable: its error is a few eps times the matrix norm, which grows with the
     # entries (up to ~1e5 here), so the bound eps_delan holds up to that rounding
@@ -27,7 +27,7 @@ def test_mass_matrix_is_symmetric_positive_definite(seed, dof, scale, init):
 
 def test_forward_and_inverse_models_are_consistent_with_euler_lagrange():
     spec, params = spec_params(kind="delan", dof=3, dtype="float64", init="xavier")
-    model = models.torch.build(spec, params)
+    model = lagbench.models.torch.build(spec, params)
     rng = np.random.default_rng(0)
     q, qdot, tau = (torch.tensor(rng.normal(size=(10, 3))) for _ in range(3))
     qddot = model.acceleration(q, qdot, tau)
@@ -43,7 +43,7 @@ def test_forward_and_inverse_models_are_consistent_with_euler_lagrange():
 def test_unrolled_spd_solve_matches_linalg_solve(d):
     """`spd_solve_unrolled` (what the exported DeLaN acceleration uses) against torch.linalg.solve on
     random SPD matrices with a leading batch shape."""
-    from models.torch.delan import spd_solve_unrolled
+    from lagbench.models.torch.delan import spd_solve_unrolled
 
     rng = np.random.default_rng(d)
     a = torch.tensor(rng.normal(size=(2, 3, d, d)))

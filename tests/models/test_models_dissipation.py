@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
 
 RAW = np.array([0.4, -0.7])
 B = np.log1p(np.exp(RAW))
@@ -19,7 +19,7 @@ def _np(x):
 
 def _build(fw, spec, params):
     conv = torch.tensor if fw == "torch" else np.asarray
-    return (models.torch.build if fw == "torch" else models.jax.build)(spec, {k: conv(v) for k, v in params.items()})
+    return (lagbench.models.torch.build if fw == "torch" else lagbench.models.jax.build)(spec, {k: conv(v) for k, v in params.items()})
 
 
 def _pair(kind, **kw):

@@ -6,10 +6,10 @@ import os
 
 import pytest
 
-import models.torch
-from models import ModelSpec, init_params
-from models.torch import inductor_cache
-from models.torch.compiled import compile_batched
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.torch import inductor_cache
+from lagbench.models.torch.compiled import compile_batched
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "getuid"), reason="POSIX owners and modes")
 
@@ -59,7 +59,7 @@ def test_a_folder_others_may_write_is_refused(monkeypatch, tmp_path, caplog, how
             pass
     # an AOT compile stops before it exports anything
     spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), dtype="float64", init="xavier", formulation="fast")
-    m = models.torch.build(spec, init_params(spec, seed=0))
+    m = lagbench.models.torch.build(spec, init_params(spec, seed=0))
     with pytest.raises(inductor_cache.InductorCacheError):
         compile_batched(m.acceleration, n_inputs=2, width=2, dtype="float64", name="acceleration")
     assert not any(good.iterdir())

@@ -5,9 +5,9 @@ import pytest
 import torch
 from models_testkit import assert_rel, make_inputs, spec_params, to_jax
 
-import models.jax
-import models.torch
-from models import ModelSpec
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec
 
 
 @pytest.mark.parametrize("n, r", [(5, 1), (7, 1), (10, 1), (13, 1), (9, 2), (12, 2), (100, 1)])
@@ -15,17 +15,17 @@ def test_banded_equals_dense_torch(n, r):
     spec, params = spec_params(kind="lgn", dof=10, dtype="float64", lgn_radius=r, formulation="banded")
     x = make_inputs(spec, batch=4, seed=n, n=n)
     q, qdot = torch.tensor(x["q"]), torch.tensor(x["qdot"])
-    banded, n_bad = models.torch.build(spec, params).acceleration_info(q, qdot)
+    banded, n_bad = lagbench.models.torch.build(spec, params).acceleration_info(q, qdot)
     dense_spec = ModelSpec.from_dict(spec.to_dict() | {"formulation": "dense"})
-    dense = models.torch.build(dense_spec, params).acceleration(q, qdot)
+    dense = lagbench.models.torch.build(dense_spec, params).acceleration(q, qdot)
     assert banded.shape == (4, n) and int(n_bad) == 0
     assert_rel(banded.detach(), dense.detach(), "float64", f"banded vs dense n={n} r={r}", factor=100)
 
 
 def test_banded_equals_dense_jax_and_transfers_to_a_larger_grid():
     spec, params = spec_params(kind="lgn", dof=10, dtype="float64", formulation="banded")
-    model = models.jax.build(spec, params)
-    dense = models.jax.build(ModelSpec.from_dict(spec.to_dict() | {"formulation": "dense"}), params)
+    model = lagbench.models.jax.build(spec, params)
+    dense = lagbench.models.jax.build(ModelSpec.from_dict(spec.to_dict() | {"formulation": "dense"}), params)
     for n in (10, 100):
         x = to_jax(make_inputs(spec, batch=3, seed=n, n=n))
         a, n_bad = model.acceleration_info(x["q"], x["qdot"])
@@ -36,7 +36,7 @@ def test_banded_equals_dense_jax_and_transfers_to_a_larger_grid():
 def test_tiny_grids_use_the_dense_path():
     spec, params = spec_params(kind="lgn", dof=3, dtype="float64", formulation="banded")
     x = make_inputs(spec, batch=2, n=3)
-    a = models.torch.build(spec, params).acceleration(torch.tensor(x["q"]), torch.tensor(x["qdot"]))
+    a = lagbench.models.torch.build(spec, params).acceleration(torch.tensor(x["q"]), torch.tensor(x["qdot"]))
     assert a.shape == (2, 3) and np.all(np.isfinite(a.detach().numpy()))
 
 
@@ -53,11 +53,11 @@ def test_hand_written_band_terms_equal_generic_autodiff(r, fw):
     if fw == "jax":
         import jax.numpy as jnp
 
-        from models.jax.lgn import banded_terms
-        q, qdot, m = jnp.asarray(x["q"]) * 3.0, jnp.asarray(x["qdot"]), models.jax.build(spec, params)
+        from lagbench.models.jax.lgn import banded_terms
+        q, qdot, m = jnp.asarray(x["q"]) * 3.0, jnp.asarray(x["qdot"]), lagbench.models.jax.build(spec, params)
     else:
-        from models.torch.lgn import banded_terms
-        q, qdot, m = torch.tensor(x["q"]) * 3.0, torch.tensor(x["qdot"]), models.torch.build(spec, params)
+        from lagbench.models.torch.lgn import banded_terms
+        q, qdot, m = torch.tensor(x["q"]) * 3.0, torch.tensor(x["qdot"]), lagbench.models.torch.build(spec, params)
     band, rhs = m._banded_terms(q, qdot)
     band_ref, rhs_ref = banded_terms(m._lagrangian, q, qdot, r)
     assert band.shape == (3, 13, 4 * r + 1)
@@ -71,7 +71,7 @@ def test_singular_band_takes_the_counted_pinv_fallback_with_finite_gradients():
     spec, params = spec_params(kind="lgn", dof=10, dtype="float64", formulation="banded")
     params["mlp.0.weight"][:, 3:] = 0.0
     x = make_inputs(spec, batch=4, seed=2, n=10)
-    m = models.torch.build(spec, params)
+    m = lagbench.models.torch.build(spec, params)
     a, n_bad = m.acceleration_info(torch.tensor(x["q"]), torch.tensor(x["qdot"]))
     assert int(n_bad) == 4
     np.testing.assert_allclose(a.detach().numpy(), 0.0, atol=1e-12)
@@ -84,12 +84,12 @@ def test_banded_euler_lagrange_info_is_one_public_mirror():
     on the model's own Lagrangian it gives the LGN's banded accelerations and fallback count."""
     import jax.numpy as jnp
 
-    from models.jax.lgn import banded_euler_lagrange_info as jax_info
-    from models.torch.lgn import banded_euler_lagrange_info as torch_info
+    from lagbench.models.jax.lgn import banded_euler_lagrange_info as jax_info
+    from lagbench.models.torch.lgn import banded_euler_lagrange_info as torch_info
 
     spec, params = spec_params(kind="lgn", dof=10, dtype="float64", formulation="banded")
     x = make_inputs(spec, batch=3, seed=5, n=10)
-    mt, mj = models.torch.build(spec, params), models.jax.build(spec, params)
+    mt, mj = lagbench.models.torch.build(spec, params), lagbench.models.jax.build(spec, params)
     q, qdot = torch.tensor(x["q"]), torch.tensor(x["qdot"])
     a_t, n_t = torch_info(mt._lagrangian, q, qdot, spec.lgn_radius)
     a_j, n_j = jax_info(mj._lagrangian, jnp.asarray(x["q"]), jnp.asarray(x["qdot"]), spec.lgn_radius)

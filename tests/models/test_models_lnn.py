@@ -9,10 +9,10 @@ import pytest
 import torch
 from models_testkit import assert_rel, make_inputs, spec_params, to_jax, to_torch
 
-import models.jax
-import models.jax.lnn as jlnn
-import models.torch
-import models.torch.lnn as tlnn
+import lagbench.models.jax
+import lagbench.models.jax.lnn as jlnn
+import lagbench.models.torch
+import lagbench.models.torch.lnn as tlnn
 
 G = 9.8
 
@@ -70,7 +70,7 @@ def test_free_fall_gives_minus_g_appendix_b(fw):
 
 
 def test_system_registry_accelerations_if_available():
-    systems = pytest.importorskip("systems")
+    systems = pytest.importorskip("lagbench.systems")
     if not hasattr(systems, "get"):
         pytest.skip("systems.get not available yet")
     q, qdot = _states()
@@ -83,7 +83,7 @@ def test_system_registry_accelerations_if_available():
 def test_fast_equals_paper_where_the_hessian_is_well_conditioned(fw):
     spec, params = spec_params(kind="lnn", dof=3, dtype="float64", init="xavier")
     x = make_inputs(spec, batch=24, seed=5)
-    build, conv = (models.jax.build, to_jax) if fw == "jax" else (models.torch.build, to_torch)
+    build, conv = (lagbench.models.jax.build, to_jax) if fw == "jax" else (lagbench.models.torch.build, to_torch)
     model, xs = build(spec, params), conv(x)
     L = model.lagrangian
     fast, n_bad = FW[fw][0].euler_lagrange_info(L, xs["q"], xs["qdot"], "fast")
@@ -132,7 +132,7 @@ def test_fallback_gradients_stay_finite():
 def test_relu_lnn_has_a_zero_hessian_everywhere_and_every_sample_falls_back(fw):
     spec, params = spec_params(kind="lnn", dof=2, dtype="float64", activation="relu")
     x = make_inputs(spec, batch=10)
-    build, conv = (models.jax.build, to_jax) if fw == "jax" else (models.torch.build, to_torch)
+    build, conv = (lagbench.models.jax.build, to_jax) if fw == "jax" else (lagbench.models.torch.build, to_torch)
     xs = conv(x)
     qddot, n_bad = build(spec, params).acceleration_info(xs["q"], xs["qdot"])
     assert int(n_bad) == 10
@@ -147,7 +147,7 @@ def test_hand_written_fast_terms_equal_forward_over_reverse(fw, activation, extr
     spec, params = spec_params(kind="lnn", dof=2, dtype="float64", init="xavier", activation=activation,
                                extra_inputs=extra, input_scale=scale, angle_wrap=True)
     x = make_inputs(spec, batch=16, seed=3)
-    build, conv, lib = (models.jax.build, to_jax, jlnn) if fw == "jax" else (models.torch.build, to_torch, tlnn)
+    build, conv, lib = (lagbench.models.jax.build, to_jax, jlnn) if fw == "jax" else (lagbench.models.torch.build, to_torch, tlnn)
     model, xs = build(spec, params), conv(x)
     e = xs["extra"] if extra else None
     hand = model._fast_terms(xs["q"], xs["qdot"], e)
@@ -159,7 +159,7 @@ def test_hand_written_fast_terms_equal_forward_over_reverse(fw, activation, extr
 def test_pinv_solve_by_svd_matches_pinv():
     """pinv_solve(..., by_svd=True) (the banded LGN's exported fallback) equals the torch.linalg.pinv
     form: full-rank, rank-deficient (dropped singular values), zero and non-finite matrices."""
-    from models.torch.lnn import pinv_solve
+    from lagbench.models.torch.lnn import pinv_solve
 
     rng = np.random.default_rng(5)
     u = torch.tensor(rng.normal(size=(4, 6, 3)))
@@ -179,7 +179,7 @@ def test_dissipation_removes_energy_at_the_rate_of_its_rayleigh_function(fw, ori
     """With D = 1/2 sum b qdot^2 the learned energy E = qdot . dL/dqdot - L, oriented by s = sign(tr H), changes
     at d(sE)/dt = -sum b qdot^2 along the model's own motion (the model's Hessian and gradients,
     finite-differenced along that motion), and the acceleration is the conservative one less H^-1 s b qdot."""
-    from models import ModelSpec, init_params
+    from lagbench.models import ModelSpec, init_params
 
     def _np(x):
         return x.detach().numpy() if hasattr(x, "detach") else np.asarray(x)
@@ -191,7 +191,7 @@ def test_dissipation_removes_energy_at_the_rate_of_its_rayleigh_function(fw, ori
         params[k] = orientation * params[k]
     b = np.log1p(np.exp(params["dissipation.raw"]))
     conservative = ModelSpec(kind="lnn", dof=2, hidden=(16, 16), dtype="float64")
-    build, conv = (models.jax.build, jnp.asarray) if fw == "jax" else (models.torch.build, torch.tensor)
+    build, conv = (lagbench.models.jax.build, jnp.asarray) if fw == "jax" else (lagbench.models.torch.build, torch.tensor)
     m = build(spec, {k: conv(v) for k, v in params.items()})
     m0 = build(conservative, {k: conv(v) for k, v in params.items() if k != "dissipation.raw"})
     rng = np.random.default_rng(0)

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
-from models.jax.lnn import fast_terms as jax_fast_terms
-from models.lorentz import lorentz_factor, lorentz_slopes
-from models.torch.lnn import fast_terms as torch_fast_terms
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.jax.lnn import fast_terms as jax_fast_terms
+from lagbench.models.lorentz import lorentz_factor, lorentz_slopes
+from lagbench.models.torch.lnn import fast_terms as torch_fast_terms
 
 SCALE = (0.5, 2.0, 1.0, 1.0, 0.01, 0.02, 0.1)   # [q (2), qdot (2), gamma (2), g]: every slot its own scale
 
@@ -29,7 +29,7 @@ def _case(kind, seed=3):
 
 def test_hand_written_lnn_terms_equal_autodiff_through_gamma():
     spec, p, q, v, e = _case("lnn")
-    mj, mt = models.jax.build(spec, p), models.torch.build(spec, p)
+    mj, mt = lagbench.models.jax.build(spec, p), lagbench.models.torch.build(spec, p)
     hj, rj = mj._fast_terms(jnp.asarray(q), jnp.asarray(v), jnp.asarray(e))
     ha, ra = jax_fast_terms(mj._lagrangian, jnp.asarray(q), jnp.asarray(v), jnp.asarray(e))
     ht, rt = mt._fast_terms(torch.tensor(q), torch.tensor(v), torch.tensor(e))
@@ -42,7 +42,7 @@ def test_hand_written_lnn_terms_equal_autodiff_through_gamma():
 @pytest.mark.parametrize("kind", ["lnn", "hnn"])
 def test_frameworks_agree_with_gamma(kind):
     spec, p, q, v, e = _case(kind, seed=5)
-    mj, mt = models.jax.build(spec, p), models.torch.build(spec, p)
+    mj, mt = lagbench.models.jax.build(spec, p), lagbench.models.torch.build(spec, p)
     J, T = (jnp.asarray(a) for a in (q, v, e)), (torch.tensor(a) for a in (q, v, e))
     if kind == "lnn":
         a, b = np.asarray(mj.acceleration(*J)), mt.acceleration(*T).detach().numpy()
@@ -55,7 +55,7 @@ def test_frameworks_agree_with_gamma(kind):
 
 def test_torch_hnn_hand_written_gradient_includes_gamma():
     spec, p, q, v, e = _case("hnn", seed=7)
-    mt = models.torch.build(spec, p)
+    mt = lagbench.models.torch.build(spec, p)
     y = torch.tensor(v, requires_grad=True)
     x = torch.tensor(q, requires_grad=True)
     (dh_dx, dh_dy) = torch.autograd.grad(mt.hamiltonian(x, y, torch.tensor(e)).sum(), (x, y))

@@ -16,8 +16,8 @@ from models_testkit import (
     torch_loss_and_grads,
 )
 
-import models.jax
-import models.torch
+import lagbench.models.jax
+import lagbench.models.torch
 
 CASES = [
     ("baseline", {"activation": "relu"}),
@@ -91,7 +91,7 @@ def _torch_scalar_and_grads(fn, *args):
 def test_float64_energy_function_and_its_gradients_agree(kind):
     spec, params = spec_params(kind=kind, dof=5 if kind == "lgn" else 3, dtype="float64", init="xavier")
     x = make_inputs(spec, batch=6, seed=2)
-    mj, mt = models.jax.build(spec, params), models.torch.build(spec, params)
+    mj, mt = lagbench.models.jax.build(spec, params), lagbench.models.torch.build(spec, params)
     name = "hamiltonian" if kind == "hnn" else "lagrangian"
     xj, xt = to_jax(x), to_torch(x)
     got_j = _jax_scalar_and_grads(getattr(mj, name), xj["q"], xj["qdot"])
@@ -104,12 +104,12 @@ def test_float64_velocity_hessian_and_delan_terms_agree():
     spec, params = spec_params(kind="lnn", dof=3, dtype="float64")
     x = make_inputs(spec, batch=6, seed=3)
     xj, xt = to_jax(x), to_torch(x)
-    hj = models.jax.build(spec, params).velocity_hessian(xj["q"], xj["qdot"])
-    ht = models.torch.build(spec, params).velocity_hessian(xt["q"], xt["qdot"])
+    hj = lagbench.models.jax.build(spec, params).velocity_hessian(xj["q"], xj["qdot"])
+    ht = lagbench.models.torch.build(spec, params).velocity_hessian(xt["q"], xt["qdot"])
     assert hj.shape == (6, 3, 3)
     assert_rel(hj, ht.detach(), "float64", "velocity Hessian")
     spec, params = spec_params(kind="delan", dof=3, dtype="float64", init="xavier")
-    mj, mt = models.jax.build(spec, params), models.torch.build(spec, params)
+    mj, mt = lagbench.models.jax.build(spec, params), lagbench.models.torch.build(spec, params)
     for name, args in [("mass_matrix", ("q",)), ("gravity", ("q",)), ("coriolis", ("q", "qdot")),
                        ("potential", ("q",)), ("lagrangian", ("q", "qdot"))]:
         a = getattr(mj, name)(*[xj[k] for k in args])
@@ -121,6 +121,6 @@ def test_float64_lgn_paper_formulation_agrees():
     spec, params = spec_params(kind="lgn", dof=6, dtype="float64", formulation="paper")
     x = make_inputs(spec, batch=4, seed=4)
     xj, xt = to_jax(x), to_torch(x)
-    a = models.jax.build(spec, params).acceleration(xj["q"], xj["qdot"])
-    b = models.torch.build(spec, params).acceleration(xt["q"], xt["qdot"])
+    a = lagbench.models.jax.build(spec, params).acceleration(xj["q"], xj["qdot"])
+    b = lagbench.models.torch.build(spec, params).acceleration(xt["q"], xt["qdot"])
     assert_rel(a, b.detach(), "float64", "lgn paper qddot")

@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
-from models.jax.lnn import euler_lagrange as jax_euler_lagrange
-from models.jax.lnn import fast_terms as jax_fast_terms
-from models.torch.lnn import euler_lagrange as torch_euler_lagrange
-from models.torch.lnn import fast_terms as torch_fast_terms
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.jax.lnn import euler_lagrange as jax_euler_lagrange
+from lagbench.models.jax.lnn import fast_terms as jax_fast_terms
+from lagbench.models.torch.lnn import euler_lagrange as torch_euler_lagrange
+from lagbench.models.torch.lnn import fast_terms as torch_fast_terms
 
-FW = {"jax": (models.jax, jnp.asarray, np.asarray), "torch": (models.torch, torch.tensor, lambda t: t.detach().numpy())}
+FW = {"jax": (lagbench.models.jax, jnp.asarray, np.asarray), "torch": (lagbench.models.torch, torch.tensor, lambda t: t.detach().numpy())}
 # [cos q0, sin q0, q1, cos q2, sin q2, qdot (3), gamma (3), extra]: every slot its own scale
 SCALE = (0.5, 2.0, 1.5, 0.7, 1.3, 0.3, 1.1, 0.9, 0.02, 0.05, 0.01, 0.1)
 
@@ -86,7 +86,7 @@ def test_fast_lnn_equals_the_paper_formulation(fw):
 
 def test_torch_hnn_hand_written_gradient_equals_autograd():
     spec, p, q, v, e = _case("hnn", seed=3, extra_inputs=1, lorentz_factor=True, input_scale=SCALE)
-    m = models.torch.build(spec, p)
+    m = lagbench.models.torch.build(spec, p)
     x, y = torch.tensor(q, requires_grad=True), torch.tensor(v, requires_grad=True)
     dh_dx, dh_dy = torch.autograd.grad(m.hamiltonian(x, y, torch.tensor(e)).sum(), (x, y))
     xdot, ydot = m.time_derivative(torch.tensor(q), torch.tensor(v), torch.tensor(e))

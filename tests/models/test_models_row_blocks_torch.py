@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 import torch
 
-from models import ModelSpec
-from models.row_blocks import block_plan, block_size, rows_per_sample
-from models.torch.compiled import BlockedMethod, compile_batched
-from models.torch.lnn import solve_with_fallback
+from lagbench.models import ModelSpec
+from lagbench.models.row_blocks import block_plan, block_size, rows_per_sample
+from lagbench.models.torch.compiled import BlockedMethod, compile_batched
+from lagbench.models.torch.lnn import solve_with_fallback
 
 RNG = np.random.default_rng(11)
 
@@ -35,7 +35,7 @@ def test_rows_per_sample_follow_the_jax_models(kind, form, dof, rows):
 def test_in_row_blocks_mirrors_jax_with_padding_and_none_arguments():
     """`models.torch.blocking.in_row_blocks`, the mirror of `models.jax.blocking.in_row_blocks`: blocks
     equal one call, padding sliced off, None arguments passed through, small batches in one call."""
-    from models.torch.blocking import in_row_blocks
+    from lagbench.models.torch.blocking import in_row_blocks
 
     n = 3 * block_size(5) + 7                               # forces blocks and a padded last block
     a, b = torch.tensor(RNG.normal(size=(n, 3))), torch.tensor(RNG.normal(size=(n, 2, 2)))

@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-from models import ModelSpec, init_params
-from models.jax.mlp import mlp
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.jax.mlp import mlp
 
-FW = {"jax": (models.jax, jnp.asarray, np.asarray), "torch": (models.torch, torch.tensor, lambda t: t.detach().numpy())}
+FW = {"jax": (lagbench.models.jax, jnp.asarray, np.asarray), "torch": (lagbench.models.torch, torch.tensor, lambda t: t.detach().numpy())}
 
 
 def _states(dof, extra, seed, n=9):

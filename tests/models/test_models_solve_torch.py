@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from models.torch.lnn import small_inverse, solve_with_fallback
+from lagbench.models.torch.lnn import small_inverse, solve_with_fallback
 
 RNG = np.random.default_rng(11)
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import torch
 
-import models.jax
-import models.torch
-from models import ACTIVATIONS, INITS, KINDS, ModelSpec, init_params, param_shapes
+import lagbench.models.jax
+import lagbench.models.torch
+from lagbench.models import ACTIVATIONS, INITS, KINDS, ModelSpec, init_params, param_shapes
 
 
 @pytest.mark.parametrize("bad, match", [
@@ -41,12 +41,12 @@ def test_layout_and_round_trip_through_both_frameworks(kind, init):
     params = init_params(spec, seed=3)
     assert {k: v.shape for k, v in params.items()} == param_shapes(spec)
     assert all(v.dtype == np.float64 for v in params.values())
-    for mod in (models.jax, models.torch):
+    for mod in (lagbench.models.jax, lagbench.models.torch):
         back = mod.to_params(mod.build(spec, params))
         assert back.keys() == params.keys()
         for k in params:
             np.testing.assert_array_equal(back[k], params[k])
-    mt = models.torch.build(spec, params)
+    mt = lagbench.models.torch.build(spec, params)
     assert all(p.requires_grad and p.dtype == torch.float64 for p in mt.parameters())
     np.testing.assert_array_equal(init_params(spec, seed=3)["mlp.0.weight"], params["mlp.0.weight"])
 
@@ -54,15 +54,15 @@ def test_layout_and_round_trip_through_both_frameworks(kind, init):
 def test_both_registries_come_from_the_capability_table():
     """A kind is one row of `models.spec.CAPABILITIES`: both build registries list exactly its kinds, each
     the class the row names from `models/<framework>/<kind>.py`; the kind-specific checks read the row."""
-    from models.jax.build import CLASSES as JAX_CLASSES
-    from models.spec import CAPABILITIES
-    from models.torch.build import CLASSES as TORCH_CLASSES
+    from lagbench.models.jax.build import CLASSES as JAX_CLASSES
+    from lagbench.models.spec import CAPABILITIES
+    from lagbench.models.torch.build import CLASSES as TORCH_CLASSES
 
     assert KINDS == tuple(CAPABILITIES) == ("baseline", "lnn", "hnn", "delan", "lgn")
     for classes, fw in ((JAX_CLASSES, "jax"), (TORCH_CLASSES, "torch")):
         assert tuple(classes) == KINDS
         for kind, cls in classes.items():
-            assert (cls.__module__, cls.__name__) == (f"models.{fw}.{kind}", CAPABILITIES[kind].model_class)
+            assert (cls.__module__, cls.__name__) == (f"lagbench.models.{fw}.{kind}", CAPABILITIES[kind].model_class)
     for kind in ("delan", "lgn"):
         with pytest.raises(ValueError, match="takes no extra_inputs"):
             ModelSpec(kind=kind, dof=2, hidden=(8,), extra_inputs=1)
@@ -104,7 +104,7 @@ def test_activations_cover_the_paper_study():
 def test_build_rejects_wrong_params():
     spec = ModelSpec(kind="lnn", dof=2, hidden=(8,))
     params = init_params(spec)
-    for mod in (models.jax, models.torch):
+    for mod in (lagbench.models.jax, lagbench.models.torch):
         with pytest.raises(ValueError, match="expected shape"):
             mod.build(spec, params | {"mlp.0.weight": np.zeros((8, 5), np.float32)})
         with pytest.raises(ValueError, match="missing"):
@@ -113,7 +113,7 @@ def test_build_rejects_wrong_params():
 
 @pytest.mark.parametrize("fw", ["jax", "torch"])
 def test_bad_inputs_give_clear_errors(fw):
-    mod, arr = (models.jax, jnp.asarray) if fw == "jax" else (models.torch, torch.tensor)
+    mod, arr = (lagbench.models.jax, jnp.asarray) if fw == "jax" else (lagbench.models.torch, torch.tensor)
     spec = ModelSpec(kind="lnn", dof=2, hidden=(8,), dtype="float64")
     m = mod.build(spec, init_params(spec))
     q = arr(np.zeros((4, 2)))

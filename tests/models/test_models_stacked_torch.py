@@ -7,9 +7,9 @@ import pytest
 import torch
 from models_testkit import assert_rel, make_inputs
 
-import models.torch
-from models import ModelSpec, init_params
-from replication.training.objective import loss_value
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training.objective import loss_value
 
 K = 3
 CASES = {
@@ -47,7 +47,7 @@ def _loss(model, x, axis=None):
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_each_stacked_member_equals_its_own_model(case):
     spec, params, inputs = _members(CASES[case])
-    stacked = models.torch.build_stacked(spec, params)
+    stacked = lagbench.models.torch.build_stacked(spec, params)
     x = {k: None if inputs[0][k] is None else torch.tensor(np.stack([i[k] for i in inputs])) for k in inputs[0]}
     pred, n_bad, losses = _loss(stacked, x, axis=-1)
     assert losses.shape == (K,)
@@ -55,7 +55,7 @@ def test_each_stacked_member_equals_its_own_model(case):
     grads = {k: p.grad for k, p in stacked.named_parameters()}
     total_bad = 0
     for i in range(K):
-        alone = models.torch.build(spec, params[i])
+        alone = lagbench.models.torch.build(spec, params[i])
         xi = {k: None if v is None else torch.tensor(v) for k, v in inputs[i].items()}
         p_i, bad_i, loss_i = _loss(alone, xi)
         loss_i.backward()
@@ -74,8 +74,8 @@ def test_each_stacked_member_equals_its_own_model(case):
 
 def test_kinds_whose_maths_is_not_written_for_members_are_refused():
     spec = ModelSpec(kind="hnn", dof=2, hidden=(8, 8), dtype="float64")
-    assert not models.torch.stacks(spec)
+    assert not lagbench.models.torch.stacks(spec)
     with pytest.raises(ValueError, match="does not take stacked members"):
-        models.torch.build_stacked(spec, [init_params(spec, seed=0)])
+        lagbench.models.torch.build_stacked(spec, [init_params(spec, seed=0)])
     paper = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), dtype="float64", formulation="paper")
-    assert not models.torch.stacks(paper)
+    assert not lagbench.models.torch.stacks(paper)

@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 import torch
 
-import models.torch
-from models import ModelSpec, init_params
-from models.graph import periodic_neighbours
-from models.torch.compiled import compile_batched, trace_flat
-from models.torch.lgn import _neighbours
-from models.torch.lnn import solve_with_fallback
-from speedstudy.evaluators import make_evaluator
+import lagbench.models.torch
+from lagbench.models import ModelSpec, init_params
+from lagbench.models.graph import periodic_neighbours
+from lagbench.models.torch.compiled import compile_batched, trace_flat
+from lagbench.models.torch.lgn import _neighbours
+from lagbench.models.torch.lnn import solve_with_fallback
+from lagbench.speedstudy.evaluators import make_evaluator
 
 RNG = np.random.default_rng(5)
 
@@ -26,7 +26,7 @@ def _states(b, d):
 @pytest.mark.parametrize("kind, form, dof", [("lnn", "paper", 2), ("lgn", "dense", 8)])
 def test_torch_func_models_compile_once_traced(kind, form, dof):
     spec = ModelSpec(kind=kind, dof=dof, hidden=(16, 16), dtype="float64", init="xavier", formulation=form)
-    m = models.torch.build(spec, init_params(spec, seed=1))
+    m = lagbench.models.torch.build(spec, init_params(spec, seed=1))
     with pytest.raises(Exception):  # noqa: B017 - what torch.export raises on torch.func is torch's to name
         compile_batched(m.acceleration, 2, dof, "float64", batch=3)
     f = compile_batched(m.acceleration, 2, dof, "float64", batch=3, flatten=True)

@@ -8,8 +8,8 @@ agreement of the frameworks is the parity tests' (`tests/replication/training/te
 """
 import pytest
 
-from replication.claims import CLAIMS
-from replication.run import runner
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.run import runner
 
 BOTH = ("appendix_b",)
 ONE_FRAMEWORK = {"dp_loss": "jax", "dp_energy": "jax",   # one training chain (claim 2 rolls out claim 1's models)

@@ -3,9 +3,9 @@ import json
 
 import pytest
 
-from replication.cli import build_parser, main
-from replication.run.estimate import describe, estimate, scheduled_wall
-from replication.run.runner import plan
+from lagbench.cli import build_parser, main
+from lagbench.replication.run.estimate import describe, estimate, scheduled_wall
+from lagbench.replication.run.runner import plan
 
 
 def test_list_names_everything(capsys):
@@ -40,7 +40,7 @@ def test_estimate_counts_each_training_once_and_skips_cached_ones(tmp_path):
     assert est["wall_s"] >= est["train_s"]          # one worker: the sum
     assert "dp_loss" in describe(units, units[:1]) and "(0 to run)" in describe(units, units[:1])
     # once the training is in OUT/trained it costs nothing
-    from replication.training.train import train_cached
+    from lagbench.replication.training.train import train_cached
     u = units[0]
     train_cached(tmp_path, u.framework, u.spec(), u.protocol(), u.seed)
     again = estimate(units, tmp_path)
@@ -57,7 +57,7 @@ def test_wall_replays_the_pool_schedule():
 
 
 def test_estimate_wall_follows_the_executor_chains(tmp_path, monkeypatch):
-    from replication.run import estimate as E
+    from lagbench.replication.run import estimate as E
 
     monkeypatch.setattr(E, "_plain_step", lambda *a: 1.0)
     monkeypatch.setattr(E, "_members_step", lambda *a: 1.0)
@@ -70,7 +70,7 @@ def test_estimate_wall_follows_the_executor_chains(tmp_path, monkeypatch):
 
 def test_estimate_says_where_the_time_goes_by_claim(tmp_path, monkeypatch):
     # a shared training counts once, for the first claim planned with it; the claims' seconds add up
-    from replication.run import estimate as E
+    from lagbench.replication.run import estimate as E
 
     monkeypatch.setattr(E, "_plain_step", lambda *a: 1.0)
     monkeypatch.setattr(E, "_members_step", lambda *a: 1.0)
@@ -82,8 +82,8 @@ def test_estimate_says_where_the_time_goes_by_claim(tmp_path, monkeypatch):
 
 
 def test_a_resumed_run_on_the_same_machine_reuses_its_probes_and_another_machine_probes_again(tmp_path, monkeypatch):
-    from replication.run import environment as env
-    from replication.run import estimate as E
+    from lagbench.replication.run import environment as env
+    from lagbench.replication.run import estimate as E
 
     calls = []
     monkeypatch.setattr(E, "_plain_step", lambda *a: calls.append("plain") or 2.0)
@@ -109,8 +109,8 @@ def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, m
     # workers train on one PyTorch thread; probes at this process's default ran up to 34x slow (estimate.py)
     import torch
 
-    from replication.run import estimate as E
-    from replication.run.environment import worker_torch_threads
+    from lagbench.replication.run import estimate as E
+    from lagbench.replication.run.environment import worker_torch_threads
 
     seen = []
     monkeypatch.setattr(E, "_plain_step", lambda *a: seen.append(torch.get_num_threads()) or 1e-3)
@@ -143,8 +143,8 @@ def test_full_profile_inherits_quick_where_a_claim_is_silent():
 
 
 def test_a_run_trains_in_its_profiles_frameworks_unless_told():
-    from replication.claims.base import PROFILE_FRAMEWORKS
-    from replication.claims.registration import fingerprint
+    from lagbench.replication.claims.base import PROFILE_FRAMEWORKS
+    from lagbench.replication.claims.registration import fingerprint
 
     # quick, the preliminary profile, decides in JAX alone; the profiles of record in both frameworks
     assert PROFILE_FRAMEWORKS["quick"] == ("jax",)
@@ -155,7 +155,7 @@ def test_a_run_trains_in_its_profiles_frameworks_unless_told():
     assert {u.framework for u in plan("quick", claims=["hnn_energy"], frameworks=("jax", "torch"))} == {"jax", "torch"}
     assert {u.framework for u in plan("full", claims=["hnn_energy"], frameworks=("torch",))} == {"torch"}
     # the frameworks a claim is decided in are part of what is registered for it
-    from replication.claims import get
+    from lagbench.replication.claims import get
     assert fingerprint(get("hnn_energy"), "quick")["frameworks"] == ["jax"]
     assert fingerprint(get("hnn_energy"), "full")["frameworks"] == ["jax", "torch"]
 
@@ -170,21 +170,21 @@ def test_train_target_command_writes_rows_and_log(tmp_path, capsys):
     log = pd.read_csv(out / "train_target" / "train_target_log.csv")
     assert set(rows["protocol"]) == {"variant"} and (rows["budget"] == 1024).all()
     assert log["samples"].max() == 1024 and log["heldout_l1"].notna().all()
-    from models import ModelSpec
-    from replication.results import load_npz
+    from lagbench.files.results import load_npz
+    from lagbench.models import ModelSpec
 
     spec = ModelSpec.from_dict(json.loads((out / "train_target" / "variant.spec.json").read_text()))
     params = load_npz(out / "train_target" / "variant.npz")
     assert spec.kind == "lnn" and spec.hidden == (8, 8)
-    import models.jax
-    from replication.training import device
-    from speedstudy import train_target as TT
-    from speedstudy.target_loop import heldout_l1
+    import lagbench.models.jax
+    from lagbench.replication.training import device
+    from lagbench.speedstudy import train_target as TT
+    from lagbench.speedstudy.target_loop import heldout_l1
 
     proto = TT.protocols(1024, 64)["variant"].protocol  # the saved model gives the final held-out L1 again
     # where and as the command computed it (on a GPU it asks for full float32 products, not the default TF32)
     with device.placed("jax", device.resolve(device.request(), "jax")):
-        l1 = heldout_l1(spec, proto)(models.jax.build(spec, params))
+        l1 = heldout_l1(spec, proto)(lagbench.models.jax.build(spec, params))
     assert l1 == pytest.approx(rows["final_l1"].iloc[0], rel=1e-5)
     assert "variant" in capsys.readouterr().out
 
@@ -203,8 +203,8 @@ def test_one_meaning_per_option_name_and_the_old_spellings_still_read(capsys):
     """`run --split` is the development or test split, `train-target --heldout-states` a count of states, so
     fit's row hold-out is --holdout and its fraction --holdout-fraction; their old spellings are read with a
     notice, never both at once."""
-    from replication.cli import build_parser
-    from replication.fit import options
+    from lagbench.cli import build_parser
+    from lagbench.replication.fit import options
 
     args = build_parser().parse_args(["fit", "--data", "x.csv", "--model", "lnn", "--split", "random", "--heldout", "0.3"])
     got = options.from_args(args)

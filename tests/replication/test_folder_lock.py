@@ -9,8 +9,8 @@ import time
 
 import numpy as np
 
-from replication import results as R
-from replication.fit.task import fit
+from lagbench.files import results as R
+from lagbench.replication.fit.task import fit
 
 
 def _data(path):
@@ -21,7 +21,7 @@ def _data(path):
 
 
 def _fit_cli(data, out, steps=2):
-    return [sys.executable, "-m", "replication.cli", "fit", "--data", str(data), "--model", "baseline",
+    return [sys.executable, "-m", "lagbench", "fit", "--data", str(data), "--model", "baseline",
             "--steps", str(steps), "--hidden", "8", "--batch", "16", "--restarts", "0", "--framework", "torch",
             "--quiet", "--device", "cpu", "--out", str(out)]
 
@@ -73,10 +73,10 @@ def test_two_fits_into_one_folder_at_once_never_both_report_success(tmp_path):
 def test_a_run_into_a_locked_folder_is_refused_before_it_plans(tmp_path, monkeypatch):
     """`lagbench run` plans every claim's units before it takes its folder; a folder another command holds
     is refused first, with the same line, and planning never starts."""
-    from replication.run import runner
+    from lagbench.replication.run import runner
 
     out = tmp_path / "out"
-    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from replication import results as R\n"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from lagbench.files import results as R\n"
                                "with R.writing():\n    R.output_folder(sys.argv[1]); print('held', flush=True); "
                                "time.sleep(60)", str(out)], stdout=subprocess.PIPE, text=True)
     try:

@@ -3,11 +3,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.fit import userdata
-from replication.fit.task import fit
-from replication.run.runner import plan
-from replication.training.protocol import Data, Protocol
+from lagbench.cli import main
+from lagbench.files import user_data
+from lagbench.replication.fit.task import fit
+from lagbench.replication.run.runner import plan
+from lagbench.replication.training.protocol import Data, Protocol
 
 
 @pytest.mark.parametrize("kwargs, words", [
@@ -58,13 +58,13 @@ def test_user_data_errors(tmp_path):
         fit(tmp_path / "d.npz")
     (tmp_path / "e.npz").write_bytes(b"not a zip")
     with pytest.raises(ValueError, match="cannot read"):
-        userdata.load(str(tmp_path / "e.npz"))
+        user_data.load(str(tmp_path / "e.npz"))
     with pytest.raises(ValueError, match="--model"):
         fit(_write(tmp_path, "f.csv", **ok), model="gpt")
 
 
 def test_fit_trains_on_a_user_file_in_both_frameworks(tmp_path):
-    import systems
+    from lagbench import systems
 
     s = systems.get("pendulum")
     st = s.sample_states(400, np.random.default_rng(1))

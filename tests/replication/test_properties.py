@@ -9,11 +9,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import systems
-from replication.evaluation import metrics
-from replication.fit import userdata
-from replication.training.protocol import Data, Protocol
-from replication.training.schedules import SCHEDULES, Constant, OneCycle, StepDecay, learning_rate
+from lagbench import systems
+from lagbench.files import user_data
+from lagbench.replication.evaluation import metrics
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.replication.training.schedules import SCHEDULES, Constant, OneCycle, StepDecay, learning_rate
 
 CLEAN = (ValueError, TypeError, KeyError)
 FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -109,12 +109,12 @@ def test_user_data_loads_or_names_the_problem(tmp_path, data, suffix):
         cols = {f"{k}{j}": pd.Series(v[:, j]) for k, v in data.items() for j in range(v.shape[1])}
         pd.DataFrame(cols).to_csv(path, index=False)
     try:
-        d = userdata.load(str(path))
+        d = user_data.load(str(path))
     except Exception as e:  # noqa: BLE001
         _clean(e)
         assert str(path) in str(e)
         return
-    assert set(userdata.REQUIRED) <= set(d)
+    assert set(user_data.REQUIRED) <= set(d)
     shapes = {v.shape for v in d.values()}
     assert len(shapes) == 1 and next(iter(shapes))[0] >= 20
     assert all(np.all(np.isfinite(v)) for v in d.values())
@@ -124,7 +124,7 @@ def test_user_data_with_text_in_a_column(tmp_path):
     path = tmp_path / "text.csv"
     pd.DataFrame({"q0": ["a"] * 30, "qdot0": np.ones(30), "qddot0": np.ones(30)}).to_csv(path, index=False)
     with pytest.raises(ValueError, match="q0"):
-        userdata.load(str(path))
+        user_data.load(str(path))
 
 
 # --- metrics ------------------------------------------------------------------------------------------

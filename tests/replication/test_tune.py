@@ -5,14 +5,14 @@ import json
 
 import pytest
 
-from replication.claims import get, untuned
-from replication.claims.registration import protocol_hash
-from replication.cli import main
-from replication.run import splits
-from replication.training import data as datamod
-from replication.tuning import choose, records, search
-from replication.tuning import tune as tune_module
-from replication.tuning.tune import tune
+from lagbench.cli import main
+from lagbench.replication.claims import get, untuned
+from lagbench.replication.claims.registration import protocol_hash
+from lagbench.replication.run import splits
+from lagbench.replication.training import data as datamod
+from lagbench.replication.tuning import choose, records, search
+from lagbench.replication.tuning import tune as tune_module
+from lagbench.replication.tuning.tune import tune
 
 
 def test_configs_start_from_the_registered_setting_and_are_distinct():
@@ -77,7 +77,7 @@ def test_the_whole_search_extends_an_edge_for_every_model_and_confirms_on_three_
     again = tune("dp_loss", profile="smoke", out=tmp_path / "fresh", progress=False, record=record)
     assert again["models"] == ledger["models"]
     assert json.loads((record.parent / "ledger.json").read_text())["models"] == json.loads(json.dumps(ledger["models"]))
-    from replication.tuning import summary
+    from lagbench.replication.tuning import summary
     text = summary.table([record.parent / "ledger.json"])
     assert "| dp_loss | smoke | lnn | 11 | lr x1, width x4 |" in text and "| dp_loss | smoke | baseline | 11 | lr x1, width x1 |" in text
 
@@ -138,7 +138,7 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
     assert protocol_hash(get("dp_loss"), "smoke") == before   # the claim is untouched
     # a rerun into the same folder reads the finished units back: nothing trained or evaluated again
     ran = []
-    monkeypatch.setattr("replication.tuning.tune.run_units", lambda units, *a, **k: ran.append(units))
+    monkeypatch.setattr("lagbench.replication.tuning.tune.run_units", lambda units, *a, **k: ran.append(units))
     again = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
     assert ran == [] and again["models"] == ledger["models"]
     # a changed protocol is another unit: its recorded row is not reused
@@ -168,7 +168,7 @@ def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_p
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--widths" in err
     trained = []   # the units each configuration trains (the training itself is the search test's above)
-    monkeypatch.setattr("replication.tuning.tune.run_units", lambda units, *a, **k: trained.append(units))
+    monkeypatch.setattr("lagbench.replication.tuning.tune.run_units", lambda units, *a, **k: trained.append(units))
     ledger = tune("dp_loss", profile="smoke", n_seeds=1, out=tmp_path, progress=False, widths=["2"])
     assert ledger["kind"] == "width sweep" and ledger["search"] == {"lr": [1.0], "width": [1.0, 2.0]}
     assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
@@ -198,9 +198,9 @@ def test_claim_13s_online_learners_are_searched_and_learn_at_their_protocols_rat
     a training's, and the online learner takes the unit's rate and widths."""
     from types import SimpleNamespace
 
-    from replication.claims import tuned
-    from replication.evaluation import online_claim
-    from replication.studies import online_learner
+    from lagbench.replication.claims import tuned
+    from lagbench.replication.evaluation import online_claim
+    from lagbench.replication.studies import online_learner
 
     claim = untuned("delan_online")
     assert [m.label for m in claim.models if tuned.searched(claim, m, "quick")] == ["delan", "ff"]

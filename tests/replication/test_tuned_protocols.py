@@ -8,9 +8,9 @@ from types import SimpleNamespace
 
 import pytest
 
-from replication.claims import CLAIMS, get, tuned, untuned
-from replication.training.protocol import canonical_hash
-from replication.tuning import adopt
+from lagbench.replication.claims import CLAIMS, get, tuned, untuned
+from lagbench.replication.training.protocol import canonical_hash
+from lagbench.replication.tuning import adopt
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -141,7 +141,7 @@ def test_the_running_claims_are_the_written_ones_with_the_adopted_knobs():
 
 
 def test_report_flags_a_model_tuned_less_than_its_rivals():
-    from reports import sections_registration as sr
+    from lagbench.reports import sections_registration as sr
 
     def prereg(tuning):
         return {"protocol_hash": "x", "registered": True, "frozen": "2026-01-01", "registrations": 1, "tuning": tuning}
@@ -164,7 +164,7 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
 
 
 def test_the_scorecard_says_in_one_paragraph_how_each_claim_was_chosen():
-    from reports import sections_registration as sr
+    from lagbench.reports import sections_registration as sr
 
     t = {"configs_tried": 4, "scored_on": "dev", "knobs": {"lr": 1.0, "width": 2.0}, "seeds": [0]}
     hand = {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": []}
@@ -186,7 +186,7 @@ def test_every_data_file_the_package_reads_ships_in_it():
 
     data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
     for f in ROOT.glob("replication/**/*.json"):
-        package = ".".join(f.parent.relative_to(ROOT).parts)
+        package = ".".join(("lagbench", *f.parent.relative_to(ROOT).parts))
         assert f.name in data.get(package, []), f"{f.relative_to(ROOT)} is not package data in pyproject.toml"
 
 

@@ -1,4 +1,4 @@
-"""The one boundary with a user's code (`replication.user_functions`): an exception in it is one line naming the
+"""The one boundary with a user's code (`lagbench.files.user_functions`): an exception in it is one line naming the
 user's file, line, function and the exception, and whether a rerun can help; its traceback is the user's; a
 module loads from the user's folder first, and a name that collides with a suite package is refused."""
 import sys
@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from replication.user_functions import (
+from lagbench.files.user_functions import (
     NO_RERUN,
     UserCodeError,
     array_of,
@@ -81,15 +81,26 @@ def test_a_module_that_raises_on_import_is_one_line(tmp_path, monkeypatch):
             import_function(ref, "--predict")
 
 
-def test_a_users_file_named_like_a_suite_package_loads_from_its_path_or_is_refused(tmp_path, monkeypatch):
+def test_a_users_module_named_like_a_suite_folder_is_the_users(tmp_path, monkeypatch):
+    """The suite installs only `lagbench`: a user's systems.py or models/ is theirs by module name."""
     (tmp_path / "systems.py").write_text("def make(dof):\n    return 'mine'\n")
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "__init__.py").write_text("def make(dof):\n    return 'my models'\n")
     monkeypatch.chdir(tmp_path)
-    assert import_function("systems.py:make", "--add-model")(1) == "mine"   # by path: the user's file
-    with pytest.raises(ValueError, match="systems.py in the working folder has the name of the suite's package "
-                                         "'systems'.*give its path \\(systems.py:make\\)"):
-        import_function("systems:make", "--add-model")
+    assert import_function("systems:make", "--add-model")(1) == "mine"
+    assert import_function("models:make", "--add-model")(1) == "my models"
+    assert import_function("systems.py:make", "--add-model")(1) == "mine"
+
+
+def test_a_users_file_named_like_the_suite_package_loads_from_its_path_or_is_refused(tmp_path, monkeypatch):
+    (tmp_path / "lagbench.py").write_text("def make(dof):\n    return 'mine'\n")
+    monkeypatch.chdir(tmp_path)
+    assert import_function("lagbench.py:make", "--add-model")(1) == "mine"   # by path: the user's file
+    with pytest.raises(ValueError, match="lagbench.py in the working folder has the name of the suite's package "
+                                         "'lagbench'.*give its path \\(lagbench.py:make\\)"):
+        import_function("lagbench:make", "--add-model")
     monkeypatch.chdir(tmp_path.parent)   # no file of that name here: the suite's own module, as named
-    assert import_function("systems:get", "--predict").__module__.startswith("systems")
+    assert import_function("lagbench.systems:get", "--predict").__module__.startswith("lagbench.systems")
 
 
 def test_a_module_of_the_working_folder_is_imported_before_an_installed_one(tmp_path, monkeypatch):

@@ -21,7 +21,7 @@ def small_results_dir(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def built(results_dir, tmp_path_factory) -> dict:
-    from reports import build_report
+    from lagbench.reports import build_report
 
     out = tmp_path_factory.mktemp("report")
     return build_report(results_dir, out)

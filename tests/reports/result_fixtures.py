@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from replication.training.protocol import Data, Protocol
+from lagbench.replication.training.protocol import Data, Protocol
 
 FRAMEWORKS = ["jax", "torch"]
 PROTOCOL = Protocol(data=Data("double_pendulum_iid", n_train=10000), steps=100, batch=32).to_dict()

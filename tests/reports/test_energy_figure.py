@@ -3,8 +3,8 @@ rollouts and seeds, a diverged rollout counted in the legend and kept out of the
 import numpy as np
 import pandas as pd
 
-from reports import figures as F
-from reports.load import Unit
+from lagbench.reports import figures as F
+from lagbench.reports.load import Unit
 
 
 def _unit(tmp_path, model, seed, errors):

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reports import figures_delan as FD
+from lagbench.reports import figures_delan as FD
 
 
 @dataclass

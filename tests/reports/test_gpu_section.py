@@ -6,9 +6,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from reports.compare import gpu_vs_cpu_table
-from reports.load import load_results
-from reports.sections_speed import speed_sections
+from lagbench.reports.compare import gpu_vs_cpu_table
+from lagbench.reports.load import load_results
+from lagbench.reports.sections_speed import speed_sections
 
 MEASURED = Path(__file__).resolve().parents[2] / "docs" / "speed" / "gpu_h100"
 

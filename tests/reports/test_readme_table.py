@@ -4,7 +4,7 @@ report."""
 import json
 from pathlib import Path
 
-from reports import readme_table
+from lagbench.reports import readme_table
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLE = ROOT / "docs" / "sample_report"
@@ -16,7 +16,7 @@ def test_readme_table_is_the_generated_one():
     a = text.index(readme_table.BEGIN)
     b = text.index(readme_table.END) + len(readme_table.END)
     assert text[a:b] == readme_table.block(SAMPLE), ("the README's claims table differs from the sample run's; "
-                                                      "regenerate it: python -m reports.readme_table docs/sample_report")
+                                                      "regenerate it: python -m lagbench.reports.readme_table docs/sample_report")
 
 
 def test_the_sample_is_a_test_split_run_and_its_report_shows_the_same_verdicts():

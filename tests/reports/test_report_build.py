@@ -9,14 +9,14 @@ from pathlib import Path
 
 from result_fixtures import CLAIMS, CORRUPT, NOT_RUN_CLAIM, write_json
 
-from reports import build_report
-from reports.pdf import page_count
+from lagbench.reports import build_report
+from lagbench.reports.pdf import page_count
 
 # the report recomputes verdicts with replication.claims.verdicts and the claim records (pure NumPy/pandas);
 # it never loads a framework, the systems or models, or the training and evaluation code
-HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "replication.training.train",
-         "replication.training.train_jax", "replication.training.train_torch", "replication.evaluation.routines", "replication.run.units",
-         "replication.run.runner", "replication.training.data"]
+HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "lagbench.replication.training.train",
+         "lagbench.replication.training.train_jax", "lagbench.replication.training.train_torch", "lagbench.replication.evaluation.routines", "lagbench.replication.run.units",
+         "lagbench.replication.run.runner", "lagbench.replication.training.data"]
 
 
 def table_rows(md: str, title: str) -> dict[str, list[str]]:
@@ -171,8 +171,8 @@ def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(small_re
 
 
 def test_cross_framework_table_flags_a_difference_beyond_the_seed_spread(results_dir):
-    from reports.compare import cross_framework_table
-    from reports.load import load_results
+    from lagbench.reports.compare import cross_framework_table
+    from lagbench.reports.load import load_results
 
     df = cross_framework_table(load_results(results_dir)).set_index(["claim", "model"])
     row = df.loc[("dp_loss", "baseline")]
@@ -186,9 +186,9 @@ def test_cross_framework_table_flags_a_difference_beyond_the_seed_spread(results
 
 
 def test_the_metric_dumps_sit_in_an_appendix_and_shared_trainings_are_drawn_once(results_dir, tmp_path):
-    from reports.build import build_sections
-    from reports.load import load_results
-    from reports.sections_claims import claim_section
+    from lagbench.reports.build import build_sections
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_claims import claim_section
 
     sections = build_sections(results_dir, tmp_path / "a")
     titles = [s.title for s in sections]

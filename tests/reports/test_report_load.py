@@ -5,8 +5,8 @@ import json
 import pandas as pd
 from result_fixtures import CORRUPT, NOT_RUN_CLAIM, checksum, write_results
 
-from reports.integrity import canonical_json, result_checksum
-from reports.load import load_results
+from lagbench.reports.integrity import canonical_json, result_checksum
+from lagbench.reports.load import load_results
 
 
 def test_canonical_form_is_sorted_compact_json_without_checksum():

@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from replication.cli import main
-from reports import build_report
+from lagbench.cli import main
+from lagbench.reports import build_report
 
 
 def test_a_symlinked_report_is_replaced_not_written_through(tmp_path):
@@ -58,8 +58,8 @@ def test_report_refuses_a_results_folder_that_is_not_one(tmp_path, capsys, make,
 def test_a_killed_builds_temporaries_and_staging_folder_are_cleaned_by_the_next(tmp_path):
     """A build killed part-way (issue 58, item 7; issue 85, item 5): its half-written temporaries go at the next
     build, and so does its staging folder with what it wrote there; nothing of it reached the report."""
-    from replication.results import writing
-    from reports import output
+    from lagbench.files.results import writing
+    from lagbench.reports import output
 
     out = tmp_path / "out"
     with writing():   # the killed build's process: its lock goes with it
@@ -82,7 +82,7 @@ def test_report_prints_a_path_with_undecodable_bytes_escaped(small_results_dir, 
 
     out = os.fsencode(str(tmp_path)) + b"/rep\xffort"
     env = {**os.environ, "PYTHONIOENCODING": "utf-8"}
-    r = subprocess.run([sys.executable, "-m", "replication.cli", "report", "--results", str(small_results_dir),
+    r = subprocess.run([sys.executable, "-m", "lagbench", "report", "--results", str(small_results_dir),
                         "--out", os.fsdecode(out)], capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, r.stderr
     assert "\\udcff" in r.stdout and os.path.isdir(out)
@@ -91,7 +91,7 @@ def test_report_prints_a_path_with_undecodable_bytes_escaped(small_results_dir, 
 def test_the_pdf_shows_characters_its_fonts_lack_as_code_points():
     """CJK in a user's path (issue 58, item 7): U+XXXX in the PDF's source instead of empty boxes; the
     report's own symbols stay as they are."""
-    from reports.pdf import lit
+    from lagbench.reports.pdf import lit
 
     s = lit('data/中文-한국-ファイル.csv: "q̇" γ × 3 − 1 ≈ 2 😀')
     assert "U+4E2D" in s and "U+D55C" in s and "U+30D5" in s and "U+1F600" in s
@@ -126,7 +126,7 @@ def test_no_pdf_writes_the_markdown_alone_and_a_missing_typst_says_what_to_do(sm
 def _fake_pdf(label: bytes):
     """A stand-in for `write_pdf` (typst's compile is not what these tests are about): REPORT.typ and REPORT.pdf
     marked with `label`, written where the build asks."""
-    from reports import output
+    from lagbench.reports import output
 
     def write_pdf(title, sections, out_dir):
         return output.write(out_dir / "REPORT.typ", label), output.write(out_dir / "REPORT.pdf", b"%PDF " + label)
@@ -150,17 +150,17 @@ def _other_results(small_results_dir, tmp_path):
 
 def test_an_interrupted_rebuild_leaves_the_previous_report_whole(small_results_dir, tmp_path, monkeypatch, capsys):
     """Issue 85, item 5: never a new REPORT.md beside the previous build's REPORT.pdf."""
-    import reports.build
-    from reports import output
+    import lagbench.reports.build
+    from lagbench.reports import output
 
     out = tmp_path / "out"
-    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", _fake_pdf(b"first"))
     assert main(["report", "--results", str(small_results_dir), "--out", str(out)]) in (0, None)
     before = _files(out)
 
     def interrupted(title, sections, out_dir):
         raise KeyboardInterrupt
-    monkeypatch.setattr(reports.build, "write_pdf", interrupted)
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", interrupted)
     capsys.readouterr()
     assert main(["report", "--results", str(_other_results(small_results_dir, tmp_path)), "--out", str(out)]) == 130
     assert "the previous report is left whole" in capsys.readouterr().err
@@ -168,13 +168,13 @@ def test_an_interrupted_rebuild_leaves_the_previous_report_whole(small_results_d
 
 
 def test_without_typst_the_previous_pdf_goes_and_the_error_says_so(small_results_dir, tmp_path, monkeypatch, capsys):
-    import reports.build
+    import lagbench.reports.build
 
     out = tmp_path / "out"
-    real = reports.build.write_pdf
-    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    real = lagbench.reports.build.write_pdf
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", _fake_pdf(b"first"))
     first = build_report(small_results_dir, out)["markdown"].read_text()
-    monkeypatch.setattr(reports.build, "write_pdf", real)
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", real)
     monkeypatch.setitem(sys.modules, "typst", None)   # `import typst` raises ImportError
     capsys.readouterr()
     assert main(["report", "--results", str(_other_results(small_results_dir, tmp_path)), "--out", str(out)]) == 2
@@ -189,16 +189,16 @@ def test_a_signal_while_the_report_moves_in_arrives_after_it_is_whole(small_resu
     import signal
     import threading
 
-    import reports.build
-    import reports.output
-    from reports import output
+    import lagbench.reports.build
+    import lagbench.reports.output
+    from lagbench.reports import output
 
     if threading.current_thread() is not threading.main_thread():
         pytest.skip("signal handlers are set in the main thread only")
     out = tmp_path / "out"
-    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"first"))
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", _fake_pdf(b"first"))
     first = build_report(small_results_dir, out)["markdown"].read_text()
-    monkeypatch.setattr(reports.build, "write_pdf", _fake_pdf(b"second"))
+    monkeypatch.setattr(lagbench.reports.build, "write_pdf", _fake_pdf(b"second"))
     replace, sent = os.replace, []
 
     def replace_then_stop(src, dst):   # SIGTERM right after the first output is moved into the report's folder
@@ -213,7 +213,7 @@ def test_a_signal_while_the_report_moves_in_arrives_after_it_is_whole(small_resu
     def stop(signum, frame):
         raise Stopped
 
-    monkeypatch.setattr(reports.output.os, "replace", replace_then_stop)
+    monkeypatch.setattr(lagbench.reports.output.os, "replace", replace_then_stop)
     old = signal.signal(signal.SIGTERM, stop)
     try:
         with pytest.raises(Stopped):

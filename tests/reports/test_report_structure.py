@@ -3,9 +3,9 @@ numbers and figures) and speed against error, with every dump, table of counters
 import pytest
 from result_fixtures import CLAIMS, NOT_RUN_CLAIM
 
-from reports.build import TITLE, body_and_appendix
-from reports.document import Figure, Table
-from reports.pdf import page_count, write_pdf
+from lagbench.reports.build import TITLE, body_and_appendix
+from lagbench.reports.document import Figure, Table
+from lagbench.reports.pdf import page_count, write_pdf
 
 DUMPS = ("competence bars", "rollout metrics", "all recorded metrics", "Reasons in full", "Parts of the paper claims",
          "Registered protocols", "Tuning ledger", "Units per claim")
@@ -67,7 +67,7 @@ def test_the_body_is_short_and_the_appendix_starts_a_page(sections):
 
 
 def test_a_model_kind_keeps_its_colour_from_figure_to_figure():
-    from reports.figures import model_colours
+    from lagbench.reports.figures import model_colours
 
     a = model_colours(["lnn", "baseline"])
     b = model_colours(["baseline_spring", "hnn_spring"])
@@ -81,8 +81,8 @@ def test_a_model_kind_keeps_its_colour_from_figure_to_figure():
 def test_no_figure_keeps_a_linear_axis_over_more_than_three_decades(results_dir, tmp_path, monkeypatch):
     import numpy as np
 
-    from reports import figures as F
-    from reports.build import build_sections
+    from lagbench.reports import figures as F
+    from lagbench.reports.build import build_sections
 
     fig, (ax,) = F.new_figure()
     ax.plot([0, 1, 2], [1e-3, 1.0, 1e2])
@@ -100,7 +100,7 @@ def test_no_figure_keeps_a_linear_axis_over_more_than_three_decades(results_dir,
         out = real(fig, path)
         spans.extend(F.linear_span(a, axis) for a in fig.axes for axis in ("x", "y"))
         return out
-    from reports import figures_precision, figures_speed
+    from lagbench.reports import figures_precision, figures_speed
 
     for module in (F, figures_precision, figures_speed):
         monkeypatch.setattr(module, "save", check)

@@ -1,7 +1,7 @@
 """The fit section's models table counts a `--test` file's rows (recorded apart from the fit's split)."""
 from types import SimpleNamespace
 
-from reports.sections_fit import _models_table
+from lagbench.reports.sections_fit import _models_table
 
 
 def test_the_rows_column_counts_the_test_file():

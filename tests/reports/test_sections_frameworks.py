@@ -9,9 +9,9 @@ import pandas as pd
 import pytest
 from result_fixtures import CORRUPT, checksum, sha, write_json
 
-from reports.document import Bullets, Table
-from reports.load import Results, load_results
-from reports.sections_frameworks import (
+from lagbench.reports.document import Bullets, Table
+from lagbench.reports.load import Results, load_results
+from lagbench.reports.sections_frameworks import (
     PART,
     START_TOL,
     _flag,

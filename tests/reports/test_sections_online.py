@@ -7,9 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.studies import online as O
-from replication.studies.online_learner import claim_model, learner
+from lagbench.cli import main
+from lagbench.replication.studies import online as O
+from lagbench.replication.studies.online_learner import claim_model, learner
 
 
 @pytest.fixture(scope="module")
@@ -45,9 +45,9 @@ def test_the_learners_follow_the_arm_and_default_to_the_two_link_arm():
 
 
 def test_the_summary_reaches_the_report_as_its_own_section(tiny_run, tmp_path):
-    from reports.document import Table
-    from reports.load import load_results
-    from reports.sections_online import online_sections
+    from lagbench.reports.document import Table
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_online import online_sections
 
     (section,) = online_sections(load_results(tiny_run), tmp_path)
     assert section.title == "Learning online while tracking the four-joint arm (study)"
@@ -70,9 +70,9 @@ def test_a_bad_system_is_one_line(tmp_path, capsys):
 
 
 def test_a_summary_without_the_first_crossing_shows_its_t_reach_as_the_first_crossing(tmp_path):
-    from reports.document import Table
-    from reports.load import load_results
-    from reports.sections_online import FOLDER, online_sections
+    from lagbench.reports.document import Table
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_online import FOLDER, online_sections
 
     (tmp_path / FOLDER).mkdir()
     pd.DataFrame([{"controller": "ff", "framework": "jax", "seed": 0, "t_reach_s": 0.5, "t_settle_s": 9.0,

@@ -1,9 +1,9 @@
 """The stiff-solver study's output reaches the report, with the picked solver marked."""
 import json
 
-from replication.studies.stiff_solvers import stiff_study
-from reports.load import load_results
-from reports.sections_stiff import stiff_sections
+from lagbench.replication.studies.stiff_solvers import stiff_study
+from lagbench.reports.load import load_results
+from lagbench.reports.sections_stiff import stiff_sections
 
 
 def test_stiff_study_rows_reach_the_report(tmp_path):

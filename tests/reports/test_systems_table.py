@@ -5,9 +5,9 @@ import shutil
 import numpy as np
 import pandas as pd
 
-from replication.cli import main
-from replication.predictor.score import score
-from reports.systems_table import shown, systems_table
+from lagbench.cli import main
+from lagbench.replication.predictor.score import score
+from lagbench.reports.systems_table import shown, systems_table
 
 
 def test_one_row_per_claim_model_and_framework_with_its_seeds_spread(results_dir, tmp_path, capsys):
@@ -40,8 +40,8 @@ def test_the_table_names_what_it_leaves_out_in_the_reports_words(small_results_d
     """Issue 85, item 5: a unit whose checksum fails is flagged by `lagbench table` as the report flags it."""
     import json
 
-    from reports.load import load_results
-    from reports.tables import excluded_note, problem_units_table
+    from lagbench.reports.load import load_results
+    from lagbench.reports.tables import excluded_note, problem_units_table
 
     root = tmp_path / "r"
     shutil.copytree(small_results_dir, root)

@@ -1,8 +1,8 @@
 """The report reads `lagbench train-target --out ROOT` results (ROOT/train_target/): a table and the curve."""
 import pandas as pd
 
-from reports.load import load_results
-from reports.sections_speed import speed_sections
+from lagbench.reports.load import load_results
+from lagbench.reports.sections_speed import speed_sections
 
 THRESHOLDS = (10.0, 3.0, 1.0, 0.3, 0.073)
 

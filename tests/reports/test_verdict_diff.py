@@ -1,7 +1,7 @@
 """`reports.verdict_diff`: two runs' verdicts part by part, and the exit status that says whether they agree."""
 import json
 
-from reports import verdict_diff
+from lagbench.reports import verdict_diff
 
 
 def _verdicts(verdict, lo, hi, distance):

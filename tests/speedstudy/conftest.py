@@ -5,10 +5,10 @@ import json
 
 import pytest
 
-from models import ModelSpec, init_params
-from replication.results import write_npz
-from replication.training.protocol import Data, Protocol
-from speedstudy import run_bench
+from lagbench.files.results import write_npz
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.speedstudy import run_bench
 
 PROTOCOL = Protocol(data=Data("double_pendulum_iid", n_train=64), steps=10, batch=8).to_dict()
 

@@ -5,8 +5,8 @@ one. One small compile per timed thread count (pendulum, one degree of freedom).
 import numpy as np
 import pytest
 
-import systems
-from speedstudy.evaluators import TorchAotEvaluator, make_evaluator
+from lagbench import systems
+from lagbench.speedstudy.evaluators import TorchAotEvaluator, make_evaluator
 
 
 @pytest.mark.slow   # slow: a speed-study compile path (`lagbench bench`'s quick preset); the paths verdicts use stay in the default run

@@ -6,10 +6,19 @@ import shutil
 
 import pytest
 
-import speedstudy as B
-from speedstudy import inference as INF
-from speedstudy import latency, members, rollout, roofline, scaling, structure, train_target, training
-from speedstudy.resume import StageCache
+from lagbench import speedstudy as B
+from lagbench.speedstudy import inference as INF
+from lagbench.speedstudy import (
+    latency,
+    members,
+    rollout,
+    roofline,
+    scaling,
+    structure,
+    train_target,
+    training,
+)
+from lagbench.speedstudy.resume import StageCache
 
 STAGES = ["inference", "single-sample latency", "training", "rollouts", "scaling", "fast vs paper", "structure",
           "train to target", "members"]

@@ -2,8 +2,8 @@
 (inductor fixes a kernel's OpenMP thread count when it compiles), and a call picks the current count's."""
 import torch
 
-from speedstudy.evaluators import for_threads, per_thread_count
-from speedstudy.timing import torch_threads
+from lagbench.speedstudy.evaluators import for_threads, per_thread_count
+from lagbench.speedstudy.timing import torch_threads
 
 
 def test_one_library_per_thread_count_and_the_current_one_runs():

@@ -9,12 +9,12 @@ from dataclasses import replace
 import pandas as pd
 import pytest
 
-from reports.document import Table
-from reports.load import BENCH_COLUMNS, load_results
-from reports.sections_speed import speed_sections
-from speedstudy import bench as BENCH
-from speedstudy import control_rate as CR
-from speedstudy.timing import FULL, GPU, QUICK, STAGES, TINY
+from lagbench.reports.document import Table
+from lagbench.reports.load import BENCH_COLUMNS, load_results
+from lagbench.reports.sections_speed import speed_sections
+from lagbench.speedstudy import bench as BENCH
+from lagbench.speedstudy import control_rate as CR
+from lagbench.speedstudy.timing import FULL, GPU, QUICK, STAGES, TINY
 
 SECONDS = 0.1   # 50 ticks per loop, the first 25 left out
 TITLE = "Control-loop rate on one core (the DeLaN paper's robot: 500 Hz)"

@@ -6,7 +6,7 @@ import csv
 import numpy as np
 import pytest
 
-from speedstudy import delan_dof
+from lagbench.speedstudy import delan_dof
 
 
 def _read(path):

@@ -4,11 +4,11 @@ adapter's `qddot`, for every double-pendulum kind (the HNN through its time deri
 import numpy as np
 import pytest
 
-import systems
-from models import init_params
-from replication.evaluation.adapters import adapter
-from speedstudy.evaluators import make_evaluator
-from speedstudy.inference import model_spec
+from lagbench import systems
+from lagbench.models import init_params
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.speedstudy.evaluators import make_evaluator
+from lagbench.speedstudy.inference import model_spec
 
 
 @pytest.mark.parametrize("framework", ["jax", "torch"])

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import torch
 
-from models.jax import blocking
-from replication.cli import main
-from speedstudy import run_bench
-from speedstudy.device import NoGPUError
-from speedstudy.timing import GPU, GPU_TINY, STAGES, TINY
+from lagbench.cli import main
+from lagbench.models.jax import blocking
+from lagbench.speedstudy import run_bench
+from lagbench.speedstudy.device import NoGPUError
+from lagbench.speedstudy.timing import GPU, GPU_TINY, STAGES, TINY
 
 
 @pytest.mark.skipif(torch.cuda.is_available(), reason="this machine has a GPU")

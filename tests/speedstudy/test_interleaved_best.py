@@ -1,7 +1,7 @@
 """Interleaved timing rounds (the scaling study's sizes, the roofline's three) and the scaling groups;
 no timing asserted: calls are counted."""
-from speedstudy.scaling import scaling_groups
-from speedstudy.timing import LONG_CALL_S, interleaved_best
+from lagbench.speedstudy.scaling import scaling_groups
+from lagbench.speedstudy.timing import LONG_CALL_S, interleaved_best
 
 
 def _counting(names):

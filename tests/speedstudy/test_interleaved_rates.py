@@ -3,7 +3,7 @@ fn beside a slow one gets many timed windows (not as few as the slow one), and t
 the right order. Counts calls, asserts no wall-clock figure."""
 import time
 
-from speedstudy.latency import interleaved_rates
+from lagbench.speedstudy.latency import interleaved_rates
 
 
 def test_fast_fn_gets_many_windows_beside_a_slow_one():

@@ -4,7 +4,7 @@ came from, and the note of a ratio beyond 2x names them; the DeLaN target reads 
 rows timed in the same interleaved rounds as their JAX twin are compared within those rounds."""
 import pytest
 
-from speedstudy import tables, targets
+from lagbench.speedstudy import tables, targets
 
 
 def _row(fw, mode, threads, batch, rate, model="delan"):

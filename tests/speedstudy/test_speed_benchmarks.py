@@ -12,10 +12,10 @@ Each benchmark's `extra_info` holds the samples per call, so samples/s = batch /
 import numpy as np
 import pytest
 
-import systems
-from models import init_params
-from speedstudy.evaluators import make_evaluator
-from speedstudy.inference import model_spec
+from lagbench import systems
+from lagbench.models import init_params
+from lagbench.speedstudy.evaluators import make_evaluator
+from lagbench.speedstudy.inference import model_spec
 
 pytestmark = pytest.mark.bench
 

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from speedstudy.inference import TORCH_THREAD_CHOICES
+from lagbench.speedstudy.inference import TORCH_THREAD_CHOICES
 
 COLUMNS = {
     "inference": ["system", "model", "formulation", "framework", "mode", "threads", "dtype", "batch", "samples_per_s",
@@ -132,7 +132,7 @@ def test_machine_and_targets(bench_dir):
 
 
 def test_report_loader_accepts_bench_files(bench_dir):
-    from reports.load import load_results
+    from lagbench.reports.load import load_results
 
     out, _ = bench_dir
     res = load_results(out)
@@ -142,7 +142,7 @@ def test_report_loader_accepts_bench_files(bench_dir):
 
 
 def test_report_speed_section_shows_latency_train_target_and_targets(bench_dir, tmp_path):
-    from reports.sections_speed import speed_sections
+    from lagbench.reports.sections_speed import speed_sections
 
     out, _ = bench_dir
     titles = [b.title for s in speed_sections(load_results_of(out), tmp_path) for b in s.blocks if hasattr(b, "df")]
@@ -156,7 +156,7 @@ def test_report_speed_section_shows_latency_train_target_and_targets(bench_dir, 
 
 
 def load_results_of(out):
-    from reports.load import load_results
+    from lagbench.reports.load import load_results
 
     return load_results(out)
 
@@ -185,9 +185,9 @@ def test_members_time_pytorch_eager_and_compiled_where_the_preset_compiles(monke
     import os
     from dataclasses import replace
 
-    from replication.training import compile_torch
-    from speedstudy import members
-    from speedstudy.timing import QUICK
+    from lagbench.replication.training import compile_torch
+    from lagbench.speedstudy import members
+    from lagbench.speedstudy.timing import QUICK
 
     seen = []
 
@@ -207,14 +207,14 @@ def test_members_time_pytorch_eager_and_compiled_where_the_preset_compiles(monke
     by = {(r["framework"], r["mode"], r["members"], r["batch"]): r["cost_vs_one"] for r in rows}
     assert by[("torch", "compiled", 8, 32)] == 2.0 and by[("torch", "eager", 8, 32)] == 3.0
     assert ("torch", "eager (torch.compile failed: BackendCompilerFailed)", 1, 256) in by
-    from speedstudy.targets import members_target
+    from lagbench.speedstudy.targets import members_target
     t = members_target(rows)
     assert (t["jax"], t["torch"], t["torch_compiled"]) == (3.0, 3.0, 2.0) and t["met"] is False
     assert members.n_cases(replace(sizes, torch_compile=False)) == 2
 
 
 def test_the_members_target_sets_the_members_beside_one_model_at_eight_times_the_batch():
-    from speedstudy.targets import members_target
+    from lagbench.speedstudy.targets import members_target
 
     rows = [_members_row("jax", 1, 32, 1.0), _members_row("jax", 8, 32, 3.0), _members_row("jax", 1, 256, 2.4),
             _members_row("torch", 1, 32, 1.0), _members_row("torch", 8, 32, 2.4), _members_row("torch", 1, 256, 2.0)]

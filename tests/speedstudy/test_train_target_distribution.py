@@ -10,11 +10,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.run import splits
-from replication.training import data as datamod
-from speedstudy import target_distribution as TD
-from speedstudy import train_target as TT
+from lagbench.cli import main
+from lagbench.replication.run import splits
+from lagbench.replication.training import data as datamod
+from lagbench.speedstudy import target_distribution as TD
+from lagbench.speedstudy import train_target as TT
 
 TINY = ["--budget", "4000", "--hidden", "8,8", "--heldout-states", "64", "--quiet"]
 HELDOUT, WIDTHS = 64, (8, 8)

@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-import systems
-from models import ModelSpec
-from speedstudy.train_target import hessian_rel_err, protocols
+from lagbench import systems
+from lagbench.models import ModelSpec
+from lagbench.speedstudy.train_target import hessian_rel_err, protocols
 
 
 class _FakeLNN:

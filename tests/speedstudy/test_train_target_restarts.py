@@ -3,13 +3,13 @@ training loss is continued, and the budget counts every scout's samples."""
 import numpy as np
 import pytest
 
-from models import ModelSpec
-from replication.claims.double_pendulum import MODELS
-from replication.training import scouting
-from replication.training.schedules import learning_rate
-from replication.training.spike_guard import SpikeGuard
-from speedstudy import target_loop as TL
-from speedstudy import train_target as TT
+from lagbench.models import ModelSpec
+from lagbench.replication.claims.double_pendulum import MODELS
+from lagbench.replication.training import scouting
+from lagbench.replication.training.schedules import learning_rate
+from lagbench.replication.training.spike_guard import SpikeGuard
+from lagbench.speedstudy import target_loop as TL
+from lagbench.speedstudy import train_target as TT
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +105,7 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
 
 def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured():
     """full's claims 1-2 train what restarts_halved trains at FULL_SAMPLES (4e7): the same protocol."""
-    from replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
+    from lagbench.replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
     full = PROTOCOLS["full"]
     entry = TT.protocols(FULL_SAMPLES, full.data.n_heldout)["restarts_halved"]
     logging_only = {"log_every": 1, "tracking": None}

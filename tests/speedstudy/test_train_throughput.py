@@ -2,7 +2,7 @@
 frameworks on the device asked for, and says where and how fast it trained."""
 import math
 
-from speedstudy.train_throughput import main, measure
+from lagbench.speedstudy.train_throughput import main, measure
 
 
 def test_throughput_rows_per_framework_on_the_cpu(tmp_path):

@@ -3,7 +3,7 @@
 import numpy as np
 import sympy as sp
 
-import systems
+from lagbench import systems
 
 
 def test_free_fall_symbolic_answer_is_minus_g_zero():

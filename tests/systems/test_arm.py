@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-import systems
+from lagbench import systems
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +47,7 @@ def test_inverse_then_forward_round_trip(states, friction):
 
 
 def test_arm_dataset_families_differ_and_torques_are_exact(arm):
-    from systems.datasets import arm_dataset
+    from lagbench.systems.datasets import arm_dataset
 
     train = arm_dataset("train", 4, 50, 0, cache=False)
     test = arm_dataset("test", 4, 50, 0, cache=False)

@@ -6,7 +6,7 @@ import arm4_reference as ref
 import numpy as np
 import pytest
 
-import systems
+from lagbench import systems
 
 FRICTION = {"friction": 0.4, "coulomb": 0.3}
 
@@ -70,7 +70,7 @@ def test_energy_and_yaw_momentum_conserved_without_friction(arm):
 
 
 def test_suite_integrator_conserves_energy(arm):
-    from systems.trajectories import integrate
+    from lagbench.systems.trajectories import integrate
 
     st = arm.sample_states(2, 5)
     q, qdot = integrate(arm, st["q"], st["qdot"], np.linspace(0.0, 0.5, 11), solver="dopri5", rtol=1e-10,
@@ -165,7 +165,7 @@ def test_rod_defaults_and_non_physical_parameters():
 
 @pytest.mark.parametrize("kind", ["train", "test"])
 def test_arm_data_family_for_four_joints(arm, kind):
-    from systems.datasets import arm_dataset
+    from lagbench.systems.datasets import arm_dataset
 
     d = arm_dataset(kind, 3, 60, 0, system="four_joint_arm", cache=False)
     assert d["q"].shape == d["tau"].shape == (3, 60, 4) and d["energy"].shape == (3, 60)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-import systems
+from lagbench import systems
 
 CASES = [(n, {}) for n in systems.names()] + [("wave", {"variant": "textbook", "n": 12}),
                                                ("pendulum_chain", {"n": 4})]
@@ -65,7 +65,7 @@ F64_OR_OTHER = (np.zeros(2), 1.0, [1.0, 2.0], jnp.zeros(2), torch.zeros(2, dtype
 
 
 def test_the_result_is_float32_only_where_every_given_input_is():
-    from systems.backends import result_dtype
+    from lagbench.systems.backends import result_dtype
 
     assert result_dtype() == result_dtype(None) == "float64"
     for a in F32:

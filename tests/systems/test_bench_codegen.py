@@ -14,8 +14,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-import systems
-from systems import closed_form
+from lagbench import systems
+from lagbench.systems import closed_form
 
 pytestmark = pytest.mark.bench
 

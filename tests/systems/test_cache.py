@@ -7,9 +7,9 @@ import os
 import numpy as np
 import pytest
 
-import systems
-from systems import cache, cache_key, datasets
-from systems import system as system_mod
+from lagbench import systems
+from lagbench.systems import cache, cache_key, datasets
+from lagbench.systems import system as system_mod
 
 
 @pytest.fixture()
@@ -140,7 +140,7 @@ def test_the_key_is_private(fresh_cache):
 
 @pytest.mark.parametrize("mask, mode", [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
 def test_cache_and_result_files_follow_the_umask(fresh_cache, mask, mode):
-    from replication import results as R
+    from lagbench.files import results as R
     old = os.umask(mask)
     try:
         written = [cache.store_text("codegen", "x", "pass\n"), cache.store_arrays("y", {"a": np.zeros(2)})]

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-import systems
-from systems import closed_form
-from systems.datasets import iid_dataset, trajectory_dataset
+from lagbench import systems
+from lagbench.systems import closed_form
+from lagbench.systems.datasets import iid_dataset, trajectory_dataset
 
 
 def test_double_pendulum_iid_distribution_and_targets():

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-import systems
-from systems import closed_form
+from lagbench import systems
+from lagbench.systems import closed_form
 
 
 def test_acceleration_matches_assencio_closed_form():
@@ -37,7 +37,7 @@ def test_structure_and_defaults():
 
 
 def test_momentum_rate_is_the_time_derivative_of_momentum():
-    from systems.trajectories import integrate
+    from lagbench.systems.trajectories import integrate
 
     s = systems.get("double_pendulum")
     st = s.sample_states(3, 2)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-import systems
-from systems.trajectories import integrate
+from lagbench import systems
+from lagbench.systems.trajectories import integrate
 
 
 def _max_drift(s, q, qdot, **params):

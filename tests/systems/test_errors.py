@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import systems
+from lagbench import systems
 
 
 def test_names_are_the_spec_table():

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-import systems
-from systems import closed_form
+from lagbench import systems
+from lagbench.systems import closed_form
 
 
 @pytest.mark.parametrize("name,standard", [("relativistic", False), ("relativistic_standard", True)])

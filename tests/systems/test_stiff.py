@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-import systems
-from systems.stiffness import linear_rates, pick_solver
-from systems.trajectories import integrate
+from lagbench import systems
+from lagbench.systems.stiffness import linear_rates, pick_solver
+from lagbench.systems.trajectories import integrate
 
 ACCURACY = 1e-6   # the rule: final-state error and relative energy drift below this at tol 1e-10
 

@@ -3,7 +3,7 @@ import jax
 import jax.numpy as jnp
 import pytest
 
-import systems  # noqa: F401  (float64 on, as every systems test has it)
+from lagbench import systems  # noqa: F401  (float64 on, as every systems test has it)
 
 
 def test_strict_numerics_are_on():

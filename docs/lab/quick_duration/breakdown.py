@@ -8,9 +8,9 @@ import sys
 from collections import defaultdict
 from pathlib import Path
 
-from replication.run import estimate as E
-from replication.run.environment import torch_threads
-from replication.run.runner import plan
+from lagbench.replication.run import estimate as E
+from lagbench.replication.run.environment import torch_threads
+from lagbench.replication.run.runner import plan
 
 profile = sys.argv[1]
 units = plan(profile, frameworks=("jax", "torch"), split="test")

@@ -8,8 +8,8 @@ import time
 
 import jax.monitoring as mon
 
-from replication.run.runner import plan
-from replication.training.train import run_training
+from lagbench.replication.run.runner import plan
+from lagbench.replication.training.train import run_training
 
 acc = collections.Counter()
 mon.register_event_duration_secs_listener(lambda ev, d, **kw: acc.__setitem__(ev, acc[ev] + d))

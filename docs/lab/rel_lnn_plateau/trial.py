@@ -15,11 +15,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from replication.claims import get
-from replication.run import splits
-from replication.run.executor import run_units
-from replication.run.units import Unit
-from replication.training.protocol import Tracking
+from lagbench.replication.claims import get
+from lagbench.replication.run import splits
+from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.units import Unit
+from lagbench.replication.training.protocol import Tracking
 
 out = Path(sys.argv[1])
 steps = int(sys.argv[2]) if len(sys.argv) > 2 else 120_000

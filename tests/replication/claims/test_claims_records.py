@@ -2,9 +2,9 @@
 follow its stated power rule, every claim its seed rule, and a variant differs from the paper's model only in its departure."""
 import pytest
 
-from replication.claims import CLAIMS, PROFILES, seed_rule
-from replication.claims.base import Claim
-from replication.claims.stats import seeds_needed
+from lagbench.replication.claims import CLAIMS, PROFILES, seed_rule
+from lagbench.replication.claims.base import Claim
+from lagbench.replication.claims.stats import seeds_needed
 
 
 def test_checks_are_apart_from_the_paper_claims():
@@ -37,7 +37,7 @@ def test_the_seed_rule_follows_from_the_interval():
     the interval `stats.ratio_interval` really gives on seeds of equal spread; 5 seeds of record."""
     import numpy as np
 
-    from replication.claims.stats import Stat, ratio_interval
+    from lagbench.replication.claims.stats import Stat, ratio_interval
 
     for n in (2, 3, 5):
         z = np.linspace(-1, 1, n)
@@ -71,8 +71,8 @@ def test_a_variant_differs_from_the_paper_model_only_in_its_departure(cid):
 
 
 def test_a_part_naming_an_unknown_model_is_refused():
-    from replication.claims.parts import Part
-    from replication.claims.rules import bound
+    from lagbench.replication.claims.parts import Part
+    from lagbench.replication.claims.rules import bound
 
     c = CLAIMS["dp_loss"]
     with pytest.raises(ValueError, match="unknown models"):

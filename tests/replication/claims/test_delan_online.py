@@ -5,10 +5,10 @@ import math
 
 import pandas as pd
 
-from replication.claims import PROFILES, get, tuned
-from replication.claims.verdicts import judge
-from replication.studies import online as O
-from replication.studies.online_learner import claim_model
+from lagbench.replication.claims import PROFILES, get, tuned
+from lagbench.replication.claims.verdicts import judge
+from lagbench.replication.studies import online as O
+from lagbench.replication.studies.online_learner import claim_model
 
 CLAIM = get("delan_online")
 

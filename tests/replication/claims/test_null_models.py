@@ -13,14 +13,14 @@ import numpy as np
 import pytest
 from null_models import Diverging, FieldOracle, NoisyOracle, Zero
 
-import models.torch.lnn as torch_lnn
-from models import init_params
-from replication.claims import CLAIMS
-from replication.claims.verdicts import frame, judge
-from replication.evaluation.adapters import adapter
-from replication.evaluation.registry import EVALUATIONS
-from replication.evaluation.routines import Context, system_of
-from replication.run.runner import plan
+import lagbench.models.torch.lnn as torch_lnn
+from lagbench.models import init_params
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.claims.verdicts import frame, judge
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.evaluation.registry import EVALUATIONS
+from lagbench.replication.evaluation.routines import Context, system_of
+from lagbench.replication.run.runner import plan
 
 SEEDS = (0, 1, 2)
 NULLS = ("zero", "untrained", "diverging")

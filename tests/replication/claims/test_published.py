@@ -1,6 +1,6 @@
 """Published values say what they are; only one of the same kind, under the same conditions, is a target."""
-from replication.claims import CLAIMS
-from replication.claims.published import Published
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.claims.published import Published
 
 
 def test_like_for_like_needs_same_kind_conditions_and_data():

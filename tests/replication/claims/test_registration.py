@@ -3,13 +3,13 @@ matches a committed registration; changing a model's protocol, the evaluation or
 changes the hash and leaves the claim unregistered until a new dated line discloses the change."""
 import dataclasses
 
-from replication.claims import CLAIMS, PROFILES, get
-from replication.claims import registration as reg
+from lagbench.replication.claims import CLAIMS, PROFILES, get
+from lagbench.replication.claims import registration as reg
 
 
 def test_every_claim_and_profile_is_registered():
     missing = [f"{c.id}/{p}" for c in CLAIMS.values() for p in PROFILES if not reg.status(c, p)["registered"]]
-    assert not missing, ("protocols changed without a registration (run `python -m replication.claims.registration "
+    assert not missing, ("protocols changed without a registration (run `python -m lagbench.replication.claims.registration "
                          f"--note ...` and say why): {missing}")
 
 
@@ -19,7 +19,7 @@ def test_a_changed_protocol_evaluation_or_threshold_is_unregistered(monkeypatch)
     assert before["registered"] and before["frozen"]
     longer = dataclasses.replace(claim, protocols={**claim.protocols, "quick": claim.protocols["quick"].replace(steps=1)})
     other_eval = dataclasses.replace(claim, eval_config={**claim.eval_config, "quick": {"n_ics": 1}})
-    from replication.claims.rules import similar
+    from lagbench.replication.claims.rules import similar
     part = dataclasses.replace(claim.parts[0], rule=similar("lnn", "baseline", 3.5, claim.metric))
     looser = dataclasses.replace(claim, parts=(part, *claim.parts[1:]))
     hashes = {reg.protocol_hash(c, "quick") for c in (claim, longer, other_eval, looser)}
@@ -32,7 +32,7 @@ def test_a_changed_protocol_evaluation_or_threshold_is_unregistered(monkeypatch)
 def test_a_rules_comparison_code_or_level_is_part_of_its_hash(monkeypatch):
     """The same rule, name and thresholds, with other comparison code (a helper it reaches in rules.py or
     stats.py) or another interval level, is a new protocol."""
-    from replication.claims import rules, stats
+    from lagbench.replication.claims import rules, stats
 
     claim = get("dp_energy")
     before = reg.protocol_hash(claim, "quick")
@@ -69,7 +69,7 @@ def test_register_appends_a_dated_line_for_a_changed_protocol_only(tmp_path, mon
 def test_verdicts_carry_the_registration():
     import pandas as pd
 
-    from replication.claims.verdicts import judge
+    from lagbench.replication.claims.verdicts import judge
 
     v = judge(get("dp_loss"), pd.DataFrame(columns=["claim", "framework", "model", "seed", "status"]), "quick")
     assert v["preregistration"]["registered"] and v["preregistration"]["protocol_hash"] == reg.protocol_hash(
@@ -98,8 +98,8 @@ def test_no_claim_imports_another_claim():
     assert len(claims) == len(CLAIMS)
     for name in claims:
         tree = ast.parse((folder / f"{name}.py").read_text())
-        used = {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module == "replication.claims"
+        used = {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module == "lagbench.replication.claims"
                 for a in n.names}
         used |= {n.module.rsplit(".", 1)[1] for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module
-                 and n.module.startswith("replication.claims.")}
+                 and n.module.startswith("lagbench.replication.claims.")}
         assert not used & (claims - {name}), f"{name} imports {used & claims}"

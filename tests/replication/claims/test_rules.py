@@ -5,8 +5,8 @@ import math
 
 import pytest
 
-from replication.claims.bars import Bar, competence
-from replication.claims.rules import (
+from lagbench.replication.claims.bars import Bar, competence
+from lagbench.replication.claims.rules import (
     PART_VERDICTS,
     Outcome,
     Stat,

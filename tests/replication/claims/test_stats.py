@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 from scipy.stats import mannwhitneyu
 
-from replication.claims.stats import Stat, _u_counts, hodges_lehmann, ratio_interval, seeds_needed, wilson
+from lagbench.replication.claims.stats import (
+    Stat,
+    _u_counts,
+    hodges_lehmann,
+    ratio_interval,
+    seeds_needed,
+    wilson,
+)
 
 
 @pytest.mark.parametrize("m, n", [(1, 1), (2, 3), (3, 3), (4, 2)])

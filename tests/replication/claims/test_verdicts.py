@@ -4,8 +4,8 @@ missing models, seeds that disagree, frameworks that disagree, parts that differ
 import pandas as pd
 import pytest
 
-from replication.claims import CLAIMS
-from replication.claims.verdicts import judge
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.claims.verdicts import judge
 
 NULL = 1000.0   # every null predictor's error: every model below is far under its bar
 
@@ -146,7 +146,7 @@ def test_one_diverged_baseline_rollout_cannot_decide_claim_2():
     over initial conditions each seed is read by is unmoved, so the LNN is not "far better"."""
     import numpy as np
 
-    from replication.evaluation.metrics import energy_errors
+    from lagbench.replication.evaluation.metrics import energy_errors
 
     rows = []
     for k in range(5):

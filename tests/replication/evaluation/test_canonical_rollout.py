@@ -8,14 +8,14 @@ H_true(q, p) whatever the learned dH/dp."""
 import numpy as np
 import pytest
 
-import systems
-import systems.trajectories
-from replication.claims import CLAIMS
-from replication.evaluation.canonical import canonical_rollout, state_velocity, velocity
-from replication.evaluation.registry import EVALUATIONS
-from replication.evaluation.routines import Context, system_of
-from replication.run.runner import plan
-from systems.derive import NotQuadraticError
+import lagbench.systems.trajectories
+from lagbench import systems
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.evaluation.canonical import canonical_rollout, state_velocity, velocity
+from lagbench.replication.evaluation.registry import EVALUATIONS
+from lagbench.replication.evaluation.routines import Context, system_of
+from lagbench.replication.run.runner import plan
+from lagbench.systems.derive import NotQuadraticError
 
 V0 = np.array([[0.9], [0.99], [-0.999]])   # |qdot| near c: gamma 2.3, 7.1, 22
 G = np.array([5.0, -3.0, 2.0])
@@ -71,7 +71,7 @@ def test_a_quadratic_kinetic_energy_has_dh_dp_equal_to_m_inverse_p():
     qdot = velocity(exact_h, q, p)
     m_inv_p = np.linalg.solve(s.mass_matrix(q), p[..., None])[..., 0]
     np.testing.assert_allclose(qdot, m_inv_p, rtol=1e-12, atol=1e-12)
-    q_true, qd_true = systems.trajectories.integrate(s, q0, qd0, t)
+    q_true, qd_true = lagbench.systems.trajectories.integrate(s, q0, qd0, t)
     np.testing.assert_allclose(q, q_true, atol=1e-7)   # RK4 at 0.01: ~2e-8
     np.testing.assert_allclose(qdot, qd_true, atol=1e-7)
 
@@ -166,7 +166,7 @@ class TwiceTheVelocity(PendulumH):
 
 
 def test_the_energy_rollout_reads_the_true_energy_of_the_predicted_state_not_the_learned_velocity():
-    from replication.evaluation.routines import _model_rollout
+    from lagbench.replication.evaluation.routines import _model_rollout
 
     ctx = _context("hnn_energy", "hnn_pendulum", TwiceTheVelocity)
     s = system_of(ctx.protocol)

@@ -6,11 +6,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import systems
-from replication.claims import get
-from replication.claims.bars import competence
-from replication.evaluation.control import FAMILIES, eval_control
-from replication.run.splits import DEV, TEST
+from lagbench import systems
+from lagbench.replication.claims import get
+from lagbench.replication.claims.bars import competence
+from lagbench.replication.evaluation.control import FAMILIES, eval_control
+from lagbench.replication.run.splits import DEV, TEST
 
 PLANT = systems.get("two_link_arm")
 
@@ -60,7 +60,7 @@ def test_the_test_split_tracks_other_references():
 
 def test_tracking_the_families_in_one_batch_gives_each_familys_own_numbers():
     """The three families are simulated side by side; each scores as when tracked on its own."""
-    from replication.studies import control
+    from lagbench.replication.studies import control
 
     def fn(q, v, a):
         return 0.8 * PLANT.inverse_dynamics(q, v, a)

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from replication.evaluation.routines import pdot_to_qddot, system_of
-from replication.training.protocol import Data, Protocol
+from lagbench.replication.evaluation.routines import pdot_to_qddot, system_of
+from lagbench.replication.training.protocol import Data, Protocol
 
 
 @pytest.mark.parametrize("data", ["relativistic_iid", "charged_magnetic_iid", "double_pendulum_iid"])

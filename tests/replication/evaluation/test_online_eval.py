@@ -9,11 +9,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from models import ModelSpec
-from replication.claims import get
-from replication.claims.bars import competence
-from replication.evaluation.online_claim import _windows, eval_online
-from replication.run.splits import DEV, TEST
+from lagbench.models import ModelSpec
+from lagbench.replication.claims import get
+from lagbench.replication.claims.bars import competence
+from lagbench.replication.evaluation.online_claim import _windows, eval_online
+from lagbench.replication.run.splits import DEV, TEST
 
 CFG = {"seconds": 1.0, "window": 0.5, "n_unseen": 1, "unseen_duration": 0.4}
 SPECS = {"delan": ModelSpec(dof=2, hidden=(16, 16), kind="delan", activation="softplus", init="xavier"),

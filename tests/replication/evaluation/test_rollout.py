@@ -3,7 +3,7 @@ scan and its handling of a diverging trajectory."""
 import numpy as np
 import pytest
 
-from replication.evaluation.rollout import lagrangian_field, rk4_scan, rk4_step, rollout
+from lagbench.replication.evaluation.rollout import lagrangian_field, rk4_scan, rk4_step, rollout
 
 
 def _oscillator(dtype, seen=None):

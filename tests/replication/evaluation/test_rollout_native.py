@@ -6,10 +6,10 @@ enough to compile its step gives the eager numbers (`tox -e slow`)."""
 import numpy as np
 import pytest
 
-from models import ModelSpec, init_params
-from replication.evaluation import rollout_native as native
-from replication.evaluation.adapters import adapter
-from replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.evaluation import rollout_native as native
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.evaluation.rollout import hamiltonian_field, lagrangian_field, rollout
 
 T = np.concatenate([np.linspace(0.0, 0.3, 7), [0.37, 0.41, 0.6]])   # uneven: 1, 2 and 4 steps an interval
 DT = 0.05

@@ -5,11 +5,11 @@ test split draws other initial states than the development split."""
 import numpy as np
 import pytest
 
-from replication.claims import CLAIMS
-from replication.evaluation.registry import EVALUATIONS
-from replication.evaluation.routines import Context, system_of
-from replication.run.runner import plan
-from replication.run.splits import DEV, TEST
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.evaluation.registry import EVALUATIONS
+from lagbench.replication.evaluation.routines import Context, system_of
+from lagbench.replication.run.runner import plan
+from lagbench.replication.run.splits import DEV, TEST
 
 CLAIM = CLAIMS["rel_coords"]
 CFG = CLAIM.evaluation_config("smoke")

@@ -1,7 +1,7 @@
 """Valid prediction time and the Lyapunov time (`replication.evaluation.valid_time`) on series with known answers."""
 import numpy as np
 
-from replication.evaluation.valid_time import lyapunov_time, normalised_rmse, valid_time, valid_times
+from lagbench.replication.evaluation.valid_time import lyapunov_time, normalised_rmse, valid_time, valid_times
 
 
 def test_normalised_rmse_divides_by_each_components_spread_and_counts_nan_as_infinite():

@@ -2,8 +2,8 @@
 ratio, a flag when it is not clearly better (`replication.fit.competence`), exit status 1 only with --strict."""
 import pytest
 
-from replication.cli import main
-from replication.fit.competence import FACTOR, competence
+from lagbench.cli import main
+from lagbench.replication.fit.competence import FACTOR, competence
 
 
 def test_the_ratio_decides_and_a_missing_null_gives_nothing():
@@ -29,7 +29,7 @@ def test_a_starved_fit_is_flagged_and_strict_fails_it(data, tmp_path, capsys):
     out = capsys.readouterr().out
     assert out.startswith("done: ") and "BETTER THAN THE NULL PREDICTOR" in out and "x the null predictor's" in out
     assert main([*argv, "--lr", "1e-6", "--out", str(tmp_path / "b"), "--strict"]) == 1
-    from reports.build import build_sections
+    from lagbench.reports.build import build_sections
 
     sections = build_sections(tmp_path / "a", tmp_path / "rep")
     assert any("Not clearly better than the null predictor" in getattr(b, "text", "") for s in sections for b in s.blocks)
@@ -40,7 +40,7 @@ def test_a_fit_that_learned_says_ok_with_its_ratio(data, tmp_path, capsys):
                  "--lr", "3e-3", "--quiet", "--strict", "--out", str(tmp_path / "c")]) == 0
     out = capsys.readouterr().out
     assert out.startswith("ok: ") and "x the null predictor's" in out and "BETTER" not in out
-    from reports.build import build_sections
+    from lagbench.reports.build import build_sections
 
     sections = build_sections(tmp_path / "c", tmp_path / "rep")
     assert not any("Not clearly better" in getattr(b, "text", "") for s in sections for b in s.blocks)

@@ -5,10 +5,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.fit import rows as fit_data
-from replication.fit import time_base, trajectories, userdata
-from replication.fit.task import resolved
+from lagbench.cli import main
+from lagbench.files import user_data
+from lagbench.replication.fit import rows as fit_data
+from lagbench.replication.fit import time_base, trajectories
+from lagbench.replication.fit.task import resolved
 
 RATE = 50.0
 
@@ -51,7 +52,7 @@ def test_seconds_given_as_milliseconds_too_coarse_and_a_state_file_are_named(tmp
     coarse = tmp_path / "coarse.csv"
     pd.DataFrame({"t": np.arange(40) * 5000.0, "q0": np.zeros(40)}).to_csv(coarse, index=False)
     with pytest.raises(ValueError, match="too far apart for its motion in seconds or milliseconds"):
-        time_base.check_unit(coarse, userdata.read(str(coarse))[1], "pendulum", "s")
+        time_base.check_unit(coarse, user_data.read(str(coarse))[1], "pendulum", "s")
     state = tmp_path / "state.npz"
     np.savez(state, q=np.zeros((30, 1)), qdot=np.zeros((30, 1)), qddot=np.zeros((30, 1)))
     with pytest.raises(ValueError, match="^--time-unit ms: .* has no t column"):
@@ -66,10 +67,10 @@ def test_a_50_hz_recording_passes_in_seconds_and_is_refused_in_milliseconds(syst
 
 @pytest.mark.parametrize("sep, decimal", [(";", "."), ("\t", "."), (";", ",")])
 def test_semicolon_and_tab_separated_files_are_read(tmp_path, sep, decimal):
-    comma = userdata.read(str(_recording(tmp_path / "c.csv")))[1]
+    comma = user_data.read(str(_recording(tmp_path / "c.csv")))[1]
     other = tmp_path / "o.csv"
     pd.read_csv(tmp_path / "c.csv").to_csv(other, index=False, sep=sep, decimal=decimal)
-    d = userdata.read(str(other))[1]
+    d = user_data.read(str(other))[1]
     assert set(d) == set(comma)
     for k in d:
         np.testing.assert_allclose(d[k], comma[k])
@@ -89,14 +90,14 @@ def test_a_nan_row_is_named_by_its_line_and_trajectory(tmp_path, capsys):
     q[4] = np.inf
     np.savez(npz, q=q, qdot=q, qddot=np.zeros((30, 1)))
     with pytest.raises(ValueError, match=r"1 row with NaN or infinite values \(in q, qdot\), the first at row 4"):
-        userdata.read(str(npz))
+        user_data.read(str(npz))
 
 
 def test_a_one_row_trajectory_gives_its_error_without_warnings(tmp_path, capsys):
     path = _recording(tmp_path / "one.csv")
     pd.concat([pd.read_csv(path), pd.DataFrame({"traj": [9], "t": [0.0], "q0": [0.1]})]).to_csv(path, index=False)
     with pytest.raises(ValueError, match="trajectory 9 has 1 sample; estimating"):  # a NumPy warning fails here
-        trajectories.with_derivatives(userdata.read(str(path))[1], str(path))
+        trajectories.with_derivatives(user_data.read(str(path))[1], str(path))
     assert _fit(tmp_path, path, "--quiet") == 2
     captured = capsys.readouterr()
     assert captured.err.count("\n") == 1 and "Warning" not in captured.err + captured.out, captured.err

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from replication.fit import kind_defaults
+from lagbench.replication.fit import kind_defaults
 
 DOC = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 ROWS = {"lnn": ("lnn", "acceleration"), "baseline (q̈)": ("baseline", "acceleration"), "hnn": ("hnn", "hamiltonian"),

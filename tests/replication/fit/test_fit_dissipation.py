@@ -11,19 +11,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import systems
-from replication.cli import main
-from replication.evaluation.adapters import adapter
-from replication.evaluation.routines import Evaluation
-from replication.fit import userdata
-from replication.fit.dissipation import (
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.files import user_data
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.evaluation.routines import Evaluation
+from lagbench.replication.fit.dissipation import (
     ABLATION_MIN,
     HESSIAN_RESIDUAL_MAX,
     OFF,
     dissipation_metrics,
     without_dissipation_l1,
 )
-from replication.fit.load import Padded, load_fitted
+from lagbench.replication.fit.load import Padded, load_fitted
 
 DOC = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 MARKER = "<!-- dissipative example: tests/replication/fit/test_fit_dissipation.py runs this block -->"
@@ -83,7 +83,7 @@ def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
     params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
     g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
-    rows = userdata.rows(str(next(dissipative_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
+    rows = user_data.rows(str(next(dissipative_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
     out = Evaluation()
     out.metrics.update({"test_l1": without_dissipation_l1(f, rows), "null_test_l1": f.result["metrics"]["null_test_l1"]})
     dissipation_metrics(g, rows, "test", systems.get("pendulum"), out)

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from replication.cli import main
-from replication.fit.load import load_fitted
+from lagbench.cli import main
+from lagbench.replication.fit.load import load_fitted
 
 README = Path(__file__).resolve().parents[3] / "docs" / "fit.md"
 MARKER = "<!-- worked example: tests/replication/fit/test_fit_example.py runs this block -->"

@@ -4,9 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication import results as R
-from replication.cli import build_parser, main
-from replication.fit.task import fit
+from lagbench.cli import build_parser, main
+from lagbench.files import results as R
+from lagbench.replication.fit.task import fit
 
 FAST = {"model": "baseline", "steps": 4, "hidden": (8,), "batch": 16}
 
@@ -34,12 +34,12 @@ def test_changed_data_is_trained_afresh_and_the_old_fit_is_kept(tmp_path):
 
 
 def test_a_file_edited_after_setup_is_refused(tmp_path):
-    from replication.fit import userdata
+    from lagbench.files import user_data
     data = _pendulum(tmp_path / "d.npz")
-    digest, _ = userdata.read(str(data))
+    digest, _ = user_data.read(str(data))
     _pendulum(data, scale=2.0)
     with pytest.raises(ValueError, match="changed since"):
-        userdata.split_rows(userdata.reference(str(data), digest).removeprefix("file:"), "acceleration", "train")
+        user_data.split_rows(user_data.reference(str(data), digest).removeprefix("file:"), "acceleration", "train")
 
 
 def _csv(path, header, rows=40, big=False):
@@ -128,7 +128,7 @@ def test_a_moved_folder_or_a_renamed_copy_of_the_data_reuses_the_fit(tmp_path):
 def test_evaluate_takes_fitted_and_reads_the_old_model_spelling_with_a_notice(tmp_path, capsys):
     """`evaluate --fitted DIR`; `--model DIR` (its old spelling; in `fit`, --model is the model kind) still
     works and says so; neither, or both, is one line naming --fitted."""
-    from replication.fit import cli
+    from lagbench.replication.fit import cli
 
     parser = build_parser()
     args = parser.parse_args(["evaluate", "--model", "results/fit", "--data", "d.csv"])

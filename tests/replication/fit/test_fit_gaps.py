@@ -3,8 +3,8 @@ dropped frames interpolated, split at or refused (`--gaps`), against analytic tr
 import numpy as np
 import pytest
 
-from replication.cli import main
-from replication.fit import trajectories
+from lagbench.cli import main
+from lagbench.replication.fit import trajectories
 
 W = trajectories.WINDOW
 

@@ -6,10 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import build_parser, main
-from replication.fit import userdata
-from replication.fit.load import load_fitted
-from replication.fit.task import fit
+from lagbench.cli import build_parser, main
+from lagbench.files import user_data
+from lagbench.replication.fit.load import load_fitted
+from lagbench.replication.fit.task import fit
 
 TINY = {"steps": 6, "hidden": (8,), "batch": 32}
 
@@ -55,7 +55,7 @@ def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
     assert list(one["quantity"]) == ["tau", "tau"] and list(one["component"]) == [0, 1]
     folder = tmp_path / "out/units/fit/jax/delan/seed0"
     tc = load_fitted(tmp_path / "out", framework="torch")  # trained in JAX, loaded in PyTorch
-    rows = userdata.rows(d["eval_config"]["test"], "test")
+    rows = user_data.rows(d["eval_config"]["test"], "test")
     saved = np.load(folder / "arrays.npz")  # the JAX model's own predictions on those rows, saved by the fit
     tau = tc.inverse_dynamics(rows["q"], rows["qdot"], rows["qddot"])
     np.testing.assert_allclose(tau, saved["test_pred"], rtol=1e-4, atol=1e-5)
@@ -80,7 +80,7 @@ def test_an_inverse_dynamics_baseline_and_a_damaged_fit(tmp_path):
 
 
 def test_the_metric_is_named_for_the_loss_and_the_rows():
-    from replication.fit.task import metric_of
+    from lagbench.replication.fit.task import metric_of
 
     assert metric_of({"train": 9, "heldout": 1}, False, "mse") == ("heldout_mse", "held-out MSE")
     assert metric_of({"train": 9, "heldout": 1}, True, "l1") == ("test_l1", "test L1")
@@ -99,7 +99,7 @@ def test_every_fit_option_shows_its_default():
 
 
 def test_a_users_energy_function_is_imported_and_checked_before_any_work(tmp_path, monkeypatch):
-    from replication.fit.evaluate import energy_function
+    from lagbench.replication.fit.evaluate import energy_function
 
     (tmp_path / "my_energy.py").write_text("def pendulum(q, qdot):\n    return 0.5 * (qdot**2).sum(-1) - 3 * __import__('numpy').cos(q).sum(-1)\n"
                                            "def wrong(q, qdot):\n    return q\n")

@@ -2,10 +2,10 @@
 function's, every option is checked by its own rule, and an unknown keyword is refused."""
 import pytest
 
-from replication.cli import build_parser
-from replication.fit import kind_defaults
-from replication.fit import options as fit_options
-from replication.fit.task import fit
+from lagbench.cli import build_parser
+from lagbench.replication.fit import kind_defaults
+from lagbench.replication.fit import options as fit_options
+from lagbench.replication.fit.task import fit
 
 
 def test_the_command_lines_defaults_are_the_functions():
@@ -46,10 +46,10 @@ def test_an_unknown_keyword_is_refused(tmp_path):
 def test_a_fit_at_its_defaults_trains_as_the_claim_that_tuned_its_kind(tmp_path, kind, task):
     """The protocol `fit` builds from the kind's defaults is the claim's quick protocol with its adopted tuning
     in every training part (schedule, restarts and their halving, guard, batch, steps, loss, L2, width)."""
-    from replication.claims.base import per_profile
-    from replication.fit import task as fit_task
-    from replication.training.protocol import Guard, Scouting
-    from replication.training.schedules import Constant, OneCycle
+    from lagbench.replication.claims.base import per_profile
+    from lagbench.replication.fit import task as fit_task
+    from lagbench.replication.training.protocol import Guard, Scouting
+    from lagbench.replication.training.schedules import Constant, OneCycle
 
     claim, entry, p = kind_defaults._entry(kind, task)
     assert p == entry.protocol(per_profile(claim.protocols, "quick"), "quick")
@@ -95,7 +95,7 @@ def _trajectory_and_state_files(folder):
 def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claims(tmp_path):
     """`ON_RECORDINGS` multiplies the kind's steps for a trajectory file only (the restarts follow the steps);
     every other default and every other kind stays the claim's."""
-    from replication.fit.task import resolved
+    from lagbench.replication.fit.task import resolved
 
     traj, states = _trajectory_and_state_files(tmp_path)
     for kind in ("lnn", "baseline"):
@@ -114,8 +114,8 @@ def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claim
 def test_the_console_line_names_where_a_recordings_defaults_come_from(tmp_path, monkeypatch, capsys):
     """`lagbench fit` on a trajectory file says, before training, that the LNN's steps are the claim's times
     the trajectory-file factor; on a file of states it names the claim alone."""
-    from replication.cli import main
-    from replication.fit import task
+    from lagbench.cli import main
+    from lagbench.replication.fit import task
 
     def stop(*args, **kwargs):
         raise ValueError("stopped before training")

@@ -8,10 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.fit import userdata
-from replication.fit.load import load_fitted
-from replication.fit.task import fit
+from lagbench.cli import main
+from lagbench.files import user_data
+from lagbench.replication.fit.load import load_fitted
+from lagbench.replication.fit.task import fit
 
 
 def _spinning_pendulum(path, n_traj=4, n=160, dt=0.05):
@@ -44,13 +44,13 @@ def test_an_lnn_fits_unwrapped_angles_as_cos_and_sin(tmp_path):
     assert d["status"] == "ok"
     spec = d["model_spec"]
     assert spec["periodic"] == [0] and len(spec["input_scale"]) == 3   # [cos q, sin q, qdot]
-    train = userdata.rows(d["protocol"]["data"]["recipe"], "train")
+    train = user_data.rows(d["protocol"]["data"]["recipe"], "train")
     feats = np.concatenate([np.cos(train["q"]), np.sin(train["q"]), train["qdot"]], 1)
     np.testing.assert_allclose(spec["input_scale"], 1 / feats.std(0), rtol=1e-5)
     fj = load_fitted(tmp_path / "out")
     ft = load_fitted(tmp_path / "out", framework="torch")
     assert fj.spec.periodic == ft.spec.periodic == (0,)
-    rows = userdata.rows(d["protocol"]["data"]["recipe"], "heldout")
+    rows = user_data.rows(d["protocol"]["data"]["recipe"], "heldout")
     a = fj.acceleration(rows["q"], rows["qdot"])
     assert a.shape == rows["q"].shape and np.all(np.isfinite(a))
     np.testing.assert_allclose(ft.acceleration(rows["q"], rows["qdot"]), a, rtol=1e-4, atol=1e-5)

@@ -3,9 +3,9 @@ successive halving) and the gradient-spike guard, recorded in the fit's protocol
 default (the double-pendulum claims' protocol), off with 0."""
 import pytest
 
-from replication.cli import main
-from replication.fit import kind_defaults
-from replication.fit.task import fit
+from lagbench.cli import main
+from lagbench.replication.fit import kind_defaults
+from lagbench.replication.fit.task import fit
 
 
 @pytest.fixture(scope="module")

@@ -3,9 +3,9 @@ shorter than a trajectory's first interval), with progress reported per evaluati
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.fit.evaluate_file import evaluate
-from replication.fit.task import fit
+from lagbench.cli import main
+from lagbench.replication.fit.evaluate_file import evaluate
+from lagbench.replication.fit.task import fit
 
 FAST = {"model": "lnn", "steps": 4, "hidden": (8,), "batch": 16}
 

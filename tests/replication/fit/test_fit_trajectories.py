@@ -5,8 +5,9 @@ import pandas as pd
 import pytest
 from scipy.signal import savgol_coeffs
 
-from replication.fit import rows as fit_data
-from replication.fit import trajectories, userdata
+from lagbench.files import user_data
+from lagbench.replication.fit import rows as fit_data
+from lagbench.replication.fit import trajectories
 
 H = 0.02  # 50 samples per second
 W, P = trajectories.WINDOW, trajectories.POLYORDER
@@ -55,7 +56,7 @@ def _file(path, n_traj=3, n=40, shuffle=True, **cols):
 
 def test_trajectory_rows_are_sorted_and_given_derivatives_kept(tmp_path):
     path = str(_file(tmp_path / "a.csv"))
-    d = trajectories.with_derivatives(userdata.read(path)[1], path)
+    d = trajectories.with_derivatives(user_data.read(path)[1], path)
     assert set(d) == {"traj", "t", "q", "qdot", "qddot"}
     assert len(d["q"]) == 3 * (40 - 2 * (W // 2))  # the ends of each trajectory, without a centred window, dropped
     for k in range(3):
@@ -64,7 +65,7 @@ def test_trajectory_rows_are_sorted_and_given_derivatives_kept(tmp_path):
         np.testing.assert_allclose(d["qdot"][rows, 0], np.cos(d["t"][rows] + k), atol=1e-6)
     n = 120
     given = str(_file(tmp_path / "b.csv", shuffle=False, qdot0=np.full(n, 7.0)))
-    d = trajectories.with_derivatives(userdata.read(given)[1], given)
+    d = trajectories.with_derivatives(user_data.read(given)[1], given)
     assert np.all(d["qdot"] == 7.0) and np.allclose(d["qddot"], 0.0, atol=1e-9)  # qddot from the given qdot
 
 
@@ -80,7 +81,7 @@ def test_bad_trajectories_name_the_problem(tmp_path, change, message):
     path = tmp_path / "c.csv"
     pd.DataFrame({"t": t, "q0": np.sin(t)}).to_csv(path, index=False)
     with pytest.raises(ValueError, match=message):
-        trajectories.with_derivatives(userdata.read(str(path))[1], str(path), window=change.get("window", W))
+        trajectories.with_derivatives(user_data.read(str(path))[1], str(path), window=change.get("window", W))
 
 
 def test_splits_hold_out_whole_trajectories_random_rows_or_nothing(tmp_path):
@@ -88,7 +89,7 @@ def test_splits_hold_out_whole_trajectories_random_rows_or_nothing(tmp_path):
     by = fit_data.prepare(tmp_path / "out", path)             # trajectory file: by-trajectory by default
     kept = 40 - 2 * (W // 2)
     assert by.trajectories == {"heldout": 1, "train": 9} and by.counts == {"heldout": kept, "train": 9 * kept}
-    rows = {k: userdata.rows(by.reference, k) for k in ("train", "heldout")}
+    rows = {k: user_data.rows(by.reference, k) for k in ("train", "heldout")}
     assert not set(rows["train"]["traj"]) & set(rows["heldout"]["traj"])
     again = fit_data.prepare(tmp_path / "out", path)
     assert again.reference == by.reference                    # same data and options: the same prepared file

@@ -4,9 +4,9 @@ import json
 
 import pytest
 
-from replication.cli import main
-from replication.fit import rows as fit_rows
-from replication.tuning import search
+from lagbench.cli import main
+from lagbench.replication.fit import rows as fit_rows
+from lagbench.replication.tuning import search
 
 
 @pytest.fixture(scope="module")

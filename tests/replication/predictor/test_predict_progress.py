@@ -4,8 +4,8 @@ import time
 
 import pytest
 
-from replication.cli import main
-from replication.predictor.score import calls_of, score, setup
+from lagbench.cli import main
+from lagbench.replication.predictor.score import calls_of, score, setup
 
 FUNCTIONS = '''
 import time

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-import systems
-from replication.cli import main
-from replication.predictor.score import score, setup
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.replication.predictor.score import score, setup
 
 DP = systems.get("double_pendulum")
 
@@ -85,7 +85,7 @@ def test_the_command_writes_the_record_and_names_bad_input(tmp_path, monkeypatch
 
 
 def test_the_report_shows_verified_predictors_and_names_a_tampered_one(tmp_path):
-    from reports.build import build_sections
+    from lagbench.reports.build import build_sections
 
     for name, fn in (("exact", exact), ("zero", zero)):
         score(fn, "double_pendulum", "smoke", out=tmp_path, label=name)
@@ -101,8 +101,8 @@ def test_the_report_shows_verified_predictors_and_names_a_tampered_one(tmp_path)
 
 def heldout_of_predictor(system, profile):
     """The held-out states a predictor of `system` is scored on."""
-    from replication.evaluation.routines import heldout_of
-    from replication.run.splits import TEST
+    from lagbench.replication.evaluation.routines import heldout_of
+    from lagbench.replication.run.splits import TEST
 
     class Ctx:
         protocol, split = setup(system, profile).protocol, TEST
@@ -128,7 +128,7 @@ def test_a_function_that_raises_is_one_line_and_a_non_finite_one_is_scored_faile
     assert f"--predict odd.py:nan7: failed: {why}" in capsys.readouterr().err
     assert main(["table", "--results", str(out)]) == 0
     assert f"failed: {why}" in capsys.readouterr().out   # the table says why its numbers are no scores
-    from reports.build import build_sections
+    from lagbench.reports.build import build_sections
 
     table = next(b for s in build_sections(out, tmp_path / "report") if s.title == "Your predictors"
                  for b in s.blocks if hasattr(b, "df"))

@@ -6,15 +6,15 @@ import re
 import numpy as np
 import pytest
 
-import systems
-from models import ModelSpec, init_params
-from replication.claims import CLAIMS
-from replication.claims.bars import Bar, added_competence
-from replication.cli import main
-from replication.evaluation.adapters import adapter
-from replication.run import added_models
-from replication.run.runner import plan
-from replication.user_functions import NO_RERUN, UserCodeError
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.files.user_functions import NO_RERUN, UserCodeError
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.claims import CLAIMS
+from lagbench.replication.claims.bars import Bar, added_competence
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.run import added_models
+from lagbench.replication.run.runner import plan
 
 MODEL = '''import torch
 
@@ -179,9 +179,9 @@ def _added(tmp_path, text, name):
 def _learns_the_springs_k(framework, spec, key, **protocol):
     """Trained on the spring (k = 1) with restarts over initialisations (the scouts train as members), the
     module's k (2 at the start) comes within 5 % of the spring's."""
-    from replication.training.protocol import Data, Protocol, Scouting
-    from replication.training.schedules import OneCycle
-    from replication.training.train import run_training
+    from lagbench.replication.training.protocol import Data, Protocol, Scouting
+    from lagbench.replication.training.schedules import OneCycle
+    from lagbench.replication.training.train import run_training
 
     coords = {"coords": "qp"} if protocol.get("task") == "hamiltonian" else {}
     p = Protocol(data=Data("spring_iid", n_train=256, n_heldout=64, **coords), steps=150, batch=32, loss="mse",
@@ -334,7 +334,7 @@ def test_a_run_says_once_that_a_rerun_cannot_help_and_a_non_finite_model_fails(b
 
 
 def test_unit_errors_are_printed_once_per_message_with_the_exit_status_they_call_for(capsys):
-    from replication.cli import _print_errors
+    from lagbench.cli import _print_errors
 
     mine = "--add-model m.py:f: the factory f(dof) raised KeyError: 'a' (m.py line 2, in f); " + NO_RERUN
     assert _print_errors([f"a/torch/m/seed1: {mine}", f"b/torch/m/seed1: {mine}", "c/jax/lnn/seed1: OSError: gone"]) == 2

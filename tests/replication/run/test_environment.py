@@ -1,5 +1,5 @@
 """What a result records of the machine: the CPU's vector features, which decide the kernels' rounding."""
-from replication.run.environment import cpu_description, hardware
+from lagbench.replication.run.environment import cpu_description, hardware
 
 ZEN4 = """processor\t: 0
 vendor_id\t: AuthenticAMD

@@ -10,9 +10,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from replication.run import executor, runner
-from replication.run.environment import one_thread_env
-from replication.run.same_numbers import TIMING
+from lagbench.replication.run import executor, runner
+from lagbench.replication.run.environment import one_thread_env
+from lagbench.replication.run.same_numbers import TIMING
 
 CLAIMS = ["dp_loss", "dp_energy", "appendix_b"]
 
@@ -132,7 +132,7 @@ def test_workers_exit_when_their_driver_is_killed(tmp_path):
     """SIGKILL on the driver (a scheduler's time limit, `kill -9`) as soon as its two workers exist: they
     exit, and write no unit (left alone, each would finish its chain first)."""
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "replication.cli", "run", "--profile", "smoke", "--claims", "dp_loss,appendix_b",
+    cmd = [sys.executable, "-m", "lagbench", "run", "--profile", "smoke", "--claims", "dp_loss,appendix_b",
            "--frameworks", "jax", "--jobs", "2", "--quiet", "--out", str(out)]
     driver = subprocess.Popen(cmd, start_new_session=True)
     try:

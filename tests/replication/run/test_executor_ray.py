@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from replication.run import executor_ray, runner
+from lagbench.replication.run import executor_ray, runner
 
 ray = pytest.importorskip("ray", reason="Ray is an optional extra (pip install 'lagbench[ray]')")
 
@@ -201,7 +201,7 @@ def test_ctrl_c_on_a_driver_joining_with_address(cluster, local, tmp_path):
     """The command line, as another process joining the instance with --address, interrupted (SIGINT)
     while the chain's first unit is held stopped and once the untrained unit is written."""
     env = {**os.environ, "LAGBENCH_WORKER_DIR": str(cluster["worker"])}
-    cmd = [sys.executable, "-m", "replication.cli", "run", "--profile", "smoke", "--claims", ",".join(KW["claims"]),
+    cmd = [sys.executable, "-m", "lagbench", "run", "--profile", "smoke", "--claims", ",".join(KW["claims"]),
            "--models", ",".join(KW["models"]), "--frameworks", "torch", "--out", str(tmp_path), "--quiet",
            "--executor", "ray", "--address", cluster["address"]]
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -7,12 +7,12 @@ import sys
 
 import pytest
 
-from replication.run import jax_cache
+from lagbench.replication.run import jax_cache
 
 # One process: point JAX at the cache as `lagbench` does, compile one program, say whether it was read back.
 PROBE = """
 import json, sys
-from replication.run import jax_cache
+from lagbench.replication.run import jax_cache
 jax_cache.MIN_COMPILE_S = 0.0   # keep even this small program
 on = jax_cache.private()
 import jax, jax.numpy as jnp, jax.monitoring as mon
@@ -73,7 +73,7 @@ def test_the_folder_is_named_by_the_install_and_the_cpu(monkeypatch):
 
 
 def test_a_command_that_compiles_nothing_makes_no_cache_folder(tmp_path, monkeypatch, capsys):
-    from replication.cli import main
+    from lagbench.cli import main
 
     monkeypatch.delenv("JAX_COMPILATION_CACHE_DIR")   # set for the test run by conftest.py
     monkeypatch.setenv("LAGBENCH_CACHE", str(tmp_path))

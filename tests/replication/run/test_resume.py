@@ -7,8 +7,8 @@ import subprocess
 import sys
 import time
 
-from replication import results as R
-from replication.run.runner import run
+from lagbench.files import results as R
+from lagbench.replication.run.runner import run
 
 ARGS = ["--profile", "smoke", "--claims", "dp_loss", "--quiet"]
 
@@ -21,7 +21,7 @@ def _metrics(out):
 def test_killed_run_resumes_to_the_same_numbers(smoke_results, tmp_path):
     """Killed between its two units, resumed: the numbers of the session's uninterrupted smoke run."""
     killed = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "replication.cli", "run", *ARGS, "--frameworks", "jax", "--out"]
+    cmd = [sys.executable, "-m", "lagbench", "run", *ARGS, "--frameworks", "jax", "--out"]
     proc = subprocess.Popen([*cmd, str(killed)], start_new_session=True)
     deadline = time.time() + 300
     while time.time() < deadline and not list(killed.glob("units/*/*/*/seed*/result.json")):
@@ -58,7 +58,7 @@ def test_corrupt_result_is_detected_and_rerun(tmp_path):
 
 
 def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatch):
-    from replication.claims import get
+    from lagbench.replication.claims import get
 
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
               progress=False)
@@ -75,7 +75,7 @@ def test_a_changed_protocol_reruns_and_keeps_the_old_result(tmp_path, monkeypatc
 
 
 def test_a_dry_run_of_a_finished_folder_says_so_and_writes_nothing(tmp_path, monkeypatch, capsys):
-    from replication.claims import get
+    from lagbench.replication.claims import get
 
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_loss"], frameworks=("jax",), models=["baseline"],
               progress=False)
@@ -87,14 +87,14 @@ def test_a_dry_run_of_a_finished_folder_says_so_and_writes_nothing(tmp_path, mon
     assert "1 units, every one finished" in capsys.readouterr().out
     claim = get("dp_loss")   # a changed protocol: the dry run counts the unit as to run, and still writes nothing
     monkeypatch.setitem(claim.protocols, "smoke", claim.protocols["smoke"].replace(steps=7))
-    monkeypatch.setattr("replication.run.runner.announce", lambda *a, **k: {"probed": True})
+    monkeypatch.setattr("lagbench.replication.run.runner.announce", lambda *a, **k: {"probed": True})
     assert run(**kw, dry_run=True)["todo"] == 1
     assert "nothing to run" not in capsys.readouterr().out
     assert snapshot() == before
 
 
 def test_a_changed_evaluation_config_reruns_too(tmp_path, monkeypatch):
-    from replication.claims import get
+    from lagbench.replication.claims import get
 
     kw = dict(profile="smoke", out=tmp_path, claims=["dp_energy"], frameworks=("jax",), models=["baseline"],
               progress=False)
@@ -113,7 +113,7 @@ def _release_calls(monkeypatch, tmp_path, budget):
     import jax
     import jax.monitoring
 
-    from replication.run import chains, runner, units
+    from lagbench.replication.run import chains, runner, units
     calls, traced, per_unit = [], [], []
     real_clear, real_unit = jax.clear_caches, units.run_unit
     monkeypatch.setattr(jax, "clear_caches", lambda: (calls.append(1), real_clear()))
@@ -161,10 +161,10 @@ def test_released_compilations_keep_the_memory_map_count_flat():
     import numpy as np
     import pytest
 
-    from models import ModelSpec, init_params
-    from replication.evaluation.adapters import adapter
-    from replication.run.chains import map_count
-    from replication.run.executor import release_compiled
+    from lagbench.models import ModelSpec, init_params
+    from lagbench.replication.evaluation.adapters import adapter
+    from lagbench.replication.run.chains import map_count
+    from lagbench.replication.run.executor import release_compiled
 
     if not os.path.exists("/proc/self/maps"):
         pytest.skip("no /proc/self/maps on this system")

@@ -5,8 +5,8 @@ import json
 
 import pytest
 
-from replication.cli import main
-from replication.run import runner, units
+from lagbench.cli import main
+from lagbench.replication.run import runner, units
 
 ONE = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--models", "baseline", "--quiet"]
 

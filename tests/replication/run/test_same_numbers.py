@@ -1,7 +1,7 @@
 """`replication.run.same_numbers`: two runs' units.csv compared column by column, timings apart."""
 import pandas as pd
 
-from replication.run.same_numbers import compare, main
+from lagbench.replication.run.same_numbers import compare, main
 
 ROWS = pd.DataFrame({"claim": ["a", "a"], "framework": ["jax", "torch"], "model": ["lnn", "lnn"], "seed": [1000, 1000],
                      "heldout_l1": [0.1, float("nan")], "status": ["ok", "failed"], "wall_time_s": [3.0, 4.0]})

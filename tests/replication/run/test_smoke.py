@@ -5,9 +5,9 @@ import json
 import pandas as pd
 import pytest
 
-from replication import results as R
-from replication.claims import CLAIMS, VERDICTS
-from replication.run.runner import run
+from lagbench.files import results as R
+from lagbench.replication.claims import CLAIMS, VERDICTS
+from lagbench.replication.run.runner import run
 
 
 def _every_claim_has_a_verdict(summary, frameworks_of):
@@ -60,7 +60,7 @@ def test_a_rerun_skips_finished_units(smoke_results, smoke_frameworks):
 
 
 def test_report_builds_from_real_smoke_results(smoke_results, tmp_path):
-    import reports
+    from lagbench import reports
 
     out, _ = smoke_results
     paths = reports.build_report(out, tmp_path)

@@ -5,10 +5,10 @@ import json
 
 import pytest
 
-from replication.claims import CLAIMS, PROFILES
-from replication.run import runner, splits
-from replication.run import units as units_mod
-from replication.training import data as datamod
+from lagbench.replication.claims import CLAIMS, PROFILES
+from lagbench.replication.run import runner, splits
+from lagbench.replication.run import units as units_mod
+from lagbench.replication.training import data as datamod
 
 KW = dict(profile="smoke", claims=["dp_loss"], frameworks=("jax",), models=["baseline", "lnn"], progress=False)
 
@@ -68,7 +68,7 @@ def test_a_test_run_trains_on_development_draws_and_decides_on_the_test_draw(tmp
 
 
 def test_summary_and_report_judge_one_split(tmp_path, reads):
-    from reports.load import load_results
+    from lagbench.reports.load import load_results
 
     runner.run(out=tmp_path, split="dev", **KW)
     dev = json.loads((tmp_path / "summary" / "verdicts.json").read_text())

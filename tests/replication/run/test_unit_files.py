@@ -2,8 +2,8 @@
 import pandas as pd
 import pytest
 
-from replication import results as R
-from replication.run import unit_files
+from lagbench.files import results as R
+from lagbench.replication.run import unit_files
 
 
 def unit_folder(root, name="units/c/jax/m/seed0"):

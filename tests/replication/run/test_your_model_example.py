@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from replication.cli import main
+from lagbench.cli import main
 
 README = Path(__file__).resolve().parents[3] / "README.md"
 

@@ -4,9 +4,9 @@ null), a diverging model is marked and scores no error, and the references are t
 import numpy as np
 import pytest
 
-import systems
-from replication.cli import main
-from replication.studies import control as C
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.replication.studies import control as C
 
 PLANT = systems.get("two_link_arm")
 
@@ -35,7 +35,7 @@ def test_a_model_of_zero_torque_is_pd_alone_and_a_diverging_one_is_marked(refs):
 
 
 def test_the_references_are_unseen_shapes_and_the_training_family_twice_as_fast():
-    from systems.arm_data import arm_dataset
+    from lagbench.systems.arm_data import arm_dataset
 
     fast = C.references("train_x2", n=2, duration=1.0, rate=100.0)
     slow = arm_dataset("train", n_traj=2, n_points=101, seed=C.SEED, duration=2.0, cache=False)
@@ -58,7 +58,7 @@ def test_the_command_writes_the_study_for_a_folder_without_models(tmp_path, caps
 def test_the_report_shows_the_study_and_flags_a_controller_no_better_than_pd(tmp_path):
     import pandas as pd
 
-    from reports.sections_control import _table
+    from lagbench.reports.sections_control import _table
 
     df = pd.DataFrame([{"family": "test", "controller": c, "framework": fw, "seed": s, "track_mse": m,
                         "ratio_to_pd": m / 0.3, "torque_effort": 1.0, "n_diverged": 0}

@@ -9,10 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import systems
-from replication.cli import main
-from replication.studies import arm4_control as A
-from replication.studies import control as C
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.replication.studies import arm4_control as A
+from lagbench.replication.studies import control as C
 
 ARM4 = systems.get("four_joint_arm")
 TINY = {"n_train": 2, "n_points": 40, "duration": 4.0}
@@ -80,9 +80,9 @@ def test_a_rerun_reuses_the_fits(tiny_run):
 
 
 def test_the_run_reaches_the_report_as_its_own_section(tiny_run, tmp_path):
-    from reports.document import Figure, Table
-    from reports.load import load_results
-    from reports.sections_control import control_sections
+    from lagbench.reports.document import Figure, Table
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_control import control_sections
 
     (section,) = control_sections(load_results(tiny_run), tmp_path)   # no two-link study here: one section
     assert section.title == "Closed-loop tracking control of the four-joint arm (study)"
@@ -96,7 +96,7 @@ def test_the_run_reaches_the_report_as_its_own_section(tiny_run, tmp_path):
 
 
 def test_the_two_link_study_is_what_it_was():
-    from systems.arm_data import arm_dataset
+    from lagbench.systems.arm_data import arm_dataset
 
     refs = C.references("test", n=1, duration=0.1)
     d = arm_dataset("test", n_traj=1, n_points=51, seed=C.SEED, duration=0.1, cache=False)

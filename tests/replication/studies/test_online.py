@@ -9,11 +9,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import systems
-from replication.cli import main
-from replication.studies import control as C
-from replication.studies import online as O
-from replication.studies.online_learner import ReplayBuffer, learner
+from lagbench import systems
+from lagbench.cli import main
+from lagbench.replication.studies import control as C
+from lagbench.replication.studies import online as O
+from lagbench.replication.studies.online_learner import ReplayBuffer, learner
 
 PLANT = systems.get("two_link_arm")
 TINY = (8, 8)

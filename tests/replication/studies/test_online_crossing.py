@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.studies import online as O
+from lagbench.replication.studies import online as O
 
 WINDOW, LINE = 0.5, 0.1
 ABOVE, BELOW = 1.0, 0.05

@@ -5,10 +5,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from replication.cli import main
-from replication.studies import control as C
-from replication.studies import robustness as R
-from replication.studies.robustness_scenes import Plant, Scene, scene_data
+from lagbench.cli import main
+from lagbench.replication.studies import control as C
+from lagbench.replication.studies import robustness as R
+from lagbench.replication.studies.robustness_scenes import Plant, Scene, scene_data
 
 TINY = {"n_train": 2, "n_test": 2, "n_points": 40, "n_refs": 1, "ref_duration": 0.1}
 
@@ -96,9 +96,9 @@ def test_bad_options_are_one_line_naming_the_option_and_write_nothing(tmp_path, 
 def test_the_run_reaches_the_report_with_its_settings_table_and_figure(tiny_run, tmp_path):
     import json
 
-    from reports.document import Figure, Table
-    from reports.load import load_results
-    from reports.sections_robustness import robustness_sections
+    from lagbench.reports.document import Figure, Table
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_robustness import robustness_sections
 
     settings = json.loads((tiny_run / "robustness" / "study.json").read_text())
     assert settings["steps"] == 3 and settings["seeds"] == [0] and settings["sizes"] == TINY

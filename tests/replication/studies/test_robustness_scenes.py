@@ -4,11 +4,11 @@ recording, and the tracker is control.py's on the nominal arm, bit for bit."""
 import numpy as np
 import pytest
 
-import systems
-from replication.studies import control as C
-from replication.studies import robustness_scenes as S
-from replication.studies.robustness_scenes import Plant, Scene, scene_data
-from systems.arm_data import arm_dataset
+from lagbench import systems
+from lagbench.replication.studies import control as C
+from lagbench.replication.studies import robustness_scenes as S
+from lagbench.replication.studies.robustness_scenes import Plant, Scene, scene_data
+from lagbench.systems.arm_data import arm_dataset
 
 ARM = systems.get("two_link_arm")
 

@@ -23,9 +23,9 @@ import sys
 
 import numpy as np
 
-from models import init_params
-from replication.training import loop, scouting, train_jax, train_torch
-from replication.training.data import BatchStream
+from lagbench.models import init_params
+from lagbench.replication.training import loop, scouting, train_jax, train_torch
+from lagbench.replication.training.data import BatchStream
 
 _JAX_STEPS: dict = {}
 

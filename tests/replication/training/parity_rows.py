@@ -12,9 +12,9 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from models import ModelSpec
-from replication.training.protocol import Data, Guard, Protocol, Scouting
-from replication.training.schedules import Constant, OneCycle, StepDecay
+from lagbench.models import ModelSpec
+from lagbench.replication.training.protocol import Data, Guard, Protocol, Scouting
+from lagbench.replication.training.schedules import Constant, OneCycle, StepDecay
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python

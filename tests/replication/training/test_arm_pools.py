@@ -2,9 +2,9 @@
 samples over several trajectories, and the cache key sees the change."""
 import numpy as np
 
-from replication.training import data as datamod
-from replication.training.protocol import Data, Protocol
-from replication.training.schedules import Constant
+from lagbench.replication.training import data as datamod
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.replication.training.schedules import Constant
 
 ARM = Protocol(data=Data("two_link_arm", n_train=256, n_heldout=512), task="inverse_dynamics", steps=10, batch=32, loss="mse", schedule=Constant(lr=1e-3))
 

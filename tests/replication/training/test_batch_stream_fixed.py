@@ -5,9 +5,9 @@ epoch). The field is validated, and a protocol without it keeps its canonical fo
 import numpy as np
 import pytest
 
-from replication.training.data import BatchStream
-from replication.training.protocol import Data, Protocol
-from systems.closed_form import relativistic_acceleration
+from lagbench.replication.training.data import BatchStream
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.systems.closed_form import relativistic_acceleration
 
 N, BATCH = 64, 16
 DATA = Data("relativistic_iid", n_train=N, resample=True)

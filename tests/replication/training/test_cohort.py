@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from parity_rows import BY_NAME
 
-from replication.training import scouting
-from replication.training import train as training
-from replication.training.protocol import Data, Protocol, Scouting
-from replication.training.schedules import OneCycle
+from lagbench.replication.training import scouting
+from lagbench.replication.training import train as training
+from lagbench.replication.training.protocol import Data, Protocol, Scouting
+from lagbench.replication.training.schedules import OneCycle
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PROTOCOL = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=8, log_every=1, cohort=2)

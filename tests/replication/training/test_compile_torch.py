@@ -9,10 +9,10 @@ import torch
 from parity_kit import compare, trace
 from parity_rows import BY_NAME
 
-from models import ModelSpec, init_params
-from replication.training import compile_torch, train_torch
-from replication.training.data import BatchStream
-from replication.training.outcome import joined_modes
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training import compile_torch, train_torch
+from lagbench.replication.training.data import BatchStream
+from lagbench.replication.training.outcome import joined_modes
 
 
 def _traced(monkeypatch, setting, row):
@@ -97,7 +97,7 @@ def test_joined_modes_name_each_phase_mode_once_in_order():
 
 
 def test_compiling_is_not_tracing_or_exporting():
-    from models.torch import export_paths
+    from lagbench.models.torch import export_paths
 
     assert not export_paths.compiling() and not export_paths.tracing()
     seen = {}
@@ -126,7 +126,7 @@ def test_estimate_probes_compile_where_the_phase_they_stand_for_will(monkeypatch
 def test_without_a_cxx_compiler_training_is_eager_with_one_warning(monkeypatch, caplog):
     import shutil
 
-    from replication.training import compile_torch as ct
+    from lagbench.replication.training import compile_torch as ct
 
     monkeypatch.setattr(shutil, "which", lambda name: None)
     monkeypatch.setattr(ct, "_WARNED", set())

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from replication.training import device
+from lagbench.replication.training import device
 
 NO_GPU = not any(device.gpu_seen(fw)[0] for fw in ("jax", "torch"))
 
@@ -45,7 +45,7 @@ def test_without_a_gpu_auto_takes_the_cpu_and_gpu_names_what_is_missing():
 def test_a_gpu_asked_for_where_none_is_seen_is_one_line_and_writes_nothing(tmp_path, argv, framework, fitted):
     out = tmp_path / "out"
     argv = [a.format(fit=fitted["fit"], data=fitted["data"]) for a in argv]
-    r = subprocess.run([sys.executable, "-m", "replication.cli", *argv, "--out", str(out)], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "lagbench", *argv, "--out", str(out)], capture_output=True,
                        text=True, cwd=tmp_path, timeout=300)
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
@@ -56,8 +56,8 @@ def test_a_gpu_asked_for_where_none_is_seen_is_one_line_and_writes_nothing(tmp_p
 @pytest.fixture(scope="module")
 def fitted(tmp_path_factory):
     """A tiny fit of simulated data (for `evaluate`), made on the CPU."""
-    from replication.fit.simulate import simulate
-    from replication.fit.task import fit
+    from lagbench.replication.fit.simulate import simulate
+    from lagbench.replication.fit.task import fit
 
     root = tmp_path_factory.mktemp("fitted")
     data = root / "pendulum.csv"
@@ -85,9 +85,9 @@ def test_describe_records_the_device():
 
 
 def test_a_training_records_where_it_computed(tmp_path, monkeypatch):
-    from models import ModelSpec
-    from replication.training.protocol import Data, Protocol
-    from replication.training.train import train_cached
+    from lagbench.models import ModelSpec
+    from lagbench.replication.training.protocol import Data, Protocol
+    from lagbench.replication.training.train import train_cached
 
     monkeypatch.setenv(device.ENV, "cpu")
     spec = ModelSpec(kind="baseline", dof=1, hidden=(8,), activation="tanh", init="xavier")
@@ -100,8 +100,8 @@ def test_a_training_records_where_it_computed(tmp_path, monkeypatch):
 
 
 def test_ray_tasks_ask_for_a_gpu_share_in_either_framework_unless_the_cpu_is_asked_for():
-    from replication.run.executor_ray import resources
-    from replication.run.runner import plan
+    from lagbench.replication.run.executor_ray import resources
+    from lagbench.replication.run.runner import plan
 
     for unit in plan("smoke", claims=["dp_loss"]):
         assert resources(unit, 1.0)["num_gpus"] > 0

@@ -3,12 +3,12 @@ relativistic particle near the speed of light, the chaos floor beside every roll
 import numpy as np
 import pytest
 
-import systems
-from models import ModelSpec, init_params
-from replication.training import hessian_probe
-from replication.training.protocol import Data, Protocol
-from replication.training.schedules import Constant
-from replication.training.train import run_training
+from lagbench import systems
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training import hessian_probe
+from lagbench.replication.training.protocol import Data, Protocol
+from lagbench.replication.training.schedules import Constant
+from lagbench.replication.training.train import run_training
 
 
 @pytest.mark.parametrize("framework", ["jax", "torch"])
@@ -26,10 +26,10 @@ def test_fresh_lnn_has_indefinite_velocity_hessians_and_says_so():
     """The reference measured 42 % indefinite at the empirical init (4-600-600-600-1, training states)."""
     import jax.numpy as jnp
 
-    import models.jax
+    import lagbench.models.jax
 
     spec = ModelSpec(kind="lnn", dof=2, hidden=(600, 600, 600), dtype="float64", angle_wrap=True)
-    m = models.jax.build(spec, init_params(spec, seed=0))
+    m = lagbench.models.jax.build(spec, init_params(spec, seed=0))
     st = systems.get("double_pendulum").sample_states(2000, np.random.default_rng(0))
     H = np.asarray(m.velocity_hessian(jnp.asarray(st["q"]), jnp.asarray(st["qdot"])))
     eig = np.linalg.eigvalsh(H)

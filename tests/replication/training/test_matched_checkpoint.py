@@ -5,11 +5,11 @@ import math
 import numpy as np
 from parity_rows import BY_NAME
 
-from replication.evaluation import matched
-from replication.evaluation.adapters import adapter
-from replication.training import scouting
-from replication.training.protocol import Tracking
-from replication.training.train import run_training
+from lagbench.replication.evaluation import matched
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.training import scouting
+from lagbench.replication.training.protocol import Tracking
+from lagbench.replication.training.train import run_training
 
 SPEC = BY_NAME["lnn_scouted"].spec
 PLAIN = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=9, log_every=2)

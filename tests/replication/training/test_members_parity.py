@@ -7,8 +7,8 @@ import pytest
 from parity_kit import Recorder
 from parity_rows import BY_NAME
 
-from models import init_params
-from replication.training.data import BatchStream
+from lagbench.models import init_params
+from lagbench.replication.training.data import BatchStream
 
 # the guard on and tight (clip below the norms, skip at the median): members clip and skip on different steps
 ROW = BY_NAME["lnn_members"]

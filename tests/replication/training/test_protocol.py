@@ -4,8 +4,16 @@ import json
 
 import pytest
 
-from replication.training.protocol import KEY_VERSION, Adam, Data, Guard, Protocol, Scouting, Tracking
-from replication.training.schedules import Constant, OneCycle, StepDecay
+from lagbench.replication.training.protocol import (
+    KEY_VERSION,
+    Adam,
+    Data,
+    Guard,
+    Protocol,
+    Scouting,
+    Tracking,
+)
+from lagbench.replication.training.schedules import Constant, OneCycle, StepDecay
 
 BASE = Protocol(data=Data("double_pendulum_iid", n_train=64), steps=10, batch=8, log_every=5)
 FULL = BASE.replace(guard=Guard(clip=100.0, skip=10.0), tracking=Tracking(every=5),

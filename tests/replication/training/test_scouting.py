@@ -4,10 +4,10 @@ import pytest
 from parity_kit import Recorder
 from parity_rows import BY_NAME
 
-from models import init_params
-from replication.training import scouting
-from replication.training.data import BatchStream
-from replication.training.protocol import Protocol, Scouting
+from lagbench.models import init_params
+from lagbench.replication.training import scouting
+from lagbench.replication.training.data import BatchStream
+from lagbench.replication.training.protocol import Protocol, Scouting
 
 # the parity table's scouted row (JAX against PyTorch there), longer: the same compiled steps
 SPEC = BY_NAME["lnn_scouted"].spec
@@ -68,7 +68,7 @@ def test_protocol_checks_and_keys():
 def test_scouts_and_continuation_start_their_one_cycles_apart():
     """The scouting's schedule sets the scouts' starting phase; the continuation starts at the protocol's
     schedule's, so it can warm up from below the rate a fresh Adam would be thrown by."""
-    from replication.training.schedules import OneCycle, learning_rate
+    from lagbench.replication.training.schedules import OneCycle, learning_rate
 
     p = PROTOCOL.replace(schedule=OneCycle(lr=1e-2, start=0.1),
                          **{"scouting.schedule": OneCycle(lr=1e-3, start=0.2)})

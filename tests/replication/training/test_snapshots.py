@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from parity_rows import GUARDED, LNN
 
-from replication.training import snapshots
-from replication.training.protocol import Scouting, Tracking
-from replication.training.schedules import OneCycle
-from replication.training.train import train_cached, train_key
+from lagbench.replication.training import snapshots
+from lagbench.replication.training.protocol import Scouting, Tracking
+from lagbench.replication.training.schedules import OneCycle
+from lagbench.replication.training.train import train_cached, train_key
 
 SPEC = LNN                                            # the chaotic double-pendulum LNN: any drift would show
 ONE = GUARDED.replace(steps=30, tracking=Tracking(every=5, keep=True))   # guard acting often, tracking, kept checkpoints
@@ -147,7 +147,7 @@ def test_a_damaged_or_foreign_snapshot_is_not_used(tmp_path, caplog):
 
 
 def test_a_snapshot_of_another_training_is_not_used(tmp_path, caplog):
-    from replication.training.snapshots import Snapshots
+    from lagbench.replication.training.snapshots import Snapshots
     protocol = ONE.replace(tracking=None, steps=12)
     with pytest.raises(Killed):
         train_cached(tmp_path / "cut", "jax", SPEC, protocol, 0, on_log=_killer(6))
@@ -160,7 +160,7 @@ def test_a_snapshot_of_another_training_is_not_used(tmp_path, caplog):
 
 
 def test_a_failed_snapshot_write_does_not_stop_the_training(tmp_path, caplog):
-    from replication.training.snapshots import Snapshots
+    from lagbench.replication.training.snapshots import Snapshots
     (tmp_path / "file").write_text("x")
     store = Snapshots(tmp_path / "file" / "inflight", "k")    # a folder that cannot be made
     with caplog.at_level(logging.WARNING, logger="lagbench"):

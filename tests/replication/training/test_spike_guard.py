@@ -7,12 +7,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-import models.jax
-from models import ModelSpec, init_params
-from replication.training import train_jax
-from replication.training.data import BatchStream
-from replication.training.protocol import Data, Guard, Protocol
-from replication.training.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
+import lagbench.models.jax
+from lagbench.models import ModelSpec, init_params
+from lagbench.replication.training import train_jax
+from lagbench.replication.training.data import BatchStream
+from lagbench.replication.training.protocol import Data, Guard, Protocol
+from lagbench.replication.training.spike_guard import MIN_HISTORY, WINDOW, SpikeGuard
 
 BASE = Protocol(data=Data("double_pendulum_iid", n_train=32, resample=True), steps=5, batch=8, dtype="float64")
 
@@ -94,7 +94,7 @@ def test_guard_fields_validated_and_keyed():
 
 def test_jax_step_skip_leaves_model_and_state():
     spec = ModelSpec(kind="lnn", dof=2, hidden=(8, 8), dtype="float64", angle_wrap=True)
-    model = models.jax.build(spec, init_params(spec, seed=0))
+    model = lagbench.models.jax.build(spec, init_params(spec, seed=0))
     opt, step = train_jax.make_step(spec, BASE)
     state = opt.init(eqx.filter(model, eqx.is_inexact_array))
     batch = {k: jnp.asarray(v) for k, v in BatchStream(BASE, 0).batch(0).items()}

@@ -5,12 +5,12 @@ import pandas as pd
 import pytest
 from parity_rows import BY_NAME
 
-from replication.evaluation.adapters import adapter
-from replication.training import scouting
-from replication.training.objective import loss_value, predict
-from replication.training.protocol import Tracking
-from replication.training.tracking import TRACK_STATES, Tracker
-from replication.training.train import run_training
+from lagbench.replication.evaluation.adapters import adapter
+from lagbench.replication.training import scouting
+from lagbench.replication.training.objective import loss_value, predict
+from lagbench.replication.training.protocol import Tracking
+from lagbench.replication.training.tracking import TRACK_STATES, Tracker
+from lagbench.replication.training.train import run_training
 
 SPEC = BY_NAME["lnn_scouted"].spec   # a small float64 double-pendulum LNN
 PLAIN = scouting.scout_protocol(BY_NAME["lnn_scouted"].protocol).replace(steps=9, log_every=2)
@@ -44,7 +44,7 @@ def test_a_scouted_run_tracks_its_continuation_with_the_scouts_samples_counted()
 
 
 def test_kept_checkpoints_are_stored_only_when_asked_so_other_protocols_keep_their_keys():
-    from replication.training.protocol import Protocol
+    from lagbench.replication.training.protocol import Protocol
 
     assert PLAIN.replace(tracking=Tracking(every=4)).to_dict()["tracking"] == {"every": 4}
     kept = PLAIN.replace(tracking=Tracking(every=4, keep=True))
@@ -69,7 +69,7 @@ class _Unit:
 
 
 def test_work_precision_draws_tracked_logs_only(tmp_path):
-    from reports.figures_precision import tracked, work_precision
+    from lagbench.reports.figures_precision import tracked, work_precision
 
     log = pd.DataFrame({"step": [0, 1, 2], "loss": [3.0, 2.0, 1.0], "heldout_loss": [3.0, np.nan, 1.5],
                         "samples": [8, np.nan, 24], "train_s": [0.1, np.nan, 0.3]})

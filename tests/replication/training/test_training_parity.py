@@ -17,11 +17,11 @@ import pytest
 from parity_kit import Recorder, cached_trace, compare, run_row, step_diffs, within
 from parity_rows import BY_NAME, F32, F64, ROWS, Row
 
-from models import FORMULATIONS, KINDS, ModelSpec, init_params
-from replication.claims import rel_coords
-from replication.training.data import BatchStream
-from replication.training.protocol import DTYPES, LOSSES, Data, Protocol
-from replication.training.schedules import SCHEDULES
+from lagbench.models import FORMULATIONS, KINDS, ModelSpec, init_params
+from lagbench.replication.claims import rel_coords
+from lagbench.replication.training.data import BatchStream
+from lagbench.replication.training.protocol import DTYPES, LOSSES, Data, Protocol
+from lagbench.replication.training.schedules import SCHEDULES
 
 
 @pytest.mark.parametrize("row", [pytest.param(r, id=r.name, marks=[pytest.mark.slow] * r.slow) for r in ROWS])

@@ -5,7 +5,7 @@ import pytest
 from parity_kit import compare, trace, within
 from parity_rows import F64
 
-from replication.training import device
+from lagbench.replication.training import device
 
 GPU = all(device.gpu_seen(fw)[0] for fw in ("jax", "torch"))
 pytestmark = pytest.mark.skipif(not GPU, reason="needs a GPU that both JAX and PyTorch see")
@@ -40,8 +40,8 @@ def test_the_gpu_trains_as_the_cpu_does(framework):
 def test_a_unit_trains_and_is_evaluated_on_the_gpu(tmp_path, monkeypatch, framework):
     # the evaluation's model is built on the run's device, where its inputs are made (a PyTorch model built
     # outside it kept its parameters on the CPU and failed on CUDA inputs)
-    from replication.run.runner import plan
-    from replication.run.units import run_unit
+    from lagbench.replication.run.runner import plan
+    from lagbench.replication.run.units import run_unit
 
     monkeypatch.setenv(device.ENV, "gpu")
     unit = next(u for u in plan("smoke", claims=["dp_loss"], frameworks=(framework,), models=["lnn"]))

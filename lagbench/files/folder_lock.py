@@ -15,6 +15,8 @@ import os
 from contextlib import contextmanager
 from pathlib import Path
 
+from lagbench.files.clock import now
+
 LOCK_NAME = ".lagbench.lock"
 _LOCKS: dict = {}   # resolved folder -> the open lock file this process holds on it
 
@@ -43,8 +45,6 @@ def lock(path: Path, option: str) -> None:
         os.close(fd)
         raise err from None
     os.ftruncate(fd, 0)
-    from replication.run.environment import now  # imports the standard library only
-
     os.write(fd, f"pid {os.getpid()}, since {now()}".encode())
     _LOCKS[key] = fd
 

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from replication.results import sha256_bytes
+from lagbench.files.results import sha256_bytes
 
 REQUIRED = ("q", "qdot", "qddot")
 ARRAYS = (*REQUIRED, "tau")

@@ -6,13 +6,14 @@ import logging
 import signal
 import sys
 import threading
+import traceback
 from pathlib import Path
 
-from replication.results import DiskFull, writing
-from replication.run import jax_cache
-from replication.training.device import HELP as DEVICE_HELP
-from speedstudy.bench_cli import add_bench
-from speedstudy.train_target_cli import add_train_target
+from lagbench.files.results import DiskFull, writing
+from lagbench.replication.run import jax_cache
+from lagbench.replication.training.device import HELP as DEVICE_HELP
+from lagbench.speedstudy.bench_cli import add_bench
+from lagbench.speedstudy.train_target_cli import add_train_target
 
 
 def _csv(s):
@@ -21,15 +22,15 @@ def _csv(s):
 
 def write_folder(path: Path) -> Path:
     """The output folder, made and checked before any work (a ValueError naming --out)."""
-    from replication.results import output_folder
+    from lagbench.files.results import output_folder
 
     return output_folder(path, "--out")
 
 
 def cmd_list(args):
-    import systems
-    from models import ACTIVATIONS, INITS, KINDS
-    from replication.claims import CLAIMS, PROFILES
+    from lagbench import systems
+    from lagbench.models import ACTIVATIONS, INITS, KINDS
+    from lagbench.replication.claims import CLAIMS, PROFILES
 
     print("systems:    " + ", ".join(systems.names()))
     print("models:     " + ", ".join(KINDS))
@@ -51,9 +52,9 @@ def cmd_list(args):
 
 
 def cmd_run(args):
-    from replication.claims.base import run_frameworks
-    from replication.run.runner import run
-    from replication.training import device
+    from lagbench.replication.claims.base import run_frameworks
+    from lagbench.replication.run.runner import run
+    from lagbench.replication.training import device
 
     frameworks = _csv(args.frameworks)   # None: the profile's (`PROFILE_FRAMEWORKS`)
     device.apply(args.device, run_frameworks(args.profile, frameworks))
@@ -73,7 +74,7 @@ def cmd_run(args):
 def _print_errors(errors) -> int:
     """Each unit error once, units failing with the same message on one line; the exit status: 2 where the
     user's code failed (a rerun cannot help), 1 for other errors (a rerun retries them), 0 for none."""
-    from replication.user_functions import is_users
+    from lagbench.files.user_functions import is_users
 
     by_message: dict = {}
     for e in errors:
@@ -87,8 +88,8 @@ def _print_errors(errors) -> int:
 
 
 def cmd_stiff(args):
-    import systems
-    from replication.studies.stiff_solvers import write_study
+    from lagbench import systems
+    from lagbench.replication.studies.stiff_solvers import write_study
 
     systems.get(args.system)  # an unknown name fails here, listing the valid ones
     folder = write_folder(Path(args.out) / "stiff")
@@ -127,7 +128,7 @@ def build_parser():
     p = argparse.ArgumentParser(prog="lagbench", description="Replication suite for learned Lagrangian and "
                                 "Hamiltonian dynamics (LNN, DeLaN, HNN, baselines) in JAX and PyTorch.",
                                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    p.add_argument("-v", "--verbose", action="store_true", help="log progress details; on an error, print its traceback too")
     p.add_argument("--version", action="version", version=f"lagbench {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("list", help="list systems, models, claims and profiles")
@@ -160,15 +161,15 @@ def build_parser():
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_run)
-    from replication.results_cli import add_commands as add_results_commands
-    from replication.studies.control_cli import add_command as add_control
-    from replication.studies.online_cli import add_command as add_online
-    from replication.studies.robustness_cli import add_command as add_robustness
-    from replication.tuning.cli import add_command as add_tune
+    from lagbench.replication.studies.control_cli import add_command as add_control
+    from lagbench.replication.studies.online_cli import add_command as add_online
+    from lagbench.replication.studies.robustness_cli import add_command as add_robustness
+    from lagbench.replication.tuning.cli import add_command as add_tune
+    from lagbench.results_cli import add_commands as add_results_commands
 
     add_tune(sub)
     add_results_commands(sub)   # report, table
-    from replication.fit.cli import add_commands
+    from lagbench.replication.fit.cli import add_commands
 
     add_commands(sub)  # simulate, fit, evaluate
     add_bench(sub)
@@ -206,10 +207,29 @@ def _terminate(signum, frame):
 READS_ONLY = ("list", "report", "table")   # commands that compile nothing, so make no compilation cache
 
 
+REPORT = ("a bug in lagbench, not in your input: please report it with the command you ran, the traceback "
+          "that `lagbench -v ...` prints and `pip show lagbench`'s version")
+
+
+def _internal(e: BaseException) -> bool:
+    """A KeyError whose message is not a sentence (a lookup that failed inside the suite, `KeyError('lr')`):
+    the suite's own errors for bad input say what is wrong in words."""
+    return isinstance(e, KeyError) and not (e.args and isinstance(e.args[0], str) and " " in e.args[0])
+
+
+def _bug(e: BaseException, verbose: bool) -> int:
+    if verbose:
+        traceback.print_exc()
+    print(f"lagbench: internal error: {type(e).__name__}: {e}; {REPORT}"
+          + ("" if verbose else " (rerun with -v for the traceback)"), file=sys.stderr)
+    return 1
+
+
 def main(argv=None):
-    """Every error is one line on stderr and a non-zero exit: 2 for bad input or an OS error (a file
-    where a folder belongs, no permission, a full disk), 130 for Ctrl-C and 143 for SIGTERM (with how to
-    resume)."""
+    """A user's error is one line on stderr and exit 2: bad input or an OS error (a file where a folder belongs,
+    no permission, a full disk); 130 for Ctrl-C and 143 for SIGTERM (with how to resume). `-v` adds the
+    traceback (a user's code's own, where it failed). Any other exception is a bug in the suite: one line that
+    says how to report it, exit 1, its traceback with `-v`."""
     for stream in (sys.stdout, sys.stderr):   # a path with undecodable bytes is printed escaped, never an error
         if hasattr(stream, "reconfigure"):
             stream.reconfigure(errors="backslashreplace")
@@ -223,9 +243,15 @@ def main(argv=None):
         with writing():   # the folders the command locks are let go when it ends
             code = args.func(args)
     except (KeyError, ValueError, FileNotFoundError) as e:
+        if _internal(e):
+            return _bug(e, args.verbose)
         msg = e.args[0] if isinstance(e, KeyError) and e.args else e
-        if args.verbose and getattr(e, "details", ""):   # a user's code failed: its traceback, not the suite's
-            print(e.details, file=sys.stderr, end="" if e.details.endswith("\n") else "\n")
+        if args.verbose:   # a user's code failed: its traceback, not the suite's
+            details = getattr(e, "details", "")
+            if details:
+                print(details, file=sys.stderr, end="" if details.endswith("\n") else "\n")
+            else:
+                traceback.print_exc()
         print(f"lagbench: error: {msg}", file=sys.stderr)
         return 2
     except DiskFull as e:
@@ -243,6 +269,8 @@ def main(argv=None):
         how = "terminated (SIGTERM)" if isinstance(e, Terminated) else "interrupted"
         print(f"\nlagbench: {how}; {hint}", file=sys.stderr)
         return 143 if isinstance(e, Terminated) else 130
+    except Exception as e:   # noqa: BLE001 - anything else is the suite's bug, reported as such
+        return _bug(e, args.verbose)
     return code or 0
 
 

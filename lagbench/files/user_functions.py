@@ -6,8 +6,9 @@ factory and module, `--predict`'s and `--energy`'s function). Imported only when
 A module named without a path is imported with the working folder first on sys.path; a file given by its path
 runs with its own folder first, so the modules beside it import (an exception while either runs is a
 `UserCodeError`, as below). A module
-named without a path whose top-level name is one of the suite's packages (`SUITE`) while the working folder
+named without a path whose top-level name is the suite's package (`SUITE`, "lagbench") while the working folder
 holds a file or package of that name is refused, naming the collision: the suite's own would be imported.
+Every other name is free: the suite installs nothing else at the top level.
 
 `call(option, ref, what, fn, *args, **kwargs)`: fn's result; any exception it raises becomes a `UserCodeError`:
 one line naming the option and reference, the call (`what`), the user's file and line and the exception, and
@@ -39,7 +40,7 @@ import time
 import traceback
 from pathlib import Path
 
-SUITE = ("systems", "models", "replication", "reports", "speedstudy")   # the suite's top-level packages
+SUITE = "lagbench"   # the suite's one top-level package
 NO_RERUN = "an error in your code: a rerun fails the same way until it is fixed"
 MAY_RERUN = "a rerun may help once its cause (memory, files, network) is gone"
 TRANSIENT = (MemoryError, ConnectionError, TimeoutError)
@@ -67,14 +68,14 @@ def is_users(error: str) -> bool:
 
 def _collision(module: str, option: str, ref: str) -> None:
     top = module.split(".")[0]
-    if top not in SUITE:
+    if top != SUITE:
         return
     cwd = Path.cwd()
     mine = [p for p in (cwd / f"{top}.py", cwd / top / "__init__.py") if p.is_file()]
-    suite = Path(__file__).resolve().parents[1] / top
+    suite = Path(__file__).resolve().parents[1]   # the lagbench package's own folder
     if mine and mine[0].parent.resolve() != suite:
         raise ValueError(f"{option} {ref}: {mine[0].relative_to(cwd)} in the working folder has the name of the "
-                         f"suite's package {top!r} ({', '.join(SUITE)} are taken): the suite's would be imported instead; "
+                         f"suite's package {top!r}: the suite's would be imported instead; "
                          f"give its path ({mine[0].relative_to(cwd)}:{ref.rpartition(':')[2]}) or rename it")
 
 

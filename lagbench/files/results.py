@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 # the folder locks: `output_folder` takes one; every command runs inside `writing` (re-exported for callers)
-from replication.folder_lock import _LOCKS, LOCK_NAME, lock, refuse_if_locked, writes, writing  # noqa: F401
+from lagbench.files.folder_lock import _LOCKS, LOCK_NAME, lock, refuse_if_locked, writes, writing  # noqa: F401
 
 SCHEMA = 1
 

@@ -19,7 +19,7 @@ def _results_folder(results: Path) -> Path:
 
 
 def cmd_report(args):
-    import reports
+    from lagbench import reports
 
     results = _results_folder(Path(args.results))
     out = Path(args.out) if args.out else Path("report") / (results.resolve().name or "results")
@@ -33,9 +33,9 @@ def cmd_report(args):
 
 
 def cmd_table(args):
-    from replication.results import output_folder, write_csv
-    from reports.load import load_results
-    from reports.systems_table import excluded, shown, systems_table
+    from lagbench.files.results import output_folder, write_csv
+    from lagbench.reports.load import load_results
+    from lagbench.reports.systems_table import excluded, shown, systems_table
 
     results = _results_folder(Path(args.results))
     res = load_results(results)

@@ -1,0 +1,6 @@
+"""`python -m lagbench`: the command line."""
+import sys
+
+from lagbench.cli import main
+
+sys.exit(main())
