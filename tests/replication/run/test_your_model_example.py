@@ -1,7 +1,7 @@
-"""The README's "Compare your own model", run end to end as written: its model file and its commands, in a
-fresh folder. The user's model trains in the double-pendulum claims beside the paper's models (PyTorch only),
-is judged by the claim's bar, and no part reads it; the exact acceleration scores at the chaos floor and the
-zero function as the null."""
+"""The example of docs/your_model.md, run end to end as written: its model file and its commands, in a fresh
+folder (the README shows the same commands). The user's model trains in the double-pendulum claims beside the
+paper's models (PyTorch only), is judged by the claim's bar, and no part reads it; the exact acceleration
+scores at the chaos floor and the zero function as the null."""
 import json
 import re
 import shlex
@@ -11,15 +11,28 @@ import pytest
 
 from lagbench.cli import main
 
-README = Path(__file__).resolve().parents[3] / "README.md"
+ROOT = Path(__file__).resolve().parents[3]
+DOC = ROOT / "docs" / "your_model.md"
+MARKER = "<!-- your-model example: tests/replication/run/test_your_model_example.py runs this file and these commands -->"
+
+
+def _commands(block: str) -> list[list[str]]:
+    return [shlex.split(line) for line in block.splitlines() if line.startswith("lagbench ")]
 
 
 def _example():
-    text = README.read_text(encoding="utf-8")
-    section = text.split("## Compare your own model", 1)[1].split("\n## ", 1)[0]
+    text = DOC.read_text(encoding="utf-8")
+    assert MARKER in text, "docs/your_model.md lost the example's marker"
+    section = text[text.index(MARKER):]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     commands = re.search(r"```bash\n(.*?)```", section, re.S).group(1)
-    return code, [shlex.split(line) for line in commands.splitlines() if line.startswith("lagbench ")]
+    return code, _commands(commands)
+
+
+def test_the_readme_shows_the_commands_this_test_runs():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    blocks = [_commands(b) for b in re.findall(r"```bash\n(.*?)```", readme, re.S)]
+    assert _example()[1] in blocks, "the README's your-model commands differ from docs/your_model.md's example"
 
 
 @pytest.fixture(scope="module")
