@@ -30,8 +30,20 @@ def write_folder(path: Path) -> Path:
 def cmd_list(args):
     from lagbench import systems
     from lagbench.models import ACTIVATIONS, INITS, KINDS
-    from lagbench.replication.claims import CLAIMS, PROFILES
+    from lagbench.replication.claims import CLAIMS, PROFILES, get
 
+    if args.claim or args.profile:   # one claim as it runs under one profile (`claims.resolved`)
+        from lagbench.replication.claims.resolved import resolved
+
+        if not (args.claim and args.profile):
+            raise ValueError("--claim and --profile go together: what a claim runs depends on the profile")
+        if args.profile not in PROFILES:
+            raise ValueError(f"--profile: unknown {args.profile!r}; valid: {', '.join(PROFILES)}")
+        c = get(args.claim)
+        print(f"claim {c.number} {c.id} [{c.paper} {c.section}] under profile {args.profile}: {c.title}")
+        print(f"evaluation: {c.evaluate}; metric: {c.metric}")
+        print("\n".join(resolved(c, args.profile).describe()))
+        return 0
     print("systems:    " + ", ".join(systems.names()))
     print("models:     " + ", ".join(KINDS))
     print("activations:" + " " + ", ".join(ACTIVATIONS))
@@ -40,13 +52,10 @@ def cmd_list(args):
     print("claims (a check tests the implementation or the numerics, not a paper claim):")
     for c in CLAIMS.values():
         print(f"  {c.number:>2} {c.id:<17} [{c.paper} {c.section}]{' (check)' if c.kind == 'check' else ''} {c.title}")
-        controls = {x for p in c.parts for x in p.controls} - {x for p in c.parts for x in p.reads}
-        variant = {v for var in c.variants for _, v in var.replaces}
-        paper = [m.label for m in c.models if m.label not in controls | variant]
-        print(f"     models: {', '.join(paper)}")
+        print(f"     models: {', '.join(c.paper_models())}")
         print(f"     parts: {'; '.join(p.name + (' (check)' if p.check else '') for p in c.parts)}")
-        if controls:
-            print(f"     positive controls: {', '.join(sorted(controls))}")
+        if c.controls():
+            print(f"     positive controls: {', '.join(c.controls())}")
         for var in c.variants:
             print(f"     variant: {var.name} ({', '.join(v for _, v in var.replaces)}; never decides)")
 
@@ -131,7 +140,11 @@ def build_parser():
     p.add_argument("-v", "--verbose", action="store_true", help="log progress details; on an error, print its traceback too")
     p.add_argument("--version", action="version", version=f"lagbench {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
-    s = sub.add_parser("list", help="list systems, models, claims and profiles")
+    s = sub.add_parser("list", help="list systems, models, claims and profiles; with --claim and --profile, what "
+                       "one claim runs under that profile")
+    s.add_argument("--claim", help="a claim id: print what it runs under --profile (its models' protocols, widths, "
+                   "seeds, frameworks, evaluation config, tuned or hand-chosen); default: list everything")
+    s.add_argument("--profile", help="smoke | quick | full | paper, with --claim (default: none, list everything)")
     s.set_defaults(func=cmd_list)
     s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units")
     s.add_argument("--profile", default="quick", help="smoke | quick | full | paper (default: quick)")
@@ -142,7 +155,7 @@ def build_parser():
                    "preliminary profile; jax,torch for smoke, full and paper)")
     s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module "
                    "(factory(dof)) or equinox Module (factory(dof, key)) mapping (q, qdot) to q-double-dot, trained "
-                   "in every claim it fits beside the paper's models (repeatable; README 'Compare your own model')")
+                   "in every claim it fits beside the paper's models (repeatable; docs/your_model.md)")
     s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
     s.add_argument("--split", default="test", choices=("test", "dev"), help="test: seeds 1000.. and held-out "
                    "data and initial conditions no protocol choice has seen, where verdicts are decided; dev: "

@@ -13,7 +13,7 @@ Schemes (n_in = fan_in, n_out = fan_out of a weight of shape (n_out, n_in)):
   pytorch_default  torch.nn.Linear: W ~ U(+-1/sqrt(n_in)) (kaiming_uniform, a = sqrt 5), b ~ U(+-1/sqrt(n_in)).
   xavier           W ~ N(0, 2/(n_in + n_out)) (gain 1), biases 0. Heads alike.
   kaiming          W ~ N(0, 2/n_in) (fan_in, ReLU gain), biases 0. Heads alike.
-For DeLaN the diagonal is softplus(raw + spec.delan_diag_offset), so zero biases give
+For DeLaN the diagonal is softplus(raw + spec.own.diag_offset), so zero biases give
 diag(L) ~ softplus(offset) at init.
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""The Lorentz factor as an MLP input feature (`ModelSpec.lorentz_factor`), written once for both frameworks:
-only arithmetic that JAX arrays and PyTorch tensors share.
+"""The Lorentz factor as an MLP input feature (`ModelSpec.lorentz_factor`: an own field of the LNN and the HNN),
+written once for both frameworks: only arithmetic that JAX arrays and PyTorch tensors share.
 
 `velocity_parts(spec, qdot) -> [qdot]` or `[qdot, gamma(qdot)]`: the velocity's parts of the MLP input.
 `lorentz_factor(v)`: gamma = (1 - v^2)^(-1/2) elementwise (c = 1). `lorentz_slopes(v)`: (gamma', gamma'') for

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lagbench.models.spec import USER_KIND, ModelSpec
+from lagbench.models.spec import USER_KIND, ModelSpec, capability
 
 
 def layer_table(spec: ModelSpec) -> list:
@@ -22,7 +22,7 @@ def layer_table(spec: ModelSpec) -> list:
     n = len(sizes) - 1
     rows = []
     for i in range(n):
-        last = i == n - 1 and spec.kind != "delan"
+        last = i == n - 1 and capability(spec.kind).mlp_head
         role = "output" if last else ("first" if i == 0 else "hidden")
         rows.append((f"mlp.{i}", sizes[i], sizes[i + 1], role))
     if spec.kind == "delan":

@@ -37,5 +37,7 @@ def block_plan(n: int, rows_per_sample: int) -> tuple[int, int] | None:
 def rows_per_sample(spec) -> int | None:
     if spec.kind == "lnn":
         return spec.dof + 1
-    banded = spec.formulation in ("banded", "fast") and banded_supported(spec.dof, spec.lgn_radius)
-    return spec.dof + 1 if spec.kind == "lgn" and not banded else None
+    if spec.kind != "lgn":
+        return None
+    banded = spec.own.formulation in ("banded", "fast") and banded_supported(spec.dof, spec.own.radius)
+    return None if banded else spec.dof + 1

@@ -40,14 +40,14 @@ def files_of(spec, module) -> tuple:
     a library's (a torch.nn.Sequential the factory built)."""
     b = _boundary()
     own = type(module).__module__.split(".")[0] not in ("torch", "equinox")
-    return tuple(dict.fromkeys(f for f in (b.source_file(_factory(spec.factory)), own and b.source_file(module)) if f))
+    return tuple(dict.fromkeys(f for f in (b.source_file(_factory(spec.own.factory)), own and b.source_file(module)) if f))
 
 
 def forward(spec, module, fn, *args):
     """fn(*args), a call of `module` (an equinox module itself, or torch's `functional_call` of it): any exception
     is the boundary's one line naming the module's forward (`lagbench.files.user_functions.call`)."""
     name = f"{type(module).__name__}.{'forward' if hasattr(module, 'forward') else '__call__'}(q, qdot)"
-    return _boundary().call(OPTION, spec.factory, name, fn, *args, files=lambda: files_of(spec, module))
+    return _boundary().call(OPTION, spec.own.factory, name, fn, *args, files=lambda: files_of(spec, module))
 
 
 def factory_source(ref: str) -> str:
@@ -72,22 +72,22 @@ def framework_of(ref: str) -> str:
 def make_module(spec, seed: int = 0):
     """A fresh module of spec's factory: PyTorch's in spec.dtype (under the caller's torch seed), equinox's
     from jax.random.PRNGKey(seed)."""
-    fn = _factory(spec.factory)   # imported once: a file named by its path runs on each import
+    fn = _factory(spec.own.factory)   # imported once: a file named by its path runs on each import
     b, name = _boundary(), getattr(fn, "__name__", "factory")
     if _framework(fn) == "jax":
         import equinox as eqx
         import jax
 
-        module = b.call(OPTION, spec.factory, f"the factory {name}(dof, key)", fn, spec.dof, key=jax.random.PRNGKey(seed))
+        module = b.call(OPTION, spec.own.factory, f"the factory {name}(dof, key)", fn, spec.dof, key=jax.random.PRNGKey(seed))
         if not isinstance(module, eqx.Module):
-            raise b.wrong(OPTION, spec.factory, f"the factory takes a key but returned {type(module).__name__}, not "
+            raise b.wrong(OPTION, spec.own.factory, f"the factory takes a key but returned {type(module).__name__}, not "
                           f"an equinox Module")
         return module
     import torch
 
-    module = b.call(OPTION, spec.factory, f"the factory {name}(dof)", fn, spec.dof)
+    module = b.call(OPTION, spec.own.factory, f"the factory {name}(dof)", fn, spec.dof)
     if not isinstance(module, torch.nn.Module):
-        raise b.wrong(OPTION, spec.factory, f"the factory returned {type(module).__name__}, not a torch.nn.Module "
+        raise b.wrong(OPTION, spec.own.factory, f"the factory returned {type(module).__name__}, not a torch.nn.Module "
                       f"(an equinox factory takes a key: factory(dof, key))")
     return module.to(getattr(torch, spec.dtype))
 
@@ -146,13 +146,13 @@ def scalar(spec, out, like):
     if out.shape[-1:] == (1,) and out.ndim == like.ndim:
         out = out[..., 0]
     if tuple(out.shape) != tuple(like.shape[:-1]):
-        raise _boundary().wrong(OPTION, spec.factory, f"a scalar module's forward(q, qdot) returned shape "
+        raise _boundary().wrong(OPTION, spec.own.factory, f"a scalar module's forward(q, qdot) returned shape "
                                 f"{tuple(out.shape)}, expected {tuple(like.shape[:-1])} (one scalar per sample)")
     return out
 
 
 def check_output(spec, out, like) -> None:
     if tuple(out.shape) != tuple(like.shape):
-        raise _boundary().wrong(OPTION, spec.factory, f"forward(q, qdot) returned shape {tuple(out.shape)}, "
+        raise _boundary().wrong(OPTION, spec.own.factory, f"forward(q, qdot) returned shape {tuple(out.shape)}, "
                                 f"expected {tuple(like.shape)} (q-double-dot, one per coordinate)")
 

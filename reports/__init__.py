@@ -2,7 +2,8 @@
 
 Reads the files described in ``docs/RESULTS.md`` (plus ``bench/``) with pandas/NumPy, draws
 figures with matplotlib and typesets the PDF with typst. Never imports jax, torch, equinox, optax,
-diffrax, the suite's ``systems`` or ``models``, or its training and evaluation code; from
+diffrax, the suite's ``systems``, its ``models`` beyond their NumPy parameter layout (``models.params``, which
+counts a unit's parameters from its recorded spec), or its training and evaluation code; from
 ``replication`` it takes only the claim records and ``replication.claims.verdicts.judge`` (NumPy and pandas),
 so that its verdicts are the runner's own rule applied to the unit files it reads.
 """

@@ -1,7 +1,9 @@
 """Entry point: ``build_report(results_dir, out_dir) -> dict`` (what ``lagbench report`` calls).
 
 Reads only the result files of ``docs/RESULTS.md`` (and ``bench/``), never JAX, PyTorch or
-training code. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
+training code. The sections are built, their tables tidied (``reports.tidy``), the glossary set after the
+scorecard (``reports.glossary``), every table and figure numbered (``document.number``) and the index of them
+added last, so that REPORT.md and the PDF carry the same numbers. Writes into ``out_dir``: ``REPORT.md``, ``REPORT.typ``, ``REPORT.pdf`` and
 ``figures/*.png``, built aside and moved in as a whole (``reports.output``). Returns ``{"markdown": Path,
 "typst": Path, "pdf": Path, "figures": [Path, ...]}``, and ``"not_rebuilt": [Path, ...]`` where a
 ``--no-pdf`` build leaves a REPORT.pdf or REPORT.typ it did not write and may not remove (not on record,
@@ -19,9 +21,10 @@ from pathlib import Path
 
 from lagbench.files.results import writes
 from lagbench.reports import output
-from lagbench.reports.document import Figure, Para, Section, tables_and_figures
+from lagbench.reports.document import Figure, Para, Section, number, tables_and_figures
 from lagbench.reports.environment import environment_sections, sources_sections
 from lagbench.reports.findings import findings_sections
+from lagbench.reports.glossary import glossary_section
 from lagbench.reports.load import load_results
 from lagbench.reports.markdown import render_markdown
 from lagbench.reports.pdf import write_pdf
@@ -37,35 +40,51 @@ from lagbench.reports.sections_robustness import robustness_sections
 from lagbench.reports.sections_speed import speed_appendix, speed_sections
 from lagbench.reports.sections_stiff import stiff_sections
 from lagbench.reports.systems_table import systems_sections
+from lagbench.reports.tidy import tidy
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
 
 
 APPENDIX = ("What the body's numbers rest on: every part with its interval, the reasons in full, the "
-            "registrations and the tuning ledger, the run's status, each claim's competence and rollout tables, each unit's speed "
-            "against error, the findings (paper against original code), the cross-framework comparison, the velocity-Hessian health, the stiff-solver study, the results "
-            "by system, the environment, every recorded metric and the source files of every table and figure.")
+            "registrations and the tuning ledger, the run's status, each claim's competence and rollout tables, "
+            "each unit's speed against error, the findings (paper against original code), the cross-framework "
+            "comparison, the velocity-Hessian health, the stiff-solver study, the results by system, the "
+            "environment, every recorded metric, and the index of every table and figure with its source files.")
+
+
+def _finish(body: list[Section], appendix: list[Section], res) -> tuple[list, list]:
+    """Tables tidied (`reports.tidy`), the glossary after the scorecard (the body's first section) when the
+    report has one, every table and figure numbered, and the index of them closing the appendix."""
+    tidy(body + appendix)
+    if body and body[0].title == "Scorecard":
+        body.insert(1, glossary_section(body + appendix))
+    number(body + appendix)
+    index = sources_sections(res, body + appendix)
+    number(body + appendix + index)
+    return body, appendix + index
 
 
 def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
-    """The report's body (the scorecard, a page per claim with its figures, the closed-loop control and
-    robustness studies, speed against error) and its
-    appendix (everything else), as two lists of sections."""
+    """The report's body (the scorecard, the glossary, a page per claim with its figures, the closed-loop
+    control and robustness studies, speed against error) and its appendix (everything else), as two lists of
+    sections, tables tidied and every table and figure numbered."""
     res = load_results(results_dir)
     mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
     if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
         sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
-        return sections, sources_sections(res, sections)
+        return _finish(sections, [], res)
     moved: dict = {}   # figures a claim's page sends to its details in the appendix
     body = [scorecard_section(res)] + theme_sections(res, out_dir, moved) + control_sections(res, out_dir)
     body += online_sections(res, out_dir)
     body += robustness_sections(res, out_dir)
     body += speed_sections(res, out_dir)
-    appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), scorecard_appendix(res)]
+    first = scorecard_appendix(res)
+    first.level = 2   # under the appendix's heading, on its page: the heading never stands alone on a page
+    appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), first]
     appendix += summary_sections(res) + claim_details(res, moved) + speed_appendix(res, out_dir)
     appendix += findings_sections(res) + frameworks_sections(res) + hessian_sections(res) + stiff_sections(res)
     appendix += systems_sections(results_dir) + mine + environment_sections(res, now) + metrics_appendix(res)
-    return body, appendix + sources_sections(res, body + appendix)
+    return _finish(body, appendix, res)
 
 
 def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:

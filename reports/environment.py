@@ -1,5 +1,6 @@
-"""Environment section (run.json, unit versions/hardware/commits, bench/machine.json) and the Sources
-appendix (every table and figure with the result files its numbers come from, and every unit file).
+"""Environment section (run.json, unit versions/hardware/commits, bench/machine.json) and the closing
+appendix: the index of tables and figures (each with its number, its section and the result files its
+numbers come from) and every unit file.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ import datetime as dt
 import pandas as pd
 
 from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
-from lagbench.reports.fmt import cell
+from lagbench.reports.fmt import cell, plain
 from lagbench.reports.load import Results
 
 
@@ -19,7 +20,7 @@ def flatten(d, prefix: str = "") -> dict[str, str]:
         for k, v in d.items():
             out.update(flatten(v, f"{prefix}{k}."))
     elif isinstance(d, list | tuple):
-        out[prefix.rstrip(".")] = ", ".join(map(str, d)) if d else "none"
+        out[prefix.rstrip(".")] = plain(d)
     else:
         out[prefix.rstrip(".")] = cell(d, "none")
     return out
@@ -62,19 +63,24 @@ def environment_sections(res: Results, now: dt.datetime | None = None) -> list[S
     return [s]
 
 
+INDEX = "Appendix: index of tables and figures"
+
+
 def sources_sections(res: Results, sections: list[Section]) -> list[Section]:
     rows = []
     for sec in sections:
         for b in sec.blocks:
             if isinstance(b, Table | Figure):
-                kind = "table" if isinstance(b, Table) else "figure"
-                name = b.title if isinstance(b, Table) else b.path
-                rows.append({"item": f"{kind}: {name}", "section": sec.title,
-                             "from files": "; ".join(b.sources) or "computed"})
-    s = Section("Appendix: sources")
-    s.add(Para("Every table and figure with the result files its numbers come from (paths relative to the "
-               "results folder; <framework>/<model>/seed<k> expand to the units listed below)."))
-    s.add(Table("Sources of tables and figures", pd.DataFrame(rows) if rows else pd.DataFrame({"item": [NOT_RUN]})))
+                kind = "Table" if isinstance(b, Table) else "Figure"
+                name = b.title if isinstance(b, Table) else b.caption
+                rows.append({"number": f"{kind} {b.number}" if b.number else kind.lower(),
+                             "title": name if len(name) <= 90 else name[:89].rsplit(" ", 1)[0] + " …",
+                             "section": sec.title, "from files": "; ".join(b.sources) or "computed"})
+    s = Section(INDEX)
+    s.add(Para("Every table and figure by its number, with its section and the result files its numbers come "
+               "from (paths relative to the results folder; <framework>/<model>/seed<k> expand to the units "
+               "listed below)."))
+    s.add(Table("Tables and figures", pd.DataFrame(rows) if rows else pd.DataFrame({"number": [NOT_RUN]})))
     units = [{"unit": u.rel, "status": u.status,
               "checksum": str(u.result.get("checksum", "none"))[:12],
               "files": ", ".join(sorted((u.result.get("files") or {}).keys())) or "none"} for u in res.units]

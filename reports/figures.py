@@ -65,37 +65,50 @@ def linear_span(ax, axis: str = "y") -> float:
 def save(fig: Figure, path: Path) -> bool:
     """Render to memory, then replace ``path`` atomically (never writing through a symlink there). A linear
     axis whose positive values span more than `LINEAR_DECADES` becomes a log axis first (one outlier must not
-    flatten every other curve), unless the figure marks it linear (`ax.keep_linear`, e.g. a time axis)."""
+    flatten every other curve), unless the figure marks it linear (`ax.keep_linear`, e.g. a time axis). The
+    PNG is cut to what is drawn (``bbox_inches="tight"``), so no title, label or legend is clipped."""
     for ax in fig.axes:
         for axis in ("x", "y"):
             if axis not in getattr(ax, "keep_linear", ()) and linear_span(ax, axis) > LINEAR_DECADES:
                 (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
+    fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight", pad_inches=0.06)
     write(path, buf.getvalue())
     return True
 
 
+# colour-blind safe: Okabe and Ito's eight colours less black (the truth is drawn in black or grey), then Tol's
+# muted wine, teal, olive and indigo for figures of more models
+PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#882255", "#44AA99", "#999933",
+           "#332288", "#F0E442"]
+
+
 def colour(i: int) -> str:
-    return f"C{i % 10}"
+    return PALETTE[i % len(PALETTE)]
 
 
 def style_index(values: list[str]) -> dict[str, int]:
     return {v: i for i, v in enumerate(dict.fromkeys(values))}
 
 
-# one colour per model kind across the report (a label's kind is its part before the first "_")
-KIND_COLOURS = {"baseline": "C0", "lnn": "C1", "hnn": "C2", "delan": "C3", "lgn": "C4", "ff": "C5"}
+# one colour per model kind across the report (a label's kind is its part before the first "_"): the DeLaN
+# paper's pair (DeLaN, the feed-forward net) and the LNN paper's (LNN, baseline) in contrasting hues
+KIND_COLOURS = {"baseline": PALETTE[0], "lnn": PALETTE[1], "hnn": PALETTE[2], "delan": PALETTE[3],
+                "lgn": PALETTE[4], "ff": PALETTE[5]}
 
 
 def model_colours(labels: list[str]) -> dict[str, str]:
     """A colour per model: its kind's (`KIND_COLOURS`) when the figure's models are of different kinds, so a
-    kind keeps its colour from figure to figure; by order where two share a kind (an ablation, a data sweep)."""
+    kind keeps its colour from figure to figure; where two share a kind (an ablation, a data sweep), a label
+    that is a kind's own name keeps its kind's colour and the others take the palette's remaining colours in
+    order."""
     labels = list(dict.fromkeys(labels))
     kinds = [x.split("_", 1)[0] for x in labels]
     if len(set(kinds)) == len(kinds) and all(k in KIND_COLOURS for k in kinds):
         return {x: KIND_COLOURS[k] for x, k in zip(labels, kinds, strict=True)}
-    return {x: colour(i) for i, x in enumerate(labels)}
+    out = {x: KIND_COLOURS[x] for x in labels if x in KIND_COLOURS}
+    rest = iter([c for c in PALETTE if c not in out.values()] * (len(labels) // len(PALETTE) + 1))
+    return {x: out[x] if x in out else next(rest) for x in labels}
 
 
 def log_if_spread(ax, values, axis: str = "y", decades: float = 1.5) -> None:

@@ -4,6 +4,7 @@ the models never saw, truth against each model, closed-loop tracking of an unsee
 error over time of models learning online (claim 13)."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,9 @@ DECOMPOSITION = [("M", r"inertia $M(q)$"), ("c", r"Coriolis/centrifugal $c(q, \d
                  ("g", r"gravity $g(q)$"), ("tau", r"torque $\tau$")]
 
 
-def delan_decomposition(units: list[Unit], path: Path) -> bool:
+def delan_decomposition(units: list[Unit], path: Path) -> list[str]:
+    """Predicted against true, one panel per term the arrays hold (inertia, Coriolis, gravity, torque); returns
+    the terms drawn ([] when none)."""
     found = {}
     for key, group in _groups(units).items():
         for u in group:
@@ -33,7 +36,7 @@ def delan_decomposition(units: list[Unit], path: Path) -> bool:
                 found[key] = (arr, terms)
                 break
     if not found:
-        return False
+        return []
     terms = list(dict.fromkeys(t for _, ts in found.values() for t in ts))
     fig, axes = new_figure(ncols=len(terms), width=3.2 * len(terms), height=3.2)
     colours = model_colours([m for m, _ in found])
@@ -51,7 +54,8 @@ def delan_decomposition(units: list[Unit], path: Path) -> bool:
         ax.set_xlabel("true (SI units)")
         ax.set_ylabel("predicted (SI units)")
     axes[0].legend(fontsize=7)
-    return save(fig, path)
+    save(fig, path)
+    return [re.sub(r"\s*\$.*\$", "", name) for _, name in terms]
 
 
 def torque_traces(units: list[Unit], path: Path) -> bool:

@@ -25,9 +25,10 @@ from lagbench.reports.figures import (
 from lagbench.reports.load import Unit
 
 
-def model_panels(units: list[Unit], path: Path, models: list[str]) -> bool:
+def model_panels(units: list[Unit], path: Path, models: list[str]) -> list[str]:
     """Panel per model of `models` (in that order; JAX's where both frameworks ran): the velocity of each
-    rollout, truth solid and grey, the model dashed in its colour (first seed)."""
+    rollout, truth solid and grey, the model dashed in its colour (first seed). Returns the models drawn
+    ([] when none has the arrays)."""
     found, fws = {}, {}
     for (m, fw), arr in sorted(_first_with(units, ("t", "qdot_true", "qdot_pred")).items(),
                                key=lambda kv: kv[0][1] != "jax"):   # JAX's where both frameworks ran
@@ -35,7 +36,7 @@ def model_panels(units: list[Unit], path: Path, models: list[str]) -> bool:
             found[m], fws[m] = arr, fw
     shown = [m for m in models if m in found]
     if not shown:
-        return False
+        return []
     fig, axes = new_figure(ncols=len(shown), width=3.3 * len(shown) + 0.6, height=3.2, gap=0.75)
     colours = model_colours(shown)
     for ax, m in zip(axes, shown, strict=True):
@@ -50,7 +51,8 @@ def model_panels(units: list[Unit], path: Path, models: list[str]) -> bool:
         ax.set_xlabel("time t (s)")
         ax.set_ylabel("velocity q̇ (units of c)")
     axes[0].legend(fontsize=7)
-    return save(fig, path)
+    save(fig, path)
+    return shown
 
 
 def _energies(u: Unit):

@@ -4,7 +4,10 @@ it took (the SciML work-precision view of speed against error).
 ``work_precision(units, path)`` reads the tracked rows of ``train_log.csv`` (``samples``, ``train_s``,
 ``heldout_loss``: `replication.training.tracking`, present where the protocol sets ``tracking``). Per model and
 framework, the seeds share their tracking steps: the line is the mean over seeds of the held-out loss
-(plotted against the samples, and against the mean training seconds), the band the seed range.
+(plotted against the samples, and against the mean training seconds), the band the seed range. The held-out
+loss is each model's own training loss (its protocol's data loss) on held-out states, so it compares a model
+with itself over training, not models of different kinds; the axis says so. Returns the samples of the first
+tracked point drawn (the log axes start there, not at zero), or 0 when nothing was drawn.
 """
 from __future__ import annotations
 
@@ -39,10 +42,10 @@ def tracked(units: list[Unit]) -> dict[tuple[str, str], pd.DataFrame]:
     return out
 
 
-def work_precision(units: list[Unit], path: Path) -> bool:
+def work_precision(units: list[Unit], path: Path) -> float:
     curves = tracked(units)
     if not curves:
-        return False
+        return 0.0
     fig, axes = new_figure(ncols=2, width=9.0, height=3.6)
     models = model_colours([k[0] for k in curves])
     fws = style_index([k[1] for k in curves])
@@ -61,6 +64,10 @@ def work_precision(units: list[Unit], path: Path) -> bool:
         if xs and max(xs) >= 10 * min(xs):   # within one decade the minor ticks carry the only labels
             ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(label)
-    axes[0].set_ylabel("held-out loss")
+    axes[0].set_ylabel("model's own training loss,\non held-out states")
     axes[0].legend(fontsize=7)
-    return save(fig, path)
+    starts = [float(d.loc[d["samples"] > 0, "samples"].min()) for d in curves.values() if (d["samples"] > 0).any()]
+    if not starts:
+        return 0.0
+    save(fig, path)
+    return min(starts)

@@ -1,7 +1,8 @@
 """Speed, scaling and data-efficiency figures; same contract as :mod:`reports.figures`.
 
 - ``speed_error``: one point per usable unit: x = ``train_samples_per_s`` (else ``train_time_s``),
-  y = the claim metric; colour per model, marker per framework.
+  y = the claim metric (the label says whether lower or higher is better); colour per model, marker per
+  framework; nothing where every cost or every value is 0 (``degenerate`` says why, for the caller to say so).
 - ``bench_speed_error``: ``bench/inference.csv``: samples_per_s vs error, one panel per system.
 - ``bench_scaling``: ``bench/scaling.csv``: seconds_per_eval vs n per study, formulation and framework.
 - ``train_target_curve``: a train-to-target log: held-out L1 vs training samples, one line per protocol
@@ -50,13 +51,33 @@ def _x(u: Unit) -> tuple[str, float] | None:
     return None
 
 
-def speed_error(units: list[Unit], metric: str, path: Path) -> bool:
+def speed_points(units: list[Unit], metric: str) -> list:
+    """[(unit, (x label, x), y)] of the units that record both a cost and the metric, one kind of cost."""
     pts = [(u, _x(u), u.metric(metric)) for u in units]
     pts = [(u, x, y) for u, x, y in pts if x is not None and y is not None]
+    return [p for p in pts if p[1][0] == pts[0][1][0]] if pts else []
+
+
+def degenerate(units: list[Unit], metric: str) -> str:
+    """Why a speed-error figure of these units would show nothing ("" when it shows something): every cost or
+    every value zero (a model not trained offline records a training time of 0)."""
+    pts = speed_points(units, metric)
     if not pts:
+        return "no unit records both a training cost and the metric"
+    if all(x == 0 for _, (_, x), _ in pts):
+        return f"every unit's {pts[0][1][0]} is 0 (no offline training)"
+    if all(y == 0 for *_, y in pts):
+        return f"every unit's {metric} is 0"
+    return ""
+
+
+def speed_error(units: list[Unit], metric: str, path: Path, higher_better: bool = False) -> bool:
+    """One point per unit; nothing (False) where the figure would be degenerate (`degenerate`). The y label
+    says which way is better: lower for an error, higher for a share (``higher_better``)."""
+    if degenerate(units, metric):
         return False
+    pts = speed_points(units, metric)
     label = pts[0][1][0]
-    pts = [p for p in pts if p[1][0] == label]
     fig, (ax,) = new_figure(height=3.6)
     models = model_colours([u.model for u, _, _ in pts])
     fws = style_index([u.framework for u, _, _ in pts])
@@ -69,7 +90,7 @@ def speed_error(units: list[Unit], metric: str, path: Path) -> bool:
     log_if_spread(ax, [x for _, (_, x), _ in pts], axis="x", decades=1.0)
     log_if_spread(ax, [y for *_, y in pts], decades=1.0)
     ax.set_xlabel(label)
-    ax.set_ylabel(f"{metric} (claim metric, lower is better)")
+    ax.set_ylabel(f"{metric}\n({'higher' if higher_better else 'lower'} is better)")
     ax.legend(fontsize=7)
     return save(fig, path)
 

@@ -13,6 +13,7 @@ import pandas as pd
 
 from lagbench.replication.claims.findings import FINDINGS, Finding
 from lagbench.reports.document import NOT_RUN, Para, Section, Table
+from lagbench.reports.fmt import plain
 from lagbench.reports.load import Results
 
 
@@ -22,7 +23,7 @@ def _lookup(d, keys: set[str], prefix: str = "") -> dict[str, str]:
         for k, v in d.items():
             name = f"{prefix}{k}"
             if str(k).lower() in keys:   # a record (a protocol part) as its fields in one line
-                out[name] = " ".join(f"{a}={b}" for a, b in v.items() if b is not None) if isinstance(v, dict) else str(v)
+                out[name] = plain({a: b for a, b in v.items() if b is not None} if isinstance(v, dict) else v)
             else:
                 out.update(_lookup(v, keys, name + "."))
     return out
@@ -42,7 +43,7 @@ def what_ran(res: Results, f: Finding) -> str:
                 seen.setdefault(f"{src}.{k}", set()).add(v)
     if not seen:
         return "not recorded in result files"
-    return "; ".join(f"{k} = {', '.join(sorted(v)[:4])}" for k, v in sorted(seen.items())[:4])
+    return "; ".join(f"{k}: {' / '.join(sorted(v)[:4])}" for k, v in sorted(seen.items())[:4])
 
 
 def findings_sections(res: Results) -> list[Section]:

@@ -273,13 +273,14 @@ def load_results(root: str | Path) -> Results:
 
 def _recompute_verdicts(res: Results) -> None:
     """Verdicts from the verified unit files, by the runner's own function; stored ones only compared."""
-    from lagbench.replication.claims import CLAIMS
+    from lagbench.replication.claims import CLAIMS, registration, tuned
     from lagbench.replication.claims.verdicts import frame, judge, of_split
 
     profile = (res.run or {}).get("profile") or res.verdict_profile
     df = of_split(frame([u.result for u in res.units if u.status in ("ok", "failed")]), res.split)
     ids = {c["id"] for c in res.claims} | {u.claim for u in res.units}
-    res.verdicts = {cid: judge(CLAIMS[cid], df, profile) for cid in sorted(ids) if cid in CLAIMS}
+    committed, adopted = registration.registrations(), tuned.records()
+    res.verdicts = {cid: judge(CLAIMS[cid], df, profile, committed, adopted) for cid in sorted(ids) if cid in CLAIMS}
     for cid, v in res.stored_verdicts.items():
         res.verdicts.setdefault(cid, v)   # a claim this code no longer has: its recorded verdict
     stale = sorted(cid for cid, v in res.stored_verdicts.items()

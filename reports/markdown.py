@@ -1,14 +1,16 @@
 """Markdown rendering of a ``list[Section]`` (GitHub-flavoured pipe tables; no tabulate dependency).
 
 Cells are escaped (``|`` becomes ``\\|``, newlines ``<br>``); an empty cell becomes ``"not run"``.
-Figures are embedded with paths relative to the Markdown file.
+Figures are embedded with paths relative to the Markdown file. Tables and figures carry the numbers the PDF
+prints ("Table 3: ...", "Figure 7: ...", ``document.label``); the report's index of them is its appendix
+"Index of tables and figures".
 """
 
 from __future__ import annotations
 
 import pandas as pd
 
-from lagbench.reports.document import NOT_RUN, Bullets, Figure, Para, Section, Table
+from lagbench.reports.document import NOT_RUN, Bullets, Figure, Para, Section, Table, label
 
 
 def _escape(text) -> str:
@@ -36,9 +38,10 @@ def render_markdown(title: str, sections: list[Section]) -> str:
             elif isinstance(b, Bullets):
                 out += [f"- {item}" for item in b.items] + [""]
             elif isinstance(b, Table):
-                out += [f"**{b.title}**", "", table_markdown(b.df), ""]
+                out += [f"**{label(b)}**", "", table_markdown(b.df), ""]
                 if b.note:
                     out += [f"_{b.note}_", ""]
             elif isinstance(b, Figure):
-                out += [f"![{b.caption}]({b.path})", "", f"*{b.caption}*", ""]
+                alt = f"Figure {b.number}" if b.number else "figure"
+                out += [f"![{alt}]({b.path})", "", f"*{label(b)}*", ""]
     return "\n".join(out).rstrip() + "\n"

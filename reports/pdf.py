@@ -2,8 +2,15 @@
 
 All report text enters the typst source as string literals (``"..."`` with ``\\`` and ``"`` escaped), so
 no report content is ever parsed as typst markup. Tables use a small font scaled down with the number
-of columns, wrap inside their cells and break across pages (portrait throughout: at 6 pt ten columns
-fit). Figures are embedded from ``figures/`` relative to the output folder (the typst root).
+of columns (8 pt up to 4 columns, 7 pt up to 7, 6 pt beyond; ``reports.tidy`` splits a table of more than
+``tidy.MAX_COLUMNS``), wrap inside their cells, hyphenate, and break across pages (portrait throughout).
+Every column gets an explicit width (``column_widths``): at least its longest unbreakable run of characters,
+the rest of the text width shared by how much each column holds, so that no header or cell runs over its
+neighbour or past the margin; a run longer than ``RUN`` characters (a path, a long identifier) is given
+break points after ``_``, ``/``, ``,`` and ``=``, and every ``RUN`` characters where it has none
+(``breakable``). Tables and figures carry the report's numbers (``document.label``); typst's own figure
+numbering is off, so the PDF and REPORT.md print the same "Figure 7". Figures are embedded from
+``figures/`` relative to the output folder (the typst root), at a width from their size in inches.
 """
 
 from __future__ import annotations
@@ -11,24 +18,80 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from lagbench.reports.document import Bullets, Figure, Para, Section, Table
+from lagbench.reports.document import Bullets, Figure, Para, Section, Table, label
+from lagbench.reports.figures import DPI
 from lagbench.reports.output import write
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
 def figure_width(path: Path) -> str:
-    """50 % of the text width for single-panel figures, 75 % for wide multi-panel ones: a claim's page holds
-    its tables and two figures (at 55 % and 100 % the quick report's body took 23 pages, at these 20)."""
+    """The share of the text width (7 in) a figure takes, from its width in inches at ``figures.DPI``: a single
+    panel (up to 7 in) 55 %, a wider one 80 %, a figure of many panels (over 10 in, or wider than 2.4 x its
+    height) the whole width, so that a figure's lettering stays about the size of the caption's."""
     try:
         with open(path, "rb") as f:
             head = f.read(24)
         w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
     except OSError:
-        return "50%"
+        return "55%"
     if not head.startswith(PNG_SIGNATURE) or h == 0:
-        return "50%"
-    return "75%" if w / h > 2.4 else "50%"
+        return "55%"
+    inches = w / DPI
+    if inches > 10 or w / h > 2.4:
+        return "100%"
+    return "80%" if inches > 7 else "55%"
+
+
+TEXT_WIDTH = 504.0   # pt: A4 (595 pt) less the 1.6 cm margins
+INSET = 3.0          # pt, each side of a cell
+RUN = 16             # the longest run of characters a table cell keeps without a break point
+ZWSP = "\u200b"      # a break point that prints nothing
+
+
+def breakable(text: str) -> str:
+    """``text`` with break points in every run of more than `RUN` characters without a space: after ``_``,
+    ``/``, ``,``, ``;`` and ``=``, then every `RUN` characters of a piece still longer."""
+    def split(word: str) -> str:
+        if len(word) <= RUN:
+            return word
+        pieces = re.split(r"(?<=[_/,;=])", word)
+        return ZWSP.join(ZWSP.join(p[i:i + RUN] for i in range(0, len(p), RUN)) for p in pieces if p)
+    return re.sub(r"\S+", lambda m: split(m.group()), str(text))
+
+
+def longest_run(text: str) -> int:
+    """The longest run of characters ``text`` keeps without a space or a break point."""
+    return max((len(w) for w in re.split(f"[\\s{ZWSP}]+", str(text))), default=0)
+
+
+def font_size(ncol: int) -> int:
+    return 8 if ncol <= 4 else (7 if ncol <= 7 else 6)
+
+
+def column_widths(columns: list[list[str]], size: float) -> list[float]:
+    """Widths in pt of columns of cells (header first, after `breakable`): each at least its longest run at
+    0.6 em a character (no glyph of the fonts is wider on average) plus the insets, and at most what its
+    longest cell needs (0.5 em a character); the text width shared between them by their mean cell length (a
+    row is as high as its tallest cell, whose height goes as its length over its width: equal heights are
+    the lowest rows)."""
+    pad = 2 * INSET + 1
+    least = [longest_run(" ".join(c)) * 0.6 * size + pad for c in columns]
+    most = [max(lo, max((len(x) for x in c), default=0) * 0.5 * size + pad) for c, lo in zip(columns, least, strict=True)]
+    if sum(most) <= TEXT_WIDTH or sum(least) >= TEXT_WIDTH:
+        return most if sum(most) <= TEXT_WIDTH else least
+    weight = [max(sum(len(x) for x in c) / max(len(c), 1), 1.0) for c in columns]
+    fixed: dict[int, float] = {}
+    while True:   # water-filling: shares by weight, a column held at its least or its most where a share passes it
+        free = [j for j in range(len(columns)) if j not in fixed]
+        room = TEXT_WIDTH - sum(fixed.values())
+        total = sum(weight[j] for j in free)
+        width = {j: room * weight[j] / total for j in free}
+        low = {j: least[j] for j in free if width[j] < least[j]}
+        high = {j: most[j] for j in free if width[j] > most[j]}
+        if not low and not high:
+            return [fixed.get(j, width.get(j)) for j in range(len(columns))]
+        fixed.update(low or high)
 
 
 PREAMBLE = """#set document(title: {title})
@@ -57,13 +120,16 @@ def lit(text) -> str:
 
 def _table(t: Table) -> str:
     ncol = max(len(t.df.columns), 1)
-    size = 8 if ncol <= 4 else (7 if ncol <= 7 else 6)
-    cells = [lit(c) for c in t.df.columns]
-    for row in t.df.itertuples(index=False):
-        cells += [lit(str(v).strip() or "not run") for v in row]
-    body = (f"#text(size: {size}pt)[#table(columns: {ncol}, inset: 3pt, stroke: 0.4pt + gray, align: left,\n"
-            f"  table.header({', '.join(cells[:ncol])}),\n  {', '.join(cells[ncol:])})]")
-    out = f"#strong({lit(t.title)})\n\n{body}\n"
+    size = font_size(ncol)
+    columns = [[breakable(c)] + [breakable(str(v).strip() or "not run") for v in t.df.iloc[:, j]]
+               for j, c in enumerate(t.df.columns)]
+    widths = column_widths(columns, size)
+    head = [lit(c[0]) for c in columns]
+    cells = [lit(columns[j][i]) for i in range(1, len(t.df) + 1) for j in range(ncol)]
+    body = (f"#text(size: {size}pt, hyphenate: true)[#table(columns: ({', '.join(f'{w:.1f}pt' for w in widths)},), "
+            f"inset: {INSET:g}pt, stroke: 0.4pt + gray, align: left,\n"
+            f"  table.header({', '.join(head)}),\n  {', '.join(cells)})]")
+    out = f"#strong({lit(label(t))})\n\n{body}\n"
     if t.note:
         out += f"\n#emph({lit(t.note)})\n"
     return out + "\n"
@@ -88,7 +154,8 @@ def render_typst(title: str, sections: list[Section], root: Path = Path(".")) ->
                 out.append(_table(b))
             elif isinstance(b, Figure):
                 width = figure_width(root / b.path)
-                out.append(f"#figure(image({lit(b.path)}, width: {width}), caption: {lit(b.caption)})\n")
+                out.append(f"#figure(image({lit(b.path)}, width: {width}), numbering: none, "
+                           f"caption: {lit(label(b))})\n")
     return "\n".join(out)
 
 

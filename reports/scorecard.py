@@ -1,11 +1,14 @@
 """The scorecard that opens the report, and the per-claim competence and parts tables.
 
-``scorecard_section(res)``: the headline count of paper claims (checks apart); one row per paper claim,
-then one per check: the verdict (recomputed from the unit files), the key model's reproduced number per
-framework beside its published number, marked "like for like" only when the published value is of the
-same kind and measured under the same conditions (else "context", with its note), the reason, and each
-part's verdict with the interval it read; then the variants (departures from the paper, each with its own
-verdict, never a claim's) and the parts whose frameworks disagree (a defect to investigate).
+``scorecard_section(res)``: a page that stands alone: the headline count of paper claims (checks apart), how
+to read a row, then one row per paper claim and one per check: what it says and where, the verdict
+(recomputed from the unit files), why (each part under its reason's category, with its interval, level and
+seed counts: ``reports.reasons``), the key model's claim metric per framework with its unit (seed mean and
+range, a yes/no metric as k/n seeds), its published number ("like for like" only when of the same kind and
+measured under the same conditions, else "context") and the flags (far from published, near a threshold, did
+not learn, sizes that differ); then every published number beside ours (``reports.published``), the variants
+(departures from the paper, each with its own verdict, never a claim's) and the parts whose frameworks
+disagree (a defect to investigate).
 ``competence_table(res, claim)``: each model's competence bar per framework; ``parts_table(res, claim)``:
 each part per framework with its interval and its verdict at half and twice the suite's threshold.
 """
@@ -14,43 +17,14 @@ from __future__ import annotations
 
 import pandas as pd
 
-from lagbench.reports import sections_registration
+from lagbench.reports import glossary, sections_registration
+from lagbench.reports.confounds import sizes_differ
 from lagbench.reports.document import NOT_RUN, Para, Section, Table
-from lagbench.reports.fmt import cell, num, stat, summarise
+from lagbench.reports.fmt import cell, num
 from lagbench.reports.load import Results
-from lagbench.reports.tables import published_cell, published_entry, verdict_text
-
-REASON_CHARS = 120
-FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}
-
-
-def _metric_of(u, name: str):
-    if name == "final_train_loss":
-        v = u.result.get("final_train_loss")
-        return float(v) if isinstance(v, int | float) and not isinstance(v, bool) else None
-    return u.metric(name)
-
-
-def _reproduced(res: Results, claim: dict, model: str, metric: str, fw: str) -> str:
-    us = [u for u in res.usable(claim["id"]) if u.model == model and u.framework == fw]
-    vals = [_metric_of(u, metric) for u in us]
-    s = summarise(vals)
-    n_inf = sum(v is not None and v == float("inf") for v in vals)
-    text = "inf" if n_inf == len(vals) and vals else (stat(**s) if s["n"] else NOT_RUN)
-    if n_inf and n_inf < len(vals):
-        text = f"inf ({n_inf} of {len(vals)} seeds diverged; finite: {stat(**s)})"
-    return text
-
-
-def _short(text: str) -> str:
-    return text if len(text) <= REASON_CHARS else text[: REASON_CHARS - 1] + "…"
-
-
-def _reason(v: dict | None) -> str:
-    """The claim's own reason, in its first sentence (the parts' reasons in full: `reasons_table`)."""
-    if not v:
-        return "no verdict"
-    return _short(str(v.get("reason") or "").split(". ", 1)[0])
+from lagbench.reports.published import published_short, published_table
+from lagbench.reports.reasons import flags, why_text
+from lagbench.reports.tables import FRAMEWORK_NAMES, per_framework, published_entry, verdict_text
 
 
 def reasons_table(res: Results) -> pd.DataFrame | None:
@@ -108,25 +82,40 @@ def _kind(res: Results, claim: dict) -> str:
     return str((res.verdicts.get(claim["id"]) or {}).get("kind") or claim.get("kind") or "claim")
 
 
+def _unit_words(metric: str) -> str:
+    u = glossary.unit(metric)
+    return "" if u in ("", "–", "count") else f" ({u})"
+
+
+def key_number(res: Results, claim: dict, key: str, metric: str) -> str:
+    """The key model's claim metric with its unit, per framework: the seed mean with the range over seeds,
+    or "k/n seeds" for a yes/no metric; where every seed diverged, "inf on n/n seeds"."""
+    if not key or not metric:
+        return NOT_RUN
+    return f"{key} {metric}{_unit_words(metric)}: " + (per_framework(res, claim, key, metric) or NOT_RUN)
+
+
 def scorecard_table(res: Results, kind: str = "claim") -> pd.DataFrame:
-    """One row per claim of `kind`: what it says and where, its verdict, its key model's number per framework
-    beside the published one, and the reason in short."""
+    """One row per claim of `kind`: what it says and where, its verdict, why (the reason's category per part,
+    with the interval, its level and seed counts), its key model's number per framework, the published one
+    and the flags (far from published, near a threshold, did not learn, sizes that differ)."""
     rows = []
     for claim in res.claims:
         if _kind(res, claim) != kind:
             continue
         cid = claim["id"]
         key = claim.get("key") or next(iter(claim.get("models") or []), "")
-        p = published_entry(claim, key)
-        metric = (p or {}).get("metric") or claim.get("metric") or ""
-        row = {"#": cell(claim.get("number"), "–"), "claim": cid, "says": cell(claim.get("title"), "untitled"),
-               "paper": f"{cell(claim.get('paper'), '?')} {cell(claim.get('section'), '')}".strip(),
-               "verdict": verdict_text(res, claim), "key number": f"{key} {metric}" if key else NOT_RUN}
-        for fw in res.frameworks:
-            row[FRAMEWORK_NAMES.get(fw, fw)] = _reproduced(res, claim, key, metric, fw) if key else NOT_RUN
-        row["published"] = published_cell(claim, key, [u for u in res.usable(cid) if u.model == key])
-        row["why"] = _reason(res.verdicts.get(cid))
-        rows.append(row)
+        metric = claim.get("metric") or (published_entry(claim, key) or {}).get("metric") or ""
+        ran = bool(res.usable(cid))
+        rows.append({
+            "#": cell(claim.get("number"), "–"),
+            "claim": f"{cid}: {cell(claim.get('title'), 'untitled')} "
+                     f"({cell(claim.get('paper'), '?')} {cell(claim.get('section'), '')})".replace(" )", ")"),
+            "verdict": verdict_text(res, claim),
+            "why": why_text(res, claim) if ran else NOT_RUN,
+            "key number": key_number(res, claim, key, metric) if ran else NOT_RUN,
+            "published": published_short(res, claim, key) if key else NOT_RUN,
+            "flags": (flags(res, claim, sizes_differ(res, claim)) or "none") if ran else NOT_RUN})
     return pd.DataFrame(rows) if rows else pd.DataFrame({"claim": [NOT_RUN], "verdict": [NOT_RUN]})
 
 
@@ -139,9 +128,6 @@ def variants_table(res: Results) -> pd.DataFrame | None:
                          "parts": "; ".join(part_text(x) for x in var.get("parts") or [] if not x.get("check"))
                          or cell(var.get("reason"))})
     return pd.DataFrame(rows) if rows else None
-
-
-FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}
 
 
 def made_by(res: Results) -> str:
@@ -170,34 +156,35 @@ def headline(res: Results) -> str:
 
 
 SPLIT_TEXT = {
-    "test": "Decided on the test split: training seeds from 1000 on, and a held-out draw, rollout initial "
-            "conditions and sampled states from generator seeds that no trial, study or protocol choice has "
-            "read (replication/run/splits.py). The protocols were frozen before this run and chosen on the "
-            "development split (seeds from 0, the development draws): by `lagbench tune` where the registered "
-            "protocols table says so, else by hand (docs/decisions/, docs/lab/).",
+    "test": "Decided on the test split: training seeds from 1000 on, and held-out draws, rollout initial conditions "
+            "and sampled states that no trial, study or protocol choice has read (replication/run/splits.py); the "
+            "protocols were frozen before this run, chosen on the development split (`lagbench tune` where the "
+            "registered protocols table says so, else by hand: docs/decisions/, docs/lab/).",
     "dev": "Development split (seeds from 0, the development draws): the data the protocols were tuned on. "
            "These numbers are for development; verdicts of record come from the test split (`lagbench run`, "
            "its default).",
 }
 
+READING = ("How to read a row. Verdict: the runner's own rule (replication/claims/verdicts.py) recomputed from the "
+           "unit files, part by part; checks (the second table) are not counted among the claims. Why: each part "
+           "under its reason's category: BELOW BAR (a model passed its competence bar, an error at most a set "
+           "fraction, usually 0.1, of the null predictor's that learned nothing, on k/n seeds; 'did not learn': "
+           "its error sat at the null's), FAILED SEEDS, NOT RUN, STRADDLES THRESHOLD (the 90 % confidence "
+           "interval over the seeds of the ratio the rule reads holds the rule's threshold: the seeds cannot "
+           "tell), NEAR THRESHOLD (decided, the interval within 25 % of it), UNDECIDED (another reason of the "
+           "rule's) or decided, each with its interval, level and seed counts. Key number: the key model's claim "
+           "metric with its unit, seed mean (lowest to highest seed, n seeds), a yes/no metric as k/n seeds. "
+           "Published: 'like for like' only for the same kind of number under the same conditions, else context "
+           "(in full, with ours beside it: the table after the checks). Flags: far from published (over 2x or "
+           "under half), near the threshold, did not learn, sizes differ (parameters). Every term and metric "
+           "name: the Glossary, next page.")
+
 
 def scorecard_section(res: Results) -> Section:
     s = Section("Scorecard")
     s.add(Para(headline(res)))
-    s.add(Para(made_by(res)))
-    s.add(Para(SPLIT_TEXT.get(res.split, f"Split: {res.split}.")))
-    s.add(Para("One line per paper claim, then one per check (checks test the implementation and the numerics "
-               "and are not counted among the claims). The verdict is recomputed from the unit files by the "
-               "runner's own rule (replication/claims/verdicts.py): each claim is decided on the models as the "
-               "paper specified them, part by part; a part whose models are below their competence bar on any "
-               "seed (held-out error at most a set fraction of a null predictor's, rollouts that do not diverge), "
-               "or whose positive control did not learn, is 'inconclusive'; an ordering holds only if it holds "
-               "over the 90 % confidence interval of the ratio over seeds (the interval shown: Welch's t on log "
-               "ratios, wider with fewer seeds; the range over seed pairs beside it describes). 'partly' means only: the named parts reproduced, the others "
-               "did not. Frameworks that disagree on a part make it 'inconclusive' and are listed below as a "
-               "defect. A published number is 'like for like' only when it is the same kind of number "
-               "(training loss, held-out error, energy error) measured under the same conditions; otherwise it "
-               "is context, not a target."))
+    s.add(Para(made_by(res) + " " + SPLIT_TEXT.get(res.split, f"Split: {res.split}.")))
+    s.add(Para(READING))
     if res.unfinished or res.planned_missing:
         s.add(Para(f"This run is unfinished: {len(res.planned_missing)} planned unit(s) have no result "
                    "(see Run status); the verdicts below rest on the units present."))
@@ -205,15 +192,20 @@ def scorecard_section(res: Results) -> Section:
     checks = scorecard_table(res, "check")
     if "#" in checks.columns:
         s.add(Table("Checks", checks, ["claims.json", "units/*/*/*/seed*/result.json"]))
+    published = published_table(res)
+    if published is not None:
+        s.add(Table("Published numbers beside ours", published, ["claims.json", "units/*/*/*/seed*/result.json"],
+                    note="Each model's published value with where it is printed, our seed mean of the same metric "
+                         "(range over seeds) and the ratio of the two; far from published: over 2x or under half."))
     variants = variants_table(res)
     if variants is not None:
         s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
                     note="A variant is a model with a departure from the paper standing in for the paper's model; "
                          "the claim is judged again with it, on this line only. A variant never decides a claim."))
     s.add(Para(sections_registration.summary(res)))
-    flags = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
+    flagged = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
     s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
-               "batches, reach different verdicts): " + "; ".join(flags) + "." if flags else
+               "batches, reach different verdicts): " + "; ".join(flagged) + "." if flagged else
                "No part has frameworks that disagree."))
     return s
 

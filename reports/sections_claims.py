@@ -13,13 +13,14 @@ from pathlib import Path
 import pandas as pd
 
 from lagbench.reports import figures as F
-from lagbench.reports import figures_delan as FD
-from lagbench.reports import figures_paper as FL
 from lagbench.reports import figures_precision as FP
-from lagbench.reports import figures_speed as FS
+from lagbench.reports import glossary
+from lagbench.reports.claim_figures import PAPER_FIGURES, figure_specs
+from lagbench.reports.confounds import failing_seeds, model_sizes, not_tested, sizes_table
 from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
 from lagbench.reports.fmt import cell, num
 from lagbench.reports.load import Results
+from lagbench.reports.reasons import did_not_learn, published_far, why_text
 from lagbench.reports.scorecard import competence_table, parts_table
 from lagbench.reports.tables import (
     PROBLEM_UNITS,
@@ -32,21 +33,6 @@ from lagbench.reports.tables import (
 from lagbench.reports.themes import THEMES, assign
 
 RESULT_FILES = "units/{claim}/<framework>/<model>/seed<k>/"
-REASON_CHARS = 400   # a verdict's reason on a claim's page
-# the paper figure a claim's figure recreates (the LNN paper's numbering, shared/seeds): same quantity and axes
-PAPER_FIGURES = {("dp_energy", "energy"): "LNN Fig. 2(b) (energy of the double pendulum over a long time)",
-                 ("dp_energy", "trajectory"): "LNN Fig. 2(a) (the double pendulum over a short time)",
-                 ("rel_coords", "panels"): "LNN Fig. 3 (a)-(c) (the relativistic particle: HNN on non-canonical "
-                                           "coordinates, HNN on canonical ones, LNN; trajectories over t in [0, 1])",
-                 ("wave_lgn", "spacetime"): "LNN Fig. 4 (the wave equation learned by a Lagrangian graph network)",
-                 ("wave_lgn", "wave_energy"): "LNN Fig. 4's statement that the graph network almost exactly conserves "
-                                              "the energy integrated across the material",
-                 ("hnn_energy", "energy"): "HNN Fig. 2's total-energy column (mass-spring, pendulum), drawn as the "
-                                           "error against the truth's energy",
-                 ("hnn_energy", "trajectory"): "HNN Fig. 2's first column (predicted trajectories), drawn against "
-                                               "time rather than in phase space"}
-
-
 def slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "claim"
 
@@ -95,31 +81,6 @@ def _rollout_table(units) -> pd.DataFrame | None:
     return pd.DataFrame(rows)
 
 
-def _published_energy(claim: dict) -> dict:
-    """The published energy errors of a claim's models, with the conditions they were measured under."""
-    out = {}
-    for model, p in (claim.get("published") or {}).items():
-        if isinstance(p, dict) and str(p.get("metric", "")).startswith("energy_err") and isinstance(p.get("value"), int | float):
-            cond = ", ".join(f"{k} {v:g}" if isinstance(v, int | float) else f"{k} {v}"
-                             for k, v in (p.get("conditions") or {}).items())
-            out[model] = (float(p["value"]), f"{p.get('kind', 'published')}" + (f"; {cond}" if cond else ""))
-    return out
-
-
-def _paper_models(claim: dict) -> list[str]:
-    """The models the claim's parts read (the paper's models), in the parts' order; its models where it has
-    no parts."""
-    read = [m for part in claim.get("parts") or [] for m in part.get("reads") or []]
-    return list(dict.fromkeys(read or claim.get("models") or []))
-
-
-def _brief(text: str, limit: int = REASON_CHARS) -> str:
-    """A reason cut at a word for the claim's page; the parts table beside it and the appendix give it in full."""
-    if len(text) <= limit:
-        return text
-    return text[:limit].rsplit(" ", 1)[0] + " … (in full: appendix, 'Reasons in full')"
-
-
 def _trainings(units) -> tuple:
     """What identifies a claim's trainings: claims sharing them (the double pendulum's 1 and 2) share this."""
     return tuple(sorted((u.framework, u.model, u.seed, u.result.get("final_train_loss")) for u in units))
@@ -127,12 +88,13 @@ def _trainings(units) -> tuple:
 
 def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None,
                   details: dict | None = None) -> Section:
-    """The claim's page: what it says and where, its verdict and parts, the decisive numbers against the
-    published ones, then the figures that answer it. `drawn` maps the trainings whose work-precision figure is
-    already in the report to its claim, so a figure of the same trainings is drawn once. The competence and
-    rollout tables are the claim's details in the appendix (`claim_details`); so are its training curves
-    where no work-precision figure stands in for them and the page has another figure, when `details`
-    ({claim: [Figure]}) collects them."""
+    """The claim's page: what it says and where, its verdict with the category of each part's reason, its
+    parts, the decisive numbers against the published ones, what the comparison does not control (the
+    compared models' sizes and budgets, every seed of a model below its bar), then the figures that answer
+    it. `drawn` maps the trainings whose work-precision figure is already in the report to its claim, so a
+    figure of the same trainings is drawn once. The competence and rollout tables are the claim's details in
+    the appendix (`claim_details`); so are its training curves where no work-precision figure stands in for
+    them and the page has another figure, when `details` ({claim: [Figure]}) collects them."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
@@ -145,10 +107,15 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     v = res.verdicts.get(cid)
     if v is not None:
         kind = "check (not counted among the paper claims)" if v.get("kind") == "check" else "paper claim"
-        s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {_brief(cell(v.get('reason'), ''))}"))
+        why = why_text(res, claim) if units else cell(v.get("reason"), "")
+        s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {why}"))
+        far, dead = published_far(res, claim), did_not_learn(res, claim)
+        if far or dead:
+            s.add(Para("Flags: " + "; ".join([f"far from published: {', '.join(far)}"] * bool(far)
+                                              + [f"did not learn: {m} ({w})" for m, w in dead.items()]) + "."))
         for var in v.get("variants") or []:
             s.add(Para(f"Variant: {cell(var.get('name'))} ({cell(var.get('departure'))}): {cell(var.get('verdict'))}, "
-                       f"{_brief(cell(var.get('reason'), ''))}. It does not decide the claim."))
+                       f"{cell(str(var.get('reason') or '').split('. ', 1)[0], '')}. It does not decide the claim."))
     pt = parts_table(res, claim)
     if pt is not None:
         s.add(Table(f"{cid}: parts per framework", pt, [src + "result.json"],
@@ -157,61 +124,62 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     if not units:
         s.add(Para(f"Result: {NOT_RUN} (no usable unit for this claim)."))
         return s
-    s.add(Table(f"{cid}: {claim.get('metric', 'metric')} per model and framework", claim_table(res, claim),
-                ["claims.json", src + "result.json"]))
-    figs = [
-        ("energy", lambda us, p: F.energy_drift(us, p, published=_published_energy(claim)),
-         "|Energy error| over time against truth, log axis (line: median over seeds of each seed's median over its "
-         "rollouts, band: seed range; diverged rollouts counted in the legend, not in the line; dotted: a published "
-         "value, under the conditions its legend names)", "timeseries.csv"),
-        ("panels", lambda us, p: FL.model_panels(us, p, _paper_models(claim)),
-         "Velocity over time from three held-out initial states, one panel per paper model (first seed): truth "
-         "(grey) against the model (dashed)", "arrays.npz"),
-        ("trajectory", F.trajectory, "Trajectory: truth against each model", "arrays.npz"),
-        ("spacetime", F.wave_spacetime, "Space-time image of the field: truth, model, difference", "arrays.npz"),
-        ("wave_energy", FL.wave_energy, "Total energy of the pulse over time (line: median over seeds, band: seed "
-                                        "range; diverged seeds counted in the legend, not drawn) and its error "
-                                        "against the truth's, log axis", "timeseries.csv"),
-        ("torques", FD.torque_traces, "Torque per joint on the unseen trajectories: truth against each model "
-                                      "trained on the full data set (first seed)", "arrays.npz"),
-        ("tracking", FD.tracking, "Computed-torque tracking at 500 Hz of the first unseen reference: each joint's "
-                                  "reference against the executed angle, and the error's norm (log axis), per learned "
-                                  "controller (first seed)", "arrays.npz"),
-        ("online", FD.online_learning, "Learning online: each 0.5 s window's tracking MSE over PD alone's in the same "
-                                       "window, against the seconds learned, one line per seed", "arrays.npz"),
-        ("decomposition", FD.delan_decomposition, "Decomposition into inertial, Coriolis and gravity terms "
-                                                 "(predicted against true)", "arrays.npz"),
-        ("data_efficiency", lambda us, p: FS.data_efficiency(us, p, claim.get("metric")),
-         "Data efficiency: error against training samples, log-log (bars: seed range)", "result.json"),
-    ]
+    metric = claim.get("metric", "metric")
+    u = glossary.unit(metric)
+    s.add(Table(f"{cid}: {metric}{f' ({u})' if u and u != '–' else ''} per model and framework", claim_table(res, claim),
+                ["claims.json", src + "result.json"],
+                note="Seed mean (lowest to highest seed, n seeds); a yes/no metric as k/n seeds; every seed where "
+                     "a model is below its competence bar."))
+    _confounds(s, res, claim, src)
     done = set()
-    for kind, fn, caption, file in figs:
+    for kind, fn, caption, shows, file in figure_specs(res, claim):
         rel = f"figures/{slug(cid)}_{kind}.png"
         if kind == "trajectory" and "panels" in done:   # the per-model panels show the same rollouts
             continue
-        if fn(units, out_dir / rel):
+        got = fn(units, out_dir / rel)
+        if got:
             done.add(kind)
-            paper = PAPER_FIGURES.get((cid, kind))
-            s.add(Figure(rel, f"{cid}: {caption}." + (f" It stands for {paper}." if paper else ""), [src + file]))
+            s.add(Figure(rel, f"{cid}: {caption(got)}.", [src + file], shows=shows,
+                         paper=PAPER_FIGURES.get((cid, kind), "")))
     drawn = {} if drawn is None else drawn
     key = _trainings(units)
     if key in drawn:
         s.add(Para(f"Training: the same trainings as {drawn[key]}'s; its training figure shows them."))
         return s
     rel = f"figures/{slug(cid)}_work_precision.png"
-    if FP.work_precision(units, out_dir / rel):   # it shows the training curve; a separate one would repeat it
+    if (first := FP.work_precision(units, out_dir / rel)):   # it shows the training curve; a separate one would repeat it
         drawn[key] = cid
-        s.add(Figure(rel, f"{cid}: Work-precision: held-out loss against training samples and against training "
-                          f"time (line: mean over seeds, band: seed range).", [src + "train_log.csv"]))
+        s.add(Figure(rel, f"{cid}: Work-precision: each model's own training loss measured on held-out states, "
+                          f"against training samples and against training time (line: mean over seeds, band: seed "
+                          f"range). Both axes are logarithmic, so they start at the first tracked point "
+                          f"({num(first)} samples), not at zero.", [src + "train_log.csv"],
+                     shows="held-out value of each model's own training loss (not comparable across model kinds) "
+                           "against training samples and training time (s)"))
     elif F.training_curves(units, out_dir / (rel := f"figures/{slug(cid)}_training.png")):
         drawn[key] = cid
-        fig = Figure(rel, f"{cid}: Training curves (mean over seeds).", [src + "train_log.csv"])
+        fig = Figure(rel, f"{cid}: Training curves (mean over seeds), from the first logged step.",
+                     [src + "train_log.csv"], shows="training loss (each model's own loss function) against step")
         if details is None or not done:   # the page's only figure stays on it
             s.add(fig)
         else:
             details.setdefault(cid, []).append(fig)
             s.add(Para("Training curves: in the appendix, with the claim's details."))
     return s
+
+
+def _confounds(s: Section, res: Results, claim: dict, src: str) -> None:
+    """What the comparison does not control: the compared models' sizes and budgets, the rule's blind spots,
+    and every seed of a model below its competence bar."""
+    sizes = model_sizes(res, claim)
+    table = sizes_table(res, claim, sizes)
+    if table is not None:
+        s.add(Table(f"{claim['id']}: the compared models' sizes and budgets", table, [src + "result.json"],
+                    note="Parameters counted from each unit's recorded model spec (median over seeds of training "
+                         "samples and seconds)."))
+    s.add(Para("Not tested by the rule: " + not_tested(res, claim, sizes)))
+    seeds = failing_seeds(res, claim)
+    if seeds is not None:
+        s.add(Table(f"{claim['id']}: every seed of a model below its competence bar", seeds, [src + "result.json"]))
 
 
 def claim_details(res: Results, figures: dict | None = None) -> list[Section]:

@@ -136,7 +136,9 @@ def study_section(res: Results, out_dir: Path, study: Study) -> list[Section]:
         traces = {}
     if _figure(traces, out_dir / study.figure):
         s.add(Figure(study.figure, "Closed-loop tracking: the error on the first unseen reference over time, per "
-                                   "controller (first seed of each framework).", [f"{study.folder}/traces.npz"]))
+                                   "controller (first seed of each framework).", [f"{study.folder}/traces.npz"],
+                     shows="|q - q_ref| (rad) against time t (s)", paper="the DeLaN paper's tracking experiment "
+                                                                           "(its tracking-error figure), on our arm"))
     return [s]
 
 

@@ -224,18 +224,20 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
     if e.blocks:
         out.append(e)
     g = Section("Figures", level=2)
-    figs = [("parity", parity, "Prediction against data on the test (else held-out) rows", "arrays.npz"),
+    figs = [("parity", parity, "Prediction against data on the test (else held-out) rows", "arrays.npz",
+             "predicted against recorded q̈ (or τ)"),
             ("trajectory", F.trajectory, "A test trajectory: data against each model's rollout from its first state",
-             "arrays.npz"),
+             "arrays.npz", "coordinates q against time t (s)"),
             ("energy", lambda us, p: F.energy_drift(us, p, "true energy error / mean kinetic energy"),
-             "True energy along each rollout against along the data", "timeseries.csv"),
+             "True energy along each rollout against along the data", "timeseries.csv",
+             "|true energy error| / mean kinetic energy against time t (s)"),
             ("decomposition", FD.delan_decomposition, "DeLaN's inertia, Coriolis and gravity terms against the "
-                                                     "system's", "arrays.npz"),
-            ("training", F.training_curves, "Training curves", "train_log.csv")]
-    for kind, fn, caption, file in figs:
+                                                     "system's", "arrays.npz", "predicted against true torque terms"),
+            ("training", F.training_curves, "Training curves", "train_log.csv", "training loss against step")]
+    for kind, fn, caption, file, shows in figs:
         rel = f"figures/fit_{kind}.png"
         if fn(units, out_dir / rel):
-            g.add(Figure(rel, f"{caption}.", [SRC.format(claim="*") + file]))
+            g.add(Figure(rel, f"{caption}.", [SRC.format(claim="*") + file], shows=shows))
     if g.blocks:
         out.append(g)
     return out

@@ -66,7 +66,7 @@ def tuning_table(res: Results) -> pd.DataFrame | None:
             rows.append({"claim": claim["id"], "model": model, "configurations": t["configs_tried"],
                          "scored on": cell(t["scored_on"]), "dev seeds": ", ".join(map(str, t["seeds"])) or "-",
                          "confirmed on": ", ".join(map(str, confirmed)) or "-", "chosen": _knobs(t["knobs"]),
-                         "flag": "; ".join(flags)})
+                         "flag": "; ".join(flags) or "none"})
     return pd.DataFrame(rows) if rows else None
 
 

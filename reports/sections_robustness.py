@@ -90,6 +90,7 @@ def robustness_sections(res: Results, out_dir: Path) -> list[Section]:
     if _figure(df, out_dir / FIGURE):
         s.add(Figure(FIGURE, "How much of DeLaN's advantage survives: DeLaN's error over the feed-forward net's "
                              "against the violation's magnitude (0: the nominal arm), torque error above, tracking "
-                             "error below; at 1 the advantage is gone.", ["robustness/scenes.csv"]))
+                             "error below; at 1 the advantage is gone.", ["robustness/scenes.csv"],
+                     shows="DeLaN's error / the feed-forward net's (torque nMSE, tracking MSE) against the magnitude"))
     return [s]
 

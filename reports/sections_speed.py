@@ -42,14 +42,21 @@ def speed_appendix(res: Results, out_dir: Path) -> list[Section]:
     s.add(Para("Each point is one unit (claim x framework x model x seed): training throughput (or training "
                "time) against the claim's metric; colour per model, marker per framework. Lower error and "
                "higher throughput are better."))
-    any_fig = False
+    any_fig, skipped = False, []
     for claim in res.claims:
-        metric = claim.get("metric")
+        metric, units = claim.get("metric"), res.usable(claim["id"])
         rel = f"figures/{slug(claim['id'])}_speed_error.png"
-        if metric and FS.speed_error(res.usable(claim["id"]), metric, out_dir / rel):
+        why = FS.degenerate(units, metric) if metric and units else ""
+        if why and FS.speed_points(units, metric):
+            skipped.append(f"{claim['id']}: {why}")
+        elif metric and FS.speed_error(units, metric, out_dir / rel, higher_better=bool(claim.get("pooled"))):
             any_fig = True
-            s.add(Figure(rel, f"{claim['id']}: speed against {metric}.",
-                         [f"units/{claim['id']}/<framework>/<model>/seed<k>/result.json"]))
+            way = "higher" if claim.get("pooled") else "lower"
+            s.add(Figure(rel, f"{claim['id']}: speed against {metric}, one point per unit.",
+                         [f"units/{claim['id']}/<framework>/<model>/seed<k>/result.json"],
+                         shows=f"{metric} ({way} is better) against {FS.speed_points(units, metric)[0][1][0]}"))
+    if skipped:
+        s.add(Para("Not drawn, the figure being empty of information: " + "; ".join(skipped) + "."))
     if not any_fig:
         s.add(Para(f"Units with throughput and error: {NOT_RUN}."))
     return [s]
@@ -72,14 +79,15 @@ def speed_sections(res: Results, out_dir: Path) -> list[Section]:
         b.add(Para(f"Speed study: {NOT_RUN} (no bench/ files)."))
     if FS.bench_speed_error(res.bench.get("inference"), out_dir / "figures/bench_inference.png"):
         b.add(Figure("figures/bench_inference.png", "Inference throughput against error per system "
-                     "(colour: model/formulation; marker: framework).", ["bench/inference.csv"]))
+                     "(colour: model/formulation; marker: framework).", ["bench/inference.csv"],
+                     shows="error (the bench metric) against inference throughput (samples/s)"))
     bc = bench_cheapest_table(res)
     if bc is not None:
         b.add(Table(f"Cheapest model within {TOLERANCE:g}x of the best inference error, per system", bc,
                     ["bench/inference.csv"]))
     if FS.bench_scaling(res.bench.get("scaling"), out_dir / "figures/bench_scaling.png"):
         b.add(Figure("figures/bench_scaling.png", "Cost per evaluation against size, per formulation.",
-                     ["bench/scaling.csv"]))
+                     ["bench/scaling.csv"], shows="seconds per evaluation against size n"))
     for name, title in (("training", "Training throughput"), ("rollout", "Rollout cost and error per solver "
                                                                         "(truth and learned models)"),
                         ("members", "Many seeds for the price of one: K models trained as one program against one "
@@ -133,7 +141,8 @@ def _gpu_section(res: Results, out_dir: Path) -> Section | None:
                "the CPU study's only as ratios, in the table below."))
     if FS.bench_speed_error(res.bench_gpu.get("inference"), out_dir / "figures/bench_gpu_inference.png"):
         g.add(Figure("figures/bench_gpu_inference.png", "GPU: inference throughput against error per system "
-                     "(colour: model/formulation; marker: framework).", ["bench_gpu/inference.csv"]))
+                     "(colour: model/formulation; marker: framework).", ["bench_gpu/inference.csv"],
+                     shows="error (the bench metric) against inference throughput (samples/s)"))
     bc = bench_cheapest_table(res, gpu=True)
     if bc is not None:
         g.add(Table(f"GPU: cheapest model within {TOLERANCE:g}x of the best inference error, per system", bc,
@@ -146,7 +155,7 @@ def _gpu_section(res: Results, out_dir: Path) -> Section | None:
                          "use needs, not how fast either framework is."))
     if FS.bench_scaling(res.bench_gpu.get("scaling"), out_dir / "figures/bench_gpu_scaling.png"):
         g.add(Figure("figures/bench_gpu_scaling.png", "GPU: cost per evaluation against size, per formulation.",
-                     ["bench_gpu/scaling.csv"]))
+                     ["bench_gpu/scaling.csv"], shows="seconds per evaluation against size n"))
     for name, title in (("training", "GPU: training throughput"), ("fast_paper", "GPU: LNN fast against paper "
                                                                                "formulation (3 x 600, batch 4096)")):
         if name in res.bench_gpu:
@@ -173,8 +182,9 @@ def _train_target(b: Section, tables: dict, folder: str, out_dir: Path, title: s
     b.add(Table(title, _bench_table(tt[cols], missing="-"), [f"{folder}/train_target.csv"], note=TRAIN_TARGET_NOTE))
     fig = f"figures/{folder}_train_target.png"
     if FS.train_target_curve(tables.get("train_target_log"), out_dir / fig):
-        b.add(Figure(fig, "Held-out L1 against training samples, per protocol (log-log).",
-                     [f"{folder}/train_target_log.csv"]))
+        b.add(Figure(fig, "Held-out L1 against training samples, per protocol (log-log: the axis starts at the "
+                          "first logged point, not at zero).", [f"{folder}/train_target_log.csv"],
+                     shows="heldout_l1 of q̈ against training samples"))
 
 
 def _distribution(b: Section, d: pd.DataFrame | None) -> None:

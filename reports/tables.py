@@ -2,7 +2,9 @@
 
 Numbers are recomputed here from the unit ``result.json`` files (corrupt and failed units excluded), so
 they match the units actually listed; verdicts are recomputed from them too (``reports.load``). A claim with no
-usable unit reads ``"not run"`` in every cell that would hold a number.
+usable unit reads ``"not run"`` in every cell that would hold a number. A claim's metric reads as its seed mean
+with the range over seeds (``fmt.seed_values``; a pooled claim's yes/no metric as "k/n seeds"), per framework
+(``per_framework``).
 """
 
 from __future__ import annotations
@@ -11,7 +13,8 @@ import pandas as pd
 
 from lagbench.replication.claims.published import Published
 from lagbench.reports.document import NOT_RUN
-from lagbench.reports.fmt import cell, num, stat, summarise
+from lagbench.reports.fmt import cell, num, seed_values, stat, summarise
+from lagbench.reports.glossary import unit
 from lagbench.reports.load import Results, Unit
 
 
@@ -87,8 +90,11 @@ def verdict_text(res: Results, claim: dict) -> str:
 
 
 def claim_table(res: Results, claim: dict) -> pd.DataFrame:
-    """Rows: models; columns: published value and the claim metric per framework (mean ± std (n))."""
-    vals = values(res.claim_units(claim["id"]), claim.get("metric"))
+    """Rows: models; columns: published value and the claim metric per framework: the seed mean with the range
+    over seeds (a yes/no metric of a pooled claim as "k/n seeds"), every seed's value where a seed of the
+    model is below its competence bar."""
+    metric = claim.get("metric")
+    comp = (res.verdicts.get(claim["id"]) or {}).get("competence") or {}
     rows = []
     for model in claim_models(res, claim):
         units = [u for u in res.usable(claim["id"]) if u.model == model]
@@ -96,8 +102,11 @@ def claim_table(res: Results, claim: dict) -> pd.DataFrame:
         row = {"model": f"{model} (added: --add-model; no verdict reads it)" if added else model,
                "published": published_cell(claim, model, units)}
         for fw in res.frameworks or ["any framework"]:
-            per = vals.get(fw, {}).get(model)
-            row[fw] = stat(**per) if per else NOT_RUN
+            mine = [u for u in units if u.framework == fw or fw == "any framework"]
+            vals = [u.metric(metric) for u in mine] if metric else []
+            row[fw] = seed_values(vals, bool(claim.get("pooled"))) if any(v is not None for v in vals) else NOT_RUN
+            if ((comp.get(fw) or {}).get(model) or {}).get("passed") is False and len(mine) > 1:
+                row[fw] += "; per seed: " + ", ".join(f"{u.seed} {num(u.metric(metric))}" for u in mine)
         rows.append(row)
     return pd.DataFrame(rows) if rows else pd.DataFrame({"model": [NOT_RUN]})
 
@@ -112,7 +121,8 @@ def metric_names(units: list[Unit]) -> list[str]:
 
 
 def metrics_table(res: Results, claim: dict, max_metrics: int = 7) -> pd.DataFrame | None:
-    """Rows: (model, framework); columns: every recorded metric (mean ± std), first ``max_metrics``."""
+    """Rows: (model, framework); columns: every recorded metric (mean ± std; a yes/no metric as k/n seeds),
+    first ``max_metrics``."""
     units = res.usable(claim["id"])
     names = metric_names(units)
     if claim.get("metric") in names:
@@ -129,8 +139,10 @@ def metrics_table(res: Results, claim: dict, max_metrics: int = 7) -> pd.DataFra
                 continue
             row = {"model": model, "framework": fw, "n": str(len(group))}
             for name in names:
-                s = summarise([u.metric(name) for u in group])
-                row[name] = stat(s["mean"], s["std"]) if s["n"] else "not recorded"
+                vals = [u.metric(name) for u in group]
+                s = summarise(vals)
+                row[name] = ("not recorded" if not s["n"] else seed_values(vals, share=True)
+                             if unit(name) == "share" else stat(s["mean"], s["std"]))
             rows.append(row)
     return pd.DataFrame(rows) if rows else None
 
@@ -171,3 +183,25 @@ def problem_units_table(res: Results) -> pd.DataFrame | None:
     rows += [{"unit": p, "status": "missing", "reason": "planned in run.json, no result.json"}
              for p in res.planned_missing if p not in res.listed_missing]
     return pd.DataFrame(rows) if rows else None
+
+
+FRAMEWORK_NAMES = {"jax": "JAX", "torch": "PyTorch"}
+
+
+def metric_of(u, name: str):
+    """A unit's metric, or its recorded final training loss (not among its metrics)."""
+    if name == "final_train_loss":
+        v = u.result.get("final_train_loss")
+        return float(v) if isinstance(v, int | float) and not isinstance(v, bool) else None
+    return u.metric(name)
+
+
+def per_framework(res: Results, claim: dict, model: str, metric: str) -> str:
+    """"JAX 0.141 (0.137 to 0.145, 2 seeds); PyTorch ..." ("" where no framework recorded it)."""
+    share = bool(claim.get("pooled")) or unit(metric) == "share"
+    per = []
+    for fw in res.frameworks:
+        vals = [metric_of(u, metric) for u in res.usable(claim["id"]) if u.model == model and u.framework == fw]
+        if any(v is not None for v in vals):
+            per.append(f"{FRAMEWORK_NAMES.get(fw, fw)} {seed_values(vals, share)}")
+    return "; ".join(per)

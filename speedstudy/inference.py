@@ -128,7 +128,7 @@ def trained_cases(out: Path, batches: tuple) -> list[Case]:
         if spec.dof != 2 or spec.extra_inputs:
             continue
         fw = res.get("framework", res_path.parts[-4])
-        form = spec.formulation if CAPABILITIES[spec.kind].formulations else "-"
+        form = spec.own.formulation if CAPABILITIES[spec.kind].formulations else "-"
         cases.append(Case("double_pendulum", {}, spec.kind, form,
                           fw, spec.dtype, batches, spec, load_npz(ckpt), source=f"trained:{res.get('claim')}",
                           extra={"hidden": "x".join(map(str, spec.hidden))}))

@@ -19,6 +19,7 @@ import sys
 import pandas as pd
 
 from lagbench.replication.claims import get as get_claim
+from lagbench.replication.claims.resolved import resolved
 from lagbench.replication.training import compile_torch
 from lagbench.replication.training import device as dev
 from lagbench.replication.training.train import run_training
@@ -29,7 +30,7 @@ def measure(claim: str = "dp_loss", model: str = "lnn", profile: str = "paper", 
     from lagbench.replication.run.units import Unit
 
     c = get_claim(claim)
-    entry = c.entry(model)
+    entry = resolved(c, profile).model(model).entry   # as it runs: the adopted tuning applied
     where = dev.check(device, frameworks)
     rows = []
     for fw in frameworks:

@@ -45,12 +45,12 @@ class DeLaN(Model):
         """(Lc (..., d, d), V (...,)) from the trunk on q."""
         spec, d = self.spec, self.spec.dof
         h = mlp(self.params, mlp_input(spec, [q_features(spec, q)]), spec, final_linear=False)
-        diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
+        diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.own.diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
         return _lower(jnp.concatenate(parts, axis=-1), d), linear(self.params, "delan_potential", h)[..., 0]
 
     def _mass_of(self, lc):
-        return lc @ jnp.swapaxes(lc, -1, -2) + self.spec.delan_eps * jnp.eye(self.spec.dof, dtype=lc.dtype)
+        return lc @ jnp.swapaxes(lc, -1, -2) + self.spec.own.eps * jnp.eye(self.spec.dof, dtype=lc.dtype)
 
     def _heads_tangents(self, q):
         """(Lc (..., d, d), dLc (..., d_k, d, d) = dLc/dq_k, V (...,), dV/dq (..., d)): the trunk with
@@ -68,7 +68,7 @@ class DeLaN(Model):
         for i in range(n_layers(spec)):
             h, s1 = act_and_slope(spec.activation, linear(p, f"mlp.{i}", h))
             dh = s1[..., None, :] * (dh @ p[f"mlp.{i}.weight"].T)
-        diag, s1 = act_and_slope("softplus", linear(p, "delan_diag", h) + spec.delan_diag_offset)
+        diag, s1 = act_and_slope("softplus", linear(p, "delan_diag", h) + spec.own.diag_offset)
         ddiag = s1[..., None, :] * (dh @ p["delan_diag.weight"].T)
         if d > 1:
             vec = jnp.concatenate([diag, linear(p, "delan_lower", h)], axis=-1)

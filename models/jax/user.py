@@ -22,7 +22,7 @@ def skeleton(spec):
     """(parameter names in leaf order, the arrays' treedef, the module's non-array part) of spec's factory."""
     module = user.make_module(spec)
     if not callable(module):
-        raise user._boundary().wrong(user.OPTION, spec.factory, "the equinox module is not callable as module(q, qdot)")
+        raise user._boundary().wrong(user.OPTION, spec.own.factory, "the equinox module is not callable as module(q, qdot)")
     arrays, static = eqx.partition(module, eqx.is_inexact_array)
     paths, treedef = jax.tree_util.tree_flatten_with_path(arrays)
     return tuple(jax.tree_util.keystr(p) for p, _ in paths), treedef, static
@@ -52,7 +52,7 @@ class UserModel(Model):
         self._check_state(x, y, extra)
         module = self._module()
         if user.returns(module) != "hamiltonian":
-            raise ValueError(f"--add-model {self.spec.factory}: time_derivative is for a module that returns a "
+            raise ValueError(f"--add-model {self.spec.own.factory}: time_derivative is for a module that returns a "
                              f"Hamiltonian (returns = 'hamiltonian')")
         h = lambda a, b: jnp.sum(user.scalar(self.spec, user.forward(self.spec, module, module, a, b), a))  # noqa: E731
         dh_dx, dh_dy = jax.grad(h, argnums=(0, 1))(x, y)

@@ -84,7 +84,7 @@ class DeLaN(Model):
         """(Lc (..., d, d), V (...,)) from the trunk on q (no derivatives)."""
         spec, d = self.spec, self.spec.dof
         h = mlp(self.params, mlp_input(spec, [q_features(spec, q)]), spec, final_linear=False)
-        diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.delan_diag_offset)
+        diag = ACT["softplus"](linear(self.params, "delan_diag", h) + spec.own.diag_offset)
         parts = [diag, linear(self.params, "delan_lower", h)] if d > 1 else [diag]
         return _lower(torch.cat(parts, dim=-1), self.tril, d), linear(self.params, "delan_potential", h)[..., 0]
 
@@ -104,7 +104,7 @@ class DeLaN(Model):
             a = linear(p, f"mlp.{i}", h)
             h, s1, _ = derivs(a)
             dh = s1[..., None, :] * _lin(dh, p[f"mlp.{i}.weight"])
-        raw = linear(p, "delan_diag", h) + spec.delan_diag_offset
+        raw = linear(p, "delan_diag", h) + spec.own.diag_offset
         diag, s1, _ = ACT_DERIVS["softplus"](raw)
         ddiag = s1[..., None, :] * _lin(dh, p["delan_diag.weight"])
         if d > 1:
@@ -116,7 +116,7 @@ class DeLaN(Model):
         return _lower(vec, self.tril, d), _lower(dvec, self.tril, d), v, _lin(dh, p["delan_potential.weight"])[..., 0]
 
     def _mass_of(self, lc):
-        return lc @ lc.transpose(-1, -2) + self.spec.delan_eps * self.eye
+        return lc @ lc.transpose(-1, -2) + self.spec.own.eps * self.eye
 
     def _dynamics(self, q, qdot):
         """(M, c, g) at (q, qdot), one trunk pass."""

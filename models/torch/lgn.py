@@ -3,7 +3,7 @@
 q, qdot (..., n) with any n at call time (a model trained at n = 10 runs at n = 100). The density MLP
 sees [q_{i-r..i+r}, qdot_{i-r..i+r}] (2(2r+1) inputs): the neighbours `models.graph.periodic_neighbours`
 names, taken by rolls.
-Accelerations by spec.formulation:
+Accelerations by spec.own.formulation:
   "dense":  full n x n Hessian (forward-over-reverse) + solve with the counted pinv fallback (`lnn`).
   "paper":  the original code's full Hessian, full mixed Jacobian and pinv (`lnn`, "paper").
   "banded" (alias "fast"): the velocity Hessian is cyclic-banded (half-bandwidth 2r), solved in O(n) by
@@ -111,8 +111,8 @@ def _neighbours(x, r):
 
 class LGN(Model):
     def _lagrangian(self, q, qdot):
-        x = mlp_input(self.spec, [_neighbours(wrap_angles(self.spec, q), self.spec.lgn_radius),
-                                  _neighbours(qdot, self.spec.lgn_radius)])
+        x = mlp_input(self.spec, [_neighbours(wrap_angles(self.spec, q), self.spec.own.radius),
+                                  _neighbours(qdot, self.spec.own.radius)])
         return torch.sum(mlp(self.params, x, self.spec)[..., 0], dim=-1)
 
     def _banded_terms(self, q, qdot):
@@ -122,7 +122,7 @@ class LGN(Model):
         q slots) give every term: node i adds G_i[a, b] to H[i+a-r, i+b-r] (band column 2r+b-a),
         G_i[a, k] to (J qdot)[i+a-r] and s_q[b] g_i[b] to dL/dq[i+b-r]. Rolling slot a's terms by a-r moves
         them all into place."""
-        spec, (bsz, n), r = self.spec, q.shape, self.spec.lgn_radius
+        spec, (bsz, n), r = self.spec, q.shape, self.spec.own.radius
         k = 2 * r + 1
         qdot_nb = _neighbours(qdot, r)
         x = mlp_input(spec, [_neighbours(wrap_angles(spec, q), r), qdot_nb]).reshape(bsz * n, 2 * k)
@@ -146,9 +146,9 @@ class LGN(Model):
         return self._lagrangian(q, qdot)
 
     def acceleration_info(self, q, qdot, extra=None):
-        """(qddot (..., n), n_fallback) with spec.formulation."""
+        """(qddot (..., n), n_fallback) with spec.own.formulation."""
         self._check_state(q, qdot, extra, width=q.shape[-1])
-        form, n, r = self.spec.formulation, q.shape[-1], self.spec.lgn_radius
+        form, n, r = self.spec.own.formulation, q.shape[-1], self.spec.own.radius
         if form in ("banded", "fast") and banded_supported(n, r):
             band, rhs = self._banded_terms(q.reshape(-1, n), qdot.reshape(-1, n))
             x, n_bad = _banded_solve_info(band, rhs, r)

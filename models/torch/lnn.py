@@ -167,7 +167,7 @@ def velocity_hessian(L_fn, q, qdot, extra=None):
 
 def _scaled_q_part(x, f, nq):
     """x's q slots with their value s_q f(q) (exactly x's) but the q-derivative df/dq, for
-    `ModelSpec.scale_q_before_grad`: the original LNN code forms q / 10 before jax.grad, so its dL/dq and mixed
+    `Lnn.scale_q_before_grad` (`models.kinds`): the original LNN code forms q / 10 before jax.grad, so its dL/dq and mixed
     term are those in the scaled q, without the factor s_q. f - f.detach() is exactly 0 and carries f's
     derivatives (detach stops the gradient under torch.func's transforms too)."""
     return x[..., :nq].detach() + (f - f.detach())
@@ -182,12 +182,12 @@ class LNN(Model):
     @classmethod
     def stacks(cls, spec) -> bool:
         """The fast formulation's hand-written terms take stacked members; the paper's torch.func ones do not."""
-        return spec.formulation == "fast"
+        return spec.own.formulation == "fast"
 
     def _lagrangian(self, q, qdot, extra=None):
         spec, f = self.spec, q_features(self.spec, q)
         x = mlp_input(spec, [f, *velocity_parts(spec, qdot), *self._parts(extra)])
-        if spec.scale_q_before_grad:   # the original's convention: q-derivatives in the scaled x_q = s_q f(q)
+        if spec.own.scale_q_before_grad:   # the original's convention: q-derivatives in the scaled x_q = s_q f(q)
             x = torch.cat([_scaled_q_part(x, f, spec.q_width()), x[..., spec.q_width():]], dim=-1)
         return mlp(self.params, x, spec)[..., 0]
 
@@ -198,14 +198,14 @@ class LNN(Model):
         s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has
         no qdot in it: H needs none of its curvature). With the Lorentz factor, x = scale * [f(q), qdot,
         gamma(qdot), extra]: column k also has s_g[k] gamma'(qdot_k) in the gamma slot k, and H gains the
-        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma''). With spec.scale_q_before_grad both q-side
+        curvature of the feature itself, diag(dL/dx_gamma_k s_g[k] gamma''). With spec.own.scale_q_before_grad both q-side
         factors s_q are 1: the q-derivatives are taken in the scaled x_q, as the original code does."""
         spec, lead, d = self.spec, q.shape[:-1], q.shape[-1]   # lead: (B,), or (K, B) for stacked members
         x = mlp_input(spec, [q_features(spec, q), *velocity_parts(spec, qdot), *self._parts(extra)])
         scale = input_scale(spec, x.shape[-1], x.dtype, x.device)
         nq = spec.q_width()
         s_q, s_qd, s_g = scale[:nq], scale[nq:nq + d], scale[nq + d:nq + 2 * d]
-        if spec.scale_q_before_grad:   # q-derivatives in the scaled x_q (the original's convention): no factor s_q
+        if spec.own.scale_q_before_grad:   # q-derivatives in the scaled x_q (the original's convention): no factor s_q
             s_q = torch.ones_like(s_q)
         width = x.shape[-1]   # built out of place: under torch.func.vmap (stacked members) qdot is batched
         used = nq + (2 * d if spec.lorentz_factor else d)
@@ -238,11 +238,11 @@ class LNN(Model):
         return hess.reshape(*q.shape, d)
 
     def acceleration_info(self, q, qdot, extra=None):
-        """(qddot (..., dof), n_fallback) with spec.formulation."""
+        """(qddot (..., dof), n_fallback) with spec.own.formulation."""
         self._check_state(q, qdot, extra)
         extra = extra if self.spec.extra_inputs else None
-        if self.spec.formulation != "fast":
-            return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.formulation, extra)
+        if self.spec.own.formulation != "fast":
+            return euler_lagrange_info(self._lagrangian, q, qdot, self.spec.own.formulation, extra)
         d = q.shape[-1]
         hess, rhs = self._fast_terms(self._rows(q, d), self._rows(qdot, d), self._rows(extra))
         if self.spec.dissipation:   # Rayleigh D = 1/2 sum b qdot^2 against L's orientation: -sign(tr H) b qdot

@@ -37,7 +37,7 @@ class UserModel(Model):
         """A Hamiltonian module's (xdot, ydot) = (dH/dy, -dH/dx), H = forward(x, y) (...,): Hamilton's equations."""
         self._check_state(x, y, extra)
         if user.returns(self._net) != "hamiltonian":
-            raise ValueError(f"--add-model {self.spec.factory}: time_derivative is for a module that returns a "
+            raise ValueError(f"--add-model {self.spec.own.factory}: time_derivative is for a module that returns a "
                              f"Hamiltonian (returns = 'hamiltonian')")
         dh_dx, dh_dy = grad(lambda a, b: user.scalar(self.spec, self._forward(a, b), a).sum(), argnums=(0, 1))(x, y)
         return dh_dy, -dh_dx

@@ -8,7 +8,9 @@ must pass (`bars.Bar`), its parts (`parts.Part`: each a rule from `rules`, the m
 positive controls; sanity checks among them marked as such) and its variants (`parts.Variant`: models
 with a departure from the paper, judged on their own line). ``kind`` is "claim" for a paper claim and
 "check" for an implementation or numerics check, reported apart and not counted among the claims.
-Where a verdict is decided: `replication.claims.verdicts.judge`.
+A claim is written as literals and read as written; what runs under a profile, the adopted tuning applied, is
+`replication.claims.resolved.resolved(claim, profile)`. Where a verdict is decided:
+`replication.claims.verdicts.judge`.
 """
 from __future__ import annotations
 
@@ -20,8 +22,8 @@ from lagbench.replication.claims.rules import VERDICTS
 from lagbench.replication.training.protocol import Protocol
 
 PROFILES = ("smoke", "quick", "full", "paper")
-# a profile that a claim's per-profile table does not name takes its parent's entry: `full` is `quick`
-# except where a claim says otherwise (longer budgets, more seeds, the paper's evaluation horizon)
+# no profile inherits another's settings (`per_profile`): every per-profile table of a claim names each profile
+# it serves, and a `full` that runs quick's settings names quick's values under "full"
 KINDS = ("claim", "check")
 FRAMEWORKS = ("jax", "torch")
 # the frameworks a profile trains and decides in when a run names none: `quick`, the preliminary profile, in
@@ -104,7 +106,9 @@ class Claim:
     variants: tuple = ()     # `parts.Variant`s: departures from the paper, each judged on its own line
     kind: str = "claim"      # "claim" (a paper claim) or "check" (implementation, numerics)
     key: str = ""            # the model whose number the scorecard shows (default: the first)
-    seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": seed_rule.PRELIMINARY_SEEDS, "paper": 3})
+    # seeds a model per profile; the default is the seed rule's count (`seed_rule`) in every profile
+    seeds: dict = field(default_factory=lambda: {"smoke": 1, "quick": seed_rule.PRELIMINARY_SEEDS,
+                                                 "full": seed_rule.RECORD_SEEDS, "paper": seed_rule.RECORD_SEEDS})
     eval_config: dict = field(default_factory=dict)   # profile -> dict of evaluation settings
     pooled: bool = False     # the rule reads the seeds as one sample (a share), not each seed as a replication
 
@@ -135,6 +139,25 @@ class Claim:
                 "key": self.key_model, "seeds": dict(self.seeds), "pooled": self.pooled,
                 "seed_rule": {p: seed_rule.describe(self, p) for p in PROFILES},
                 "protocol": {p: pr.to_dict() for p, pr in self.protocols.items()}}
+
+    def controls(self) -> list:
+        """The positive controls (models a part controls and none reads), in the claim's model order."""
+        controlling = {x for p in self.parts for x in p.controls} - {x for p in self.parts for x in p.reads}
+        return [m.label for m in self.models if m.label in controlling]
+
+    def variant_models(self) -> list:
+        """The variants' models (`parts.Variant`: each stands in for a paper model), in the claim's model order."""
+        standing_in = {v for var in self.variants for _, v in var.replaces}
+        return [m.label for m in self.models if m.label in standing_in]
+
+    def paper_models(self) -> list:
+        """The models the claim is decided on: neither a positive control nor a variant's."""
+        other = {*self.controls(), *self.variant_models()}
+        return [m.label for m in self.models if m.label not in other]
+
+    def paper_model(self, label: str) -> str:
+        """The paper model a variant's model stands in for; any other model's own label."""
+        return {v: p for var in self.variants for p, v in var.replaces}.get(label, label)
 
     @property
     def key_model(self) -> str:

@@ -42,11 +42,10 @@ MODELS = (ModelEntry("delan_relativistic", _delan, hidden=W, overrides=REL),
           ModelEntry("delan_control", _delan, hidden=W, overrides=CONTROL))
 _data = Data("charged_magnetic_iid", n_train=640, n_heldout=512)
 _base = Protocol(data=_data, steps=20, batch=32, loss="l1", schedule=OneCycle(lr=1e-3), log_every=5)
-PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 200, n_heldout=10_000), log_every=50),
+QUICK = _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 200, n_heldout=10_000), log_every=50)
+PROTOCOLS = {"smoke": _base, "quick": QUICK, "full": QUICK,   # full runs quick's protocol
              "paper": _base.replace(steps=100_000, batch=512, data=_data.replace(n_train=512 * 1000, n_heldout=100_000),
                                     log_every=1000)}
-PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 
 
 CLAIM = Claim(

@@ -18,15 +18,14 @@ MODELS = (ModelEntry("hnn_spring", _hnn, hidden=W, overrides={"data.recipe": "sp
           ModelEntry("baseline_pendulum", _base_m, hidden=W, overrides={"data.recipe": "pendulum_iid"}))
 _data = Data("spring_iid", n_train=640, n_heldout=512)
 _base = Protocol(data=_data, steps=20, batch=32, loss="mse", schedule=OneCycle(lr=1e-3), log_every=5)
-PROTOCOLS = {"smoke": _base,
-             "quick": _base.replace(steps=2000, batch=128, data=_data.replace(n_train=128 * 200, n_heldout=5000), log_every=50),
+QUICK = _base.replace(steps=2000, batch=128, data=_data.replace(n_train=128 * 200, n_heldout=5000), log_every=50)
+PROTOCOLS = {"smoke": _base, "quick": QUICK, "full": QUICK,   # full runs quick's protocol
              "paper": _base.replace(steps=20_000, batch=256, data=_data.replace(n_train=256 * 500, n_heldout=20_000),
                                     log_every=500)}
-PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
+QUICK_EVAL = {"n_ics": 10, "t_end": 30.0, "n_t": 301, "dt": 0.02, "energy_scale": 1.0}   # RK4 drift ~1e-6
 EVAL = {"smoke": {"n_ics": 3, "t_end": 2.0, "n_t": 21, "dt": 0.01, "energy_scale": 1.0},
-        "quick": {"n_ics": 10, "t_end": 30.0, "n_t": 301, "dt": 0.02, "energy_scale": 1.0},  # RK4 drift ~1e-6
+        "quick": QUICK_EVAL, "full": QUICK_EVAL,
         "paper": {"n_ics": 25, "t_end": 100.0, "n_t": 1000, "dt": 0.01, "energy_scale": 1.0}}
-EVAL["full"] = EVAL["quick"]
 
 
 CLAIM = Claim(

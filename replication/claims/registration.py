@@ -1,16 +1,19 @@
 """Frozen protocols: what decides each claim under each profile, registered before its test-split run.
 
-`fingerprint(claim, profile) -> dict`: everything that decides the claim's numbers and its verdict under
-the profile: the frameworks it is decided in (the profile's), per model that runs, its model spec fields,
+`fingerprint(claim, profile, adopted=None) -> dict`: everything that decides the claim's numbers and its verdict
+under the profile, read from what runs (`resolved.resolved`, the adopted tuning `adopted` applied; default
+tuned.json's): the frameworks it is decided in (the profile's), per model that runs, its model spec fields,
 widths and protocol; the evaluation config and the evaluation routines' version
 (`replication.evaluation.version`); the seed count; the competence bars; the parts (the models they read
 and control, their rule, the rule's parameters and a hash of the rule's code with every rule and
 statistics function it reaches); the variants; the metric.
-`protocol_hash(claim, profile) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its canonical JSON).
+`protocol_hash(claim, profile, adopted=None) -> str`: its `canonical_hash` (16 hex digits of the sha256 of its
+canonical JSON).
 `registrations()`: the committed records (`registrations.json`): {claim id: [line, ...]} oldest first, a
 line {"profile", "protocol_hash", "frozen" (the date it was frozen), "tuned_on" (the split its choices
 read), "note" (how it was chosen)}.
-`status(claim, profile) -> dict`: {"protocol_hash", "registered" (a line holds this hash), "frozen" (that
+`status(claim, profile, committed=None, adopted=None) -> dict`: against the registrations `committed` (default:
+the file's) {"protocol_hash", "registered" (a line holds this hash), "frozen" (that
 line's date, else None), "tuned_on", "note", "registrations" (lines of this profile: more than one means the
 protocol was changed after an earlier registration, each change disclosed)}. A protocol that matches no
 line is unregistered: the tests forbid it, so a changed protocol is a new, dated line, never a silent edit.
@@ -28,7 +31,8 @@ from functools import lru_cache
 from pathlib import Path
 
 from lagbench.replication.claims import bars, stats
-from lagbench.replication.claims.base import PROFILE_FRAMEWORKS, PROFILES
+from lagbench.replication.claims.base import PROFILES
+from lagbench.replication.claims.resolved import resolved
 from lagbench.replication.evaluation.version import EVALUATION_VERSION
 from lagbench.replication.training.protocol import canonical_hash
 
@@ -90,21 +94,19 @@ def _rule(rule) -> dict:
             "code": canonical_hash({"sources": _code(rule, set()), "constants": _constants()}, 16)}
 
 
-def fingerprint(claim, profile: str) -> dict:
-    base = claim.protocol(profile)
-    models = {m.label: {"spec": m.spec_fields(profile), "hidden": list(m.widths(profile)),
-                        "protocol": m.protocol(base, profile).to_dict()}
-              for m in claim.models if m.runs_in(profile)}
-    return {"claim": claim.id, "profile": profile, "frameworks": list(PROFILE_FRAMEWORKS[profile]), "models": models,
-            "eval": claim.evaluation_config(profile), "evaluation_version": EVALUATION_VERSION,
-            "seeds": claim.n_seeds(profile), "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
+def fingerprint(claim, profile: str, adopted: dict | None = None) -> dict:
+    run = resolved(claim, profile, adopted)
+    models = {m.label: {"spec": m.spec, "hidden": list(m.hidden), "protocol": m.protocol.to_dict()} for m in run.models}
+    return {"claim": claim.id, "profile": profile, "frameworks": list(run.frameworks), "models": models,
+            "eval": run.eval, "evaluation_version": EVALUATION_VERSION,
+            "seeds": run.seeds, "metric": claim.metric, "bars": [b.describe() for b in claim.bars],
             "bars_code": canonical_hash({"source": _relative(inspect.getsource(bars)), "share": bars.SHARE}, 16),
             "parts": [{**p.describe(), **_rule(p.rule)} for p in claim.parts],
             "variants": [v.describe() for v in claim.variants]}
 
 
-def protocol_hash(claim, profile: str) -> str:
-    return canonical_hash(fingerprint(claim, profile), 16)
+def protocol_hash(claim, profile: str, adopted: dict | None = None) -> str:
+    return canonical_hash(fingerprint(claim, profile, adopted), 16)
 
 
 @lru_cache(maxsize=1)
@@ -112,9 +114,10 @@ def registrations() -> dict:
     return json.loads(FILE.read_text()) if FILE.is_file() else {}
 
 
-def status(claim, profile: str) -> dict:
-    h = protocol_hash(claim, profile)
-    lines = [x for x in registrations().get(claim.id, []) if x["profile"] == profile]
+def status(claim, profile: str, committed: dict | None = None, adopted: dict | None = None) -> dict:
+    h = protocol_hash(claim, profile, adopted)
+    lines = [x for x in (registrations() if committed is None else committed).get(claim.id, [])
+             if x["profile"] == profile]
     hit = next((x for x in reversed(lines) if x["protocol_hash"] == h), None)
     return {"protocol_hash": h, "registered": hit is not None, "frozen": hit and hit["frozen"],
             "tuned_on": hit and hit["tuned_on"], "note": hit and hit["note"], "registrations": len(lines)}

@@ -4,7 +4,7 @@ canonical (q, p) and an LNN on (q, qdot) succeed.
 Original protocol (reference §5): L = (1-qdot^2)^(-1/2) - 1 + g q, q ~ U[-10, 10], field g ~ N(0, 10^2)
 given as an input, qdot = 0.99999 tanh(2 N(0,1)); 4x500 softplus; L1 weighted by 1 + gamma; Adam with
 one-cycle, peak 1e-3; q and g divided by 10 at the input (the canonical HNN does not scale q), the LNN's
-q-derivatives taken in the scaled q (q / 10 is formed before differentiating: `ModelSpec.scale_q_before_grad`);
+q-derivatives taken in the scaled q (q / 10 is formed before differentiating: the LNN record's `scale_q_before_grad`, `models/kinds.py`);
 the velocities drawn once and reused every epoch, q and g redrawn each epoch (`Data.fixed`). Every model here
 trains on that sampling and the LNNs on that parametrisation.
 The HNNs are trained on [qdot, pdot] (non-canonical: pdot := qdot-double-dot; canonical: the exact
@@ -70,19 +70,20 @@ _base = Protocol(data=_data, steps=20, batch=32, loss="l1_gamma", schedule=OneCy
 _SRC = "original code, SpecialRelativity notebooks, weighted-L1 training loss: "
 # the original's models: 4 x 500, 100 epochs x 3000 minibatches x 512
 ORIGINAL = {"width": (500, 500, 500, 500), "samples": 100 * 3000 * 512}
+# quick: restarts over initialisations at a ten times higher rate, for every model alike: 8 scouts x 200 steps
+# at 1e-2, the best by training loss continued 1500 steps at 1e-2 (one-cycle)
+QUICK = _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 400, n_heldout=20_000), log_every=50,
+                      tracking=Tracking(every=100), schedule=OneCycle(lr=1e-2, start=0.3),
+                      scouting=Scouting(count=8, steps=200, batch=256, schedule=OneCycle(lr=1e-2, start=0.3)))
 PROTOCOLS = {
     "smoke": _base,
-    # restarts over initialisations at a ten times higher rate, for every model alike: 8 scouts x 200 steps
-    # at 1e-2, the best by training loss continued 1500 steps at 1e-2 (one-cycle)
-    "quick": _base.replace(steps=1500, batch=256, data=_data.replace(n_train=256 * 400, n_heldout=20_000), log_every=50,
-                           tracking=Tracking(every=100), schedule=OneCycle(lr=1e-2, start=0.3),
-                           scouting=Scouting(count=8, steps=200, batch=256, schedule=OneCycle(lr=1e-2, start=0.3))),
+    "quick": QUICK,
+    # full: 13x quick's continuation, judged on 1e5 held-out states
+    "full": QUICK.replace(steps=20_000, data=QUICK.data.replace(n_heldout=100_000), log_every=500,
+                          tracking=Tracking(every=2000)),
     "paper": _base.replace(steps=300_000, batch=512, data=_data.replace(n_train=512 * 3000, n_heldout=100_000),
                            log_every=1000),
 }
-# full: 13x quick's continuation, judged on 1e5 held-out states
-PROTOCOLS["full"] = PROTOCOLS["quick"].replace(steps=20_000, data=PROTOCOLS["quick"].data.replace(n_heldout=100_000),
-                                               log_every=500, tracking=Tracking(every=2000))
 
 # rollouts for the trajectory figure (LNN Fig. 3: the original plots t in [0, 1] at 50 points); no verdict reads them
 TRAJECTORIES = {"n_ics": 3, "t_end": 1.0, "n_t": 50, "dt": 0.005}

@@ -1,4 +1,4 @@
-"""Protocols chosen by `lagbench tune`: a claim's models with the knob values its adopted search chose.
+"""The adopted tuning: the records of `tuned.json` and which one serves a model of a claim under a profile.
 
 `tuned.json` (beside this file): {claim id: {profile: record}}, a record being {"ledger_hash" (the
 `canonical_hash` of the adopted ledger.json), "split" ("dev", the only split a choice may read), "seeds",
@@ -7,24 +7,25 @@
 "configs_tried", "score", "confirm_seeds"}}}. Written by
 `python -m lagbench.replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
 
+`records()`: the file's records (the one reader of the file).
 `with_knobs(entry, base, profile, knobs) -> ModelEntry`: the entry with the knob values applied under
 `profile` only (peak rate, the scouting round's with it, as a multiple of the entry's own; every hidden
 width as a multiple): the tuning search's configurations and an adopted choice are both this.
-`apply(claim) -> Claim`: the claim with each adopted model's knobs applied under each adopted profile, and
-under a profile the claim is silent about (a model that runs there exactly as under quick: `full` for most
-claims), quick's choice, the search having run at that profile's budget too.
-A claim whose models are another claim's trainings (`SHARED`) takes that claim's choices (under the profile
-whose protocol it trains with), so that their trainings stay one; a variant takes its paper model's choice
-(its departure is all that differs), and a positive control with `tuned_as` that of the model it vouches
-for. Models and profiles without a record keep their registered
+`choice(claim, entry, profile, adopted) -> Adopted | None`: the adopted record that serves a model of the claim
+as written under the profile, in `adopted` (the records): the claim's own record for the profile, and under a
+profile the claim is silent about (a model that runs there exactly as under quick: `full` for most claims),
+quick's, the search having run at that profile's budget too. A claim whose models are another claim's
+trainings (`SHARED`) takes that claim's choices (under the profile whose protocol it trains with), so that
+their trainings stay one; a variant takes its paper model's choice (its departure is all that differs), and a
+positive control with `tuned_as` that of the model it vouches for. None: the model keeps its registered
 (hand-chosen) setting.
-`tuning(claim, profile) -> {label: {...}}`: for verdicts.json and the report, per trained model the
-configurations its protocol was chosen among, and the split they were scored on (0 and None: by hand).
+Applying a choice to a claim is `resolved.resolved`'s, the one place where the written claim becomes what runs.
 """
 from __future__ import annotations
 
 import dataclasses
 import json
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
@@ -42,6 +43,29 @@ SHARED = {"dp_energy": ("dp_loss", {}, {}), "delan_tracking": ("delan_arm", {}, 
 # claims whose models learn inside their evaluation (claim 13's online learners, `train=False`): the learning
 # rate and widths they learn with are their protocol's and their spec's, searched and adopted as a training's
 LEARNS_IN_EVALUATION = ("online",)
+
+
+@dataclass(frozen=True)
+class Adopted:
+    """The adopted choice a model takes: where it stands in tuned.json (`claim`, `profile`, `label`: another
+    claim's, profile's or model's where the model shares that training) and what the search chose."""
+
+    claim: str
+    profile: str
+    label: str
+    knobs: dict            # {"lr": multiple of the registered peak rate, "width": multiple of the widths}
+    configs_tried: int
+    confirm_seeds: tuple
+    score: float | None    # the chosen configuration's development score
+    ledger_hash: str
+    ledger: str | None     # the ledger's file, where the record names it
+    split: str             # "dev"
+    seeds: tuple           # the search's seeds
+
+    def describe(self) -> dict:
+        return {"claim": self.claim, "profile": self.profile, "label": self.label, "knobs": dict(self.knobs),
+                "configs_tried": self.configs_tried, "confirm_seeds": list(self.confirm_seeds), "score": self.score,
+                "ledger_hash": self.ledger_hash, "ledger": self.ledger, "split": self.split, "seeds": list(self.seeds)}
 
 
 def searched(claim, entry, profile: str) -> bool:
@@ -75,20 +99,11 @@ def records() -> dict:
     return json.loads(FILE.read_text())
 
 
-def _record(claim_id: str, profile: str) -> tuple[dict | None, dict]:
-    """The adopted record that serves the claim under the profile, and the label map into it."""
+def _record(claim_id: str, profile: str, adopted: dict) -> tuple[str, str, dict | None, dict]:
+    """(the claim and profile whose record serves the claim under the profile, that record, the label map)."""
     source, names, profiles = SHARED.get(claim_id, (claim_id, {}, {}))
-    return records().get(source, {}).get(profiles.get(profile, profile)), names
-
-
-def _chosen(claim, rec: dict | None, names: dict, label: str) -> dict | None:
-    """The record's choice for a model: a variant (a departure from the paper) takes its paper model's, so
-    that the departure is all that tells them apart; a model with `tuned_as` (a positive control) takes
-    that model's."""
-    entry = next((m for m in claim.models if m.label == label), None)
-    label = (entry.tuned_as if entry is not None and entry.tuned_as else label)
-    paper = {variant: p for v in claim.variants for p, variant in v.replaces}.get(label, label)
-    return (rec or {}).get("models", {}).get(names.get(paper, paper))
+    at = profiles.get(profile, profile)
+    return source, at, adopted.get(source, {}).get(at), names
 
 
 def _same_as_quick(claim, entry, profile: str) -> bool:
@@ -102,49 +117,20 @@ def _same_as_quick(claim, entry, profile: str) -> bool:
             and entry.protocol(claim.protocol(profile), profile) == entry.protocol(claim.protocol("quick"), "quick"))
 
 
-def _serving(claim, entry, profile: str) -> tuple[dict | None, dict]:
-    """The adopted record that serves the entry under the profile (its own, else quick's where the entry runs
-    as under quick), and the label map into it."""
-    rec, names = _record(claim.id, profile)
+def choice(claim, entry, profile: str, adopted: dict) -> Adopted | None:
+    """The adopted choice that serves `entry` (a model of `claim` as written) under `profile`, or None."""
+    source, at, rec, names = _record(claim.id, profile, adopted)
     if rec is None and _same_as_quick(claim, entry, profile):
-        rec, names = _record(claim.id, "quick")
-    return rec, names
-
-
-def apply(claim):
-    models = list(claim.models)
-    for profile in PROFILES:
-        if per_profile(claim.protocols, profile) is None:
-            continue
-        base = claim.protocol(profile)
-        for i, m in enumerate(models):
-            rec, names = _serving(claim, claim.models[i], profile)   # judged on the claim as written
-            chosen = _chosen(claim, rec, names, m.label)
-            if chosen and searched(claim, m, profile):
-                models[i] = with_knobs(m, base, profile, chosen["knobs"])
-    return dataclasses.replace(claim, models=tuple(models))
-
-
-def tuning(claim, profile: str) -> dict:
-    from lagbench.replication.claims import untuned
-
-    try:
-        written = untuned(claim.id)   # whether a profile runs as quick is judged on the claim as written
-    except KeyError:
-        written = claim
-    out = {}
-    for m in claim.models:
-        if not searched(claim, m, profile):
-            continue
-        entry = next((w for w in written.models if w.label == m.label), m)
-        rec, names = _serving(written, entry, profile)
-        chosen = _chosen(claim, rec, names, m.label)
-        out[m.label] = ({"configs_tried": chosen["configs_tried"], "scored_on": rec["split"], "knobs": chosen["knobs"],
-                         "seeds": rec["seeds"], "confirm_seeds": chosen.get("confirm_seeds", []),
-                         "ledger_hash": rec["ledger_hash"]} if chosen else
-                        {"configs_tried": 0, "scored_on": None, "knobs": None, "seeds": [], "confirm_seeds": [],
-                         "ledger_hash": None})
-    return out
+        source, at, rec, names = _record(claim.id, "quick", adopted)
+    paper = claim.paper_model(entry.tuned_as or entry.label)
+    label = names.get(paper, paper)
+    chosen = (rec or {}).get("models", {}).get(label)
+    if not chosen:
+        return None
+    return Adopted(claim=source, profile=at, label=label, knobs=dict(chosen["knobs"]),
+                   configs_tried=chosen["configs_tried"], confirm_seeds=tuple(chosen.get("confirm_seeds", [])),
+                   score=chosen.get("score"), ledger_hash=rec["ledger_hash"], ledger=rec.get("ledger"),
+                   split=rec["split"], seeds=tuple(rec["seeds"]))
 
 
 def equal(tuning_: dict) -> bool:

@@ -30,12 +30,11 @@ MODELS = _models()
 _data = Data("two_link_arm", n_train=512, n_heldout=512)
 _base = Protocol(data=_data, task="inverse_dynamics", steps=20, batch=32, loss="mse", l2=1e-5,
                  schedule=Constant(lr=5e-4), log_every=5)
-PROTOCOLS = {"smoke": _base,
-             # 8000 steps for every pool: at 2000 the small pools were under-trained (JAX, 3 seeds, torque MSE
-             # on the training family's held-out states against the null's 34.7: DeLaN n256 3.9 -> 0.22 at
-             # 8000, FF n256 5.0 -> 3.2), and every pool gets the same steps, so that only the data differ
-             "quick": _base.replace(steps=8000, batch=256, data=_data.replace(n_train=4096, n_heldout=4000), log_every=200,
-                                    schedule=Constant(lr=1e-3)),
+# quick: 8000 steps for every pool: at 2000 the small pools were under-trained (JAX, 3 seeds, torque MSE on the
+# training family's held-out states against the null's 34.7: DeLaN n256 3.9 -> 0.22 at 8000, FF n256 5.0 -> 3.2),
+# and every pool gets the same steps, so that only the data differ
+QUICK = _base.replace(steps=8000, batch=256, data=_data.replace(n_train=4096, n_heldout=4000), log_every=200,
+                      schedule=Constant(lr=1e-3))
+PROTOCOLS = {"smoke": _base, "quick": QUICK, "full": QUICK,   # full runs quick's protocol
              "paper": _base.replace(steps=40_000, batch=512, data=_data.replace(n_train=2459, n_heldout=4000), log_every=500)}
-PROTOCOLS["full"] = PROTOCOLS["quick"]   # full runs quick's protocol
 SEEDS = {"smoke": 1, "quick": PRELIMINARY_SEEDS, "full": 5, "paper": 5}

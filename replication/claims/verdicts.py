@@ -1,4 +1,6 @@
-"""Where a verdict is decided: ``judge(claim, units, profile)``, shared by the runner and the report.
+"""Where a verdict is decided: ``judge(claim, units, profile, registrations, adopted)``, shared by the runner and
+the report: a function of its arguments alone (it reads no file; the caller loads the committed registrations,
+``registration.registrations()``, and the adopted tuning, ``tuned.records()``, and passes them in).
 
 ``units`` is the table of summary/units.csv (``frame(records)`` builds it from result.json records):
 one row per unit with claim, framework, model, seed, status, its metrics and ``final_train_loss``.
@@ -19,6 +21,10 @@ A part's frameworks combine by ``parts.combine_frameworks`` (decided verdicts th
 "inconclusive", flagged "frameworks disagree"); the claim's verdict is ``parts.claim_verdict`` of its
 counted parts (sanity checks apart). Each variant (``parts.Variant``) is judged the same way with its
 units in the paper model's place, on its own line.
+
+With a profile and ``registrations`` (then ``adopted`` too), the verdict carries its "preregistration": the
+protocol's registration status (``registration.status``) and how each model was tuned (``resolved.tuning``).
+``write_summary(out, profile, split, registrations, adopted)`` writes summary/units.csv and verdicts.json.
 """
 from __future__ import annotations
 
@@ -28,9 +34,10 @@ from pathlib import Path
 import pandas as pd
 
 from lagbench.files import results as R
-from lagbench.replication.claims import CLAIMS, registration, tuned
+from lagbench.replication.claims import registration, tuned
 from lagbench.replication.claims.bars import added_competence, competence
 from lagbench.replication.claims.parts import claim_verdict, combine_frameworks
+from lagbench.replication.claims.resolved import tuning as tuning_of
 from lagbench.replication.claims.rules import Outcome, Stat
 
 KEYS = ("claim", "framework", "model", "seed", "status")
@@ -215,16 +222,24 @@ def _seed(x):
         return x
 
 
-def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
-    """The claim's verdict from ``units`` (rows of any claims; see the module docstring)."""
+def _preregistration(claim, profile: str, registrations: dict, adopted: dict | None) -> dict:
+    if adopted is None:
+        raise TypeError("judge: registrations given without adopted (tuned.json's records)")
+    tuning = tuning_of(claim, profile, adopted)
+    return {**registration.status(claim, profile, registrations, adopted), "tuning": tuning,
+            "equal_tuning": tuned.equal(tuning)}
+
+
+def judge(claim, units: pd.DataFrame, profile: str | None = None, registrations: dict | None = None,
+          adopted: dict | None = None) -> dict:
+    """The claim's verdict from ``units`` (rows of any claims; see the module docstring). ``registrations``:
+    registrations.json's records, ``adopted``: tuned.json's; with a profile they add the preregistration."""
     sub = units[units["claim"] == claim.id] if len(units) else units
     entry = {"id": claim.id, "kind": claim.kind, "verdict": "not run", "reason": "no finished units",
              "by_framework": {}, "parts": [], "variants": [], "flags": [], "values": {}, "competence": {},
              "failed_units": {}}
-    if profile is not None:
-        tuning = tuned.tuning(claim, profile)
-        entry["preregistration"] = {**registration.status(claim, profile), "tuning": tuning,
-                                    "equal_tuning": tuned.equal(tuning)}
+    if profile is not None and registrations is not None:
+        entry["preregistration"] = _preregistration(claim, profile, registrations, adopted)
     if not len(sub):
         return entry
     entry["seeds"] = sorted({int(s) for s in sub["seed"]})
@@ -253,8 +268,11 @@ def judge(claim, units: pd.DataFrame, profile: str | None = None) -> dict:
     return entry
 
 
-def judge_all(units: pd.DataFrame, profile: str | None) -> list:
-    return [judge(c, units, profile) for c in CLAIMS.values()]
+def judge_all(units: pd.DataFrame, profile: str | None, registrations: dict | None = None,
+              adopted: dict | None = None) -> list:
+    from lagbench.replication.claims import CLAIMS
+
+    return [judge(c, units, profile, registrations, adopted) for c in CLAIMS.values()]
 
 
 def headline(judged: list) -> dict:
@@ -269,11 +287,12 @@ def headline(judged: list) -> dict:
     return out
 
 
-def write_summary(out, profile: str, split: str = "dev") -> dict:
+def write_summary(out, profile: str, split: str = "dev", registrations: dict | None = None,
+                  adopted: dict | None = None) -> dict:
     """summary/units.csv and summary/verdicts.json of the units of `split` in `out`."""
     df = of_split(collect_units(out), split)
     R.write_csv(Path(out) / "summary" / "units.csv", df)
-    judged = [{**v, "split": split} for v in judge_all(df, profile)]
+    judged = [{**v, "split": split} for v in judge_all(df, profile, registrations, adopted)]
     verdicts = {"schema": R.SCHEMA, "profile": profile, "split": split, "headline": headline(judged),
                 "claims": judged}
     return R.write_json(Path(out) / "summary" / "verdicts.json", verdicts)

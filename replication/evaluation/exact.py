@@ -25,7 +25,7 @@ def eval_exact_lagrangian(ctx) -> Evaluation:
     st = s.sample_states(ctx.protocol.data.n_heldout, rng)
     q, qdot = st["q"], st["qdot"]
     L = lagrangian_callable(s)
-    form = ctx.spec.formulation
+    form = ctx.spec.own.formulation
     if ctx.framework == "jax":
         import jax.numpy as jnp
 

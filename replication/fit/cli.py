@@ -14,7 +14,7 @@ from lagbench.replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
-             "state file: columns (arrays) q, qdot, qddot and optional tau (format: README)")
+             "state file: columns (arrays) q, qdot, qddot and optional tau (format: docs/fit.md)")
 
 
 def _show_defaults(parser) -> None:
@@ -222,7 +222,7 @@ def add_commands(sub) -> None:
     s.set_defaults(func=cmd_simulate)
     _show_defaults(s)
 
-    s = sub.add_parser("fit", help="train a model on your own data (format: README)",
+    s = sub.add_parser("fit", help="train a model on your own data (format: docs/fit.md)",
                        description="Train one model on a data file and write OUT/units/fit/<framework>/<model>/"
                        "seed<k>/ (result.json, train_log.csv, checkpoint.npz, one_step.csv, rollouts.csv), and the "
                        "prepared rows to OUT/data/. Optimiser: Adam; learning rate: the one-cycle cosine of the "

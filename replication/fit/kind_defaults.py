@@ -42,10 +42,11 @@ FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr
 def _entry(kind: str, task: str):
     from lagbench.replication.claims import get
     from lagbench.replication.claims.base import per_profile
+    from lagbench.replication.claims.resolved import resolved
 
     claim_id, label = SOURCES[(kind, task)]
     claim = get(claim_id)
-    entry = next(m for m in claim.models if m.label == label)
+    entry = resolved(claim, PROFILE).model(label).entry   # as it runs: the adopted tuning applied
     return claim, entry, entry.protocol(per_profile(claim.protocols, PROFILE), PROFILE)
 
 

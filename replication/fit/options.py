@@ -9,16 +9,17 @@ keywords of `fit` from parsed flags (a flag's text read by the option's `parse`)
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import SimpleNamespace
 
 from lagbench.models import ACTIVATIONS
+from lagbench.models.spec import CAPABILITIES
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
 from lagbench.replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
 from lagbench.replication.renamed import renamed
+from lagbench.validate import is_integer, is_real
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
 FRAMEWORKS = ("jax", "torch")
@@ -40,11 +41,7 @@ HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (l
 
 
 def count(low):
-    return lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= low
-
-
-def real(v) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+    return lambda v: is_integer(v) and v >= low
 
 
 def one_of(values):
@@ -119,16 +116,16 @@ OPTIONS = (
            parse=widths),
     Option("activation", BY_KIND, "softplus | relu | relu2 | relu3 | tanh | sigmoid" + KIND, one_of(ACTIVATIONS),
            f"one of {', '.join(ACTIVATIONS)}"),
-    Option("lr", BY_KIND, "peak learning rate, > 0" + KIND, lambda v: real(v) and v > 0, "a finite number > 0",
+    Option("lr", BY_KIND, "peak learning rate, > 0" + KIND, lambda v: is_real(v) and v > 0, "a finite number > 0",
            kind=float),
     Option("schedule", BY_KIND, "onecycle | constant" + KIND, one_of(SCHEDULES), f"one of {', '.join(SCHEDULES)}"),
     Option("lr_start", BY_KIND, "one-cycle: the phase the cycle starts at, in [0, 1) (0.5 is the peak; the rate "
-           "there is --lr x (1 - cos(2 pi phase)) / 2)" + KIND, lambda v: real(v) and 0 <= v < 1, "a number in [0, 1)",
+           "there is --lr x (1 - cos(2 pi phase)) / 2)" + KIND, lambda v: is_real(v) and 0 <= v < 1, "a number in [0, 1)",
            kind=float),
     Option("lr_min_ratio", BY_KIND, "one-cycle: final rate as a fraction of --lr" + KIND,
-           lambda v: real(v) and 0 < v <= 1, "a fraction in (0, 1]", flag="--lr-final", kind=float),
+           lambda v: is_real(v) and 0 < v <= 1, "a fraction in (0, 1]", flag="--lr-final", kind=float),
     Option("weight_decay", BY_KIND, "L2 penalty: coefficient of sum(theta^2) added to the loss" + KIND,
-           lambda v: real(v) and v >= 0, "a finite number >= 0", kind=float),
+           lambda v: is_real(v) and v >= 0, "a finite number >= 0", kind=float),
     Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
            one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
     Option("seed", 0, "initialisation and batch-order seed, >= 0", count(0), "an integer >= 0", kind=int),
@@ -143,15 +140,15 @@ OPTIONS = (
     Option("restart_batch", BY_KIND, "batch size of the restarts" + KIND + "; --batch where the kind has none",
            lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
     Option("restart_lr", None, "peak rate of the restarts' one-cycle (default: --lr x the kind's ratio, or --lr)",
-           lambda v: v is None or (real(v) and v > 0), "a finite number > 0", kind=float),
+           lambda v: v is None or (is_real(v) and v > 0), "a finite number > 0", kind=float),
     Option("guard_clip", BY_KIND, "gradient-spike guard: clip the gradient's norm to this (0: no clip)" + KIND,
-           lambda v: v is None or (real(v) and v >= 0), "a number >= 0", kind=float),
+           lambda v: v is None or (is_real(v) and v >= 0), "a number >= 0", kind=float),
     Option("guard_skip", BY_KIND, "gradient-spike guard: skip a step whose gradient norm is at least this many times "
-           "the recent median (0: no skip)" + KIND, lambda v: v is None or (real(v) and v >= 0), "a number >= 0",
+           "the recent median (0: no skip)" + KIND, lambda v: v is None or (is_real(v) and v >= 0), "a number >= 0",
            kind=float),
-    Option("delan_eps", 0.01, "DeLaN: epsilon of M = L L^T + eps I", lambda v: real(v) and v >= 0,
+    Option("delan_eps", 0.01, "DeLaN: epsilon of M = L L^T + eps I", lambda v: is_real(v) and v >= 0,
            "a finite number >= 0", kind=float),
-    Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", real, "a finite number", kind=float),
+    Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", is_real, "a finite number", kind=float),
     Option("angle_wrap", False, "input feature: wrap q to [-pi, pi) before the MLP", switch=True),
     Option("periodic", (), "input feature: coordinates fed to the network as cos and sin (angles recorded unwrapped); "
            "e.g. 0,1 (default: none)", lambda v: isinstance(v, tuple | list) and all(count(0)(k) for k in v),
@@ -163,14 +160,14 @@ OPTIONS = (
     Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q (cos, sin for --periodic), "
            "qdot(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as 1,1,0.3,0.3"
            + KIND,
-           lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(real(x) and x > 0 for x in v)),
+           lambda v: v in (None, "auto") or (isinstance(v, tuple) and all(is_real(x) and x > 0 for x in v)),
            "none, auto or positive numbers such as 1,1,0.3,0.3", parse=scale),
     Option("system", None, "a system name (see `lagbench list`) whose true energy (and DeLaN terms) the "
            "evaluation compares against (default: none)"),
     Option("energy", None, "your energy function E(q, qdot) as module:function (importable from here; (N, d) "
            "arrays to (N,)), compared along the rollouts in place of --system's"),
     Option("substeps", 2, "RK4 steps per sample interval in the rollouts", count(1), "an integer >= 1", kind=int),
-    Option("horizon", None, HORIZON_HELP + " (default: whole trajectories)", lambda v: v is None or (real(v) and v > 0),
+    Option("horizon", None, HORIZON_HELP + " (default: whole trajectories)", lambda v: v is None or (is_real(v) and v > 0),
            "a number of seconds > 0", kind=float),
 )
 BY_NAME = {o.name: o for o in OPTIONS}
@@ -199,7 +196,7 @@ def check(values: dict) -> None:
     if BY_KIND not in (keep, restarts) and keep is not None and (not restarts or keep >= restarts):
         raise ValueError(f"--restart-keep: {keep!r} needs --restarts above it (the restarts that go on after the "
                          f"first half)")
-    if values.get("dissipation") and values.get("model") == "baseline":
+    if values.get("dissipation") and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
         raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
                          "function); the baseline's q-double-dot is free-form already")
     system = values.get("system")

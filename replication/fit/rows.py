@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +30,7 @@ import pandas as pd
 from lagbench.files import results as R
 from lagbench.files import user_data
 from lagbench.replication.fit import time_base, trajectories
+from lagbench.validate import is_real
 
 SPLITS = ("by-trajectory", "random", "none")
 HELDOUT = 0.1
@@ -49,8 +49,7 @@ class Prepared:
 def check_options(split, heldout) -> None:
     if split not in SPLITS:
         raise ValueError(f"--holdout: {split!r} is not valid; expected one of {', '.join(SPLITS)}")
-    ok = isinstance(heldout, (int, float)) and not isinstance(heldout, bool) and math.isfinite(heldout)
-    if not (ok and 0 < heldout < 1):
+    if not (is_real(heldout) and 0 < heldout < 1):
         raise ValueError(f"--holdout-fraction: {heldout!r} is not valid; expected a fraction between 0 and 1 (default "
                          f"{HELDOUT})")
 

@@ -1,5 +1,5 @@
 """`lagbench simulate`: noisy trajectories of a system of `systems/`, written as a trajectory file that
-`lagbench fit` and `lagbench evaluate` read (the README's worked example makes its data with it).
+`lagbench fit` and `lagbench evaluate` read (docs/fit.md's worked example makes its data with it).
 
 `simulate(system, trajectories, duration, rate, noise, seed, velocities=False) -> DataFrame` with columns
 traj, t, q0..q{d-1} (and qdot0.. with `velocities`): each trajectory starts from a state drawn from the

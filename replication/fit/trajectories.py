@@ -37,6 +37,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from lagbench.validate import is_integer
+
 WINDOW = 15
 POLYORDER = 3
 JITTER_RTOL = 1e-3   # a step within this fraction of the median step is that step
@@ -45,8 +47,7 @@ GAPS = ("interpolate", "split", "refuse")
 
 
 def check_options(window, polyorder) -> None:
-    ok_int = all(isinstance(v, int) and not isinstance(v, bool) for v in (window, polyorder))
-    if not ok_int or polyorder < 2 or window % 2 == 0 or window < polyorder + 2:
+    if not (is_integer(window) and is_integer(polyorder)) or polyorder < 2 or window % 2 == 0 or window < polyorder + 2:
         raise ValueError(f"--window {window!r} / --polyorder {polyorder!r}: not valid; expected an odd window >= "
                          f"polyorder + 2 and a polyorder >= 2 (defaults {WINDOW} and {POLYORDER})")
 

@@ -91,11 +91,12 @@ class Predictor:
 
 def _candidates(profile: str):
     from lagbench.replication.claims import CLAIMS
+    from lagbench.replication.claims.resolved import resolved
 
     for c in CLAIMS.values():
         if c.evaluate not in SCORED_BY:
             continue
-        for m in c.models:
+        for m in (x.entry for x in resolved(c, profile).models):   # as they run: the adopted tuning applied
             if not (m.train and m.runs_in(profile)):
                 continue
             p, fields = m.protocol(c.protocol(profile), profile), m.spec_fields(profile)

@@ -6,8 +6,9 @@ factory imported and the file that defines it hashed; a ValueError naming the op
 `entries(claim, added, profile) -> [ModelEntry]`: the model's entries in `claim`. It enters a claim whose
 evaluation scores q-double-dot (held-out error, energy rollouts), once per system the claim's paper models
 run on: it stands in for the first model the claim's parts read that trains on q-double-dot from (q, qdot)
-alone (a Hamiltonian module: on the time derivative of (q, p), where the paper's HNN does), on that model's data and with its protocol and budget (the claim's tuned protocol where it has
-one). Its label is NAME, or NAME_<system> where the claim has several systems. It runs in its own framework
+alone (a Hamiltonian module: on the time derivative of (q, p), where the paper's HNN does), on that model's
+data and with its protocol and budget as they run (`claims.resolved`: the adopted tuning where it has one).
+Its label is NAME, or NAME_<system> where the claim has several systems. It runs in its own framework
 (PyTorch for a torch.nn.Module, JAX for an equinox Module), is judged by the claim's bar and tables, and no
 part or verdict reads it: an extra model beside the claim.
 """
@@ -67,23 +68,24 @@ def installed(name: str) -> str:
     return found[0]
 
 
-def _stand_in(claim, entry, profile, task: str) -> bool:
-    p = entry.protocol(claim.protocol(profile), profile)
-    fields = entry.spec_fields(profile)
-    return (entry.train and entry.runs_in(profile) and p.task == task and not fields.get("extra_inputs")
-            and fields.get("kind") != "lgn")
+def _stand_in(model, task: str) -> bool:
+    """Whether a model as it runs (`claims.resolved.RunModel`) is one a user's model of `task` stands in for."""
+    return (model.train and model.protocol.task == task and not model.spec.get("extra_inputs")
+            and model.spec.get("kind") != "lgn")
 
 
 def entries(claim, added: Added, profile: str) -> list[ModelEntry]:
+    from lagbench.replication.claims.resolved import resolved
+
     if claim.evaluate not in SCORES_QDDOT:
         return []
-    read = list(dict.fromkeys(m for part in claim.parts for m in part.reads))
+    run = resolved(claim, profile)
+    read = [m for m in dict.fromkeys(m for part in claim.parts for m in part.reads) if m in run.labels]
     by_recipe = {}
     for label in read:
-        entry = claim.entry(label)
-        if _stand_in(claim, entry, profile, "hamiltonian" if added.returns == "hamiltonian" else "acceleration"):
-            recipe = entry.protocol(claim.protocol(profile), profile).data.recipe
-            by_recipe.setdefault(recipe, entry)
+        model = run.model(label)
+        if _stand_in(model, "hamiltonian" if added.returns == "hamiltonian" else "acceleration"):
+            by_recipe.setdefault(model.protocol.data.recipe, model.entry)
     several = len(by_recipe) > 1
     out = []
     for recipe, template in by_recipe.items():

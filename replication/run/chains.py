@@ -110,11 +110,12 @@ def ref(u) -> tuple:
 
 def unit_of(r):
     from lagbench.replication.claims import get as get_claim
+    from lagbench.replication.claims.resolved import resolved
     from lagbench.replication.run.units import Unit
 
     claim_id, label, framework, seed, profile, user = r
     claim = get_claim(claim_id)
-    return Unit(claim, user or next(e for e in claim.models if e.label == label), framework, seed, profile)
+    return Unit(claim, user or resolved(claim, profile).model(label).entry, framework, seed, profile)
 
 
 def run_chain(refs, out):

@@ -19,9 +19,10 @@ from pathlib import Path
 from lagbench.files import results as R
 from lagbench.files.user_data import content_only
 from lagbench.models.spec import USER_KIND
-from lagbench.replication.claims import CLAIMS, PROFILES
+from lagbench.replication.claims import CLAIMS, PROFILES, registration, tuned
 from lagbench.replication.claims import get as get_claim
 from lagbench.replication.claims.base import FRAMEWORKS, run_frameworks
+from lagbench.replication.claims.resolved import catalogue, resolved
 from lagbench.replication.claims.verdicts import write_summary
 from lagbench.replication.evaluation.registry import EVALUATION_VERSION
 from lagbench.replication.run import added_models, splits
@@ -43,9 +44,10 @@ def _once(option: str, values) -> None:
 
 def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, models=None,
          split: str = "dev", added=()) -> list:
-    """The units of a run; a ValueError naming the option if any is invalid or nothing would run. `frameworks`:
-    None for the profile's (`PROFILE_FRAMEWORKS`). `added`: a user's models (`replication.run.added_models.Added`),
-    each entering the claims it fits, in its own framework (named in `frameworks` where those are given)."""
+    """The units of a run: each claim's models as they run under the profile (`claims.resolved.resolved`); a
+    ValueError naming the option if any is invalid or nothing would run. `frameworks`: None for the profile's
+    (`PROFILE_FRAMEWORKS`). `added`: a user's models (`replication.run.added_models.Added`), each entering the
+    claims it fits, in its own framework (named in `frameworks` where those are given)."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
     given = frameworks is not None
@@ -75,10 +77,11 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, m
         raise ValueError(f"--models: unknown {', '.join(unknown)} for the chosen claims; valid: {', '.join(labels)}")
     units = []
     for claim in chosen:
-        n = claim.n_seeds(profile)
+        run = resolved(claim, profile)
+        n = run.seeds
         if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
             n = seeds if max(claim.seeds.values()) > 1 else 1
-        for entry in (*claim.models, *extra[claim.id]):
+        for entry in (*(m.entry for m in run.models), *extra[claim.id]):
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
             for fw in ((added_models.framework(entry),) if entry.spec.get("kind") == USER_KIND else frameworks):
@@ -211,7 +214,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
                   "nothing to run", flush=True)
         return {"dry_run": True, "units": len(units), "todo": len(todo), "estimate": estimate}
     out = R.output_folder(out, "--out")
-    R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [c.catalogue() for c in CLAIMS.values()]})
+    R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [catalogue(c, profile) for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "split": split,
                 "frameworks": list(run_frameworks(profile, frameworks)), "seeds": seeds,
                 "claims": sorted({u.claim.id for u in units}), "models": sorted(models) if models else None,
@@ -244,7 +247,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
         except OSError:
             pass
         raise
-    summary = write_summary(out, profile, split)
+    summary = write_summary(out, profile, split, registration.registrations(), tuned.records())
     manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
                     units_run=len(todo), failures=failures, errors=errors)
     R.write_json(out / "run.json", manifest)

@@ -1,6 +1,6 @@
 """The suite's two splits: what a run trains its seeds on and evaluates them against.
 
-development ("dev")  seeds 0, 1, 2, ...; the held-out draw of generator seed `data.HELDOUT_SEED`; rollout
+development ("dev")  seeds 0, 1, 2, ...; the held-out draw of generator seed `HELDOUT_SEED`; rollout
                      initial conditions from each claim's `ic_seed`. Every trial, study, speed target
                      (`lagbench train-target`, its default) and protocol choice reads this split and only
                      this one.
@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lagbench.replication.training.data import HELDOUT_SEED
+from lagbench.replication.training.protocol_parts import HELDOUT_SEED
 
 
 @dataclass(frozen=True)

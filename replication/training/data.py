@@ -18,9 +18,8 @@ from functools import lru_cache
 import numpy as np
 
 from lagbench import systems
+from lagbench.replication.training.protocol_parts import HELDOUT_SEED  # noqa: F401  (data.HELDOUT_SEED)
 from lagbench.systems.arm_data import ARMS  # arm recipes by name
-
-HELDOUT_SEED = 1_000_000_000  # the original code's PRNGKey(int(1e9)) test set, by analogy
 
 
 @lru_cache(maxsize=32)

@@ -57,7 +57,7 @@ def _jax_gpu():
         devs = []
     if devs:
         return True, devs[0]
-    return False, f"JAX {jax.__version__} has no GPU backend (install the CUDA plugin: README, 'On a GPU')"
+    return False, f"JAX {jax.__version__} has no GPU backend (install the CUDA plugin: docs/gpu.md)"
 
 
 def gpu_seen(framework: str) -> tuple[bool, object]:

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import math
 from dataclasses import dataclass
 
 from lagbench.replication.training.protocol_parts import (
@@ -29,9 +28,6 @@ from lagbench.replication.training.protocol_parts import (
     Guard,
     Scouting,
     Tracking,
-    check,
-    integer,
-    real,
 )
 from lagbench.replication.training.schedules import (
     SCHEDULES,
@@ -40,6 +36,7 @@ from lagbench.replication.training.schedules import (
     schedule_from_dict,
     schedule_to_dict,
 )
+from lagbench.validate import check, integer, is_integer, one_of, real
 
 __all__ = ["LOSSES", "DTYPES", "TASKS", "COORDS", "KEY_VERSION", "Protocol", "Data", "Adam", "Guard", "Scouting",
            "Tracking", "canonical_hash"]
@@ -86,22 +83,18 @@ class Protocol:
 
     def __post_init__(self):
         for name, valid in (("loss", LOSSES), ("dtype", DTYPES), ("task", TASKS)):
-            if getattr(self, name) not in valid:
-                raise ValueError(f"unknown {name} {getattr(self, name)!r}; valid: {', '.join(valid)}")
+            one_of(name, getattr(self, name), valid)
         for name, kind in (("data", Data), ("optimiser", Adam), ("schedule", tuple(SCHEDULES.values()))):
             check(isinstance(getattr(self, name), kind), f"protocol {name} must be a record, got {getattr(self, name)!r}")
         for name in ("steps", "batch", "log_every"):
-            check(integer(getattr(self, name)) and getattr(self, name) >= 1,
-                  f"protocol {name} must be a positive integer, got {getattr(self, name)!r}")
-            object.__setattr__(self, name, int(getattr(self, name)))
-        check(real(self.l2) and math.isfinite(self.l2), f"protocol l2 must be a finite number, got {self.l2!r}")
-        object.__setattr__(self, "l2", float(self.l2))
+            object.__setattr__(self, name, integer(f"protocol {name}", getattr(self, name), low=1))
+        object.__setattr__(self, "l2", float(real("protocol l2", self.l2)))
         n_train = self.data.n_train
         check(self.batch <= n_train, f"batch {self.batch} exceeds the training pool n_train={n_train}")
         for name, kind in (*PARTS.items(), ("scouting", Scouting)):
             v = getattr(self, name)
             check(v is None or isinstance(v, kind), f"protocol {name} must be a {kind.__name__} or None, got {v!r}")
-        check(self.cohort is None or (integer(self.cohort) and self.cohort >= 2),
+        check(self.cohort is None or (is_integer(self.cohort) and self.cohort >= 2),
               f"protocol cohort must be an integer >= 2 (None: one seed at a time), got {self.cohort!r}")
         if self.cohort is not None:
             object.__setattr__(self, "cohort", int(self.cohort))

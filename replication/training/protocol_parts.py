@@ -8,13 +8,15 @@ training). Every value a part uses is written in it: nothing is inherited from t
 from __future__ import annotations
 
 import dataclasses
-import math
-import numbers
 from dataclasses import dataclass
 
 from lagbench.replication.training.schedules import SCHEDULES, Schedule
+from lagbench.validate import check, flag, integer, is_integer, one_of, positive, real
 
 COORDS = ("qqdot", "qp")
+
+
+HELDOUT_SEED = 1_000_000_000  # the held-out draw's generator seed: the original code's PRNGKey(int(1e9)) test set, by analogy
 
 
 @dataclass(frozen=True)
@@ -44,11 +46,9 @@ class Data:
     def __post_init__(self):
         check(isinstance(self.recipe, str) and self.recipe != "", f"data recipe must be a name, got {self.recipe!r}")
         for name in ("n_train", "n_heldout"):
-            check(integer(getattr(self, name)) and getattr(self, name) >= 1,
-                  f"data {name} must be a positive integer, got {getattr(self, name)!r}")
-            object.__setattr__(self, name, int(getattr(self, name)))
-        check(isinstance(self.resample, bool), f"data resample must be True or False, got {self.resample!r}")
-        check(self.coords in COORDS, f"unknown coords {self.coords!r}; valid: {', '.join(COORDS)}")
+            object.__setattr__(self, name, integer(f"data {name}", getattr(self, name), low=1))
+        flag("data resample", self.resample)
+        one_of("coords", self.coords, COORDS)
         object.__setattr__(self, "system_params", tuple(tuple(p) for p in self.system_params))
         fixed = self.fixed
         check(isinstance(fixed, (list, tuple)) and all(isinstance(k, str) and k for k in fixed)
@@ -72,11 +72,8 @@ class Adam:
 
     def __post_init__(self):
         for name in ("b1", "b2"):
-            check(real(getattr(self, name)) and 0 <= getattr(self, name) < 1,
-                  f"Adam {name} must be a number in [0, 1), got {getattr(self, name)!r}")
-        check(real(self.eps) and math.isfinite(self.eps) and self.eps > 0, f"Adam eps must be > 0, got {self.eps!r}")
-        for name in ("b1", "b2", "eps"):
-            object.__setattr__(self, name, float(getattr(self, name)))
+            object.__setattr__(self, name, float(real(f"Adam {name}", getattr(self, name), low=0, below=1)))
+        object.__setattr__(self, "eps", float(positive("Adam eps", self.eps)))
 
 
 @dataclass(frozen=True)
@@ -96,8 +93,7 @@ class Guard:
         for name in ("clip", "skip"):
             v = getattr(self, name)
             if v is not None:
-                check(real(v) and math.isfinite(v) and v > 0, f"guard {name} must be a finite number > 0, got {v!r}")
-                object.__setattr__(self, name, float(v))
+                object.__setattr__(self, name, float(positive(f"guard {name}", v)))
 
 
 @dataclass(frozen=True)
@@ -117,15 +113,14 @@ class Scouting:
     keep: int | None = None
 
     def __post_init__(self):
-        check(integer(self.count) and self.count >= 2,
+        check(is_integer(self.count) and self.count >= 2,
               f"scouting count must be an integer >= 2 (a protocol without restarts has scouting None), got {self.count!r}")
         for name in ("steps", "batch"):
-            check(integer(getattr(self, name)) and getattr(self, name) >= 1,
-                  f"scouting {name} must be a positive integer, got {getattr(self, name)!r}")
+            integer(f"scouting {name}", getattr(self, name), low=1)
         check(isinstance(self.schedule, tuple(SCHEDULES.values())),
               f"scouting schedule must be a schedule record ({', '.join(SCHEDULES)}), got {self.schedule!r}")
         if self.keep is not None:
-            check(integer(self.keep) and 1 <= self.keep < self.count,
+            check(is_integer(self.keep) and 1 <= self.keep < self.count,
                   f"scouting keep {self.keep!r} must be an integer from 1 to below count {self.count} (the scouts "
                   f"that go on after the first half; None = every scout goes on)")
             check(self.steps >= 2, "scouting keep needs steps >= 2: the cut is at half the scouts' steps")
@@ -145,20 +140,5 @@ class Tracking:
     keep: bool = False
 
     def __post_init__(self):
-        check(integer(self.every) and self.every >= 1, f"tracking every must be a positive integer, got {self.every!r}")
-        check(isinstance(self.keep, bool), f"tracking keep must be True or False, got {self.keep!r}")
-        object.__setattr__(self, "every", int(self.every))
-
-
-def check(ok: bool, message: str) -> None:
-    if not ok:
-        raise ValueError(message)
-
-
-def real(v) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
-
-
-def integer(v) -> bool:
-    """An int (or an integral finite float, as JSON may give)."""
-    return real(v) and math.isfinite(v) and v == int(v)
+        object.__setattr__(self, "every", integer("tracking every", self.every, low=1))
+        flag("tracking keep", self.keep)

@@ -13,19 +13,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 from dataclasses import dataclass
 from typing import ClassVar
 
-
-def _real(v) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+from lagbench.validate import integer, positive, real
 
 
 def _check_lr(lr) -> float:
-    if not (_real(lr) and math.isfinite(lr) and lr > 0):
-        raise ValueError(f"learning rate must be positive and finite, got {lr!r}")
-    return float(lr)
+    return float(positive("learning rate", lr))
 
 
 @dataclass(frozen=True)
@@ -49,12 +44,8 @@ class StepDecay:
 
     def __post_init__(self):
         object.__setattr__(self, "lr", _check_lr(self.lr))
-        if not (_real(self.every) and math.isfinite(self.every) and self.every == int(self.every) and self.every >= 1):
-            raise ValueError(f"step schedule every must be a positive integer, got {self.every!r}")
-        if not (_real(self.gamma) and math.isfinite(self.gamma) and 0 < self.gamma):
-            raise ValueError(f"step schedule gamma must be a finite number > 0, got {self.gamma!r}")
-        object.__setattr__(self, "every", int(self.every))
-        object.__setattr__(self, "gamma", float(self.gamma))
+        object.__setattr__(self, "every", integer("step schedule every", self.every, low=1))
+        object.__setattr__(self, "gamma", float(positive("step schedule gamma", self.gamma)))
 
     def rate(self, step: int, steps: int) -> float:
         return self.lr * self.gamma ** (step // self.every)
@@ -69,12 +60,9 @@ class OneCycle:
 
     def __post_init__(self):
         object.__setattr__(self, "lr", _check_lr(self.lr))
-        if not (_real(self.start) and 0 <= self.start < 1):
-            raise ValueError(f"one-cycle start must be a number in [0, 1) (the cycle's starting phase), got {self.start!r}")
-        if not (_real(self.min_ratio) and math.isfinite(self.min_ratio) and self.min_ratio >= 0):
-            raise ValueError(f"one-cycle min_ratio must be a finite number >= 0, got {self.min_ratio!r}")
-        object.__setattr__(self, "start", float(self.start))
-        object.__setattr__(self, "min_ratio", float(self.min_ratio))
+        object.__setattr__(self, "start", float(real("one-cycle start (the cycle's starting phase)", self.start, low=0,
+                                                     below=1)))
+        object.__setattr__(self, "min_ratio", float(real("one-cycle min_ratio", self.min_ratio, low=0)))
 
     def rate(self, step: int, steps: int) -> float:
         phase = self.start + (1.0 - self.start) * (step / max(steps, 1))
@@ -99,6 +87,5 @@ def schedule_from_dict(d: dict) -> Schedule:
 
 
 def learning_rate(protocol, step: int) -> float:
-    if not (_real(step) and math.isfinite(step) and step >= 0):
-        raise ValueError(f"the step must be a finite number >= 0, got {step!r}")
+    real("the step", step, low=0)
     return protocol.schedule.rate(step, protocol.steps)

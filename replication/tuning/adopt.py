@@ -15,7 +15,7 @@ import json
 from datetime import date
 from pathlib import Path
 
-from lagbench.replication.claims import tuned, untuned
+from lagbench.replication.claims import get, tuned
 from lagbench.replication.training.protocol import canonical_hash
 from lagbench.replication.tuning import search
 from lagbench.replication.tuning.tune import CONFIRM_SEEDS
@@ -39,7 +39,7 @@ def adopt(ledger_file, today: str | None = None) -> dict:
     except (OSError, ValueError) as e:
         raise ValueError(f"cannot read {path}: {e}") from None
     try:
-        claim, profile = untuned(ledger["claim"]), ledger["profile"]
+        claim, profile = get(ledger["claim"]), ledger["profile"]
     except (KeyError, TypeError) as e:
         raise ValueError(f"{path} is not a ledger of `lagbench tune` ({e})") from None
     if ledger.get("split") != "dev" or any(m.get("scored_on") != "dev" for m in ledger.get("models", {}).values()):

@@ -31,7 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from lagbench.files import results as R
-from lagbench.replication.claims import tuned, untuned
+from lagbench.replication.claims import get, tuned
 from lagbench.replication.run import splits
 from lagbench.replication.run.estimate import estimate
 from lagbench.replication.run.executor import run_units
@@ -139,7 +139,7 @@ def _compute(df: pd.DataFrame, pooled: bool) -> dict:
 def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="results/tune", progress: bool = True,
          n_configs: int | None = None, n_seeds: int | None = None, widths=None, record=None,
          confirm: int = CONFIRM_SEEDS, dry_run: bool = False) -> dict | None:
-    claim = untuned(claim_id)   # the search is around the claim as written, never around an adopted choice
+    claim = get(claim_id)   # the search is around the claim as written, never around an adopted choice
     pooled_seeds = POOLED_SEEDS if claim.pooled else 1
     n_seeds = pooled_seeds if n_seeds is None else n_seeds
     if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:

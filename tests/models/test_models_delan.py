@@ -22,7 +22,7 @@ def test_mass_matrix_is_symmetric_positive_definite(seed, dof, scale, init):
     # eigvalsh is backward stable: its error is a few eps times the matrix norm, which grows with the
     # entries (up to ~1e5 here), so the bound eps_delan holds up to that rounding
     rounding = 10 * dof * np.finfo(np.float64).eps * np.linalg.norm(m, ord=2, axis=(-2, -1))
-    assert np.all(np.linalg.eigvalsh(m) >= spec.delan_eps - rounding[:, None])
+    assert np.all(np.linalg.eigvalsh(m) >= spec.own.eps - rounding[:, None])
 
 
 def test_forward_and_inverse_models_are_consistent_with_euler_lagrange():

@@ -91,8 +91,8 @@ def test_banded_euler_lagrange_info_is_one_public_mirror():
     x = make_inputs(spec, batch=3, seed=5, n=10)
     mt, mj = lagbench.models.torch.build(spec, params), lagbench.models.jax.build(spec, params)
     q, qdot = torch.tensor(x["q"]), torch.tensor(x["qdot"])
-    a_t, n_t = torch_info(mt._lagrangian, q, qdot, spec.lgn_radius)
-    a_j, n_j = jax_info(mj._lagrangian, jnp.asarray(x["q"]), jnp.asarray(x["qdot"]), spec.lgn_radius)
+    a_t, n_t = torch_info(mt._lagrangian, q, qdot, spec.own.radius)
+    a_j, n_j = jax_info(mj._lagrangian, jnp.asarray(x["q"]), jnp.asarray(x["qdot"]), spec.own.radius)
     assert a_t.shape == a_j.shape == (3, 10) and int(n_t) == int(n_j) == 0
     assert_rel(a_t.detach(), mt.acceleration(q, qdot).detach(), "float64", "torch L_fn vs model")
     assert_rel(a_t.detach(), np.asarray(a_j), "float64", "torch vs jax")

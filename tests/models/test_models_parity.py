@@ -1,7 +1,7 @@
 """JAX against PyTorch on identical parameters: outputs and the gradients of the L1 training loss with
 respect to every parameter, to TOL[dtype] relative (float64 1e-10, float32 dtype-appropriate); every kind
 that takes periodic angle features has a row with them, and the LNN has rows with its q-derivatives in the
-scaled q (`ModelSpec.scale_q_before_grad`)."""
+scaled q (`Lnn.scale_q_before_grad`)."""
 import jax
 import jax.numpy as jnp
 import pytest
@@ -41,7 +41,7 @@ CASES = [
     ("hnn", {"periodic": (0, 1), "extra_inputs": 1, "input_scale": (0.5, 2.0, 1.5, 0.7, 0.3, 1.1, 2.0)}),
     ("delan", {"init": "xavier", "periodic": (1,)}),
     ("baseline", {"periodic": (0,), "extra_inputs": 2}),
-    # q-derivatives in the scaled q, the original code's convention (`ModelSpec.scale_q_before_grad`)
+    # q-derivatives in the scaled q, the original code's convention (`Lnn.scale_q_before_grad`)
     ("lnn", {"formulation": "fast", "extra_inputs": 1, "scale_q_before_grad": True,
              "input_scale": (0.1, 0.5, 1.0, 1.0, 0.1)}),
     ("lnn", {"formulation": "paper", "extra_inputs": 1, "scale_q_before_grad": True,

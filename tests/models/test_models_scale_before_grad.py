@@ -1,4 +1,4 @@
-"""The original LNN code's input-scaling convention (`ModelSpec.scale_q_before_grad`): L's q-derivatives are
+"""The original LNN code's input-scaling convention (`Lnn.scale_q_before_grad`): L's q-derivatives are
 taken in the scaled q, x = s_q q, so the Euler-Lagrange equation is H qddot = dL/dx - (d2L/dqdot dx) qdot with
 the true qdot. With s_q the same on every slot qddot is the differentiated-through one divided by s_q (1-D: the
 original's relativistic notebook, s = 1/10); with slots scaled apart, and with periodic features, the models'
@@ -124,7 +124,7 @@ def test_spec_refuses_the_field_off_the_lnn_and_keeps_old_dicts():
     orig = dataclasses.replace(plain, scale_q_before_grad=True)
     assert orig.to_dict()["scale_q_before_grad"] is True and ModelSpec.from_dict(orig.to_dict()) == orig
     assert orig.to_dict() != plain.to_dict()
-    with pytest.raises(ValueError, match="scale_q_before_grad is for kind 'lnn'"):
+    with pytest.raises(ValueError, match="scale_q_before_grad is for kind lnn, not 'hnn'"):
         ModelSpec(kind="hnn", dof=1, extra_inputs=1, input_scale=(0.1, 1.0, 0.1), scale_q_before_grad=True)
     with pytest.raises(ValueError, match="with an input_scale"):
         ModelSpec(kind="lnn", dof=1, scale_q_before_grad=True)

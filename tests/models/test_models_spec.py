@@ -13,9 +13,11 @@ from lagbench.models import ACTIVATIONS, INITS, KINDS, ModelSpec, init_params, p
     ({"kind": "cnn"}, "unknown kind 'cnn'; valid: baseline, lnn"),
     ({"activation": "gelu"}, "unknown activation 'gelu'; valid: softplus"),
     ({"init": "orthogonal"}, "unknown init 'orthogonal'; valid: cranmer2020"),
-    ({"formulation": "sparse"}, "unknown formulation 'sparse'"),
-    ({"formulation": "banded"}, "formulation for kind 'lnn'"),
-    ({"dof": 0}, "dof must be an int >= 1"),
+    ({"formulation": "sparse"}, "unknown lnn formulation 'sparse'; valid: fast, paper"),
+    ({"formulation": "banded"}, "unknown lnn formulation 'banded'"),
+    ({"dof": 0}, "dof must be an integer >= 1, got 0"),
+    ({"dof": 2.0}, "dof must be an integer >= 1, got 2.0"),
+    ({"hidden": (8.0,)}, r"hidden must be a non-empty sequence of integers >= 1, got \(8.0,\)"),
     ({"hidden": ()}, "hidden must be a non-empty"),
     ({"hidden": (32, -1)}, "hidden must be a non-empty"),
     ({"dtype": "float16"}, "unknown dtype"),
@@ -70,7 +72,8 @@ def test_both_registries_come_from_the_capability_table():
         with pytest.raises(ValueError, match="scalar output"):
             ModelSpec(kind=kind, dof=2, hidden=(8,), n_out=2)
     assert ModelSpec(kind="baseline", dof=2, hidden=(8,), n_out=3).mlp_sizes() == (4, 8, 3)
-    assert ModelSpec(kind="delan", dof=2, hidden=(8,), formulation="paper").formulation == "paper"
+    with pytest.raises(ValueError, match="formulation is for kinds lnn, lgn, not 'delan'"):
+        ModelSpec(kind="delan", dof=2, hidden=(8,), formulation="paper")
 
 
 def test_delan_layout_names():

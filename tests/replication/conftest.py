@@ -1,14 +1,13 @@
 """One smoke run shared by the replication and integration tests.
 
-The claims that tests compare across frameworks (`BOTH`) run in JAX and in PyTorch; every other claim runs in one
-framework (`ONE_FRAMEWORK`), about half of them in each, so that each framework's whole path (training,
+The claims that tests compare across frameworks (`BOTH`), and any claim `ONE_FRAMEWORK` does not list, run in JAX
+and in PyTorch; the claims it lists run in one framework (`ONE_FRAMEWORK`), about half of them in each, so that each framework's whole path (training,
 evaluation, judging, result files) is exercised while each claim is compiled and trained once. The per-step
 agreement of the frameworks is the parity tests' (`tests/replication/training/test_training_parity.py`);
 `tox -e slow` runs every claim in both frameworks (`test_smoke.py`).
 """
 import pytest
 
-from lagbench.replication.claims import CLAIMS
 from lagbench.replication.run import runner
 
 BOTH = ("appendix_b",)
@@ -33,7 +32,6 @@ def smoke_plan(plan):
 
 @pytest.fixture(scope="session")
 def smoke_results(tmp_path_factory):
-    assert set(BOTH) | set(ONE_FRAMEWORK) == set(CLAIMS), "a new claim needs a place in BOTH or ONE_FRAMEWORK"
     out = tmp_path_factory.mktemp("smoke")
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(runner, "plan", smoke_plan(runner.plan))

@@ -15,6 +15,51 @@ def test_list_names_everything(capsys):
         assert word in out
 
 
+def test_list_names_each_claims_models_controls_and_variants_from_its_record(capsys):
+    from lagbench.replication.claims import CLAIMS
+
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for c in CLAIMS.values():
+        paper, controls, variants = c.paper_models(), c.controls(), c.variant_models()
+        assert sorted(paper + controls + variants) == sorted(m.label for m in c.models) and paper
+        assert f"     models: {', '.join(paper)}\n" in out
+        assert (f"     positive controls: {', '.join(controls)}\n" in out) == bool(controls)
+        for var in c.variants:
+            assert f"variant: {var.name} ({', '.join(v for _, v in var.replaces)}" in out
+
+
+@pytest.mark.parametrize("cid, profile", [("dp_loss", "quick"), ("precision", "full"), ("appendix_b", "smoke")])
+def test_list_of_one_claim_under_a_profile_prints_what_runs(cid, profile, capsys):
+    from lagbench.replication.claims import get
+    from lagbench.replication.claims.resolved import resolved
+
+    run = resolved(get(cid), profile)
+    assert main(["list", "--claim", cid, "--profile", profile]) == 0
+    out = capsys.readouterr().out
+    assert f"seeds: {run.seeds} a model (dev {', '.join(map(str, run.seed_numbers['dev']))}" in out
+    assert f"frameworks: {', '.join(run.frameworks)}" in out
+    for m in run.models:   # widths, steps, batch, peak rate and data sizes as they run, and how they were chosen
+        line = next(x for x in out.splitlines() if x.startswith(f"  {m.label}: "))
+        assert f"widths {'x'.join(map(str, m.hidden)) or '-'};" in line
+        assert ("tuned: " in line) == (m.adopted is not None) and ("hand-chosen" in line) == (m.adopted is None)
+        p = m.protocol
+        assert (f"{p.steps} steps x batch {p.batch}, " in out and f"peak lr {p.schedule.lr:g}" in out
+                and f"{p.data.n_train} train, {p.data.n_heldout} held-out" in out)
+    assert [x.split(":")[0].strip() for x in out.splitlines() if x.startswith("  ") and not x.startswith("   ")] \
+        == run.labels
+    if cid == "dp_loss":   # the adopted search widened both models: what runs is not what the file writes
+        assert run.model("lnn").hidden != get(cid).entry("lnn").widths(profile)
+
+
+@pytest.mark.parametrize("argv, says", [(["--claim", "dp_loss"], "go together"), (["--profile", "quick"], "go together"),
+                                        (["--claim", "nope", "--profile", "quick"], "unknown claim 'nope'"),
+                                        (["--claim", "dp_loss", "--profile", "fast"], "unknown 'fast'")])
+def test_list_of_one_claim_needs_a_known_claim_and_profile(argv, says, capsys):
+    assert main(["list", *argv]) == 2
+    assert says in capsys.readouterr().err
+
+
 def test_help_describes_each_command(capsys):
     with pytest.raises(SystemExit):
         build_parser().parse_args(["run", "--help"])

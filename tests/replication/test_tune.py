@@ -6,7 +6,7 @@ import json
 import pytest
 
 from lagbench.cli import main
-from lagbench.replication.claims import get, untuned
+from lagbench.replication.claims import get
 from lagbench.replication.claims.registration import protocol_hash
 from lagbench.replication.run import splits
 from lagbench.replication.training import data as datamod
@@ -95,7 +95,7 @@ def test_an_ablation_gives_every_arm_one_configuration(tmp_path, monkeypatch):
 
 
 def test_apply_changes_only_the_knobs():
-    claim = untuned("dp_loss")
+    claim = get("dp_loss")
     entry = claim.entry("lnn")
     base = claim.protocol("quick")
     p0 = entry.protocol(base, "quick")
@@ -142,7 +142,7 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
     again = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path, progress=False)
     assert ran == [] and again["models"] == ledger["models"]
     # a changed protocol is another unit: its recorded row is not reused
-    u = tune_module._Runner(untuned("dp_loss"), "smoke", ["lnn"], ("jax",), tmp_path, None, False).units(
+    u = tune_module._Runner(get("dp_loss"), "smoke", ["lnn"], ("jax",), tmp_path, None, False).units(
         search.REGISTERED, ["lnn"], [0])[0]
     assert records.unit_key(u) in rows
     import dataclasses
@@ -173,7 +173,7 @@ def test_tune_command_runs_a_width_sweep_and_refuses_a_bad_one_in_one_line(tmp_p
     assert ledger["kind"] == "width sweep" and ledger["search"] == {"lr": [1.0], "width": [1.0, 2.0]}
     assert all(m["configs_tried"] == 2 for m in ledger["models"].values())
     widths = [{u.entry.label: u.entry.widths("smoke") for u in units} for units in trained]
-    base = untuned("dp_loss").entry("lnn").widths("smoke")
+    base = get("dp_loss").entry("lnn").widths("smoke")
     double = tuple(2 * w for w in base)   # each model's units of a configuration run as one (the record grows per model)
     assert widths == [{"lnn": base}, {"baseline": base}, {"lnn": double}, {"baseline": double}]
 
@@ -202,7 +202,7 @@ def test_claim_13s_online_learners_are_searched_and_learn_at_their_protocols_rat
     from lagbench.replication.evaluation import online_claim
     from lagbench.replication.studies import online_learner
 
-    claim = untuned("delan_online")
+    claim = get("delan_online")
     assert [m.label for m in claim.models if tuned.searched(claim, m, "quick")] == ["delan", "ff"]
     _fake_search(monkeypatch, lambda label, knobs, seed: knobs["lr"] * knobs["width"])
     ledger = tune("delan_online", profile="smoke", out=tmp_path, progress=False)

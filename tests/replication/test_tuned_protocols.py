@@ -1,14 +1,15 @@
-"""Adopted tuning (`replication.claims.tuned`, `replication.tuning.adopt`): a `lagbench tune` ledger's
-choices become the claim's protocol under its profile only when every model was searched alike on the
-development split; claims that share trainings take the same choice; verdicts and the report say how
-each model's protocol was chosen and flag a model tuned less than its rivals."""
+"""Adopted tuning (`replication.claims.tuned`, `replication.tuning.adopt`, applied by `replication.claims.resolved`):
+a `lagbench tune` ledger's choices become what a claim runs under its profile only when every model was searched
+alike on the development split; claims that share trainings take the same choice; verdicts and the report say
+how each model's protocol was chosen and flag a model tuned less than its rivals."""
 import json
 from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
 
-from lagbench.replication.claims import CLAIMS, get, tuned, untuned
+from lagbench.replication.claims import CLAIMS, PROFILES, get, tuned
+from lagbench.replication.claims.resolved import resolved, tuning
 from lagbench.replication.training.protocol import canonical_hash
 from lagbench.replication.tuning import adopt
 
@@ -17,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _ledger(claim_id="hnn_energy", profile="quick", split="dev", tried=9, knobs=None, drop=(), kind="search",
             confirm=(0, 1, 2), first=9):
-    claim = untuned(claim_id)
+    claim = get(claim_id)
     labels = [m.label for m in claim.models if m.train and m.runs_in(profile) and m.label not in drop]
     knobs = knobs or {"lr": 1 / 3, "width": 2.0}
     return {"claim": claim_id, "profile": profile, "split": split, "search": {"lr": [1 / 3, 1, 3], "width": [0.5, 1, 2]},
@@ -45,29 +46,30 @@ def test_adopt_applies_the_choice_under_its_profile_only(record_file):
     rec = adopt.adopt(_write(record_file, _ledger()), today="2026-01-01")
     assert rec["split"] == "dev" and rec["configs"] == 9 and rec["adopted"] == "2026-01-01"
     assert all(m["score"] == 1.5 and m["confirm_seeds"] == [0, 1, 2] for m in rec["models"].values())
-    claim = tuned.apply(untuned("hnn_energy"))
-    written = untuned("hnn_energy")
-    for m, w in zip(claim.models, written.models, strict=True):
-        assert m.widths("quick") == tuple(2 * x for x in w.widths("quick"))
-        assert m.protocol(claim.protocol("quick"), "quick").schedule.lr == pytest.approx(
-            w.protocol(written.protocol("quick"), "quick").schedule.lr / 3)
-        for q in ("smoke", "paper"):
-            assert m.widths(q) == w.widths(q) and m.protocol(claim.protocol(q), q) == w.protocol(written.protocol(q), q)
+    written = get("hnn_energy")
+    runs = {p: resolved(written, p) for p in PROFILES}
+    for w in written.models:
+        q = runs["quick"].model(w.label)
+        assert q.hidden == tuple(2 * x for x in w.widths("quick")) and q.adopted.knobs == {"lr": 1 / 3, "width": 2.0}
+        assert q.protocol.schedule.lr == pytest.approx(w.protocol(written.protocol("quick"), "quick").schedule.lr / 3)
+        for p in ("smoke", "paper"):
+            m = runs[p].model(w.label)
+            assert m.adopted is None and m.hidden == w.widths(p) and m.protocol == w.protocol(written.protocol(p), p)
         # full: claim 10 is silent about it (its models run there as under quick), so quick's choice serves it
-        assert m.widths("full") == m.widths("quick")
-        assert m.protocol(claim.protocol("full"), "full") == m.protocol(claim.protocol("quick"), "quick")
-    t = tuned.tuning(claim, "quick")
+        full = runs["full"].model(w.label)
+        assert full.hidden == q.hidden and full.protocol == q.protocol and full.adopted == q.adopted
+    t = tuning(written, "quick")
     assert all(x["configs_tried"] == 9 and x["scored_on"] == "dev" for x in t.values()) and tuned.equal(t)
-    assert tuned.tuning(claim, "full") == t
-    assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuned.tuning(claim, "paper").values())
+    assert tuning(written, "full") == t
+    assert all(x["configs_tried"] == 0 and x["scored_on"] is None for x in tuning(written, "paper").values())
 
 
 def test_a_profile_that_runs_otherwise_than_quick_keeps_its_own_setting(record_file):
     adopt.adopt(_write(record_file, _ledger("dp_loss", knobs={"lr": 3.0, "width": 2.0})))
-    claim, written = tuned.apply(untuned("dp_loss")), untuned("dp_loss")
-    assert claim.entry("lnn").widths("quick") != written.entry("lnn").widths("quick")
-    assert claim.entry("lnn").widths("full") == written.entry("lnn").widths("full")   # full trains longer
-    assert all(x["configs_tried"] == 0 for x in tuned.tuning(claim, "full").values())
+    written = get("dp_loss")
+    assert resolved(written, "quick").model("lnn").hidden != written.entry("lnn").widths("quick")
+    assert resolved(written, "full").model("lnn").hidden == written.entry("lnn").widths("full")   # full trains longer
+    assert all(x["configs_tried"] == 0 for x in tuning(written, "full").values())
 
 
 @pytest.mark.parametrize("ledger, says", [
@@ -94,13 +96,13 @@ def test_adopt_refuses_a_ledger_that_is_not_an_equal_dev_search(record_file, led
 
 def test_claims_that_share_trainings_take_the_same_choice(record_file):
     adopt.adopt(_write(record_file, _ledger("dp_loss", profile="smoke", knobs={"lr": 3.0, "width": 0.5})))
-    loss, energy, precision = (tuned.apply(untuned(c)) for c in ("dp_loss", "dp_energy", "precision"))
-    for label, same in (("lnn", energy.entry("lnn")), ("baseline", energy.entry("baseline")),
-                        ("baseline", precision.entry("baseline_f32"))):
-        a = loss.entry(label)
-        assert a.widths("smoke") == same.widths("smoke") == tuple(w // 2 for w in untuned("dp_loss").entry(label).widths("smoke"))
-        pa, pb = a.protocol(loss.protocol("smoke"), "smoke"), same.protocol(precision.protocol("smoke"), "smoke")
-        assert pa.schedule == pb.schedule and pa.scouting == pb.scouting
+    loss, energy, precision = (resolved(get(c), "smoke") for c in ("dp_loss", "dp_energy", "precision"))
+    for label, same in (("lnn", energy.model("lnn")), ("baseline", energy.model("baseline")),
+                        ("baseline", precision.model("baseline_f32"))):
+        a = loss.model(label)
+        assert a.hidden == same.hidden == tuple(w // 2 for w in get("dp_loss").entry(label).widths("smoke"))
+        assert a.protocol.schedule == same.protocol.schedule and a.protocol.scouting == same.protocol.scouting
+        assert same.adopted.claim == "dp_loss" and same.adopted.label == label
 
 
 def test_a_claim_that_trains_under_another_profiles_protocol_takes_that_profiles_choice(record_file):
@@ -108,14 +110,15 @@ def test_a_claim_that_trains_under_another_profiles_protocol_takes_that_profiles
     and a search of claim 1 at full's own budget does not."""
     adopt.adopt(_write(record_file, _ledger("dp_loss", knobs={"lr": 1.0, "width": 4.0})))
     adopt.adopt(_write(record_file, _ledger("dp_loss", profile="full", knobs={"lr": 1 / 3, "width": 0.5})))
-    loss, precision, written = tuned.apply(untuned("dp_loss")), tuned.apply(untuned("precision")), untuned("precision")
+    quick_loss, full_loss = resolved(get("dp_loss"), "quick"), resolved(get("dp_loss"), "full")
+    written, precision = get("precision"), resolved(get("precision"), "full")
     for dtype in ("f32", "f64"):
-        m, w = precision.entry(f"baseline_{dtype}"), written.entry(f"baseline_{dtype}")
-        assert m.widths("full") == loss.entry("baseline").widths("quick") == tuple(4 * x for x in w.widths("full"))
-        assert (m.protocol(precision.protocol("full"), "full").schedule
-                == loss.entry("baseline").protocol(loss.protocol("quick"), "quick").schedule)
-    assert loss.entry("baseline").widths("full") == tuple(x // 2 for x in untuned("dp_loss").entry("baseline").widths("full"))
-    assert all(x["configs_tried"] == 9 for x in tuned.tuning(precision, "full").values())
+        m, w = precision.model(f"baseline_{dtype}"), written.entry(f"baseline_{dtype}")
+        assert m.hidden == quick_loss.model("baseline").hidden == tuple(4 * x for x in w.widths("full"))
+        assert m.protocol.schedule == quick_loss.model("baseline").protocol.schedule
+        assert (m.adopted.claim, m.adopted.profile) == ("dp_loss", "quick")
+    assert full_loss.model("baseline").hidden == tuple(x // 2 for x in get("dp_loss").entry("baseline").widths("full"))
+    assert all(x["configs_tried"] == 9 for x in tuning(written, "full").values())
 
 
 def test_every_adopted_choice_is_its_committed_ledgers():
@@ -132,12 +135,30 @@ def test_every_adopted_choice_is_its_committed_ledgers():
             assert ledger["split"] == rec["split"] == "dev"
             for label, m in rec["models"].items():
                 assert ledger["models"][label]["chosen_knobs"] == m["knobs"]
-            assert tuned.equal(tuned.tuning(get(claim_id), profile))
+            assert tuned.equal(tuning(get(claim_id), profile))
 
 
-def test_the_running_claims_are_the_written_ones_with_the_adopted_knobs():
-    for claim_id, claim in CLAIMS.items():
-        assert claim == tuned.apply(untuned(claim_id))
+def test_what_runs_is_the_written_claim_with_exactly_the_adopted_knobs():
+    """Per claim, profile and model: the adopted record `resolved` names holds the knobs it applied (the rate and
+    every width a multiple of the written ones, as `search.apply` makes a configuration); a model without one
+    runs as written."""
+    from lagbench.replication.tuning import search
+
+    records = tuned.records()
+    applied = 0
+    for claim in CLAIMS.values():
+        for profile in PROFILES:
+            base = claim.protocol(profile)
+            for m in resolved(claim, profile).models:
+                w, a = claim.entry(m.label), m.adopted
+                knobs = a.knobs if a else search.REGISTERED
+                if a:
+                    assert records[a.claim][a.profile]["models"][a.label]["knobs"] == knobs
+                    applied += 1
+                entry = search.apply(w, base, profile, knobs)
+                assert m.hidden == entry.widths(profile) and m.protocol == entry.protocol(base, profile)
+                assert m.spec == w.spec_fields(profile) and m.train == w.train
+    assert applied   # tuned.json's choices reach what runs
 
 
 def test_report_flags_a_model_tuned_less_than_its_rivals():
@@ -159,7 +180,7 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
     ledger = sr.tuning_table(res).set_index(["claim", "model"])
     assert ledger.loc[("a", "baseline"), "flag"] == "LESS TUNING than a rival"
     assert ledger.loc[("d", "lgn"), "flag"] == "partial search (4 of 9); unconfirmed: one seed"
-    assert ledger.loc[("b", "hnn"), "flag"] == "" and ledger.loc[("b", "hnn"), "confirmed on"] == "0, 1, 2"
+    assert ledger.loc[("b", "hnn"), "flag"] == "none" and ledger.loc[("b", "hnn"), "confirmed on"] == "0, 1, 2"
     assert set(ledger.index.get_level_values(0)) == {"a", "b", "d"}
 
 
@@ -202,8 +223,8 @@ def test_a_missing_adopted_tuning_file_is_an_error(tmp_path, monkeypatch):
 
 def test_the_control_claim_trains_claim_9s_models_with_its_choice(record_file):
     adopt.adopt(_write(record_file, _ledger("delan_arm", profile="smoke", knobs={"lr": 3.0, "width": 0.5})))
-    arm, control = (tuned.apply(untuned(c)) for c in ("delan_arm", "delan_tracking"))
+    arm, control = (resolved(get(c), "smoke") for c in ("delan_arm", "delan_tracking"))
     for label in ("delan", "ff"):
-        a, b = arm.entry(label), control.entry(label)
-        assert a.widths("smoke") == b.widths("smoke") == tuple(w // 2 for w in untuned("delan_arm").entry(label).widths("smoke"))
-        assert a.protocol(arm.protocol("smoke"), "smoke") == b.protocol(control.protocol("smoke"), "smoke")
+        a, b = arm.model(label), control.model(label)
+        assert a.hidden == b.hidden == tuple(w // 2 for w in get("delan_arm").entry(label).widths("smoke"))
+        assert a.protocol == b.protocol

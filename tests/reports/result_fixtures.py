@@ -1,8 +1,9 @@
 """Hand-made result files following docs/RESULTS.md exactly, checksums included (used by the
 conftest.py fixtures and the tests).
 
-``write_results(root)`` writes run.json, claims.json (the ten claims), units for every claim except
-``activation_study`` (which stays "not run") in jax and torch with two seeds, summary/units.csv,
+``write_results(root)`` writes run.json, claims.json (the ten claims; ``init_study`` a pooled claim whose
+metric is a yes/no per seed), units for every claim except ``activation_study`` (which stays "not run") in jax
+and torch with two seeds, summary/units.csv,
 summary/verdicts.json and bench/ files; plus one corrupt unit (``dp_loss/torch/lnn/seed2``: its metrics
 were edited after the checksum was written). Checksums are computed here independently of ``reports``.
 """
@@ -21,6 +22,7 @@ from lagbench.replication.training.protocol import Data, Protocol
 FRAMEWORKS = ["jax", "torch"]
 PROTOCOL = Protocol(data=Data("double_pendulum_iid", n_train=10000), steps=100, batch=32).to_dict()
 SEEDS = [0, 1]
+POOLED = "init_study"   # a claim whose metric is a yes/no per seed (left_plateau: 1 on seed 0, 0 on seed 1)
 CORRUPT = ("dp_loss", "torch", "lnn", 2)
 NOT_RUN_CLAIM = "activation_study"
 
@@ -36,7 +38,7 @@ CLAIMS = [
     ("appendix_b", 5, "LNN", "App. B", "free_fall", ["lnn_exact"], "max_abs_err", {"lnn_exact": 0.0}),
     ("init_study", 6, "LNN", "App. C", "double_pendulum",
      ["lnn_init-cranmer2020", "lnn_init-xavier", "lnn_init-kaiming", "lnn_init-pytorch_default"],
-     "final_train_loss", {}),
+     "left_plateau", {}),
     ("activation_study", 7, "LNN", "App. C", "double_pendulum",
      ["lnn_act-softplus", "lnn_act-relu2", "lnn_act-tanh"], "final_train_loss", {}),
     ("delan_table1", 8, "LNN", "Table 1", ["relativistic", "charged_magnetic"], ["delan", "lnn"], "heldout_l1",
@@ -67,7 +69,7 @@ def claim_record(c) -> dict:
     cid, number, paper, section, system, models, metric, published = c
     return {"id": cid, "number": number, "paper": paper, "section": section, "title": f"claim {cid}",
             "system": system, "models": models, "metric": metric, "metric_label": metric,
-            "published": published, "verdict_rule": "first model < second model",
+            "published": published, "verdict_rule": "first model < second model", "pooled": cid == POOLED,
             "protocol": {"smoke": {"steps": 10}, "quick": {"steps": 100}, "paper": {"steps": 1000}}}
 
 
@@ -81,6 +83,8 @@ def metrics_for(cid, model, seed, rng) -> dict:
           ("final_train_loss", 0.9), ("max_abs_err", 1), ("torque_mse_train", 0.5), ("torque_mse_test", 1),
           ("transfer_l1", 2))}
     m["null_heldout_l1"] = 50.0   # the null predictor's: every fixture model is far below it
+    if cid == POOLED:
+        m["left_plateau"] = float(seed == 0)
     return m
 
 

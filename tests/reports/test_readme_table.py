@@ -4,6 +4,8 @@ report."""
 import json
 from pathlib import Path
 
+from markdown_tables import claim_rows
+
 from lagbench.reports import readme_table
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -24,10 +26,8 @@ def test_the_sample_is_a_test_split_run_and_its_report_shows_the_same_verdicts()
     assert verdicts["split"] == "test"
     report = (SAMPLE / "REPORT.md").read_text(encoding="utf-8")
     rows = {}
-    for title in ("Scorecard", "Checks"):   # the claim in the second cell, its verdict in the fifth
-        block = report.split(f"**{title}**", 1)[1].split("\n\n")[1]
-        rows.update({r.strip("|").split(" | ")[1].strip(): r.strip("|").split(" | ")[4].strip()
-                     for r in block.splitlines()[2:]})
+    for title in ("Scorecard", "Checks"):   # by their "claim" and "verdict" columns
+        rows.update({cid: r["verdict"] for cid, r in claim_rows(report, title).items()})
     for c in verdicts["claims"]:
         assert rows[c["id"]].startswith(c["verdict"]), c["id"]
 

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from markdown_tables import claim_rows as rows_of
+from markdown_tables import md_table
 from result_fixtures import CLAIMS, CORRUPT, NOT_RUN_CLAIM, write_json
 
 from lagbench.reports import build_report
@@ -19,28 +21,20 @@ HEAVY = ["jax", "torch", "equinox", "optax", "diffrax", "systems", "models", "la
          "lagbench.replication.run.runner", "lagbench.replication.training.data"]
 
 
-def table_rows(md: str, title: str) -> dict[str, list[str]]:
-    """The rows of the Markdown table titled ``title``, keyed by their second cell (the claim)."""
-    block = md.split(f"**{title}**", 1)[1].split("\n\n")[1]
-    rows = [r.strip("|").split(" | ") for r in block.splitlines()[2:]]
-    return {r[1].strip(): [c.strip() for c in r] for r in rows}
-
-
-def claim_rows(md: str) -> dict[str, list[str]]:
-    """The scorecard's and the checks' rows: #, claim, says, paper, verdict, key number, JAX, PyTorch,
-    published, why."""
-    return {**table_rows(md, "Scorecard"), **table_rows(md, "Checks")}
+def claim_rows(md: str) -> dict[str, dict]:
+    """The scorecard's and the checks' rows by claim: #, claim, verdict, why, key number, published, flags."""
+    return {**rows_of(md, "Scorecard"), **rows_of(md, "Checks")}
 
 
 def test_markdown_has_every_claim_row_and_not_run(built):
     md = built["markdown"].read_text()
     rows = claim_rows(md)
     assert set(rows) == {c[0] for c in CLAIMS}
-    assert all(rows[NOT_RUN_CLAIM][i] == "not run" for i in (4, 6, 7))
+    assert all(rows[NOT_RUN_CLAIM][c] == "not run" for c in ("verdict", "why", "key number"))
     # recomputed from the unit files: dp_loss's models pass their bar (null recorded) and agree;
     # dp_energy's rollouts record no divergence count, so its LNN cannot pass its rollout bar
-    assert rows["dp_loss"][4] == "reproduced; 1 corrupt unit excluded"
-    assert rows["dp_energy"][4] == "inconclusive"
+    assert rows["dp_loss"]["verdict"] == "reproduced; 1 corrupt unit excluded"
+    assert rows["dp_energy"]["verdict"] == "inconclusive"
     assert "Claims: published against reproduced" not in md   # folded into the scorecard
     assert "summary/verdicts.json disagrees with the unit files for" in md
     for line in md.splitlines():
@@ -57,8 +51,8 @@ def test_corrupt_unit_is_listed_and_excluded(built):
     rel = "units/{}/{}/{}/seed{}".format(*CORRUPT)
     assert f"| {rel} | corrupt | result.json checksum mismatch |" in md
     assert not re.search(r"(?<![\d.])999(\.0*)?(?![\d.e])", md)   # the corrupt value, not a digit run of another
-    torch_cell = claim_rows(md)["dp_loss"][7]
-    assert torch_cell.endswith("(n=2)") and claim_rows(md)["dp_loss"][5] == "lnn heldout_l1"
+    key = claim_rows(md)["dp_loss"]["key number"]   # the corrupt third seed is not among the seeds counted
+    assert key.startswith("lnn heldout_l1") and re.search(r"PyTorch \S+ \(\S+ to \S+, 2 seeds\)$", key), key
 
 
 def test_figures_written_and_referenced(built):
@@ -98,7 +92,7 @@ def test_claims_only_reads_not_run_everywhere(tmp_path):
     paths = build_report(res, tmp_path / "out", pdf=False)
     rows = claim_rows(paths["markdown"].read_text())
     assert set(rows) == {c[0] for c in CLAIMS}
-    assert all(r[4] == "not run" for r in rows.values())
+    assert all(r["verdict"] == "not run" for r in rows.values())
     assert paths["figures"] == []
 
 
@@ -129,28 +123,32 @@ def test_report_imports_no_training_code(results_dir, tmp_path):
     assert re.search(r"%PDF-", (tmp_path / "out" / "REPORT.pdf").read_bytes()[:8].decode())
 
 
-def scorecard_rows(md: str) -> dict[str, list[str]]:
-    return table_rows(md, "Scorecard")
+def scorecard_rows(md: str) -> dict[str, dict]:
+    return rows_of(md, "Scorecard")
 
 
 def test_report_opens_with_a_scorecard_of_recomputed_verdicts(built):
     md = built["markdown"].read_text()
     assert md.index("## Scorecard") < md.index("## Summary")
     rows = scorecard_rows(md)
-    checks = table_rows(md, "Checks")
+    checks = rows_of(md, "Checks")
     assert set(rows) | set(checks) == {c[0] for c in CLAIMS} and not set(rows) & set(checks)
     assert "appendix_b" in checks and "dp_loss" in rows      # a check is kept apart from the paper claims
     assert re.search(r"Paper claims: (\d+ [a-z ]+, )*\d+ reproduced", md) and "Checks (implementation and numerics): " in md
-    assert rows["dp_loss"][4].startswith("reproduced") and rows["dp_energy"][4] == "inconclusive"
-    assert rows["dp_loss"][3].startswith("LNN") and rows["dp_loss"][2]   # the paper's section and what it says
-    assert re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][6]) and re.fullmatch(r"0\.0\d+ ± \S+ \(n=2\)", rows["dp_loss"][7])
-    assert len(rows["dp_energy"][9]) <= 120
+    assert rows["dp_loss"]["verdict"].startswith("reproduced") and rows["dp_energy"]["verdict"] == "inconclusive"
+    assert rows["dp_loss"]["claim"] == "dp_loss: claim dp_loss (LNN §5)"   # what it says and where in the paper
+    # the key number: seed mean (lowest to highest seed, n seeds) per framework, with its unit
+    assert re.fullmatch(r"lnn heldout_l1 \(units of q̈\): JAX 0\.0\d+ \(0\.0\d+ to 0\.0\d+, 2 seeds\); "
+                        r"PyTorch 0\.0\d+ \(0\.0\d+ to 0\.0\d+, 2 seeds\)", rows["dp_loss"]["key number"])
+    # why: the reason's category, the model below its bar on how many seeds
+    assert re.match(r"BELOW BAR \(.+\): lnn passed on 0/2 seeds", rows["dp_energy"]["why"]), rows["dp_energy"]["why"]
+    assert "±" not in rows["dp_loss"]["key number"] and "(n=" not in md_table(md, "Scorecard").to_string()
     assert re.search(r"Profile \w+, \w+ split, JAX and PyTorch; commit ", md)   # the frameworks it was decided in
-    parts = table_rows(md, "Parts of the paper claims")
-    assert parts["dp_loss"][2] == "similar held-out loss" and parts["dp_loss"][3] == "reproduced"
-    assert re.fullmatch(r"\S+ \[\S+, \S+\]", parts["dp_loss"][5])   # JAX: point [low, high]
-    full = table_rows(md, "Reasons in full (parts not reproduced)")
-    assert "below the competence bar" in full["dp_energy"][5]
+    parts = rows_of(md, "Parts of the paper claims")
+    assert parts["dp_loss"]["part"] == "similar held-out loss" and parts["dp_loss"]["verdict"] == "reproduced"
+    assert re.fullmatch(r"\S+ \[\S+, \S+\]", parts["dp_loss"]["JAX"])   # JAX: point [low, high]
+    full = rows_of(md, "Reasons in full (parts not reproduced)")
+    assert "below the competence bar" in full["dp_energy"]["reason"]
 
 
 def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(small_results_dir, tmp_path):
@@ -164,7 +162,7 @@ def test_deleted_units_change_the_verdict_and_an_unfinished_run_says_so(small_re
     shutil.rmtree(res / "units" / "dp_loss" / "jax" / "baseline")
     shutil.rmtree(res / "units" / "dp_loss" / "torch" / "baseline")
     md = build_report(res, tmp_path / "out", pdf=False)["markdown"].read_text()
-    assert scorecard_rows(md)["dp_loss"][4].startswith("not run")   # the stored verdict said "reproduced"
+    assert scorecard_rows(md)["dp_loss"]["verdict"].startswith("not run")   # the stored verdict said "reproduced"
     assert "This run is unfinished: 4 planned unit(s) have no result" in md
     assert "| units/dp_loss/jax/baseline/seed0 | missing |" in md
     assert "No failed, corrupt or missing units" not in md

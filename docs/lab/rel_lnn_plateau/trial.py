@@ -16,6 +16,7 @@ from pathlib import Path
 import pandas as pd
 
 from lagbench.replication.claims import get
+from lagbench.replication.claims.resolved import resolved
 from lagbench.replication.run import splits
 from lagbench.replication.run.executor import run_units
 from lagbench.replication.run.units import Unit
@@ -30,7 +31,7 @@ full = claim.protocols["full"]
 trial = full.replace(steps=steps, batch=512, log_every=1000, tracking=Tracking(every=max(1000, steps // 20 // 1000 * 1000)),
                      data=full.data.replace(n_train=512 * 3000, n_heldout=20_000))
 claim = dataclasses.replace(claim, protocols={**claim.protocols, "full": trial})
-units = [Unit(claim, claim.entry("lnn"), "jax", s, "full") for s in seeds]
+units = [Unit(claim, resolved(claim, "full").model("lnn").entry, "jax", s, "full") for s in seeds]
 run_units(units, out, "full", progress=True, jobs=1)
 rows = []
 for u in units:

@@ -1,5 +1,8 @@
 """The claim records themselves: kinds, parts and variants name real models, a pooled claim's seed counts
 follow its stated power rule, every claim its seed rule, and a variant differs from the paper's model only in its departure."""
+import ast
+from pathlib import Path
+
 import pytest
 
 from lagbench.replication.claims import CLAIMS, PROFILES, seed_rule
@@ -8,7 +11,61 @@ from lagbench.replication.claims.stats import seeds_needed
 
 
 def test_checks_are_apart_from_the_paper_claims():
-    assert {c.id for c in CLAIMS.values() if c.kind == "check"} == {"appendix_b", "precision"}
+    """A check (an implementation or numerics check) is counted apart from the paper claims."""
+    import pandas as pd
+
+    from lagbench.replication.claims.verdicts import headline, judge
+
+    checks = {c.id for c in CLAIMS.values() if c.kind == "check"}
+    assert {"appendix_b", "precision"} <= checks
+    counted = headline([judge(c, pd.DataFrame(), None) for c in CLAIMS.values()])
+    assert sum(counted["checks"].values()) == len(checks) and sum(counted["claims"].values()) == len(CLAIMS) - len(checks)
+
+
+def _top_level_problems(tree) -> list:
+    """What makes a module more than literals: a top-level statement that changes a value after it is written
+    (an item or attribute assigned, an augmented assignment, a bare call such as `d.update(...)`), or a read
+    of the adopted tuning or of a file."""
+    out = []
+    for node in tree.body:
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
+            node, ast.AnnAssign | ast.AugAssign) else []
+        if isinstance(node, ast.AugAssign) or any(isinstance(t, ast.Subscript | ast.Attribute) for t in targets):
+            out.append(f"line {node.lineno}: changes a value after it is written")
+        if isinstance(node, ast.Expr) and not isinstance(node.value, ast.Constant):
+            out.append(f"line {node.lineno}: a bare call at import")
+        if isinstance(node, ast.ImportFrom | ast.Import):
+            names = {a.name for a in node.names} | {node.module or ""} if isinstance(node, ast.ImportFrom) else {
+                a.name for a in node.names}
+            if names & {"tuned", "resolved", "registration", "verdicts", "json", "pathlib"}:
+                out.append(f"line {node.lineno}: imports {sorted(names)}")
+    for node in ast.walk(tree):
+        name = node.attr if isinstance(node, ast.Attribute) else node.id if isinstance(node, ast.Name) else ""
+        if name in ("open", "read_text", "read_bytes", "records"):
+            out.append(f"line {node.lineno}: reads a file ({name})")
+    return out
+
+
+def test_claim_files_and_their_shared_settings_are_literals():
+    """What a claim file writes is what the claim holds: no claim module, nor a settings module a claim includes
+    (`double_pendulum`, `two_link_arm`, `pace_study`), changes a value after writing it or reads a file or the
+    adopted tuning at import; the adopted tuning is applied in one place, `claims.resolved`."""
+    import sys
+
+    from lagbench.replication import claims as package
+
+    folder = Path(package.__file__).parent
+    claims = {id(c) for c in CLAIMS.values()}
+    modules = {m.__name__.rsplit(".", 1)[1] for m in list(sys.modules.values())
+               if m.__name__.startswith(package.__name__ + ".") and id(getattr(m, "CLAIM", None)) in claims}
+    assert len(modules) == len(CLAIMS)
+    for name in sorted(modules):   # the settings modules the claims include
+        tree = ast.parse((folder / f"{name}.py").read_text())
+        modules |= {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module == package.__name__
+                    for a in n.names}
+    assert {"double_pendulum", "two_link_arm", "pace_study"} <= modules
+    problems = {name: _top_level_problems(ast.parse((folder / f"{name}.py").read_text())) for name in sorted(modules)}
+    assert not {k: v for k, v in problems.items() if v}, problems
 
 
 @pytest.mark.parametrize("cid", [c.id for c in CLAIMS.values() if c.pooled])
@@ -79,3 +136,14 @@ def test_a_part_naming_an_unknown_model_is_refused():
         Claim(**{**c.__dict__, "parts": (Part("x", bound("m", upper=1.0), reads=("nobody",)),)})
     with pytest.raises(ValueError, match="every part is a check"):
         Claim(**{**c.__dict__, "parts": (Part("x", bound("m", upper=1.0), reads=("lnn",), check=True),)})
+
+
+def test_claim_2s_registered_matched_level_is_the_adopted_baselines_score():
+    """Claim 2 reads its models at a held-out level written in its file: the development score of the baseline's
+    adopted choice (the search claim 1's models were tuned by) under each profile that decides at matched accuracy."""
+    from lagbench.replication.claims.resolved import resolved
+
+    for profile in ("quick", "full"):
+        adopted = resolved(CLAIMS["dp_loss"], profile).model("baseline").adopted
+        assert adopted is not None and adopted.claim == "dp_loss"
+        assert CLAIMS["dp_energy"].evaluation_config(profile)["match_heldout_l1"] == adopted.score

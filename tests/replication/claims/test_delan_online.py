@@ -5,7 +5,8 @@ import math
 
 import pandas as pd
 
-from lagbench.replication.claims import PROFILES, get, tuned
+from lagbench.replication.claims import PROFILES, get, registration, tuned
+from lagbench.replication.claims.resolved import tuning
 from lagbench.replication.claims.verdicts import judge
 from lagbench.replication.studies import online as O
 from lagbench.replication.studies.online_learner import claim_model
@@ -26,10 +27,11 @@ def test_both_models_learn_online_with_the_learners_fixed_settings_and_are_tuned
         assert (e["every"], e["steps"], e["batch"], e["threshold"]) == (O.EVERY, O.STEPS, O.BATCH, O.THRESHOLD)
         assert e["sustain"] == O.SUSTAIN == 5.0
         assert p == claim_model("delan")[1].replace(batch=O.BATCH, steps=round(e["seconds"] * O.C.RATE))
-        t = tuned.tuning(CLAIM, profile)   # searched like trainings (by hand until a search is adopted)
+        t = tuning(CLAIM, profile)   # searched like trainings (by hand until a search is adopted)
         assert set(t) == {"delan", "ff"} and tuned.equal(t)
     assert CLAIM.evaluation_config("quick")["seconds"] == 30.0 and CLAIM.evaluation_config("paper")["seconds"] == 60.0
-    v = judge(CLAIM, _rows({"delan": (1.0, 1.5, 2.0), "ff": (4.0, 5.0, 6.0)}), "quick")
+    v = judge(CLAIM, _rows({"delan": (1.0, 1.5, 2.0), "ff": (4.0, 5.0, 6.0)}), "quick",
+              registration.registrations(), tuned.records())
     assert v["preregistration"]["equal_tuning"] and v["verdict"] == "reproduced", v["reason"]
 
 

@@ -3,6 +3,8 @@ matches a committed registration; changing a model's protocol, the evaluation or
 changes the hash and leaves the claim unregistered until a new dated line discloses the change."""
 import dataclasses
 
+import pytest
+
 from lagbench.replication.claims import CLAIMS, PROFILES, get
 from lagbench.replication.claims import registration as reg
 
@@ -58,7 +60,7 @@ def test_register_appends_a_dated_line_for_a_changed_protocol_only(tmp_path, mon
         assert reg.register("again", today="2026-01-02") == []
         claim = get("dp_loss")
         monkeypatch.setitem(claim.protocols, "quick", claim.protocols["quick"].replace(steps=1))
-        added = reg.register("fewer steps", today="2026-01-03")   # claim 2 shares claim 1's protocols
+        added = reg.register("fewer steps", today="2026-01-03")   # claim 2 includes claim 1's PROTOCOLS record
         assert "dp_loss/quick" in added and all(a.endswith("/quick") for a in added)
         s = reg.status(claim, "quick")
         assert s["registered"] and s["frozen"] == "2026-01-03" and s["note"] == "fewer steps" and s["registrations"] == 2
@@ -66,14 +68,25 @@ def test_register_appends_a_dated_line_for_a_changed_protocol_only(tmp_path, mon
         reg.registrations.cache_clear()
 
 
-def test_verdicts_carry_the_registration():
+def test_verdicts_carry_the_registration_they_are_given():
+    """The judge reads no file: the registrations and the adopted tuning it is given decide its record."""
     import pandas as pd
 
+    from lagbench.replication.claims import tuned
     from lagbench.replication.claims.verdicts import judge
 
-    v = judge(get("dp_loss"), pd.DataFrame(columns=["claim", "framework", "model", "seed", "status"]), "quick")
-    assert v["preregistration"]["registered"] and v["preregistration"]["protocol_hash"] == reg.protocol_hash(
-        get("dp_loss"), "quick")
+    claim, none = get("dp_loss"), pd.DataFrame(columns=["claim", "framework", "model", "seed", "status"])
+    committed, adopted = reg.registrations(), tuned.records()
+    v = judge(claim, none, "quick", committed, adopted)
+    assert v["preregistration"]["registered"] and v["preregistration"]["protocol_hash"] == reg.protocol_hash(claim, "quick")
+    assert not judge(claim, none, "quick", {}, adopted)["preregistration"]["registered"]
+    # without claim 1's adopted choice its models run as written: another protocol, registered under none of its lines
+    hand = judge(claim, none, "quick", committed, {})["preregistration"]
+    assert not hand["registered"] and hand["protocol_hash"] != v["preregistration"]["protocol_hash"]
+    assert all(t["configs_tried"] == 0 for t in hand["tuning"].values())
+    assert "preregistration" not in judge(claim, none, "quick")   # nothing given: no record read behind its back
+    with pytest.raises(TypeError, match="adopted"):
+        judge(claim, none, "quick", committed)
 
 
 def test_every_claim_spells_out_every_profile():

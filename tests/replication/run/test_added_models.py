@@ -12,6 +12,7 @@ from lagbench.files.user_functions import NO_RERUN, UserCodeError
 from lagbench.models import ModelSpec, init_params
 from lagbench.replication.claims import CLAIMS
 from lagbench.replication.claims.bars import Bar, added_competence
+from lagbench.replication.claims.resolved import resolved
 from lagbench.replication.evaluation.adapters import adapter
 from lagbench.replication.run import added_models
 from lagbench.replication.run.runner import plan
@@ -49,7 +50,8 @@ def test_the_model_enters_each_claim_it_fits_once_per_system_with_the_paper_mode
     dp = CLAIMS["dp_loss"]
     (e,) = added_models.entries(dp, a, "quick")
     assert e.label == "mine" and e.spec["kind"] == "user"
-    assert e.protocol(dp.protocol("quick"), "quick") == dp.entry("lnn").protocol(dp.protocol("quick"), "quick")
+    # the LNN's protocol as it runs (`claims.resolved`: the adopted tuning applied)
+    assert e.protocol(dp.protocol("quick"), "quick") == resolved(dp, "quick").model("lnn").protocol
     hnn = CLAIMS["hnn_energy"]
     assert sorted(x.label for x in added_models.entries(hnn, a, "quick")) == ["mine_pendulum", "mine_spring"]
     # not where the paper models see an extra input (the field g), predict torques, or are graph networks
@@ -92,7 +94,7 @@ def test_a_factory_that_returns_no_module_is_refused_when_built(model_file):
         init_params(spec, 0)
     with pytest.raises(ValueError, match="needs a factory"):
         ModelSpec(kind="user", dof=2)
-    with pytest.raises(ValueError, match="needs a factory"):
+    with pytest.raises(ValueError, match="factory is for kind user, not 'lnn'"):
         ModelSpec(kind="lnn", dof=2, factory="x:y")
 
 

@@ -165,7 +165,7 @@ def table(rows) -> str:
     for row in rows:
         d, bad = run_row(row)
         p, tol = row.protocol, row.tolerance
-        form = row.spec.formulation if row.spec.kind in ("lnn", "lgn") else "-"
+        form = row.spec.own.formulation if row.spec.kind in ("lnn", "lgn") else "-"
         task = p.task + (f" ({p.data.coords})" if p.task == "hamiltonian" else "")
         guard = " + guard" if p.guard else ""
         steps = {"one": f"{d['steps']}", "members": f"{d['steps']} (x{len(row.seeds)} members)",

@@ -32,10 +32,16 @@ def test_the_canonical_form_round_trips_and_holds_every_field():
 
 
 def test_one_number_one_key():
-    """1 and 1.0 (or an integral float from JSON) give one protocol and one key."""
-    a = BASE.replace(l2=0, steps=10.0, **{"schedule.lr": 1})
-    assert a == BASE.replace(**{"schedule.lr": 1.0}) and a.key() == BASE.replace(**{"schedule.lr": 1.0}).key()
-    assert isinstance(a.steps, int) and isinstance(a.schedule.lr, float)
+    """A real field takes 1 as 1.0: one protocol and one key. A count takes no float, not even 10.0 (the shared
+    checks of `lagbench.validate`, as the model spec's)."""
+    a = BASE.replace(l2=0, **{"schedule.lr": 1, "optimiser.eps": 1})
+    assert a == BASE.replace(l2=0.0, **{"schedule.lr": 1.0, "optimiser.eps": 1.0})
+    assert a.key() == BASE.replace(**{"schedule.lr": 1.0, "optimiser.eps": 1.0}).key()
+    assert isinstance(a.l2, float) and isinstance(a.schedule.lr, float) and isinstance(a.optimiser.eps, float)
+    for field in ("steps", "batch", "log_every", "data.n_train", "data.n_heldout", "scouting.steps", "tracking.every"):
+        name = field.replace(".", " ") if "." in field else f"protocol {field}"
+        with pytest.raises(ValueError, match=f"^{name} must be an integer >= 1, got 10.0$"):
+            FULL.replace(**{field: 10.0})
     assert BASE.key() != BASE.replace(**{"schedule.lr": 2e-3}).key() and FULL.key() != BASE.key()
     assert BASE.key() != BASE.replace(**{"data.n_heldout": 11}).key()
 

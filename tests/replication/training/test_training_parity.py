@@ -35,7 +35,7 @@ def test_frameworks_agree_at_every_step(row):
 
 def test_the_table_covers_every_kind_formulation_loss_schedule_and_mode():
     default = [r for r in ROWS if not r.slow]
-    forms = {(r.spec.kind, r.spec.formulation if r.spec.kind in ("lnn", "lgn") else "-") for r in ROWS}
+    forms = {(r.spec.kind, r.spec.own.formulation if r.spec.kind in ("lnn", "lgn") else "-") for r in ROWS}
     assert {k for k, _ in forms} == set(KINDS)
     # the LGN's "fast" is an alias of "banded"
     assert {f for k, f in forms if k == "lnn"} == {"fast", "paper"}

@@ -1,0 +1,49 @@
+"""What a claim's comparison does not control (`reports.confounds`), on its page and in the scorecard's flags: the
+compared models' parameter counts from their recorded specs, a flag where they differ, every seed of a model
+below its bar."""
+import json
+import shutil
+
+import pytest
+from markdown_tables import claim_rows, md_table
+from result_fixtures import SEEDS, checksum, write_json
+
+from lagbench.reports import build_report
+
+WIDE = [64, 64]
+
+
+def mlp_parameters(sizes: list[int]) -> int:
+    """Weights and biases of a plain MLP of these layer widths, input first."""
+    return sum(a * b + b for a, b in zip(sizes, sizes[1:], strict=False))
+
+
+@pytest.fixture(scope="module")
+def report(small_results_dir, tmp_path_factory) -> str:
+    """The fixtures with dp_loss's baseline WIDE (checksums rewritten): REPORT.md of their report."""
+    root = tmp_path_factory.mktemp("wide")
+    shutil.copytree(small_results_dir, root / "res")
+    for f in (root / "res" / "units" / "dp_loss").glob("*/baseline/seed*/result.json"):
+        r = json.loads(f.read_text())
+        r["model_spec"]["hidden"] = WIDE
+        r["checksum"] = checksum(r)
+        write_json(f, r)
+    return build_report(root / "res", root / "out", pdf=False)["markdown"].read_text()
+
+
+def test_the_compared_models_sizes_are_counted_from_their_specs_and_a_difference_flagged(report):
+    # the fixture's double pendulum: dof 2, the MLP sees q and qdot; the LNN outputs a scalar, the baseline qddot
+    lnn, baseline = mlp_parameters([4, 16, 16, 1]), mlp_parameters([4, *WIDE, 2])
+    sizes = md_table(report, "dp_loss: the compared models' sizes and budgets").set_index("model")
+    assert sizes.loc["lnn", "parameters"] == f"{lnn:,}" and sizes.loc["baseline", "parameters"] == f"{baseline:,}"
+    assert sizes.loc["baseline", "hidden widths"] == "x".join(map(str, WIDE))
+    flags = claim_rows(report, "Scorecard")["dp_loss"]["flags"]
+    assert f"sizes differ: baseline {baseline:,} vs lnn {lnn:,} parameters" in flags, flags
+    assert f"does not control model size (baseline {baseline:,} vs lnn {lnn:,} parameters)" in report
+
+
+def test_every_seed_of_a_model_below_its_bar_is_on_the_claims_page(report):
+    seeds = md_table(report, "dp_energy: every seed of a model below its competence bar")
+    lnn = seeds[seeds["model"] == "lnn"]   # the fixture's rollouts record no divergence count: no seed passes
+    assert sorted(lnn["seed"]) == sorted(str(s) for s in SEEDS * 2) and set(lnn["bar"]) == {"FAILED"}
+    assert set(lnn["framework"]) == {"jax", "torch"}
