@@ -229,7 +229,7 @@ def add_commands(sub) -> None:
                        "original LNN code (starts at 35 % of --lr, peaks at --lr 37.5 % into training, ends at "
                        "--lr x --lr-final) or constant. A fit of other data or options already there is kept as "
                        "superseded-<time>-seed<k>. Load the model in Python with "
-                       "replication.fit.load.load_fitted(folder).")
+                       "lagbench.replication.fit.load.load_fitted(folder).")
     s.add_argument("--data", required=True, help=DATA_HELP)
     s.add_argument("--out", default="results/fit", help="results folder")
     fit_options.add_arguments(s)

@@ -83,7 +83,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m lagbench.replication.tuning.adopt",
                                 description="Adopt the choices of a `lagbench tune` ledger as the claim's protocol "
                                             "under its profile (then register it: python -m "
-                                            "replication.claims.registration --note ...).")
+                                            "lagbench.replication.claims.registration --note ...).")
     p.add_argument("ledgers", nargs="+", metavar="LEDGER", help="ledger.json files of `lagbench tune`")
     args = p.parse_args(argv)
     for f in args.ledgers:
