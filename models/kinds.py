@@ -165,7 +165,8 @@ class Capability:
     may see coordinates as (cos, sin) (`ModelSpec.periodic`). mlp_input: what its MLP reads: "state" ([q,
     qdot(, gamma(qdot)), extra]), "q" (q only) or "neighbours" (each node's 2r+1 neighbours' q and qdot);
     scalar_output: its MLP ends in one output (n_out must be None or 1); mlp_head: its MLP ends in an output
-    layer (False: a trunk whose every layer is activated, the heads its own, `models.params`)."""
+    layer (False: a trunk whose every layer is activated, the heads its own, `models.params`). energy: a
+    fitted model of the kind gives the system's energy (`lagbench.replication.fit.load`)."""
 
     model_class: str
     tasks: tuple
@@ -178,6 +179,7 @@ class Capability:
     mlp_input: str = "state"
     scalar_output: bool = True
     mlp_head: bool = True
+    energy: bool = False
 
     @property
     def dissipation(self) -> bool:
@@ -194,10 +196,10 @@ CAPABILITIES = {
     "baseline": Capability("Baseline", ("acceleration", "inverse_dynamics"), False, {"-": "aot"}, Baseline,
                            scalar_output=False),
     "lnn": Capability("LNN", ("acceleration",), True, {"fast": "aot", "paper": "traced"}, Lnn,
-                      formulations=("fast", "paper")),
-    "hnn": Capability("HNN", ("hamiltonian",), False, {"-": "aot"}, Hnn),
+                      formulations=("fast", "paper"), energy=True),
+    "hnn": Capability("HNN", ("hamiltonian",), False, {"-": "aot"}, Hnn, energy=True),
     "delan": Capability("DeLaN", ("acceleration", "inverse_dynamics"), False, {"-": "aot"}, Delan,
-                        extra_inputs=False, mlp_input="q", scalar_output=False, mlp_head=False),
+                        extra_inputs=False, mlp_input="q", scalar_output=False, mlp_head=False, energy=True),
     "lgn": Capability("LGN", ("acceleration",), True, {"banded": "aot", "dense": "traced"}, Lgn,
                       formulations=("fast", "banded", "dense", "paper"), extra_inputs=False, periodic=False,
                       mlp_input="neighbours"),

@@ -34,6 +34,7 @@ import numpy as np
 
 from lagbench.files import results as R
 from lagbench.models import ModelSpec
+from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.evaluation.adapters import adapter, padded_size
 from lagbench.replication.evaluation.rollout_native import native_rollout
 from lagbench.replication.training.protocol import Protocol
@@ -133,7 +134,7 @@ class Fitted:
 
     @property
     def has_energy(self) -> bool:
-        return self.spec.kind in ("delan", "hnn", "lnn")
+        return self.spec.kind in CAPABILITIES and CAPABILITIES[self.spec.kind].energy
 
     def energy(self, q, qdot):
         kind = self.spec.kind

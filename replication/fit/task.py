@@ -32,6 +32,7 @@ import numpy as np
 
 from lagbench.files import results as R
 from lagbench.files import user_data
+from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.claims.base import ModelEntry
 from lagbench.replication.fit import kind_defaults, time_base, trajectories
 from lagbench.replication.fit import options as fit_options
@@ -45,12 +46,17 @@ SET_NAMES = {"heldout": "held-out", "test": "test"}
 
 
 def task_of(model: str, has_tau: bool, path) -> str:
-    if has_tau and model in ("lnn", "hnn"):
+    """What a fit of the kind `model` trains on a file with torque columns (`has_tau`) or without: the kind's
+    first task in the table of kinds, or its inverse dynamics given torques; a kind without inverse dynamics
+    refuses torques, naming the kinds that have it."""
+    tasks = CAPABILITIES[model].tasks
+    if not has_tau:
+        return tasks[0]
+    if "inverse_dynamics" not in tasks:
+        inverse = " or ".join(k for k, c in CAPABILITIES.items() if "inverse_dynamics" in c.tasks)
         raise ValueError(f"{path}: has tau columns, but an {model.upper()} here learns unforced dynamics and would ignore "
-                         f"them; drop the tau columns, or fit delan or baseline to learn the inverse dynamics")
-    if model == "hnn":
-        return "hamiltonian"
-    return "inverse_dynamics" if has_tau else "acceleration"
+                         f"them; drop the tau columns, or fit {inverse} to learn the inverse dynamics")
+    return "inverse_dynamics"
 
 
 def auto_scale(reference: str, task: str, kind: str, periodic: tuple = ()) -> tuple:

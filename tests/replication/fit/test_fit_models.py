@@ -33,7 +33,7 @@ def test_an_lnn_or_hnn_given_torques_refuses_before_any_work(tmp_path, capsys, m
     data = _arm_trajectories(tmp_path / "arm.csv")
     assert main(["fit", "--data", str(data), "--model", model, "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "tau" in err and "delan or baseline" in err, err
+    assert err.count("\n") == 1 and "tau" in err and "fit baseline or delan" in err, err
     assert not (tmp_path / "out" / "data").exists() and not (tmp_path / "out" / "trained").exists()
 
 
