@@ -31,6 +31,7 @@ from lagbench.replication.run.estimate import PROBES, describe, estimate
 from lagbench.replication.run.executor import run_units
 from lagbench.replication.run.units import Unit
 from lagbench.replication.training import device as dev
+from lagbench.validate import is_integer
 
 log = logging.getLogger("lagbench")
 LONG_PROFILES = ("full", "paper")   # profiles that print their units and an estimated duration first
@@ -61,7 +62,7 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, m
     _once("--frameworks", frameworks)
     _once("--claims", claims or ())
     _once("--models", models or ())
-    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int)
+    if seeds is not None and (not is_integer(seeds)
                               or not 1 <= seeds <= splits.SEEDS_PER_SPLIT):
         raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer from 1 to "
                          f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
@@ -197,7 +198,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
         progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT,
         add_models=()) -> dict:
     """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`)."""
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+    if not is_integer(jobs) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
     if not dry_run:   # a folder another command is writing into is refused before the planning, not after it

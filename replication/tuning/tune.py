@@ -38,6 +38,7 @@ from lagbench.replication.run.executor import run_units
 from lagbench.replication.run.runner import is_current
 from lagbench.replication.run.units import Unit
 from lagbench.replication.tuning import choose, records, search
+from lagbench.validate import is_integer
 
 CONFIRM_SEEDS = 3   # development seeds the chosen configuration is confirmed on, against the registered one
 POOLED_SEEDS = 8    # a pooled claim's cohort of development seeds per configuration (its confirmation too)
@@ -142,9 +143,9 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
     claim = get(claim_id)   # the search is around the claim as written, never around an adopted choice
     pooled_seeds = POOLED_SEEDS if claim.pooled else 1
     n_seeds = pooled_seeds if n_seeds is None else n_seeds
-    if isinstance(n_seeds, bool) or not isinstance(n_seeds, int) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
+    if not is_integer(n_seeds) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
-    if isinstance(confirm, bool) or not isinstance(confirm, int) or not 1 <= confirm <= splits.SEEDS_PER_SPLIT:
+    if not is_integer(confirm) or not 1 <= confirm <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--confirm: {confirm!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     kind = "width sweep" if widths else "partial search" if n_configs else "search"
     configs = search.sweep(widths) if widths else search.configs(n_configs) if n_configs else search.grid()
