@@ -9,10 +9,10 @@ import sys
 from pathlib import Path
 
 import pytest
+from test_import_cycles import FOLDERS
 
 ROOT = Path(__file__).resolve().parents[1]
-SOURCES = ("pyproject.toml", "setup.py", "README.md", "LICENSE", "lagbench", "systems", "models", "replication",
-           "reports", "speedstudy")
+SOURCES = ("pyproject.toml", "setup.py", "README.md", "LICENSE", *FOLDERS)
 
 USER_MODELS = '''"""The user's own package `models`: an --add-model factory."""
 import torch
