@@ -9,6 +9,7 @@ import threading
 import traceback
 from pathlib import Path
 
+from lagbench import options
 from lagbench.files.results import DiskFull, writing
 from lagbench.replication.run import jax_cache
 from lagbench.replication.training.device import HELP as DEVICE_HELP
@@ -66,16 +67,19 @@ def cmd_run(args):
     from lagbench.replication.training import device
 
     frameworks = _csv(args.frameworks)   # None: the profile's (`PROFILE_FRAMEWORKS`)
+    seeds = options.seeds_or_count(args)   # None: the profile's
     device.apply(args.device, run_frameworks(args.profile, frameworks))
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
-                  frameworks=frameworks, seeds=args.seeds, models=_csv(args.models),
+                  frameworks=frameworks, seeds=seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
                   dry_run=args.dry_run, split=args.split, add_models=args.add_model)
     if summary.get("dry_run"):
         return 0
-    named = _csv(args.claims)
+    from lagbench.reports.load import asked_claims
+
+    asked = asked_claims(Path(args.out or f"results/{args.profile}"), earlier=False)   # this run's, as run.json has them
     for c in summary["claims"]:   # the claims this run was asked for (the summary holds every claim)
-        if named is None or c["id"] in named:
+        if asked is None or c["id"] in asked:
             print(f"{c['id']:<17} {c['verdict']:<15} {c['reason']}")
     return _print_errors(summary.get("errors", []))
 
@@ -122,13 +126,17 @@ EPILOG = """usual workflows:
   lagbench tune --claim dp_loss                                  every model of a claim searched alike
   lagbench fit --data FILE --model lnn && lagbench report --results results/fit
 
+option names mean one thing in every command: --frameworks (comma-separated jax, torch), --seeds (the seeds
+themselves, comma- or space-separated), --n-seeds (how many), --out (what the command writes); the old
+spellings (--framework, a count after --seeds, control's --results) are read until the next release, with a note.
+
 environment variables:
-  LAGBENCH_CACHE          generated code, datasets, trainings and compiled programs cache (default .cache/)
+  LAGBENCH_CACHE          generated code, datasets, trainings and compiled programs cache (default: .cache/)
   LAGBENCH_JAX_CACHE      0: JAX compiles every program anew (default: kept in LAGBENCH_CACHE/jax-compiled/)
   LAGBENCH_DEVICE         auto | cpu | gpu, as --device
   LAGBENCH_TORCH_COMPILE  off: PyTorch trains eagerly; on: compiles every phase it can
   LAGBENCH_TF32           1: allow TF32 matrix products on a GPU (default: full float32)
-  LAGBENCH_WORKER_DIR     a Ray worker's private folder (default /tmp/lagbench-ray-<uid>)
+  LAGBENCH_WORKER_DIR     a Ray worker's private folder (default: /tmp/lagbench-ray-<uid>)
   LAGBENCH_BENCH_TINY     1: the speed study at its tiny preset (seconds)
   LAGBENCH_COMMIT         the commit to record where the tree has no .git"""
 
@@ -141,12 +149,17 @@ def build_parser():
     p.add_argument("--version", action="version", version=f"lagbench {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("list", help="list systems, models, claims and profiles; with --claim and --profile, what "
-                       "one claim runs under that profile")
+                       "one claim runs under that profile", description="List the systems, models, activations, "
+                       "initialisations, profiles and claims (each claim's paper, models, parts, positive controls "
+                       "and variants); with --claim and --profile, what that claim runs under that profile.")
     s.add_argument("--claim", help="a claim id: print what it runs under --profile (its models' protocols, widths, "
-                   "seeds, frameworks, evaluation config, tuned or hand-chosen); default: list everything")
+                   "seeds, frameworks, evaluation config, tuned or hand-chosen) (default: none, list everything)")
     s.add_argument("--profile", help="smoke | quick | full | paper, with --claim (default: none, list everything)")
     s.set_defaults(func=cmd_list)
-    s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units")
+    s = sub.add_parser("run", help="run claims under a profile; resumes, skipping finished units",
+                       description="Train and evaluate every model of the chosen claims under a profile, judge each "
+                       "claim and write OUT/run.json, OUT/claims.json and OUT/units/<claim>/<framework>/<model>/"
+                       "seed<k>/. A finished unit of the same protocol is kept, so the same command resumes.")
     s.add_argument("--profile", default="quick", help="smoke | quick | full | paper (default: quick)")
     s.add_argument("--claims", help="comma-separated claim ids (default: all; see `lagbench list`)")
     s.add_argument("--models", help="comma-separated model labels to restrict to (default: all; see `lagbench "
@@ -156,7 +169,10 @@ def build_parser():
     s.add_argument("--add-model", action="append", metavar="NAME=module:factory", help="your torch.nn.Module "
                    "(factory(dof)) or equinox Module (factory(dof, key)) mapping (q, qdot) to q-double-dot, trained "
                    "in every claim it fits beside the paper's models (repeatable; docs/your_model.md)")
-    s.add_argument("--seeds", type=int, help="seeds per claim, >= 1 (default: the profile's)")
+    options.add_seeds(s, "how many seeds per claim, the split's first: dev 0.., test 1000.. (default: the "
+                      "profile's; a deterministic claim keeps one)", "the seeds themselves, of --split's range, comma- or "
+                      "space-separated, e.g. 1000,1001 (a lone number without a comma is read as --n-seeds until "
+                      "the next release; one seed: 1000,) (default: the profile's)")
     s.add_argument("--split", default="test", choices=("test", "dev"), help="test: seeds 1000.. and held-out "
                    "data and initial conditions no protocol choice has seen, where verdicts are decided; dev: "
                    "seeds 0.. and the development draws that trials and tuning read (default: test)")
@@ -165,8 +181,8 @@ def build_parser():
                    help="worker processes, one CPU thread each; units training the same model stay in one "
                         "(default: 1, everything in this process)")
     s.add_argument("--executor", default="local", choices=("local", "ray"),
-                   help="local: this process or --jobs workers (default); ray: every unit a Ray task, on a local "
-                        "Ray instance or the cluster at --address (needs `pip install 'lagbench[ray]'`)")
+                   help="local: this process or --jobs workers; ray: every unit a Ray task, on a local Ray instance "
+                        "or the cluster at --address (needs `pip install 'lagbench[ray]'`) (default: local)")
     s.add_argument("--address", help="with --executor ray: the Ray cluster to join, e.g. 10.0.0.1:6379 or auto "
                    "(default: start a local Ray instance on this machine's cores)")
     s.add_argument("--dry-run", action="store_true", help="print the units and an estimated duration (a few "
@@ -188,15 +204,23 @@ def build_parser():
     add_bench(sub)
     add_train_target(sub)
     s = sub.add_parser("stiff", help="the stiff-solver study: solvers x tolerances on a stiff system "
-                                     "(writes OUT/stiff/solvers.csv for the report)")
+                                     "(writes OUT/stiff/solvers.csv for the report)",
+                       description="Integrate a stiff system (stiff_chain unless --system names another) from 4 "
+                       "initial states "
+                       "with each solver (tsit5, dopri5, dopri8, kvaerno5 at several tolerances, and a fixed-step "
+                       "Stoermer-Verlet) against a dopri8 reference at 1e-13: state and energy error, steps and "
+                       "seconds per solver, and the solver picked. Writes OUT/stiff/solvers.csv and choice.json, "
+                       "which `lagbench report` shows.")
     s.add_argument("--out", default="results/quick", help="results folder; writes OUT/stiff/ (default: "
-                   "results/quick)")
+                   "results/quick, which `lagbench report` reads unless given --results)")
     s.add_argument("--system", default="stiff_chain", help="a system name, see `lagbench list` (default: "
                    "stiff_chain)")
     s.set_defaults(func=cmd_stiff)
     add_control(sub)
     add_online(sub)
     add_robustness(sub)
+    for command in sub.choices.values():   # "(default: X)" on every option that does not write its own
+        options.show_defaults(command)
     return p
 
 
@@ -252,7 +276,9 @@ def main(argv=None):
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(message)s")
     if args.command not in READS_ONLY:   # compiled programs shared with the processes it starts and later commands
         jax_cache.private()
+    options.forget_notices()
     try:
+        options.run_checks(args)   # an option's value checked before any work: one line naming it
         with writing():   # the folders the command locks are let go when it ends
             code = args.func(args)
     except (KeyError, ValueError, FileNotFoundError) as e:

@@ -35,7 +35,7 @@ def cmd_report(args):
 def cmd_table(args):
     from lagbench.files.results import output_folder, write_csv
     from lagbench.reports.load import load_results
-    from lagbench.reports.systems_table import excluded, shown, systems_table
+    from lagbench.reports.systems_table import by_table, excluded, mixed, shown, systems_table
 
     results = _results_folder(Path(args.results))
     res = load_results(results)
@@ -47,8 +47,10 @@ def cmd_table(args):
     left_out = excluded(results, res)
     if left_out:   # the units and records the numbers leave out, as the report names them
         print("lagbench table: " + "\n".join(left_out), file=sys.stderr)
-    for system, g in df.groupby("system", sort=True):
-        print(f"{system}\n{shown(g).to_string(index=False)}\n")
+    for line in mixed(df):   # rows of different profiles are never side by side
+        print(f"lagbench table: {line}", file=sys.stderr)
+    for title, g in by_table(df):
+        print(f"{title}\n{shown(g).to_string(index=False)}\n")
     path = output_folder(results / "summary", "--results") / "systems.csv"
     write_csv(path, df)
     print(f"written to {path}")
@@ -65,9 +67,12 @@ def add_commands(sub) -> None:
     s.add_argument("--no-pdf", action="store_true", help="write REPORT.md and the figures only (no typesetting)")
     s.set_defaults(func=cmd_report)
     s = sub.add_parser("table", help="every model of a results folder per system, the suite's and yours (writes "
-                       "RESULTS/summary/systems.csv)", description="A table per system: each claim's model and "
-                       "framework over its seeds (median [min, max]) and each predictor scored by evaluate --predict.")
+                       "RESULTS/summary/systems.csv)", description="A table per system and profile: each claim's "
+                       "model and framework over its seeds (median [min, max]) and each predictor scored by evaluate "
+                       "--predict. Rows of different profiles (a profile sets the training budget and the held-out "
+                       "set) are printed in separate tables, with a note saying so.")
     s.add_argument("--results", default="results/quick", help="a folder written by `lagbench run` or evaluate "
-                   "--predict (default: results/quick)")
+                   "--predict; read, and the table written into it as RESULTS/summary/systems.csv (default: "
+                   "results/quick)")
     s.add_argument("--system", help="one system only (default: every system in the folder)")
     s.set_defaults(func=cmd_table)

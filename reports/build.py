@@ -8,6 +8,8 @@ added last, so that REPORT.md and the PDF carry the same numbers. Writes into ``
 "typst": Path, "pdf": Path, "figures": [Path, ...]}``, and ``"not_rebuilt": [Path, ...]`` where a
 ``--no-pdf`` build leaves a REPORT.pdf or REPORT.typ it did not write and may not remove (not on record,
 or changed since).
+The title says what the folder holds (`titled`): the replication report, a fit report (`lagbench fit` /
+`evaluate` units) or a predictor report (`evaluate --predict` records alone).
 An empty or missing results folder still yields a report that says nothing was run (the command line
 refuses one that holds no results). Writes go through ``reports.output``: atomic, never through a
 symlink, and only files an earlier build recorded are ever removed.
@@ -43,6 +45,8 @@ from lagbench.reports.systems_table import systems_sections
 from lagbench.reports.tidy import tidy
 
 TITLE = "Replication report: learned Lagrangian and Hamiltonian dynamics"
+FIT_TITLE = "Fit report: models trained on your data (lagbench fit, lagbench evaluate)"
+PREDICT_TITLE = "Predictor report: your functions scored as the suite scores its models (lagbench evaluate --predict)"
 
 
 APPENDIX = ("What the body's numbers rest on: every part with its interval, the reasons in full, the "
@@ -64,15 +68,15 @@ def _finish(body: list[Section], appendix: list[Section], res) -> tuple[list, li
     return body, appendix + index
 
 
-def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
-    """The report's body (the scorecard, the glossary, a page per claim with its figures, the closed-loop
-    control and robustness studies, speed against error) and its appendix (everything else), as two lists of
-    sections, tables tidied and every table and figure numbered."""
+def titled(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[str, list, list]:
+    """The report's title, body and appendix: a folder of `lagbench fit` / `evaluate` units is a fit report,
+    one of `evaluate --predict` records alone a predictor report (neither speaks of the papers' claims, a
+    profile or a run); any other is the replication report (`body_and_appendix`)."""
     res = load_results(results_dir)
     mine = predict_sections(results_dir)   # `lagbench evaluate --predict` records, if any
     if is_fit_results(res) or (mine and not res.units):  # fit / evaluate / predict folders: no paper claims
         sections = (fit_sections(res, out_dir) if res.units else []) + mine + environment_sections(res, now)
-        return _finish(sections, [], res)
+        return (FIT_TITLE if res.units else PREDICT_TITLE, *_finish(sections, [], res))
     moved: dict = {}   # figures a claim's page sends to its details in the appendix
     body = [scorecard_section(res)] + theme_sections(res, out_dir, moved) + control_sections(res, out_dir)
     body += online_sections(res, out_dir)
@@ -84,7 +88,14 @@ def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None 
     appendix += summary_sections(res) + claim_details(res, moved) + speed_appendix(res, out_dir)
     appendix += findings_sections(res) + frameworks_sections(res) + hessian_sections(res) + stiff_sections(res)
     appendix += systems_sections(results_dir) + mine + environment_sections(res, now) + metrics_appendix(res)
-    return _finish(body, appendix, res)
+    return (TITLE, *_finish(body, appendix, res))
+
+
+def body_and_appendix(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> tuple[list, list]:
+    """The report's body (the scorecard, the glossary, a page per claim with its figures, the closed-loop
+    control and robustness studies, speed against error) and its appendix (everything else), as two lists of
+    sections, tables tidied and every table and figure numbered."""
+    return titled(results_dir, out_dir, now)[1:]
 
 
 def build_sections(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> list[Section]:
@@ -101,12 +112,13 @@ def build_report(results_dir: str | Path, out_dir: str | Path, *, pdf: bool = Tr
     out_dir = Path(out_dir)
     failure = None
     try:
-        sections = build_sections(Path(results_dir), stage)
-        built = [output.write(stage / "REPORT.md", render_markdown(TITLE, sections))]
+        title, body, appendix = titled(Path(results_dir), stage)
+        sections = body + appendix
+        built = [output.write(stage / "REPORT.md", render_markdown(title, sections))]
         built += list(dict.fromkeys(stage / b.path for b in tables_and_figures(sections) if isinstance(b, Figure)))
         if pdf:
             try:
-                built += write_pdf(TITLE, sections, stage)
+                built += write_pdf(title, sections, stage)
             except ValueError as e:   # typst missing: what is built is kept, never beside the old PDF
                 failure = e
         moved, removed = output.finish(out_dir, built)

@@ -12,6 +12,7 @@ import pandas as pd
 from lagbench.reports.document import NOT_RUN, Figure, Para, Section, Table
 from lagbench.reports.fmt import cell, plain
 from lagbench.reports.load import Results
+from lagbench.reports.sections_fit import is_fit_results
 
 
 def flatten(d, prefix: str = "") -> dict[str, str]:
@@ -35,9 +36,10 @@ def environment_sections(res: Results, now: dt.datetime | None = None) -> list[S
     s = Section("Environment")
     s.add(Para(f"Report generated {now.strftime('%Y-%m-%d %H:%M UTC')} from {res.root.as_posix()}."))
     run = res.run
-    if run is None:
+    fits = is_fit_results(res)
+    if run is None and not fits:   # a fit or evaluate folder has no run manifest, and never had
         s.add(Para(f"Run manifest (run.json): {NOT_RUN}."))
-    else:
+    elif run is not None:
         s.add(Table("Run manifest", _kv(run, "run.json"), ["run.json"]))
     usable = res.usable()
     if usable:
@@ -48,7 +50,7 @@ def environment_sections(res: Results, now: dt.datetime | None = None) -> list[S
                 for k, v in flatten(u.result.get(key) or {}).items():
                     combos.setdefault(f"{key}.{k}", set()).add(v)
             rows += [{"field": k, "values in units": "; ".join(sorted(v))} for k, v in combos.items()]
-        for key in ("commit", "profile", "dtype"):
+        for key in ("commit", "dtype") if fits else ("commit", "profile", "dtype"):   # a fit runs under no profile
             vals = sorted({cell(u.result.get(key), "none") for u in usable})
             rows.append({"field": key, "values in units": "; ".join(vals)})
         created = sorted(str(u.result.get("created")) for u in usable if u.result.get("created"))

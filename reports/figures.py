@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from lagbench.replication.evaluation.diverged import DIVERGED
 from lagbench.reports.load import Unit
 from lagbench.reports.output import write
 
@@ -134,7 +135,7 @@ def _groups(units: list[Unit]) -> dict[tuple[str, str], list[Unit]]:
     return out
 
 
-DIVERGED = 1e3   # |energy error| above this (or non-finite) at any time: a diverged rollout, left out of the curves
+# |energy error| over its scale above DIVERGED (or non-finite) at any time: a diverged rollout, left out of the curves
 
 
 def _energy_per_seed(u: Unit):

@@ -1,7 +1,8 @@
 """Formatting of numbers and cells: every cell becomes a non-empty string.
 
-``num(x)`` gives 3 significant digits (``"0.0731"``, ``"447"``, ``"34500"``, ``"4.3e-04"``); ``count(x)`` an
-exact count (``"34,465"``); ``stat(mean, std, n)`` gives
+``num(x)`` gives 3 significant digits (``"0.0731"``, ``"447"``, ``"34500"``, ``"4.3e-04"``), an integer
+(a Python or NumPy int) every digit (``"70311"``); ``count(x)`` an exact count, also of a float
+(``"34,465"``: parameters, samples, steps, rows); ``stat(mean, std, n)`` gives
 ``"0.0731 ± 0.002 (n=3)"`` (± the sample standard deviation over n seeds); ``seed_values(values)`` gives the
 seed mean with the range over seeds (``"0.0731 (0.0712 to 0.0750, 2 seeds)"``) or, for a yes/no metric
 (every seed 0 or 1), ``"7/8 seeds"`` (an infinite value, a diverged rollout or a time never reached, counted
@@ -26,6 +27,8 @@ def is_number(x) -> bool:
 def num(x, digits: int = 3) -> str:
     if not is_number(x):
         return NOT_RUN if x is None else str(x)
+    if isinstance(x, int | np.integer):   # a count or an index: every digit, never rounded nor in e-notation
+        return str(int(x))
     x = float(x)
     if math.isnan(x):
         return "NaN"
@@ -40,9 +43,9 @@ def num(x, digits: int = 3) -> str:
     return f"{x:.{digits - 1}e}"
 
 
-def count(x) -> str:
-    """An exact count (parameters, samples) with thousands separated: ``"34,465"``."""
-    return f"{int(round(float(x))):,}" if is_number(x) and math.isfinite(float(x)) else NOT_RUN
+def count(x, missing: str = NOT_RUN) -> str:
+    """An exact count (parameters, samples) with thousands separated: ``"34,465"``; `missing` without one."""
+    return f"{int(round(float(x))):,}" if is_number(x) and math.isfinite(float(x)) else missing
 
 
 def stat(mean, std=None, n=None) -> str:

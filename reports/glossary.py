@@ -15,6 +15,7 @@ import re
 
 import pandas as pd
 
+from lagbench.replication.evaluation.diverged import DIVERGED
 from lagbench.reports.document import Bullets, Para, Section, Table
 
 Q = "units of q̈"
@@ -55,7 +56,9 @@ TERMS = [
                      "not control)"),
     ("development draw / split", "seeds from 0 and data draws that protocols were tuned on; the test split "
                                  "(seeds from 1000, draws no choice read) decides the verdicts of record"),
-    ("diverged", "a rollout whose error became non-finite or exceeded 1e3; counted apart, never averaged in"),
+    ("diverged", f"a rollout whose error against the data's own scale (energy error over the mean kinetic energy, "
+                 f"state error over the states' spread) became non-finite or exceeded {DIVERGED:g}; counted apart, "
+                 f"never averaged in"),
     ("frameworks disagree", "JAX and PyTorch, from the same weights and batches, reach different decided verdicts "
                             "on a part: a defect, and the part reads inconclusive"),
 ]

@@ -8,7 +8,9 @@ leave ``None``/empty fields; problems are collected as human-readable strings in
 
 Verdicts are recomputed from the verified units by ``replication.claims.verdicts.judge`` (the function the
 runner uses; it imports no framework and no training code), so a deleted or corrupted unit never leaves
-a stale verdict; ``summary/verdicts.json`` is only compared with them. ``run.json``'s planned units
+a stale verdict; ``summary/verdicts.json`` is only compared with them. The claims are those the runs into
+the folder asked for (run.json's "claims", ``asked_claims``) and any other with units there, so that a
+two-claim run's report speaks of two claims. ``run.json``'s planned units
 that have no result are listed in ``Results.planned_missing``, and ``Results.unfinished`` is true when
 the run has not recorded its end.
 """
@@ -184,7 +186,27 @@ def _seed_key(seed: str) -> tuple[int, str]:
     return (int(seed), "") if seed.isdigit() else (1 << 30, seed)
 
 
+def asked_claims(root: Path, run: dict | None = None, earlier: bool = True) -> set[str] | None:
+    """The claims `lagbench run` was asked for in `root`: the "claims" of its run.json (`run`, read from `root`
+    when not given) and, with `earlier`, of every earlier invocation's record (runs/run-*.json); None where
+    run.json records none (an older run, or a folder of another command): then every claim is the folder's."""
+    root = Path(root)
+    run = run if run is not None else _read_json(root / "run.json", [], root)
+    if not isinstance((run or {}).get("claims"), list):
+        return None
+    asked = {c for c in run["claims"] if isinstance(c, str)}
+    for path in sorted((root / "runs").glob("run-*.json")) if earlier else ():
+        try:
+            earlier = json.loads(path.read_text(encoding="utf-8")).get("claims")
+        except (ValueError, OSError, AttributeError):
+            continue
+        asked |= {c for c in earlier if isinstance(c, str)} if isinstance(earlier, list) else set()
+    return asked
+
+
 def _catalogue(res: Results, claims_json: dict | None) -> list[dict]:
+    """The claims of the report: claims.json's that the runs into the folder asked for (`asked_claims`), and
+    any other that has units there."""
     claims = []
     if claims_json is not None:
         raw = claims_json.get("claims")
@@ -192,6 +214,9 @@ def _catalogue(res: Results, claims_json: dict | None) -> list[dict]:
             claims = [c for c in raw if isinstance(c, dict) and isinstance(c.get("id"), str)]
         else:
             res.problems.append("claims.json has no 'claims' list")
+    asked = asked_claims(res.root, res.run)
+    if asked is not None:
+        claims = [c for c in claims if c["id"] in asked | {u.claim for u in res.units}]
     known = {c["id"] for c in claims}
     extra = sorted(({u.claim for u in res.units} | set(res.verdicts)) - known)
     claims += [{"id": cid, "title": "(not in claims.json)"} for cid in extra]
@@ -282,9 +307,10 @@ def _recompute_verdicts(res: Results) -> None:
     committed, adopted = registration.registrations(), tuned.records()
     res.verdicts = {cid: judge(CLAIMS[cid], df, profile, committed, adopted) for cid in sorted(ids) if cid in CLAIMS}
     for cid, v in res.stored_verdicts.items():
-        res.verdicts.setdefault(cid, v)   # a claim this code no longer has: its recorded verdict
+        if cid in ids:
+            res.verdicts.setdefault(cid, v)   # a claim this code no longer has: its recorded verdict
     stale = sorted(cid for cid, v in res.stored_verdicts.items()
-                   if cid in CLAIMS and v.get("verdict") != res.verdicts[cid]["verdict"])
+                   if cid in CLAIMS and cid in ids and v.get("verdict") != res.verdicts[cid]["verdict"])
     if stale:
         res.problems.append("summary/verdicts.json disagrees with the unit files for " + ", ".join(stale)
                             + " (units changed since it was written, or it predates the current rules); "

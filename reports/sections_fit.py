@@ -17,17 +17,19 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from lagbench.replication.evaluation.diverged import DIVERGED, SCALED, is_diverged
 from lagbench.reports import figures as F
 from lagbench.reports import figures_delan as FD
 from lagbench.reports.document import Figure, Para, Section, Table
-from lagbench.reports.fmt import cell, num
+from lagbench.reports.fmt import cell, count, num
 from lagbench.reports.load import Results, protocol_of
 from lagbench.reports.tables import problem_units_table
 
 CLAIMS = ("fit", "evaluate")
 SETS = {"train": "train", "heldout": "held-out", "test": "test"}
 SRC = "units/{claim}/<framework>/<model>/seed<k>/"
-ROLLOUT_METRICS = [("rollout_gmean_err", "state error, geometric mean over time"),
+ROLLOUT_METRICS = [("n_diverged", f"rollouts diverged (state error over {DIVERGED:g} x the data's spread, or not finite)"),
+                   ("rollout_gmean_err", "state error, geometric mean over time"),
                    ("rollout_final_err", "state error at the end"),
                    ("learned_energy_drift", "learned energy drift (max over time)"),
                    ("energy_err_final", "true energy error at the end"),
@@ -61,10 +63,10 @@ def _models_table(units) -> pd.DataFrame:
         # a fit's --test rows are recorded apart from its own split's
         counts = {**(cfg.get("rows") or {}), **({"test": cfg["test_rows"]} if cfg.get("test_rows") is not None else {})}
         rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
-                     "steps": str(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
+                     "steps": count(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
                      "weight decay (l2)": num(p.get("l2")), "schedule": _schedule(protocol_of(r)),
-                     "rows (train/held-out/test)": "/".join(str(counts.get(k, 0))
+                     "rows (train/held-out/test)": "/".join(count(counts.get(k, 0))
                                                             for k in ("train", "heldout", "test")),
                      "final training loss": num(r.get("final_train_loss")), "train time (s)": num(r.get("train_time_s"))})
     return pd.DataFrame(rows)
@@ -107,7 +109,7 @@ def _recommendation_para(units) -> Para | None:
         return None
     best = min(cands)
     pick = min((c for c in cands if c[0] <= RECOMMEND_WITHIN * best[0]), key=lambda c: (c[1], c[0]))
-    return Para(f"Recommended on this data: {pick[2]} (rollout error {num(pick[0])}, {num(pick[1])} parameters), the "
+    return Para(f"Recommended on this data: {pick[2]} (rollout error {num(pick[0])}, {count(pick[1])} parameters), the "
                 f"fewest parameters among the fits within {RECOMMEND_WITHIN:g} x the best rollout error ({best[2]}: "
                 f"{num(best[0])}); fits not clearly better than the null predictor are left out.")
 
@@ -127,14 +129,25 @@ def _one_step_table(units) -> pd.DataFrame | None:
     return wide.reset_index().rename(columns={"row": "rows: quantity"}).fillna("–")
 
 
+def _rollout_value(u, where: str, key: str) -> str:
+    """A rollout metric as the table shows it: an error beyond the data's own scale as "diverged"
+    (`evaluation.diverged`), never as a number; the rollouts that diverged as "k of n"."""
+    v = u.metric(f"{where}_{key}")
+    if v is None:
+        return "–"
+    if key == "n_diverged":
+        of = u.metric(f"{where}_n_trajectories")
+        return count(v) + (f" of {count(of)}" if of is not None else "")
+    return "diverged" if key in SCALED and is_diverged(v) else num(v)
+
+
 def _rollout_table(units) -> pd.DataFrame | None:
     rows = []
     for u in units:
         for where in ("heldout", "test"):
-            vals = {label: u.metric(f"{where}_{k}") for k, label in ROLLOUT_METRICS}
-            if any(v is not None for v in vals.values()):
-                rows.append({"model": f"{u.claim}: {_name(u)}", "rows": where,
-                             **{k: num(v) if v is not None else "–" for k, v in vals.items()}})
+            vals = {label: _rollout_value(u, where, k) for k, label in ROLLOUT_METRICS}
+            if any(v != "–" for v in vals.values()):
+                rows.append({"model": f"{u.claim}: {_name(u)}", "rows": where, **vals})
     if not rows:
         return None
     df = pd.DataFrame(rows)
@@ -177,6 +190,8 @@ def _path(ref) -> str:
 
 
 def _data_para(units) -> Para:
+    from lagbench.replication.fit.rows import Overlap
+
     seen: dict[str, list[str]] = {}
     for u in units:
         cfg = u.result.get("eval_config") or {}
@@ -192,6 +207,8 @@ def _data_para(units) -> Para:
                 + (f"; test file {_path(cfg['test_source'])}: {cfg.get('test_rows')} rows"
                    + (f" ({cfg['test_trajectories']} whole trajectories)" if cfg.get("test_trajectories") else "")
                    if cfg.get("test_source") else "")
+                + (f"; WARNING: {Overlap(**cfg['training_rows']).words()} are training rows of the fit evaluated, "
+                   f"so its errors there are not predictions of unseen data" if cfg.get("training_rows") else "")
                 + (f"; true energy from system {cfg['system']}" if cfg.get("system") else "")
                 + (f"; true energy from {cfg['energy']}" if cfg.get("energy") else ""))
         seen.setdefault(text, []).append(f"{u.claim} {_name(u)}")

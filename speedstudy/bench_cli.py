@@ -24,8 +24,9 @@ def add_bench(sub) -> None:
                        description="The speed study: inference, latency, training, rollouts, scaling, fast vs "
                        "paper, structure and train-to-target, each with JAX and PyTorch side by side. Writes "
                        "OUT/bench/*.csv, targets.json and machine.json (quick preset: about 20 min on 2 cores).")
-    s.add_argument("--out", default="results/quick", help="results folder (default results/quick)")
-    s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes (slow; default: the "
+    s.add_argument("--out", default="results/quick", help="results folder; writes OUT/bench/ (OUT/bench_gpu/ with "
+                   "--gpu) (default: results/quick, which `lagbench report` reads unless given --results)")
+    s.add_argument("--full", action="store_true", help="all batch sizes and grid sizes, slow (without it: the "
                    "quick preset)")
     s.add_argument("--trained-from", help="results folder whose training cache holds the learned models rolled "
                                           "out in the solver study (default: --out; else tiny models are trained)")

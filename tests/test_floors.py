@@ -5,7 +5,7 @@ import ast
 
 from test_import_cycles import _modules
 
-FLOORS = [("lagbench.files", "lagbench.validate"), ("lagbench.systems",), ("lagbench.models",), ("lagbench.replication",),
+FLOORS = [("lagbench.files", "lagbench.validate", "lagbench.options"), ("lagbench.systems",), ("lagbench.models",), ("lagbench.replication",),
           ("lagbench.speedstudy", "lagbench.reports"), ("lagbench.cli", "lagbench.results_cli", "lagbench.__main__")]
 
 

@@ -78,7 +78,7 @@ def test_users_models_and_systems_packages_stay_the_users(site, tmp_path):
     (tmp_path / "models").mkdir()
     (tmp_path / "models" / "__init__.py").write_text(USER_MODELS)
     (tmp_path / "systems.py").write_text(USER_SYSTEMS)
-    r = _run(site, tmp_path, "run", "--profile", "smoke", "--claims", "dp_loss", "--frameworks", "torch", "--seeds", "1",
+    r = _run(site, tmp_path, "run", "--profile", "smoke", "--claims", "dp_loss", "--frameworks", "torch", "--n-seeds", "1",
              "--add-model", "mine=models:make", "--out", "results/mine", "--quiet")
     assert r.returncode == 0, r.stderr[-3000:]
     units = tmp_path / "results" / "mine" / "units" / "dp_loss" / "torch"

@@ -215,6 +215,11 @@ def _validate(p: Path, d: dict) -> dict:
     cols = {k: d.pop(k) for k in COLUMNS if k in d}
     trajectories = "t" in cols and "split" not in cols
     missing = [k for k in (("q",) if trajectories else REQUIRED) if k not in d]
+    what = "column" if p.suffix == ".csv" else "array"
+    if missing and "q" in d and "t" not in cols and "split" not in cols:   # positions alone, without their times
+        raise ValueError(f"{path}: no {what} t: positions q without {' and '.join(missing)} are a trajectory file, "
+                         f"whose derivatives are estimated along its times; add the time {what} t (and traj where "
+                         f"it holds several trajectories), or give {', '.join(missing)}")
     if missing:
         hint = "columns q0.., qdot0.., qddot0.." if p.suffix == ".csv" else "arrays q, qdot, qddot"
         if trajectories:

@@ -7,24 +7,17 @@ import argparse
 import sys
 from pathlib import Path
 
+from lagbench import options
+from lagbench.options import renamed
+from lagbench.options import show_defaults as _show_defaults
 from lagbench.replication.claims.base import PROFILES
+from lagbench.replication.evaluation.diverged import note as diverged_note
 from lagbench.replication.fit import options as fit_options
-from lagbench.replication.renamed import renamed
 from lagbench.replication.training.device import HELP as DEVICE_HELP
 
 DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optional qdot0.., qddot0.., tau0.. "
              "(.npz: arrays traj, t, q, ...), derivatives it lacks estimated by a Savitzky-Golay filter; or a "
              "state file: columns (arrays) q, qdot, qddot and optional tau (format: docs/fit.md)")
-
-
-def _show_defaults(parser) -> None:
-    """Every option's help ends with its default, unless it states one itself (flags and required ones aside)."""
-    for action in parser._actions:
-        text = action.help or ""
-        if ("default" in text or action.required or not action.option_strings or action.nargs == 0
-                or action.help == argparse.SUPPRESS):   # a hidden option (an old spelling) stays hidden
-            continue
-        action.help = text + (" (default: none)" if action.default is None else " (default: %(default)s)")
 
 
 def cmd_simulate(args):
@@ -64,48 +57,43 @@ class RolloutBars:
 
 
 def cmd_fit(args):
-    from tqdm.auto import tqdm
-
     from lagbench.replication.fit import kind_defaults
-    from lagbench.replication.fit.task import LOSS_NAMES, fit, resolved
+    from lagbench.replication.fit.progress import TrainingBar
+    from lagbench.replication.fit.task import fit, resolved
     from lagbench.replication.training import device
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
-    o, task, recording = resolved(args.data, given)   # a refused option: one line, nothing written
+    o, task, recording, dof = resolved(args.data, given)   # a refused option: one line, nothing written
     if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
-        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, recording)} where not given "
-              f"({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
-              f"{f', {o.restarts} restarts' if o.restarts else ''}{', spike guard' if o.guard_clip or o.guard_skip else ''})",
-              file=sys.stderr)
-    bars = []  # made at the first log row, so that a refused option prints one line and nothing else
+        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, recording, dof)} "
+              f"where not given ({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
+              f"{f', {o.restarts} restarts' if o.restarts else ''}{', spike guard' if o.guard_clip or o.guard_skip else ''}"
+              f"{f', early stop at patience {o.patience}' if o.patience else ''})", file=sys.stderr)
+    # the training's bar (restarts and main training in one) is made at its first log row, so that a refused
+    # option prints one line and nothing else; closed when the evaluation starts
+    bar = TrainingBar(f"lagbench fit {args.model}", args.quiet)
     rollouts = RolloutBars(args.quiet, f"lagbench fit {args.model}")
 
-    def on_log(row):
-        step = min(int(row["step"]) + 1, o.steps)
-        if not bars or step < bars[-1].n:   # a new training (--tune fits one per configuration)
-            bars.append(tqdm(total=o.steps, desc=f"lagbench fit {args.model}", unit="step", disable=args.quiet))
-        bar = bars[-1]
-        bar.set_postfix_str(f"training {LOSS_NAMES[o.loss]} {row['loss']:.4g}", refresh=False)
-        bar.update(step - bar.n)
-        if bar.n >= bar.total:   # closed now, so that its time is the training's, not the evaluation's too
-            bar.close()
+    def on_progress(label, done, total):
+        bar.close()
+        rollouts(label, done, total)
 
     try:
         if args.tune:
             from lagbench.replication.fit.tune import tune_fit
 
-            d, ledger = tune_fit(args.data, out=args.out, n_configs=args.tune, on_log=on_log, on_progress=rollouts,
-                                 **fit_options.from_args(args))
+            d, ledger = tune_fit(args.data, out=args.out, n_configs=args.tune, on_log=bar.row, on_progress=on_progress,
+                                 on_train=bar.start, **fit_options.from_args(args))
             scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in ledger["scores"].items())
             print(f"tune: chose configuration {ledger['chosen']} of {len(ledger['configs'])} "
                   f"(--lr {ledger['options']['lr']:.4g} --hidden {','.join(map(str, ledger['options']['hidden']))}; "
                   f"held-out {scores}), ledger in {Path(args.out) / 'tune'}")
         else:
-            d = fit(args.data, out=args.out, on_log=on_log, on_progress=rollouts, **fit_options.from_args(args))
+            d = fit(args.data, out=args.out, on_log=bar.row, on_progress=on_progress, on_train=bar.start,
+                    **fit_options.from_args(args))
     finally:
-        for bar in bars:
-            bar.close()
+        bar.close()
         rollouts.close()
     label = args.model + ("_dissipative" if args.dissipation else "")   # a dissipative fit's own folder
     folder = Path(args.out) / "units" / "fit" / args.framework / label / f"seed{args.seed}"
@@ -114,12 +102,21 @@ def cmd_fit(args):
         return 1
     from lagbench.replication.fit.competence import competence, describe
 
+    stop = d.get("early_stop") or {}
+    if stop.get("stopped_at") is not None:
+        at = stop["stopped_at"] + 1
+        anneal = min(stop.get("anneal", 0), o.steps - at)
+        print(f"lagbench fit: early stop at step {at} of {o.steps}, {stop['patience']} held-out evaluations in a row "
+              f"without a new best by {stop['min_improvement']:g} of it (held-out loss best {stop['best_heldout_loss']:.4g} "
+              f"at step {stop['best_step'] + 1}, then {stop['last_heldout_loss']:.4g})"
+              + (f"; the rate then annealed over {anneal} more steps, {at + anneal} in all" if anneal else ""),
+              file=sys.stderr)
     again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
     value = d.get("final_train_loss") if d["metric"] == "final_train_loss" else d["metrics"].get(d["metric"])
     c = competence(d["metrics"], d["metric"])
     shown = "none (not finite)" if value is None else f"{value:.6g}"
     print(f"{'ok' if c is None or c['learned'] else 'done'}: {d['metric_label']} {shown}"
-          f"{f' ({describe(c)})' if c else ''}, written to {folder}{again}")
+          f"{f' ({describe(c)})' if c else ''}{diverged_note(d['metrics'])}, written to {folder}{again}")
     return 1 if args.strict and c is not None and not c["learned"] else 0
 
 
@@ -137,7 +134,7 @@ def cmd_predict(args):
     from lagbench.replication.predictor.score import score
 
     given = [o for o, v in (("--data", args.data), ("--fitted", args.fitted or args.fitted_old), ("--energy", args.energy),
-                            ("--framework", args.framework), ("--time-unit", args.time_unit)) if v is not None]
+                            ("--frameworks", args.framework), ("--time-unit", args.time_unit)) if v is not None]
     if given:
         raise ValueError(f"{given[0]}: not used with --predict (the predictor is scored on --system's own states)")
     if not args.system:
@@ -189,15 +186,30 @@ def cmd_evaluate(args):
     finally:
         rollouts.close()
     from lagbench.replication.fit.competence import competence, describe
+    from lagbench.replication.fit.rows import Overlap
 
     for d in done:
         m, loss = d["metrics"], f"test_{d['protocol']['loss']}"
-        parts = [f"{k} {m[k]:.4g}" for k in (loss, "test_rollout_gmean_err",
-                                             "test_learned_energy_drift", "test_energy_err_final") if m.get(k) is not None]
         c = competence(m, loss)
         again = " (the earlier evaluation)" if d.get("reused") else ""
-        print(f"{d['model']} ({d['framework']}): {', '.join(parts)}{f' ({loss}: {describe(c)})' if c else ''}; "
-              f"written to {d['folder']}{again}")
+        print(f"{d['model']} ({d['framework']}): {evaluation_line(m, 'test', loss)}"
+              f"{f' ({loss}: {describe(c)})' if c else ''}; written to {d['folder']}{again}")
+        shared = (d.get("eval_config") or {}).get("training_rows")
+        if shared:
+            print(f"lagbench evaluate: warning: --data {args.data}: {Overlap(**shared).words()} are training rows "
+                  f"of the fit in {(d.get('eval_config') or {}).get('model')}; their errors are not predictions of "
+                  f"unseen data", file=sys.stderr)
+
+
+def evaluation_line(m: dict, where: str, loss: str) -> str:
+    """The metrics of an evaluation set `where` as the console shows them: an energy error beyond the data's
+    own scale as "diverged" (`evaluation.diverged`), never as a number, and the rollouts that diverged counted."""
+    from lagbench.replication.evaluation.diverged import rollouts_words, shown
+
+    keys = (loss, f"{where}_rollout_gmean_err", f"{where}_learned_energy_drift", f"{where}_energy_err_final")
+    parts = [f"{k} {m[k]:.4g}" if k in keys[:2] else f"{k} {shown(m[k])}" for k in keys if m.get(k) is not None]
+    blown = rollouts_words(m, where)
+    return ", ".join(parts) + (f" (DIVERGED: {blown})" if blown else "")
 
 
 def add_commands(sub) -> None:
@@ -218,7 +230,8 @@ def add_commands(sub) -> None:
     s.add_argument("--set", action="append", metavar="NAME=VALUE", help="a system parameter or option, e.g. "
                    "friction=0.2 (viscous friction of the pendulums and the arm; repeatable; an unknown name "
                    "lists the system's parameters)")
-    s.add_argument("--out", required=True, help="the .csv file to write")
+    s.add_argument("--out", required=True, help="required: the .csv file to write, e.g. data/train.csv (none is "
+                   "assumed, so that no simulation writes over another's file)")
     s.set_defaults(func=cmd_simulate)
     _show_defaults(s)
 
@@ -233,6 +246,8 @@ def add_commands(sub) -> None:
     s.add_argument("--data", required=True, help=DATA_HELP)
     s.add_argument("--out", default="results/fit", help="results folder")
     fit_options.add_arguments(s)
+    options.respell(s, "--framework", "--frameworks", help="the one framework the model trains in: jax or torch")
+    options.check(s, "framework", options.one_framework("fit"))
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--strict", action="store_true", help="exit with status 1 when the model is not clearly better "
                    "than the null predictor (at most half its error on the reported set)")
@@ -241,7 +256,7 @@ def add_commands(sub) -> None:
                    help="choose --lr and --hidden by the suite's declared search first: N configurations (the given "
                    "options, then peak rate x 1/3, 1, 3 and widths x 1/2, 1, 2), each fitted to the training rows and "
                    "scored on the held-out rows (never the test file); the best is fitted again into OUT "
-                   "(ledger in OUT/tune/; default: 0, no search)")
+                   "(ledger in OUT/tune/) (default: 0, no search)")
     s.set_defaults(func=cmd_fit)
     _show_defaults(s)
 
@@ -265,16 +280,20 @@ def add_commands(sub) -> None:
     s.add_argument("--label", help="with --predict: the name of its results folder (default: the function's name)")
     s.add_argument("--call-limit", type=float, metavar="SECONDS", help="with --predict: the most seconds one call of "
                    "the function may take; a call past it stops the scoring with one line (the progress bar's "
-                   "estimate, from the first calls, shows the whole; default: no limit)")
+                   "estimate, from the first calls, shows the whole) (default: no limit)")
     s.add_argument("--out", default="results/evaluate", help="results folder")
-    s.add_argument("--framework", choices=("jax", "torch"), help="default: the one each model was trained in")
+    options.add(s, "--frameworks", "--framework", dest="framework", help="the one framework to evaluate in: jax or "
+                "torch (default: the one each model was trained in)")
+    options.check(s, "framework", options.one_framework("evaluate"))
     s.add_argument("--system", help="a system name for the true energy (default: the fit's --system); with "
                    "--predict, the system to score on")
     s.add_argument("--energy", help="your energy function as module:function (default: the fit's)")
     s.add_argument("--substeps", type=int, help="RK4 steps per sample interval (default: the fit's)")
     s.add_argument("--horizon", type=float, help=fit_options.HORIZON_HELP + " (default: the fit's)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
-    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
+    s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help="where the fitted models "
+                   "predict and roll out (not used with --predict): auto (a GPU where the framework sees one, else "
+                   "the CPU), cpu, or gpu (an error if the framework sees none) (default: auto)")
     s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")
     s.add_argument("--time-unit", choices=tuple(fit_options.TIME_UNITS), help="the unit of --data's t column: s or "

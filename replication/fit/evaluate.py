@@ -18,7 +18,9 @@ rollouts   (sets with whole trajectories) every trajectory from its first state 
            (DeLaN; linear interpolation in t); cfg["progress"](set, intervals done, intervals) as it goes. State error:
            `metrics.bounded_relative_error` of (q, qdot) against the data per time; S_rollout_gmean_err
            is its geometric mean over time (`geometric_mean_over_time`), averaged over trajectories;
-           S_rollout_final_err the mean final-time error (a diverged rollout counts 1).
+           S_rollout_final_err the mean final-time error (a diverged rollout counts 1). S_n_diverged of
+           S_n_trajectories rollouts diverged: their state error normalised by the set's spread turned
+           non-finite or exceeded `evaluation.diverged.DIVERGED` (rollouts.csv: diverged).
            S_vpt_s (S_vpt_nmse_s): the median over trajectories of the time from its start until the error
            normalised by the set's spread first exceeds normalised RMSE 0.4 (MSE 0.025), `valid_time`.
 energy     (no torques) the model's own energy along its rollout (`Fitted.energy`): S_learned_energy_drift
@@ -41,6 +43,7 @@ import numpy as np
 import pandas as pd
 
 from lagbench.files import user_data
+from lagbench.replication.evaluation.diverged import diverged_trajectories
 from lagbench.replication.evaluation.metrics import (
     bounded_relative_error,
     energy_errors,
@@ -136,7 +139,7 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
     def advanced(n):
         if progress is not None:
             progress(name, done[0] + n, total)
-    errs, finals, drifts, e_sys, vpts = [], [], [], [], []
+    errs, finals, drifts, e_sys, vpts, blown = [], [], [], [], [], []
     spread = np.var(np.concatenate([r["q"], r["qdot"]], 1), axis=0)   # the set's, over all its rows
     for k, (tgrid, members) in enumerate(groups.items()):
         t = np.asarray(tgrid)
@@ -148,6 +151,7 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
         errs.append(geometric_mean_over_time(err))
         finals.append(err[:, -1])
         nrmse = normalised_rmse(z, z_data, spread)
+        blown.append(diverged_trajectories(nrmse))
         vpts.append([valid_time(nrmse, t - t[0], VPT_NRMSE), valid_time(nrmse, t - t[0], np.sqrt(VPT_NMSE))])
         sub = np.unique(np.linspace(0, t.size - 1, min(t.size, 200)).astype(int))
         for b, i in enumerate(members):
@@ -165,6 +169,9 @@ def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list
     table = pd.DataFrame({"set": name, "traj": ids, "gmean_err": np.concatenate(errs), "final_err": np.concatenate(finals)})
     out.metrics[f"{name}_rollout_gmean_err"] = float(table["gmean_err"].mean())
     out.metrics[f"{name}_rollout_final_err"] = float(table["final_err"].mean())
+    table["diverged"] = np.concatenate(blown)
+    out.metrics[f"{name}_n_diverged"] = int(table["diverged"].sum())
+    out.metrics[f"{name}_n_trajectories"] = len(table)
     table["vpt_s"], table["vpt_nmse_s"] = (np.concatenate([v[j] for v in vpts]) for j in (0, 1))
     out.metrics[f"{name}_vpt_s"] = float(table["vpt_s"].median())
     out.metrics[f"{name}_vpt_nmse_s"] = float(table["vpt_nmse_s"].median())

@@ -13,9 +13,12 @@ component, rollouts, energies with `system` or `energy` ("module:function"), DeL
 timeseries.csv, arrays.npz; `lagbench report` renders them) and OUT/data/ (the prepared rows). A verified
 earlier evaluation of the same model, data and options is returned as is; another one there is kept,
 renamed `superseded-<time>-seed<k>`. Every option and every model is checked before anything is written.
+A data file that is the fit's training file, or holds only its training rows, is refused; one that holds some
+is evaluated with their count recorded (`eval_config["training_rows"]`: `rows.Overlap`; `rows.training_rows_check`).
 """
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from lagbench.files import results as R
@@ -41,7 +44,7 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
              polyorder=None, energy=None, device="auto", horizon=None, on_progress=None, time_unit=None) -> list[dict]:
     _check(framework, system, substeps, window, polyorder, horizon, time_unit)
     path = str(Path(data).resolve())
-    raw = user_data.read(path)[1]
+    digest, raw = user_data.read(path)
     has_tau = "tau" in raw
     fits = [load_fitted(f) for f in fitted_folders(model)]
     for f in fits:   # the time base of each fit's evaluation, before anything is written
@@ -59,6 +62,11 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
     from lagbench.replication.training import device as dev
 
     dev.apply(device, sorted({framework or f.result["framework"] for f in fits}))   # before anything is written
+    shared = {}   # the fit's training rows in the file: refused when it is all or the very file, else recorded
+    for f in fits:
+        unit = time_unit or ((f.result.get("eval_config") or {}).get("derivatives") or {}).get("time_unit", "s")
+        shared[f.folder] = fit_data.training_rows_check(path, f"--data {data}", time_base.in_seconds(raw, unit), digest,
+                                                        f.result, f.folder)
     out = R.output_folder(out, "--out")
     from lagbench.replication.run.runner import is_current
 
@@ -85,6 +93,8 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
         if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys
             cfg["horizon"] = float(horizon or fcfg["horizon"])
+        if shared[f.folder] is not None:   # recorded only when the file holds some training rows
+            cfg["training_rows"] = dataclasses.asdict(shared[f.folder])
         loss = f.protocol.loss if f.protocol.loss in LOSS_NAMES else "l1"
         claim = Claim(id="evaluate", number=0, paper="user", section="-", title=f"{r['model']} on {Path(data).name}",
                       system=cfg["system"] or Path(data).name, models=(entry,), protocols={"quick": f.protocol},

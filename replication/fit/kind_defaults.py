@@ -1,5 +1,6 @@
 """`lagbench fit`'s defaults per model kind, read from the suite's own protocols (and, for an LNN on a
-trajectory file, the budget of a registered fit study: `ON_RECORDINGS`).
+trajectory file, the budget of a registered fit study: `ON_RECORDINGS`), and sized down for a system smaller
+than the one the kind's protocol was chosen on (`SMALL`).
 
 A fit trains as the claim that tuned its kind does: the registered protocol of that claim's model under the
 `quick` profile with its adopted `lagbench tune` choice (`replication.claims.get` applies it), so the LNN
@@ -12,10 +13,18 @@ inverse-dynamics baseline (data with tau) from the two-link arm's claim.
 `ON_RECORDINGS`: (kind, task) -> the factor on the claim's steps for a trajectory file, where a registered fit
 study chose a longer budget for recorded trajectories than the claim's i.i.d. states need
 (`docs/decisions/fit_budget.md`: every form got the same candidates; the LNN's held-out error chose 3 x).
-`defaults(kind, task, recording=False) -> dict`: fit option name -> value for every option in `FROM_PROTOCOL`,
-and the restarts' `restart_fraction` (their steps / the protocol's) and `restart_lr_ratio` (their peak / the
-protocol's).
-`source(kind, task, recording=False) -> str`: where they come from, for the console.
+`SMALL`: data with fewer coordinates than the system of the kind's claim (the LNN's and the q-double-dot
+baseline's: the double pendulum's 2; DeLaN's and the torque baseline's: the two-link arm's 2; the HNN's: the
+pendulum's 1, so never) train without restarts, for the claim's steps (no `ON_RECORDINGS` factor) and stop
+early: when `SMALL["patience"]` held-out evaluations in a row (`HELDOUT_CHECKS` over the steps) bring no
+improvement of `MIN_IMPROVEMENT`, then anneal over the steps the patience spans (`replication.fit.task`
+builds the `EarlyStop`; `docs/decisions/fit_budget.md` has the measurements). A system as large as
+the claim's keeps the claim's budget and no early stop.
+`defaults(kind, task, recording=False, dof=None) -> dict`: fit option name -> value for every option in
+`FROM_PROTOCOL` and `patience`, and the restarts' `restart_fraction` (their steps / the protocol's) and
+`restart_lr_ratio` (their peak / the protocol's); `dof`: the data's coordinates (None: as the claim's).
+`small(kind, task, dof) -> bool`: whether `SMALL` applies. `source(kind, task, recording=False, dof=None) -> str`:
+where the defaults come from, for the console.
 
 What the claims set for their system rather than for training stays the user's choice: wrapping angles
 (the double pendulum's q are angles; a user's may not be), and the claims' fixed input scale becomes
@@ -35,6 +44,9 @@ SOURCES = {("lnn", "acceleration"): ("dp_loss", "lnn"), ("baseline", "accelerati
            ("hnn", "hamiltonian"): ("hnn_energy", "hnn_pendulum"), ("delan", "inverse_dynamics"): ("delan_arm", "delan"),
            ("delan", "acceleration"): ("delan_arm", "delan"), ("baseline", "inverse_dynamics"): ("delan_arm", "ff")}
 ON_RECORDINGS = {("lnn", "acceleration"): 3}
+SMALL = {"restarts": None, "patience": 10}   # and the claim's steps: see `small`
+HELDOUT_CHECKS = 100   # a fit logs, and its early stop evaluates the held-out rows, this many times over its steps
+MIN_IMPROVEMENT = 0.01   # the early stop's least improvement, a fraction of the best held-out error so far
 FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr_start", "lr_min_ratio", "weight_decay",
                  "loss", "restarts", "restart_keep", "restart_batch", "guard_clip", "guard_skip", "input_scale")
 
@@ -50,19 +62,31 @@ def _entry(kind: str, task: str):
     return claim, entry, entry.protocol(per_profile(claim.protocols, PROFILE), PROFILE)
 
 
-def _steps_factor(kind: str, task: str, recording: bool) -> int:
-    return ON_RECORDINGS.get((kind, task), 1) if recording else 1
+def claim_dof(kind: str, task: str) -> int:
+    """The coordinates of the system the kind's claim trains on (its data recipe's system)."""
+    from lagbench import systems
+
+    return systems.get(_entry(kind, task)[2].data.recipe.removesuffix("_iid")).dof
+
+
+def small(kind: str, task: str, dof: int | None) -> bool:
+    """Data of `dof` coordinates are a smaller system than the kind's claim trains on."""
+    return dof is not None and dof < claim_dof(kind, task)
+
+
+def _steps_factor(kind: str, task: str, recording: bool, dof: int | None = None) -> int:
+    return ON_RECORDINGS.get((kind, task), 1) if recording and not small(kind, task, dof) else 1
 
 
 @cache
-def _defaults(kind: str, task: str, recording: bool) -> tuple:
+def _defaults(kind: str, task: str, recording: bool, dof: int | None) -> tuple:
     _, entry, p = _entry(kind, task)
     one_cycle = isinstance(p.schedule, OneCycle)
     s = p.scouting
     if s is not None and isinstance(s.schedule, OneCycle) and s.schedule.start != OneCycle.start:
         raise ValueError(f"{kind}: the claim's restarts start their one-cycle at phase {s.schedule.start}; fit's start at "
                          f"{OneCycle.start}")
-    out = {"steps": p.steps * _steps_factor(kind, task, recording), "batch": p.batch, "hidden": entry.widths(PROFILE),
+    out = {"steps": p.steps * _steps_factor(kind, task, recording, dof), "batch": p.batch, "hidden": entry.widths(PROFILE),
            "activation": entry.spec_fields(PROFILE).get("activation", "softplus"),
            "lr": p.schedule.lr, "schedule": "onecycle" if one_cycle else "constant",
            "lr_start": p.schedule.start if one_cycle else OneCycle.start,
@@ -73,35 +97,43 @@ def _defaults(kind: str, task: str, recording: bool) -> tuple:
            # the restarts' length and peak rate as fractions of the fit's --steps and --lr
            "restart_fraction": s.steps / p.steps if s else None, "restart_lr_ratio": s.schedule.lr / p.schedule.lr if s else None,
            "guard_clip": p.guard.clip if p.guard else None, "guard_skip": p.guard.skip if p.guard else None,
-           "input_scale": "auto" if entry.spec_fields(PROFILE).get("input_scale") is not None else None}
+           "input_scale": "auto" if entry.spec_fields(PROFILE).get("input_scale") is not None else None,
+           "patience": 0}
+    if small(kind, task, dof):   # the restarts' other settings stay the claim's, for a --restarts given
+        out.update(SMALL)
     return tuple(out.items())
 
 
-def defaults(kind: str, task: str, recording: bool = False) -> dict:
+def defaults(kind: str, task: str, recording: bool = False, dof: int | None = None) -> dict:
     """Fit option -> value, as the claim that tuned this kind trains it under `quick`; with `recording` (a
-    trajectory file), the steps times the kind's `ON_RECORDINGS` factor."""
-    return dict(_defaults(kind, task, recording))
+    trajectory file), the steps times the kind's `ON_RECORDINGS` factor; for data of `dof` coordinates, fewer
+    than the claim's system has, `SMALL`."""
+    return dict(_defaults(kind, task, recording, dof))
 
 
-def source(kind: str, task: str, recording: bool = False) -> str:
+def source(kind: str, task: str, recording: bool = False, dof: int | None = None) -> str:
     claim, entry, _ = _entry(kind, task)
-    factor = _steps_factor(kind, task, recording)
+    factor = _steps_factor(kind, task, recording, dof)
+    sized = (f", sized for {dof} coordinate{'s' if dof != 1 else ''} (the claim's system has {claim_dof(kind, task)}): "
+             f"{'no restarts, ' if SMALL['restarts'] is None else ''}an early stop at patience {SMALL['patience']} "
+             f"(docs/decisions/fit_budget.md)" if small(kind, task, dof) else "")
     return (f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
-            + (f", {factor} x its steps on a trajectory file (docs/decisions/fit_budget.md)" if factor != 1 else ""))
+            + (f", {factor} x its steps on a trajectory file (docs/decisions/fit_budget.md)" if factor != 1 else "")
+            + sized)
 
 
-def fill(o, task: str, recording: bool = False):
+def fill(o, task: str, recording: bool = False, dof: int | None = None):
     """The options `o` (`options.resolve`'s namespace) with every BY_KIND value set from `defaults(o.model,
-    task, recording)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch and
-    peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
+    task, recording, dof)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch
+    and peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
     from types import SimpleNamespace
 
     from lagbench.replication.fit import options as fit_options
 
-    d, v = defaults(o.model, task, recording), dict(vars(o))
+    d, v = defaults(o.model, task, recording, dof), dict(vars(o))
     given = {k for k, x in v.items() if x is not fit_options.BY_KIND}
     fit_options.check({k: v[k] for k in given})   # the given values (the defaults are valid)
-    v.update({k: d[k] for k in FROM_PROTOCOL if k not in given})
+    v.update({k: d[k] for k in (*FROM_PROTOCOL, "patience") if k not in given})
     for k in ("restarts", "guard_clip", "guard_skip"):
         if v[k] == 0:
             v[k] = None

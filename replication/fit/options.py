@@ -15,6 +15,7 @@ from types import SimpleNamespace
 
 from lagbench.models import ACTIVATIONS
 from lagbench.models.spec import CAPABILITIES
+from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
 from lagbench.replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
@@ -128,6 +129,11 @@ OPTIONS = (
            lambda v: is_real(v) and v >= 0, "a finite number >= 0", kind=float),
     Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
            one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
+    Option("patience", BY_KIND, f"early stop: the held-out rows are evaluated {HELDOUT_CHECKS} times over --steps, and "
+           f"the training stops after this many evaluations in a row that do not improve on the best so far by "
+           f"{MIN_IMPROVEMENT:g} of it, then anneals its rate over the steps the patience spans, keeping the last "
+           f"step's parameters (0: off; needs held-out rows)" + KIND,
+           count(0), "an integer >= 0", kind=int),
     Option("seed", 0, "initialisation and batch-order seed, >= 0", count(0), "an integer >= 0", kind=int),
     Option("restarts", BY_KIND, "restarts over initialisations, as the claims train LNNs off their qddot ~ 0 plateau: "
            "this many inits (>= 2; 0: none) train side by side for --restart-steps steps, the lowest training loss "

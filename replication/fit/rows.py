@@ -16,6 +16,17 @@ Splits (`SPLITS`):
                  would measure interpolation, not generalisation.
   random         a random fraction `heldout` of the rows (at least one; seed 0); the default for state files.
   none           every row trains (evaluate on a `--test` file instead).
+
+Training rows in a test file: `overlap(train_ref, d) -> Overlap | None` counts the rows of a test file's
+arrays `d` (times in seconds) that are training rows ("train") of the prepared file `train_ref` (None where
+that file is not readable with its recorded bytes): a row is shared when its values in every column both
+files hold (t, q, and qdot, qddot, tau where both give them) are equal, a trajectory when it holds more than
+half the training rows of one training trajectory (the prepared rows lack each trajectory's ends, which the
+derivative filter drops, so a test trajectory is never compared with rows the fit did not keep).
+`training_rows_check(...)` refuses a test file that is the training file itself, or whose every trajectory
+(every row of a state file) is a training one (its errors would measure memory, not prediction), and returns
+the `Overlap` of a test file that is partly training rows (then recorded and warned about: a log that
+continues the training session is legitimate data, but its errors mix seen and unseen rows), or None.
 """
 from __future__ import annotations
 
@@ -117,3 +128,81 @@ def prepare(out, path, split=None, heldout=HELDOUT, window=trajectories.WINDOW, 
     return Prepared(user_data.reference(str(target.resolve()), prepared_digest), d["q"].shape[1],
                     {str(s): int(c) for s, c in zip(names, counts, strict=True)}, traj, "tau" in d,
                     user_data.reference(path, digest))
+
+
+@dataclass(frozen=True)
+class Overlap:
+    rows: int               # the test file's rows that are training rows
+    of_rows: int
+    trajectories: int       # its trajectories holding most of a training trajectory's rows (0 of 0: state file)
+    of_trajectories: int
+
+    @property
+    def whole(self) -> bool:
+        """Every trajectory (every row, for a state file) is a training one."""
+        return (self.trajectories == self.of_trajectories if self.of_trajectories else self.rows == self.of_rows) \
+            and self.of_rows > 0
+
+    def words(self) -> str:
+        rows = f"{self.rows} of its {self.of_rows} rows"
+        return f"{self.trajectories} of its {self.of_trajectories} trajectories ({rows})" if self.of_trajectories else rows
+
+
+def _keys(d: dict, cols) -> list[bytes]:
+    """One key per row: the bytes of the row's values in `cols`, as float64."""
+    m = np.concatenate([np.asarray(d[c], np.float64).reshape(len(d["q"]), -1) for c in cols], axis=1)
+    return [row.tobytes() for row in np.ascontiguousarray(m)]
+
+
+def _training_rows(train_ref: str, folder: Path | None) -> dict | None:
+    """The "train" rows of the prepared file `train_ref`, read where it was written or, for a results folder
+    moved since, from the folder's own data/; None where neither holds it with its recorded bytes."""
+    path, digest = user_data.parse_reference(train_ref)
+    for p in [Path(path)] + ([folder / "data" / Path(path).name] if folder is not None else []):
+        if p.is_file():
+            try:
+                return user_data.rows(user_data.reference(str(p), digest) if digest else str(p), "train")
+            except ValueError:
+                continue
+    return None
+
+
+def overlap(train_ref: str, d: dict, folder: Path | None = None) -> Overlap | None:
+    train = _training_rows(train_ref, folder)
+    if train is None:
+        return None
+    cols = [c for c in ("t", *user_data.ARRAYS) if c in d and c in train]
+    owner = dict(zip(_keys(train, cols), train.get("traj", np.zeros(len(train["q"]))).tolist(), strict=True))
+    found = [owner.get(k) for k in _keys(d, cols)]   # the training trajectory each row is a row of, or None
+    shared = np.array([j is not None for j in found], bool)
+    if "traj" not in d and "t" not in d:
+        return Overlap(int(shared.sum()), int(shared.size), 0, 0)
+    sizes = dict(zip(*np.unique(train.get("traj", np.zeros(len(train["q"]))), return_counts=True), strict=True))
+    traj = d.get("traj", np.zeros(len(d["q"])))
+    most = 0
+    for k in np.unique(traj):   # a training trajectory most of whose training rows are in this one
+        ids, n = np.unique([j for j, t in zip(found, traj, strict=True) if t == k and j is not None],
+                           return_counts=True)
+        most += bool(ids.size and max(c / sizes[j] for j, c in zip(ids, n, strict=True)) > 0.5)
+    return Overlap(int(shared.sum()), int(shared.size), most, int(np.unique(traj).size))
+
+
+def training_rows_check(test_path: str, name: str, d: dict, digest: str, result: dict, folder: Path) -> Overlap | None:
+    """`name` (the option and file the user gave) refused when it is the fit's training file or holds only its
+    training rows; its `Overlap` when it holds some; None when it holds none (or the fit's rows are not readable).
+    `result`: the fit's result.json; `folder`: its unit folder (OUT/units/fit/<framework>/<model>/seed<k>)."""
+    cfg = result.get("eval_config") or {}
+    source, source_digest = user_data.parse_reference(cfg.get("source") or "")
+    fix = ("its errors would measure what the model memorised, not what it predicts: give a file of other "
+           "trajectories (e.g. `lagbench simulate --seed 1`)")
+    if source_digest == digest:
+        same = "the same file as" if Path(source) == Path(test_path) else "byte for byte the same as"
+        raise ValueError(f"{name}: {same} the training data of the fit in {folder} ({source}); {fix}")
+    recipe = ((result.get("protocol") or {}).get("data") or {}).get("recipe") or ""
+    parents = Path(folder).resolve().parents
+    found = overlap(recipe, d, parents[4] if len(parents) > 4 else None)
+    if found is None or found.rows == 0:
+        return None
+    if found.whole:
+        raise ValueError(f"{name}: {found.words()} are training rows of the fit in {folder} (from {source}); {fix}")
+    return found

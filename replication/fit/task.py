@@ -14,6 +14,11 @@ unit's result are keyed by the data's content and every option: an edited file o
 afresh, never served a stale model. A verified earlier fit of the same data and options is returned as
 is; one of other data or options is kept, renamed `superseded-<time>-seed<k>` (as `lagbench run` does).
 
+Budget: the model kind's defaults, sized to the data's coordinates (`replication.fit.kind_defaults`);
+with `patience` (a small system's default, or given) the training stops early when its held-out error stops
+improving (`replication.training.early_stop`: evaluated at each of the log's rows, `HELDOUT_CHECKS` over
+the steps), the record's `early_stop` saying when.
+
 Torques: with tau columns, delan and baseline learn the inverse dynamics tau(q, qdot, qddot); an LNN or
 HNN here learns unforced dynamics, so a file with tau is refused for them (a ValueError saying so)
 rather than its torques silently ignored.
@@ -38,7 +43,7 @@ from lagbench.replication.fit import kind_defaults, time_base, trajectories
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.run.units import Unit, run_unit
-from lagbench.replication.training.protocol import Data, Guard, Protocol, Scouting
+from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting
 from lagbench.replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
@@ -95,10 +100,11 @@ class FitSource:
 
 
 @R.writes
-def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, **options) -> dict:
+def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, on_train=None, **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
-    their defaults where not given)."""
-    o, task, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
+    their defaults where not given). `on_train(protocol)`: called before a training starts (not when an
+    earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
+    o, task, _, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps,
@@ -115,8 +121,17 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
                         schedule=OneCycle(lr=o.restart_lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle"
                         else Constant(lr=o.restart_lr), keep=o.restart_keep) if o.restarts else None
     guard = Guard(clip=o.guard_clip, skip=o.guard_skip) if (o.guard_clip or o.guard_skip) else None
+    log_every = max(1, o.steps // kind_defaults.HELDOUT_CHECKS)
+    patience = o.patience if prep.counts.get("heldout") else 0
+    if o.patience and not patience and "patience" in options:
+        raise ValueError(f"--patience {o.patience}: the early stop reads held-out rows, and this split has none "
+                         f"(--holdout, --holdout-fraction); give --patience 0")
+    # a stopped run anneals over as many steps as its patience spans (`replication.training.early_stop`)
+    early_stop = EarlyStop(every=log_every, patience=patience, min_improvement=kind_defaults.MIN_IMPROVEMENT,
+                           anneal=patience * log_every) if patience else None
     protocol = Protocol(data=data, task=task, steps=o.steps, batch=batch, loss=o.loss, l2=o.weight_decay,
-                        schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=max(1, o.steps // 100))
+                        schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=log_every,
+                        early_stop=early_stop)
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
@@ -135,15 +150,19 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
 
     if is_current(unit, out):
         return dict(R.load_result(unit.folder(out)), reused=True, metric=metric, metric_label=label)
+    if on_train:
+        on_train(protocol)
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
 
 
 class Resolved(NamedTuple):
     """`resolved`'s answer: the options with the model kind's defaults filled in, the task the data and model
-    give, and whether the data are a trajectory file (a recording) rather than a file of state samples."""
+    give, whether the data are a trajectory file (a recording) rather than a file of state samples, and the
+    data's coordinates (the kind's defaults follow them: `kind_defaults.small`)."""
     options: SimpleNamespace
     task: str
     recording: bool
+    dof: int
 
 
 def resolved(data, options: dict) -> Resolved:
@@ -155,11 +174,14 @@ def resolved(data, options: dict) -> Resolved:
     fit_options.check(vars(o))
     if o.split is not None:
         fit_data.check_options(o.split, o.heldout)
+    if options.get("patience") and (o.split == "none" or not o.heldout):
+        raise ValueError(f"--patience {options['patience']}: the early stop reads held-out rows, and --holdout "
+                         f"{o.split or 'by-trajectory'} --holdout-fraction {o.heldout:g} holds none out; give --patience 0")
     trajectories.check_options(o.window, o.polyorder)
-    raw = user_data.read(path)[1]
+    digest, raw = user_data.read(path)
     time_base.check_unit(path, raw, o.system, o.time_unit)
-    task, recording = task_of(o.model, "tau" in raw, path), "traj" in raw
-    o = kind_defaults.fill(o, task, recording=recording)
+    task, recording, dof = task_of(o.model, "tau" in raw, path), "traj" in raw, raw["q"].shape[1]
+    o = kind_defaults.fill(o, task, recording=recording, dof=dof)
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from lagbench.models import ModelSpec
         try:
@@ -180,14 +202,17 @@ def resolved(data, options: dict) -> Resolved:
 
         energy_function({"energy": o.energy}, raw["q"].shape[1])
     if o.test is not None:
-        test_raw = user_data.read(str(Path(o.test).resolve()))[1]
+        test_digest, test_raw = user_data.read(str(Path(o.test).resolve()))
+        if test_digest == digest:   # its errors would be the training error, reported as a test error
+            raise ValueError(f"--test {o.test}: byte for byte the training data (--data {data}); give a file of "
+                             f"other trajectories (e.g. `lagbench simulate --seed 1`)")
         time_base.check_unit(o.test, test_raw, o.system, o.time_unit)
         test_tau = "tau" in test_raw
         if test_tau != (task == "inverse_dynamics"):
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return Resolved(o, task, recording)
+    return Resolved(o, task, recording, dof)
 
 
 def _model_spec(o, prep, task: str) -> dict:

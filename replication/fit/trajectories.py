@@ -20,7 +20,9 @@ Checked against analytic trajectories with noise in tests/replication/fit/test_f
 
 Requirements (a ValueError naming the problem otherwise): an odd window >= polyorder + 2 >= 3 (so
 that the second derivative exists and the fit is overdetermined), at least window + 1 samples per
-trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory, and
+trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory (a
+file without a traj column is one trajectory, its rows in time order: times that repeat or go back there
+are refused, naming the traj column that several trajectories need), and
 samples on a uniform grid: the step h is the median step, a step within `JITTER_RTOL` (0.1 %) of h is h (real
 clocks, times rounded when written), and a step within that of n x h (n >= 2) is a gap of n - 1 dropped
 frames. Gaps (`gaps`, `GAPS`):
@@ -130,6 +132,8 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
     check_options(window, polyorder)
     if gaps not in GAPS:
         raise ValueError(f"--gaps: {gaps!r} is not valid; expected one of {', '.join(GAPS)}")
+    if "traj" not in d:
+        _one_trajectory(d["t"], path)
     traj = d.get("traj", np.zeros(len(d["q"])))
     estimate = "qdot" not in d or "qddot" not in d
     parts = []
@@ -150,6 +154,19 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
                              f"and last {window // 2} are dropped)")
         parts += [_derivatives(p, h, window, polyorder, estimate) for p in long_enough]
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _one_trajectory(t, path: str) -> None:
+    """A file without a traj column is one trajectory, its rows in time order: times that repeat or go back
+    are what several trajectories one after another look like (a ValueError naming the traj column)."""
+    dt = np.diff(t)
+    back = np.flatnonzero(~(dt > 0))
+    if back.size:
+        i = int(back[0])
+        how = "repeat" if dt[i] == 0 else "go back"
+        raise ValueError(f"{path}: its times {how} (t = {t[i]:.6g} then {t[i + 1]:.6g}, data rows {i + 1} and "
+                         f"{i + 2}) and it has no traj column, so it is read as one trajectory; several trajectories "
+                         f"need a traj column naming each row's trajectory")
 
 
 def _derivatives(part: dict, h: float, window: int, polyorder: int, estimate: bool) -> dict:

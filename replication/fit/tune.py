@@ -1,6 +1,6 @@
 """`lagbench fit --tune N`: the suite's declared search (`replication.tuning.search`) on a user's data.
 
-`tune_fit(data, out, n_configs, on_log, on_progress, **options) -> (record, ledger)`: the first `n_configs`
+`tune_fit(data, out, n_configs, on_log, on_progress, on_train, **options) -> (record, ledger)`: the first `n_configs`
 configurations of the search (the given options first, then other combinations of peak rate x 1/3, 1, 3
 and hidden widths x 1/2, 1, 2; the same list as every claim's) are each fitted to the training rows with no
 test file, and scored by the fit's loss on its held-out rows (the development split of the user's data: the
@@ -24,7 +24,7 @@ def _score(record: dict) -> float | None:
     return float(v) if record.get("status") == "ok" and isinstance(v, int | float) and math.isfinite(v) else None
 
 
-def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progress=None, **options):
+def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progress=None, on_train=None, **options):
     from lagbench.replication.fit.task import fit, resolved
 
     o = resolved(data, options)[0]   # the model kind's defaults where not given
@@ -41,7 +41,8 @@ def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progre
     for k, knobs in enumerate(grid):
         chosen = {**options, "lr": o.lr * knobs["lr"], "test": None,
                   "hidden": search.scaled_widths(o.hidden, knobs["width"])}
-        record = fit(data, out=out / "tune" / f"config{k}", on_log=on_log, on_progress=on_progress, **chosen)
+        record = fit(data, out=out / "tune" / f"config{k}", on_log=on_log, on_progress=on_progress, on_train=on_train,
+                     **chosen)
         rows.append({"config": k, **{f"knob_{n}": v for n, v in knobs.items()}, "lr": chosen["lr"],
                      "hidden": ",".join(map(str, chosen["hidden"])), "metric": record.get("metric"),
                      "score": _score(record), "status": record.get("status")})
@@ -58,5 +59,5 @@ def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progre
               "options": {"lr": final["lr"], "hidden": list(final["hidden"])},
               "scores": {int(r.config): (None if pd.isna(r.score) else float(r.score)) for r in df.itertuples()}}
     R.write_json(Path(out) / "tune" / "ledger.json", ledger)
-    record = fit(data, out=out, on_log=on_log, on_progress=on_progress, **final)
+    record = fit(data, out=out, on_log=on_log, on_progress=on_progress, on_train=on_train, **final)
     return record, ledger

@@ -106,6 +106,14 @@ def _candidates(profile: str):
 
 
 def setup(system: str, profile: str = "quick") -> Setup:
+    from difflib import get_close_matches
+
+    from lagbench import systems
+
+    if system not in systems.names():   # a misspelt name is named as such, not as a system no claim scores
+        near = get_close_matches(system, systems.names(), 1)
+        raise ValueError(f"--system {system}: unknown system{f' (did you mean {near[0]}?)' if near else ''}; "
+                         f"valid: {', '.join(systems.names())}")
     found = {}
     for name, s in _candidates(profile):
         if name not in found or (found[name].evaluate != "energy_rollout" and s.evaluate == "energy_rollout"):

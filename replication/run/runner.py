@@ -43,11 +43,12 @@ def _once(option: str, values) -> None:
         raise ValueError(f"{option}: {', '.join(twice)} given more than once; name each at most once")
 
 
-def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, models=None,
+def plan(profile: str, claims=None, frameworks=None, seeds: int | tuple | None = None, models=None,
          split: str = "dev", added=()) -> list:
     """The units of a run: each claim's models as they run under the profile (`claims.resolved.resolved`); a
     ValueError naming the option if any is invalid or nothing would run. `frameworks`: None for the profile's
-    (`PROFILE_FRAMEWORKS`). `added`: a user's models (`replication.run.added_models.Added`), each entering the
+    (`PROFILE_FRAMEWORKS`). `seeds`: None for the profile's, a count (the split's first seeds) or the seeds
+    themselves (a list of the split's). `added`: a user's models (`replication.run.added_models.Added`), each entering the
     claims it fits, in its own framework (named in `frameworks` where those are given)."""
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; valid: {', '.join(PROFILES)}")
@@ -62,9 +63,15 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, m
     _once("--frameworks", frameworks)
     _once("--claims", claims or ())
     _once("--models", models or ())
-    if seeds is not None and (not is_integer(seeds)
-                              or not 1 <= seeds <= splits.SEEDS_PER_SPLIT):
-        raise ValueError(f"--seeds: {seeds!r} is not valid; expected an integer from 1 to "
+    listed = isinstance(seeds, list | tuple)   # the seeds themselves, else how many
+    if listed:
+        outside = [s for s in seeds if not (is_integer(s) and splits.get(split).holds(s))]
+        first = splits.get(split).first_seed
+        if not seeds or outside:
+            raise ValueError(f"--seeds: {', '.join(map(str, outside)) or 'none given'}: not seeds of the {split} "
+                             f"split; expected integers from {first} to {first + splits.SEEDS_PER_SPLIT - 1}")
+    elif seeds is not None and (not is_integer(seeds) or not 1 <= seeds <= splits.SEEDS_PER_SPLIT):
+        raise ValueError(f"--n-seeds: {seeds!r} is not valid; expected an integer from 1 to "
                          f"{splits.SEEDS_PER_SPLIT} (a split's seeds; or leave it out for the profile's)")
     chosen = [get_claim(c) for c in claims] if claims else list(CLAIMS.values())
     extra = {c.id: [e for a in added for e in added_models.entries(c, a, profile)] for c in chosen}
@@ -81,12 +88,13 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | None = None, m
         run = resolved(claim, profile)
         n = run.seeds
         if seeds is not None:  # claims that are deterministic (one seed everywhere) keep one
-            n = seeds if max(claim.seeds.values()) > 1 else 1
+            n = (len(seeds) if listed else seeds) if max(claim.seeds.values()) > 1 else 1
+        numbers = list(dict.fromkeys(seeds))[:n] if listed else splits.get(split).seeds(n)
         for entry in (*(m.entry for m in run.models), *extra[claim.id]):
             if (models and entry.label not in models) or not entry.runs_in(profile):
                 continue
             for fw in ((added_models.framework(entry),) if entry.spec.get("kind") == USER_KIND else frameworks):
-                for seed in splits.get(split).seeds(n):
+                for seed in numbers:
                     units.append(Unit(claim, entry, fw, seed, profile))
     if not units:
         raise ValueError(f"nothing to run: no model of the chosen claims and --models runs under profile "

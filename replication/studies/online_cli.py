@@ -7,15 +7,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-FRAMEWORKS = ("jax", "torch")
+from lagbench import options
+
 MAX_SECONDS = 3600.0
-
-
-def _ints(option: str, values, low: int) -> tuple[int, ...]:
-    tokens = [t.strip() for v in values for t in v.split(",") if t.strip()]
-    if not tokens or not all(t.isdigit() and int(t) >= low for t in tokens):
-        raise ValueError(f"{option} {' '.join(values)}: expected integers >= {low} such as {low},{low + 1}")
-    return tuple(dict.fromkeys(int(t) for t in tokens))
 
 
 def _choices(option: str, text: str, valid) -> tuple[str, ...]:
@@ -52,8 +46,8 @@ def _check(args) -> dict:
             "threshold": _number("--threshold", args.threshold, 0.0),
             "sustain": _number("--sustain", args.sustain, 0.0, MAX_SECONDS, strict=False),
             "n_unseen": int(_number("--unseen-refs", args.unseen_refs, 0, strict=False)),
-            "seeds": _ints("--seeds", args.seeds, 0),
-            "frameworks": _choices("--frameworks", args.frameworks, FRAMEWORKS),
+            "seeds": options.seeds(args.seeds),
+            "frameworks": options.frameworks(args.frameworks),
             "models": _choices("--models", args.models, KINDS)}
 
 
@@ -102,10 +96,11 @@ def add_command(sub) -> None:
                        "time to first cross it, final and unseen MSE, compute "
                        "per tick against the 2 ms period) and setup.json. With --system four_joint_arm the same on "
                        "the SymPy four-joint arm, into OUT/online_four_joint_arm/. See docs/online_control.md.")
-    s.add_argument("--out", required=True, help="results folder; writes OUT/online/ (OUT/online_<system>/ for "
-                   "another arm than the two-link arm)")
-    s.add_argument("--system", default="two_link_arm", help="the arm: two_link_arm or four_joint_arm (its "
-                   "learners have 4 joints; default: two_link_arm)")
+    s.add_argument("--out", default="results/quick", help="results folder; writes OUT/online/ (OUT/online_<system>/ "
+                   "for another arm than the two-link arm) (default: results/quick, which `lagbench report` reads "
+                   "unless given --results)")
+    s.add_argument("--system", default="two_link_arm", help="the arm: two_link_arm or four_joint_arm, whose "
+                   "learners have 4 joints (default: two_link_arm)")
     s.add_argument("--seconds", type=float, default=20.0, help="simulated seconds of learning while tracking "
                    "(default: 20)")
     s.add_argument("--every", type=int, default=O.EVERY, help=f"learn every K control ticks (default: {O.EVERY})")
@@ -121,7 +116,8 @@ def add_command(sub) -> None:
     s.add_argument("--sustain", type=float, default=O.SUSTAIN, help=f"seconds the windows must stay at the bar for "
                    f"t_reach_s; 0: the first window at it (default: {O.SUSTAIN:g})")
     s.add_argument("--seeds", nargs="+", default=["0"], help="model seeds, comma- or space-separated (default: 0)")
-    s.add_argument("--frameworks", default="jax,torch", help="comma-separated: jax, torch (default: jax,torch)")
+    s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax, as `lagbench "
+                   "run`'s quick profile)")
     s.add_argument("--models", default="delan,ff", help="comma-separated: delan, ff (default: delan,ff)")
     s.add_argument("--unseen-refs", type=int, default=O.N_UNSEEN, help=f"unseen-family references the final model "
                    f"tracks, 4 s each; 0: none (default: {O.N_UNSEEN})")

@@ -6,14 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-FRAMEWORKS = ("jax", "torch")
-
-
-def _seeds(values) -> tuple[int, ...]:
-    tokens = [t.strip() for v in values for t in v.split(",") if t.strip()]
-    if not tokens or not all(t.isdigit() for t in tokens):
-        raise ValueError(f"--seeds {' '.join(values)}: expected integers >= 0 such as 0,1")
-    return tuple(dict.fromkeys(int(t) for t in tokens))
+from lagbench import options
 
 
 def _steps(text: str) -> int:
@@ -34,9 +27,7 @@ def cmd_robustness(args):
     from lagbench.files.results import output_folder
     from lagbench.replication.studies import robustness as R
 
-    steps, seeds, jobs = _steps(args.steps), _seeds(args.seeds), _jobs(args.jobs)
-    if args.framework not in FRAMEWORKS:
-        raise ValueError(f"--framework {args.framework}: expected one of {', '.join(FRAMEWORKS)}")
+    steps, seeds, jobs = _steps(args.steps), options.seeds(args.seeds), _jobs(args.jobs)
     folder = output_folder(Path(args.out) / "robustness", "--out")
     total = len(R.SCENES) * (2 + len(seeds) * len(R.MODELS))
     bar = tqdm(total=total, desc="lagbench robustness", unit="model", disable=args.quiet)
@@ -61,10 +52,13 @@ def add_command(sub) -> None:
                        "the two-link arm's training family under one budget, and score the torque error on the "
                        "unseen family and closed-loop tracking of unseen references on the scene's plant. Writes "
                        "OUT/robustness/scenes.csv, recommendation.csv and advantage.png (see docs/robustness.md).")
-    s.add_argument("--out", required=True, help="results folder; writes OUT/robustness/")
+    s.add_argument("--out", default="results/quick", help="results folder; writes OUT/robustness/ (default: "
+                   "results/quick, which `lagbench report` reads unless given --results)")
     s.add_argument("--steps", default="3000", help="optimiser steps of every model (default: 3000)")
     s.add_argument("--seeds", nargs="+", default=["0"], help="seeds, comma- or space-separated (default: 0)")
-    s.add_argument("--framework", default="jax", help="jax | torch (default: jax)")
+    options.add(s, "--frameworks", "--framework", dest="framework", default="jax", help="the one framework every "
+                "model trains in: jax or torch (default: jax)")
+    options.check(s, "framework", options.one_framework("robustness"))
     s.add_argument("--jobs", default="1", help="worker processes, a scene each at a time (default: 1; the "
                                                "fits are the same in any number of workers up to rounding)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -26,8 +26,8 @@ once at the end (an ended phase resumed returns its outcomes without a step). `s
 a snapshot's state held in memory (`loop_state.narrow` of another run's end state: the scouts that go on after a cut),
 is where the loop begins when `snapshot` has none of its own.
 
-`train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome`:
-one model; its hooks see that stepper and scalar info.
+`train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None, start_state=None)
+-> TrainOutcome`: one model; its hooks see that stepper and scalar info.
 """
 from __future__ import annotations
 
@@ -177,6 +177,7 @@ class _ScalarHook:
             self.hook.restore_snapshot(meta, arrays)
 
 
-def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None) -> TrainOutcome:
+def train(stepper, protocol, stream, on_log=None, hooks=(), compiled=False, snapshot=None,
+          start_state=None) -> TrainOutcome:
     return train_members(_One(stepper), protocol, [stream], on_log,
-                         [_ScalarHook(h, stepper) for h in hooks], compiled, snapshot)[0]
+                         [_ScalarHook(h, stepper) for h in hooks], compiled, snapshot, start_state)[0]

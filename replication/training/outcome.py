@@ -24,6 +24,7 @@ class TrainOutcome:
     step_mode: str | None = None  # "jit" (JAX); "compiled" or "eager" (PyTorch, `compile_torch`); phases joined by " + "
     device: dict | None = None    # where it computed (`replication.training.device.describe`)
     tracked: dict | None = None   # kept parameters at the tracked steps (`Tracking.keep`, `tracking.Tracker.checkpoints`)
+    early_stop: dict | None = None  # `Protocol.early_stop`'s record (`early_stop.EarlyStopper.record`): when it stopped
 
     @property
     def samples_per_s(self) -> float:

@@ -6,11 +6,11 @@ schedule record of `replication.training.schedules`), beside the loss, the L2 pe
 the batch size, the dtype and the seed. The batch order is drawn once in NumPy from the seed
 (`replication.training.data.BatchStream`) and fed to both frameworks, so two frameworks given one protocol
 see the same numbers in the same order. The optional parts, each `None` when the run does without it:
-`guard` (`Guard`), `scouting` (`Scouting`), `cohort` (seeds trained side by side) and `tracking`
-(`Tracking`).
+`guard` (`Guard`), `scouting` (`Scouting`), `cohort` (seeds trained side by side), `tracking`
+(`Tracking`) and `early_stop` (`EarlyStop`).
 
-`to_dict()` is the canonical form: every field (but `data.fixed` while empty and `tracking.keep` while off, so
-the protocols without them keep their keys), records as nested dicts, and `version` (`KEY_VERSION`), so
+`to_dict()` is the canonical form: every field (but `data.fixed` while empty, `tracking.keep` while off and
+`early_stop` while None, so the protocols without them keep their keys), records as nested dicts, and `version` (`KEY_VERSION`), so
 every cache key built from it changes when the form does; `from_dict` reads it, and the forms of earlier
 versions (`replication.training.protocol_versions`), so that older result folders still load.
 """
@@ -25,6 +25,7 @@ from lagbench.replication.training.protocol_parts import (
     COORDS,
     Adam,
     Data,
+    EarlyStop,
     Guard,
     Scouting,
     Tracking,
@@ -39,13 +40,13 @@ from lagbench.replication.training.schedules import (
 from lagbench.validate import check, integer, is_integer, one_of, real
 
 __all__ = ["LOSSES", "DTYPES", "TASKS", "COORDS", "KEY_VERSION", "Protocol", "Data", "Adam", "Guard", "Scouting",
-           "Tracking", "canonical_hash"]
+           "Tracking", "EarlyStop", "canonical_hash"]
 
 LOSSES = ("l1", "mse", "l1_gamma")
 DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 KEY_VERSION = 3
-PARTS = {"guard": Guard, "tracking": Tracking}   # optional parts stored as their fields
+PARTS = {"guard": Guard, "tracking": Tracking, "early_stop": EarlyStop}   # optional parts stored as their fields
 
 
 @dataclass(frozen=True)
@@ -59,7 +60,8 @@ class Protocol:
                normalised by the sum of weights; the relativistic protocol).
     l2:        coefficient of sum(theta^2) added to the loss (the original code's weight penalty).
     optimiser: `Adam`'s constants; schedule: the learning rate (`Constant`, `StepDecay`, `OneCycle`).
-    guard, scouting, tracking: the optional parts (`Guard`, `Scouting`, `Tracking`), None when off.
+    guard, scouting, tracking, early_stop: the optional parts (`Guard`, `Scouting`, `Tracking`, `EarlyStop`),
+               None when off.
     cohort:    train the seeds in groups of `cohort` (>= 2) as one vectorised program
                (`replication.training.train`: seeds g*cohort .. g*cohort + cohort - 1 side by side, each its
                own init, batches, guard and stop); each seed's numbers are those of its own run (up to
@@ -80,6 +82,7 @@ class Protocol:
     tracking: Tracking | None = None
     dtype: str = "float32"
     log_every: int = 50
+    early_stop: EarlyStop | None = None   # out of `to_dict` while None: the protocols without it keep their keys
 
     def __post_init__(self):
         for name, valid in (("loss", LOSSES), ("dtype", DTYPES), ("task", TASKS)):
@@ -103,9 +106,14 @@ class Protocol:
                              f"scouts train initialisations side by side; use one of them")
         if self.scouting and self.scouting.batch > n_train:
             raise ValueError(f"scouting batch {self.scouting.batch} exceeds the training pool n_train={n_train}")
-        if self.tracking and self.tracking.every % self.log_every:
-            raise ValueError(f"protocol tracking every {self.tracking.every} is not a multiple of log_every "
-                             f"{self.log_every}")
+        for name in ("tracking", "early_stop"):
+            part = getattr(self, name)
+            if part and part.every % self.log_every:
+                raise ValueError(f"protocol {name.replace('_', ' ')} every {part.every} is not a multiple of log_every "
+                                 f"{self.log_every}")
+        if self.cohort and self.early_stop:
+            raise ValueError(f"protocol cohort {self.cohort} with early_stop: the seeds of a cohort train as one "
+                             f"program and stop together; give each seed its own run")
 
     def objective_key(self) -> tuple:
         """What one optimiser step depends on besides the model: the loss and its target (task, loss, l2),
@@ -127,6 +135,8 @@ class Protocol:
         d["schedule"] = schedule_to_dict(self.schedule)
         for name in PARTS:
             d[name] = dataclasses.asdict(d[name]) if d[name] is not None else None
+        if d["early_stop"] is None:
+            del d["early_stop"]   # only a protocol that stops early stores it: other protocols keep their keys
         if d["tracking"] is not None and not d["tracking"]["keep"]:
             del d["tracking"]["keep"]   # only a kept tracking is stored: other protocols keep their keys
         if self.scouting is not None:

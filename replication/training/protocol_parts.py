@@ -2,8 +2,8 @@
 
 Always there: `Data` (what is trained on), `Adam` (the optimiser's constants) and a schedule
 (`replication.training.schedules`). Optional, `None` when a run does without them: `Guard` (the
-gradient-spike guard), `Scouting` (restarts over initialisations) and `Tracking` (held-out error during
-training). Every value a part uses is written in it: nothing is inherited from the protocol.
+gradient-spike guard), `Scouting` (restarts over initialisations), `Tracking` (held-out error during
+training) and `EarlyStop` (stop when the held-out error stops improving; `lagbench fit` only). Every value a part uses is written in it: nothing is inherited from the protocol.
 """
 from __future__ import annotations
 
@@ -142,3 +142,27 @@ class Tracking:
     def __post_init__(self):
         object.__setattr__(self, "every", integer("tracking every", self.every, low=1))
         flag("tracking keep", self.keep)
+
+
+@dataclass(frozen=True)
+class EarlyStop:
+    """Stop a training when its held-out error stops improving (`replication.training.early_stop`): every
+    `every` steps (a multiple of the protocol's log_every) and at the last, the data loss on the held-out
+    rows; at the evaluation that makes `patience` in a row without a new best lower than the best so far by
+    at least `min_improvement` (a fraction of it), the run closes: its learning rate falls along a half cosine
+    from where it is to where the schedule ends, over `anneal` more steps (0: it ends there), within the
+    protocol's steps. The parameters it ends with are the last step's (the held-out rows choose when to stop,
+    never which parameters are kept). A restarts' protocol applies it to the continuation only. `lagbench
+    fit` sets it; no claim does."""
+
+    every: int
+    patience: int
+    min_improvement: float = 0.01
+    anneal: int = 0
+
+    def __post_init__(self):
+        for name in ("every", "patience"):
+            object.__setattr__(self, name, integer(f"early stop {name}", getattr(self, name), low=1))
+        object.__setattr__(self, "min_improvement", float(real("early stop min_improvement", self.min_improvement,
+                                                               low=0, below=1)))
+        object.__setattr__(self, "anneal", integer("early stop anneal", self.anneal, low=0))

@@ -7,6 +7,8 @@ A schedule is a record holding every value its shape uses (and none it does not)
   the phase is p = start + (1 - start) * f and lr(p) = low + (high - low) * (1 - cos(2 pi p)) / 2,
   high = lr, low = lr * min_ratio. It starts part-way up (p = 0.2 in the code), peaks at p = 0.5 and falls
   back to `low` at the end.
+- `Anneal(lr, final, begin)`:       lr until step `begin`, then a half cosine down to `final` at `steps`: the
+  close of a run its early stop ended (`replication.training.early_stop`).
 `learning_rate(protocol, step)` -> float reads the protocol's schedule over its `steps`.
 """
 from __future__ import annotations
@@ -70,8 +72,25 @@ class OneCycle:
         return low + (self.lr - low) * (1.0 - math.cos(2.0 * math.pi * phase)) / 2.0
 
 
-SCHEDULES = {s.kind: s for s in (Constant, StepDecay, OneCycle)}
-Schedule = Constant | StepDecay | OneCycle
+@dataclass(frozen=True)
+class Anneal:
+    lr: float
+    final: float
+    begin: int
+    kind: ClassVar[str] = "anneal"
+
+    def __post_init__(self):
+        object.__setattr__(self, "lr", _check_lr(self.lr))
+        object.__setattr__(self, "final", float(real("anneal final rate", self.final, low=0)))
+        object.__setattr__(self, "begin", integer("anneal begin", self.begin, low=0))
+
+    def rate(self, step: int, steps: int) -> float:
+        f = min(max(step - self.begin, 0) / max(steps - self.begin, 1), 1.0)
+        return self.final + (self.lr - self.final) * (1.0 + math.cos(math.pi * f)) / 2.0
+
+
+SCHEDULES = {s.kind: s for s in (Constant, StepDecay, OneCycle, Anneal)}
+Schedule = Constant | StepDecay | OneCycle | Anneal
 
 
 def schedule_to_dict(s: Schedule) -> dict:

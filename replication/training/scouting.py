@@ -23,7 +23,8 @@ has no restarts: the report says so where a claim uses them.
 
 `train_scouted(trainer, spec, protocol, seed, on_log=None) -> TrainOutcome` (trainer: `train_jax` or
 `train_torch`): the continuation's parameters and log (its steps shifted by the scouts' samples in
-continuation steps, `progress_steps`), steps_done and samples counting every scout, its `scouting` record
+continuation steps, `progress_steps`; `on_log` sees the first scout's rows so too, with the scouts' own
+step as `restart_step`), steps_done and samples counting every scout, its `scouting` record
 {init_seeds, tail_loss, chosen, scout_steps; with a cut also cut_step, cut_tail_loss, kept}. `scout(...)`,
 `choose` and `continuation_protocol` are its parts, for callers that watch them (`speedstudy.target_loop`).
 """
@@ -83,9 +84,10 @@ def init_seeds(protocol, seed: int) -> list[int]:
 
 
 def scout_protocol(protocol):
-    """The protocol each scout trains under: the scouting's steps, batch and schedule, no scouting."""
+    """The protocol each scout trains under: the scouting's steps, batch and schedule, no scouting and no
+    early stop (the training loss chooses among scouts; an early stop is the continuation's)."""
     s = protocol.scouting
-    return protocol.replace(steps=s.steps, batch=s.batch, schedule=s.schedule, scouting=None)
+    return protocol.replace(steps=s.steps, batch=s.batch, schedule=s.schedule, scouting=None, early_stop=None)
 
 
 def continuation_protocol(protocol):
@@ -118,9 +120,10 @@ class _StopAt:
         return k + 1 >= self.steps
 
 
-class _Held:
+class HeldState:
     """A snapshot store (or none) that also keeps in memory the last state saved or loaded: the scouts'
-    state at the cut, from which the kept ones go on."""
+    state at the cut, from which the kept ones go on (and a run's at its early stop, from which it anneals:
+    `early_stop.train_stopping`)."""
 
     def __init__(self, store):
         self.store, self.state = store, None
@@ -166,7 +169,7 @@ def scout(trainer, spec, protocol, seeds, on_log=None, hooks=(), snapshot=None, 
     p, half = scout_protocol(protocol), cut_step(protocol)
     keep = _Losses()
     streams = [BatchStream(p, s) for s in seeds]
-    held = _Held(snapshot) if half is not None else snapshot
+    held = HeldState(snapshot) if half is not None else snapshot
     outcomes = trainer.train_members(spec, [init_params(spec, seed=s) for s in seeds], p, streams, on_log=on_log,
                                      hooks=(keep, *((_StopAt(half),) if half is not None else ()), *hooks),
                                      snapshot=held)
@@ -198,19 +201,20 @@ def choose(tails) -> int | None:
     return min(finite, key=lambda i: tails[i]) if finite else None
 
 
-def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, snapshot=None):
+def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, snapshot=None, stop=None):
     """Scouts, then the chosen one's continuation; `track(protocol, offset_steps, offset_samples,
     offset_seconds)` may give a held-out tracking hook for the continuation (`training.tracker_for`): the
-    scouts' samples and step time count. `snapshot` (`snapshots.Snapshots`): each phase snapshots under
+    scouts' samples and step time count; `stop(protocol, offset_steps)` an early-stop hook for it
+    (`training.stopper_for`). `snapshot` (`snapshots.Snapshots`): each phase snapshots under
     its own name ("scouts", "continuation"), so that a run killed in its continuation does not scout again."""
     from lagbench.replication.training.data import BatchStream
 
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
     done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps
 
-    def scout_log(row):   # progress in continuation steps: the scouts advance together
+    def scout_log(row):   # progress in continuation steps (the scouts advance together); the scouts' own step too
         if on_log and row.get("member", 0) == 0:
-            on_log({**row, "step": row["step"] * done // per})
+            on_log({**row, "step": row["step"] * done // per, "restart_step": row["step"]})
     record = {}
     outcomes, tails = scout(trainer, spec, protocol, seeds, on_log=scout_log,
                             snapshot=snapshot.phase("scouts") if snapshot else None, record=record)
@@ -228,12 +232,16 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
         if on_log:
             on_log({**row, "step": row["step"] + done})
     t = track(p, done, scouting_samples(protocol), outcomes[best].step_seconds) if track else None
-    out = trainer.train(spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
-                        on_log=shifted, hooks=(t,) if t else (),
-                        snapshot=snapshot.phase("continuation") if snapshot else None)
+    s = stop(p, done) if stop else None
+    from lagbench.replication.training.early_stop import train_stopping
+    out = train_stopping(trainer, spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
+                         on_log=shifted, hooks=(t,) if t else (),
+                         snapshot=snapshot.phase("continuation") if snapshot else None, stop=s)
     out.log = [{**row, "step": row["step"] + done} for row in out.log]
     if t:
         t.merge([out])
+    if s:
+        s.merge(out)
     out.samples = out.steps_done * out.batch + scouting_samples(protocol)
     out.steps_done += scouting_samples(protocol) // outcomes[0].batch
     out.train_time_s += outcomes[best].train_time_s

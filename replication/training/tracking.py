@@ -9,7 +9,8 @@ steps only, the first compiling step and these evaluations left out) and `heldou
 the outcomes' training logs as the columns `heldout_loss`, `train_s` and `samples` on the rows of the same
 step (a tracking step is also a log step: `tracking.every` is a multiple of `log_every`) and, when kept, the
 parameters as `outcome.tracked` (`checkpoints(i)`: {"step": (n,), "p/<name>": (n, ...) stacked}).
-The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
+`data_loss(framework, spec, protocol, batch, params)`: that loss of one model on a set (`early_stop` reads it
+too). The offsets shift steps, samples and seconds (a continuation after its scouts, whose samples and time count).
 Its rows and kept parameters travel in a training's snapshots (`snapshot_state`, `restore_snapshot`;
 `replication.training.snapshots`).
 """
@@ -36,10 +37,7 @@ class Tracker:
         self.kept: list[list[dict]] = []   # per member, the parameters at each tracked step (with keep)
 
     def _loss(self, params) -> float:
-        m = adapter(self.framework, self.spec, params)
-        pred = predict(m, self.spec.kind, self.protocol.task, self.batch, np.concatenate)
-        return float(loss_value(np.asarray(pred, np.float64), self.batch["target"], self.batch.get("weight"),
-                                self.protocol.loss))
+        return data_loss(self.framework, self.spec, self.protocol, self.batch, params)
 
     def __call__(self, k, stepper, info) -> bool:
         p = self.protocol
@@ -89,6 +87,13 @@ class Tracker:
                 row.update({k: v for k, v in at.get(row["step"], {}).items() if k != "step"})
             if self.keep:
                 out.tracked = self.checkpoints(i)
+
+
+def data_loss(framework, spec, protocol, batch: dict, params) -> float:
+    """The protocol's own loss (no L2 term) of the model `params` on `batch` (a held-out set's arrays)."""
+    m = adapter(framework, spec, params)
+    pred = predict(m, spec.kind, protocol.task, batch, np.concatenate)
+    return float(loss_value(np.asarray(pred, np.float64), batch["target"], batch.get("weight"), protocol.loss))
 
 
 def unstack(checkpoints: dict | None) -> list[dict]:

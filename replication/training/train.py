@@ -18,6 +18,7 @@ from lagbench.files import results as R
 from lagbench.models import init_params
 from lagbench.replication.training import device as dev
 from lagbench.replication.training.data import BatchStream, targets_version
+from lagbench.replication.training.early_stop import EarlyStopper, train_stopping
 from lagbench.replication.training.outcome import TrainOutcome, log_frame
 from lagbench.replication.training.protocol import canonical_hash
 from lagbench.replication.training.scouting import train_scouted
@@ -59,18 +60,29 @@ def tracker_for(framework, spec):
     return make
 
 
+def stopper_for(framework, spec):
+    """`make(protocol, offset_steps=0) -> EarlyStopper | None`: the early-stop hook of a protocol with
+    `early_stop` (`replication.training.early_stop`), else None."""
+    def make(protocol, offset_steps=0):
+        return EarlyStopper(framework, spec, protocol, offset_steps) if protocol.early_stop else None
+    return make
+
+
 def run_training(framework, spec, protocol, seed, on_log=None, snapshot=None) -> TrainOutcome:
     """One run of a protocol from the init of `seed`; with `protocol.scouting`, restarts over inits
-    (`replication.training.scouting`). `snapshot`: where it keeps snapshots and resumes from them."""
-    track = tracker_for(framework, spec)
+    (`replication.training.scouting`); with `protocol.early_stop`, it ends when the held-out error stops
+    improving. `snapshot`: where it keeps snapshots and resumes from them."""
+    track, stop = tracker_for(framework, spec), stopper_for(framework, spec)
     if protocol.scouting:
         return train_scouted(trainer(framework), spec, protocol, seed, on_log=on_log, track=track,
-                             snapshot=snapshot)
-    t = track(protocol)
-    out = trainer(framework).train(spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
-                                   on_log=on_log, hooks=(t,) if t else (), snapshot=snapshot)
+                             snapshot=snapshot, stop=stop)
+    t, s = track(protocol), stop(protocol)
+    out = train_stopping(trainer(framework), spec, init_params(spec, seed=seed), protocol, BatchStream(protocol, seed),
+                         on_log=on_log, hooks=(t,) if t else (), snapshot=snapshot, stop=s)
     if t:
         t.merge([out])
+    if s:
+        s.merge(out)
     return out
 
 
@@ -118,6 +130,7 @@ def _cached(folder: Path) -> TrainOutcome | None:
                         failure=meta["failure"], train_time_s=meta["train_time_s"], steps_done=meta["steps_done"],
                         batch=meta["batch"], scouting=meta.get("scouting"), samples=meta.get("samples"),
                         cohort=meta.get("cohort"), step_mode=meta.get("step_mode"), device=meta.get("device"),
+                        early_stop=meta.get("early_stop"),
                         tracked=R.load_npz(folder / "tracked.npz") if "tracked.npz" in meta["files"] else None)
 
 
@@ -131,6 +144,7 @@ def _store(folder: Path, outcome: TrainOutcome, spec, protocol, seed) -> None:
                                           "scouting": outcome.scouting, "samples": outcome.samples,
                                           "cohort": outcome.cohort, "step_mode": outcome.step_mode,
                                           "device": outcome.device,
+                                          **({"early_stop": outcome.early_stop} if outcome.early_stop else {}),
                                           "spec": spec.to_dict(),
                                           "protocol": protocol.to_dict(), "seed": seed},
                  checksum=True)

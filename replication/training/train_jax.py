@@ -5,8 +5,8 @@
 rate the loop passes; clipped to the guard's clip (`protocol.grad_clip`) and skipped above the spike guard's bound inside the
 compiled step, `replication.training.spike_guard`); `step` reuses the (optax transform, compiled step) pair of
 `make_step` across models of one protocol, so that scouts compile once. `train(spec, params, protocol,
-stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome`: `replication.training.loop.train` with this
-stepper. Both steppers give their model and Adam state as arrays for snapshots (`state_arrays`).
+stream, on_log=None, hooks=(), snapshot=None, start_state=None) -> TrainOutcome`: `replication.training.loop.train`
+with this stepper. Both steppers give their model and Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol, step=None)`: K models of one spec trained as one program (the
 stepper of `replication.training.loop.train_members`): the parameters and Adam states stacked along a leading axis
@@ -153,8 +153,9 @@ class Stepper:
         _load_state_arrays(self, arrays)
 
 
-def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome:
-    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot)
+def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None, start_state=None) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot,
+                      start_state=start_state)
 
 
 def _stack(trees):

@@ -3,8 +3,8 @@
 
 `Stepper(spec, params, protocol)`: the gradient and its global norm in `propose` (the learning rate set on
 the optimiser there); in `commit`, if the spike guard takes the step, the gradient scaled by the clip
-factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) ->
-TrainOutcome`: `replication.training.loop.train` with this stepper. Both steppers give their parameters and
+factor and one Adam step. `train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None,
+start_state=None) -> TrainOutcome`: `replication.training.loop.train` with this stepper. Both steppers give their parameters and
 Adam state as arrays for snapshots (`state_arrays`).
 
 `Members(spec, params_list, protocol)`: K models of one spec trained as one program (the stepper of
@@ -136,8 +136,9 @@ class Stepper:
                     self.opt.state[p] = {k: torch.as_tensor(a).clone() for k, a in zip(_ADAM_STATE, state, strict=True)}
 
 
-def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None) -> TrainOutcome:
-    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot)
+def train(spec, params, protocol, stream, on_log=None, hooks=(), snapshot=None, start_state=None) -> TrainOutcome:
+    return loop.train(Stepper(spec, params, protocol), protocol, stream, on_log, hooks, snapshot=snapshot,
+                      start_state=start_state)
 
 
 class _Objective(nn.Module):

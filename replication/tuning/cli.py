@@ -1,6 +1,7 @@
 """`lagbench tune`: its command line (the search itself is `tune.py`)."""
 from __future__ import annotations
 
+from lagbench import options
 from lagbench.replication.claims.base import PROFILES
 
 
@@ -11,8 +12,10 @@ def _num(v) -> str:
 def cmd_tune(args):
     from lagbench.replication.tuning.tune import tune
 
-    frameworks = tuple(x.strip() for x in args.frameworks.split(",") if x.strip()) or ("jax",)
-    ledger = tune(args.claim, profile=args.profile, n_configs=args.configs, n_seeds=args.seeds,
+    frameworks = options.frameworks(args.frameworks)
+    seeds = options.seeds_or_count(args)   # a count, the seeds themselves, or None (the claim's)
+    ledger = tune(args.claim, profile=args.profile, n_configs=args.configs,
+                  n_seeds=seeds if isinstance(seeds, int) else None, seeds=None if isinstance(seeds, int) else seeds,
                   frameworks=frameworks, out=args.out or f"results/tune/{args.claim}_{args.profile}",
                   progress=not args.quiet, record=args.record, confirm=args.confirm, dry_run=args.dry_run,
                   widths=[x for x in args.widths.split(",") if x.strip()] if args.widths else None)
@@ -49,8 +52,10 @@ def add_command(sub) -> None:
                    "edge step and no confirmation; no claim may adopt it (default: the whole search)")
     s.add_argument("--widths", help="a width sweep for trials instead of the search: comma-separated multipliers "
                    "of the registered widths (e.g. 2,4,8), each at the registered rate, every model alike")
-    s.add_argument("--seeds", type=int, help="development seeds per configuration (default: 1; a pace study: its "
-                   "cohort of 8)")
+    options.add_seeds(s, "how many development seeds, 0.., each configuration trains on (default: 1; a pace "
+                      "study: its cohort of 8)", "the development seeds themselves, comma- or space-separated, e.g. "
+                      "0,1 (a lone number without a comma is read as --n-seeds until the next release; one seed: "
+                      "5,) (default: seed 0; a pace study: 0 to 7)")
     s.add_argument("--confirm", type=int, default=3,
                    help="development seeds the chosen and the registered configuration are compared on (default: 3)")
     s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")

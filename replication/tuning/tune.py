@@ -139,12 +139,20 @@ def _compute(df: pd.DataFrame, pooled: bool) -> dict:
 @R.writes
 def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="results/tune", progress: bool = True,
          n_configs: int | None = None, n_seeds: int | None = None, widths=None, record=None,
-         confirm: int = CONFIRM_SEEDS, dry_run: bool = False) -> dict | None:
+         confirm: int = CONFIRM_SEEDS, dry_run: bool = False, seeds=None) -> dict | None:
+    """`n_seeds`: the first development seeds each configuration trains on; `seeds`: those seeds themselves."""
     claim = get(claim_id)   # the search is around the claim as written, never around an adopted choice
+    if seeds is not None:
+        seeds = list(dict.fromkeys(seeds))
+        outside = [s for s in seeds if not (is_integer(s) and splits.DEV.holds(s))]
+        if not seeds or outside:
+            raise ValueError(f"--seeds: {', '.join(map(str, outside)) or 'none given'}: not development seeds; "
+                             f"expected integers from 0 to {splits.SEEDS_PER_SPLIT - 1}")
+        n_seeds = len(seeds)
     pooled_seeds = POOLED_SEEDS if claim.pooled else 1
     n_seeds = pooled_seeds if n_seeds is None else n_seeds
     if not is_integer(n_seeds) or not 1 <= n_seeds <= splits.SEEDS_PER_SPLIT:
-        raise ValueError(f"--seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
+        raise ValueError(f"--n-seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     if not is_integer(confirm) or not 1 <= confirm <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--confirm: {confirm!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     kind = "width sweep" if widths else "partial search" if n_configs else "search"
@@ -157,7 +165,7 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
         record = Path(record)
         R.output_folder(record.parent, "--record")
     runner = _Runner(claim, profile, labels, tuple(frameworks), out, record, progress)
-    seeds = splits.DEV.seeds(n_seeds)
+    seeds = splits.DEV.seeds(n_seeds) if seeds is None else seeds
     if dry_run:
         runner.tell("grid", _plan(configs, labels, seeds))
         return None

@@ -241,7 +241,7 @@ def test_train_target_command_takes_the_init_seed_and_reads_the_old_heldout(tmp_
     assert main(["train-target", "--budget", "256", "--hidden", "8", "--heldout", "64", "--protocols", "variant",
                  "--seed", "3", "--out", str(out), "--quiet"]) == 0
     assert set(pd.read_csv(out / "train_target" / "train_target.csv")["seed"]) == {3}
-    assert "--heldout is deprecated; use --heldout-states" in capsys.readouterr().err
+    assert "note: --heldout is now --heldout-states; the old spelling is read" in capsys.readouterr().err
 
 
 def test_one_meaning_per_option_name_and_the_old_spellings_still_read(capsys):
@@ -255,7 +255,7 @@ def test_one_meaning_per_option_name_and_the_old_spellings_still_read(capsys):
     got = options.from_args(args)
     assert (got["split"], got["heldout"]) == ("random", 0.3)
     err = capsys.readouterr().err
-    assert "--split is deprecated; use --holdout" in err and "--heldout is deprecated; use --holdout-fraction" in err
+    assert "note: --split is now --holdout;" in err and "note: --heldout is now --holdout-fraction;" in err
     both = build_parser().parse_args(["fit", "--data", "x.csv", "--model", "lnn", "--split", "none", "--holdout", "none"])
     with pytest.raises(ValueError, match="--split: give it once, as --holdout"):
         options.from_args(both)
@@ -279,8 +279,8 @@ def _options():
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     for name, parser in sub.choices.items():
         for action in parser._actions:
-            if action.option_strings and action.dest != "help":
-                yield name, parser, action
+            if action.option_strings and action.dest != "help" and action.help != argparse.SUPPRESS:
+                yield name, parser, action   # an old spelling is hidden (tests/test_cli_options.py reads them)
 
 
 @pytest.mark.parametrize("command, option", [(n, a.option_strings[-1]) for n, _, a in _options()])

@@ -22,7 +22,7 @@ def _data(path):
 
 def _fit_cli(data, out, steps=2):
     return [sys.executable, "-m", "lagbench", "fit", "--data", str(data), "--model", "baseline",
-            "--steps", str(steps), "--hidden", "8", "--batch", "16", "--restarts", "0", "--framework", "torch",
+            "--steps", str(steps), "--hidden", "8", "--batch", "16", "--restarts", "0", "--frameworks", "torch",
             "--quiet", "--device", "cpu", "--out", str(out)]
 
 

@@ -38,8 +38,8 @@ def _run(tmp_path, monkeypatch, small: bool, capsys=None) -> dict:
     for args in commands:
         args = shrink(args) if small else args
         assert main(args if args[0] != "fit" else [*args, "--quiet"]) == 0, args
-        printed = capsys.readouterr().out if capsys is not None else "ok: test L1 "
-        if args[0] == "fit":  # the metric printed is named for the loss and the rows
+        printed = capsys.readouterr().out if capsys is not None else None
+        if args[0] == "fit" and printed is not None:  # the metric printed is named for the loss and the rows
             assert printed.startswith(("ok: test L1 ", "done: test L1 ")) and "null predictor" in printed, printed
     out = {}
     for path in tmp_path.glob("results/*/units/*/*/*/seed0/result.json"):
@@ -74,7 +74,9 @@ def test_the_worked_example_runs_end_to_end(tmp_path, monkeypatch, capsys):
 def test_the_worked_example_as_written_gives_what_the_readme_says(tmp_path, monkeypatch):
     metrics = _run(tmp_path, monkeypatch, small=False)
     lnn, base = metrics[("fit", "jax", "lnn")], metrics[("fit", "jax", "baseline")]
-    assert lnn["test_energy_err_final"] < base["test_energy_err_final"]
+    # about as near the true energy at the end, as the page says
+    assert lnn["test_energy_err_final"] < 1.5 * base["test_energy_err_final"]
+    assert base["test_energy_err_final"] < 1.5 * lnn["test_energy_err_final"]
     assert lnn["test_rollout_gmean_err"] < 1.5 * base["test_rollout_gmean_err"]   # about equal, as the page says
     assert lnn["test_l1"] < lnn["null_test_l1"] / 2 and base["test_l1"] < base["null_test_l1"] / 2
     assert lnn["test_learned_energy_drift"] < 1e-4 * lnn["test_energy_err_final"]  # RK4 keeps its own energy

@@ -71,7 +71,8 @@ def test_csv_headers_gaps_and_float32_range(tmp_path, header, big, message):
     (["--hidden", "8,abc"], ["--hidden", "128,128"]),
     (["--hidden", "0"], ["--hidden"]),
     (["--model", "gpt"], ["--model", "lnn, hnn, delan, baseline"]),
-    (["--framework", "mxnet"], ["--framework", "jax, torch"]),
+    (["--frameworks", "mxnet"], ["--frameworks", "jax, torch"]),
+    (["--frameworks", "jax,torch"], ["--frameworks", "one framework"]),
     (["--loss", "huber"], ["--loss", "l1, mse"]),
     (["--steps", "0"], ["--steps", ">= 1"]),
     (["--batch", "-3"], ["--batch", ">= 1"]),
@@ -133,7 +134,7 @@ def test_evaluate_takes_fitted_and_reads_the_old_model_spelling_with_a_notice(tm
     parser = build_parser()
     args = parser.parse_args(["evaluate", "--model", "results/fit", "--data", "d.csv"])
     assert cli._fitted_folder(args) == "results/fit"
-    assert "evaluate --model is deprecated; use --fitted" in capsys.readouterr().err
+    assert "note: --model is now --fitted;" in capsys.readouterr().err
     args = parser.parse_args(["evaluate", "--fitted", "results/fit", "--data", "d.csv"])
     assert cli._fitted_folder(args) == "results/fit" and capsys.readouterr().err == ""
     for argv in (["--data", "d.csv"], ["--fitted", "a", "--model", "b", "--data", "d.csv"]):

@@ -12,8 +12,11 @@ ONE = ["--profile", "smoke", "--claims", "dp_loss", "--frameworks", "jax", "--mo
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--seeds", "0"], ["--seeds", "from 1 to 1000"]),
-    (["--seeds", "-1"], ["--seeds", "from 1 to 1000"]),
+    (["--n-seeds", "0"], ["--n-seeds", "from 1 to 1000"]),
+    (["--n-seeds", "-1"], ["--n-seeds", "from 1 to 1000"]),
+    (["--seeds", "999,1000"], ["--seeds", "999", "from 1000 to 1999"]),
+    (["--seeds", "a,1"], ["--seeds", "integers >= 0"]),
+    (["--seeds", "1000,", "--n-seeds", "1"], ["--seeds", "--n-seeds", "not both"]),
     (["--models", "lnnn"], ["--models", "lnnn", "valid:", "baseline"]),
     (["--frameworks", "jax,jax"], ["--frameworks", "jax", "more than once"]),
     (["--claims", "dp_loss,dp_loss"], ["--claims", "more than once"]),

@@ -32,7 +32,7 @@ def test_unknown_split_is_refused_by_name():
 
 
 def test_more_seeds_than_a_split_holds_are_refused():
-    with pytest.raises(ValueError, match="--seeds: 1001 is not valid"):
+    with pytest.raises(ValueError, match="--n-seeds: 1001 is not valid"):
         runner.plan("quick", split="dev", seeds=1001)
 
 

@@ -76,4 +76,13 @@ def test_the_exact_acceleration_scores_at_the_chaos_floor_and_zero_as_the_null(r
     zero = json.loads((base / "zero" / "result.json").read_text())["metrics"]
     assert exact["heldout_l1"] == 0.0 and exact["vpt_s"] >= 0.5 * exact["chaos_floor_vpt_s"]
     assert zero["null_heldout_l1"] <= zero["heldout_l1"] <= 1.01 * zero["null_heldout_l1"]
-    assert zero["vpt_s"] < 0.1 * exact["chaos_floor_vpt_s"]
+    assert zero["vpt_s"] < 0.25 * exact["vpt_s"]   # smoke's short horizon: the exact function follows it whole
+
+
+def test_the_table_compares_like_with_like(ran):
+    """The functions are scored under the profile the models trained in: one profile in the table."""
+    import pandas as pd
+
+    folder, _, _ = ran
+    table = pd.read_csv(folder / "results" / "mine" / "summary" / "systems.csv")
+    assert set(table["profile"]) == {"smoke"}

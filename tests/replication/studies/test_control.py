@@ -45,13 +45,13 @@ def test_the_references_are_unseen_shapes_and_the_training_family_twice_as_fast(
 
 
 def test_the_command_writes_the_study_for_a_folder_without_models(tmp_path, capsys):
-    assert main(["control", "--results", str(tmp_path), "--references", "1", "--duration", "0.2", "--quiet"]) == 0
+    assert main(["control", "--out", str(tmp_path), "--references", "1", "--duration", "0.2", "--quiet"]) == 0
     import pandas as pd
 
     df = pd.read_csv(tmp_path / "control" / "tracking.csv")
     assert set(df["controller"]) == {"exact", "pd"} and set(df["family"]) == {"test", "train_x2"}
     assert (df.loc[df["controller"] == "pd", "ratio_to_pd"] == 1).all()
-    assert main(["control", "--results", str(tmp_path), "--references", "0", "--quiet"]) == 2
+    assert main(["control", "--out", str(tmp_path), "--references", "0", "--quiet"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
 
 

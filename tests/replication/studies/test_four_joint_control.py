@@ -23,7 +23,7 @@ def tiny_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("control4")
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(A, "SIZES", TINY)
-        assert main(["control", "--system", "four_joint_arm", "--results", str(out), "--references", "1",
+        assert main(["control", "--system", "four_joint_arm", "--out", str(out), "--references", "1",
                      "--duration", "0.1", "--steps", "3", "--quiet"]) == 0
     return out
 
@@ -73,7 +73,7 @@ def test_a_rerun_reuses_the_fits(tiny_run):
     table = (folder / "tracking.csv").read_bytes()
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(A, "SIZES", TINY)
-        assert main(["control", "--system", "four_joint_arm", "--results", str(tiny_run), "--references", "1",
+        assert main(["control", "--system", "four_joint_arm", "--out", str(tiny_run), "--references", "1",
                      "--duration", "0.1", "--steps", "3", "--quiet"]) == 0
     assert {p: p.stat().st_mtime_ns for p in units} == before
     assert (folder / "tracking.csv").read_bytes() == table
@@ -112,9 +112,9 @@ def test_the_two_link_study_is_what_it_was():
 def test_bad_options_are_one_line_errors(tmp_path, capsys):
     for bad, option in ((["--system", "three_link_arm"], "--system"), (["--steps", "5"], "--steps"),
                         (["--system", "four_joint_arm", "--steps", "0"], "--steps"),
-                        (["--system", "four_joint_arm", "--framework", "tf"], "--framework"),
+                        (["--system", "four_joint_arm", "--frameworks", "tf"], "--frameworks"),
                         (["--system", "four_joint_arm", "--seeds", "a"], "--seeds")):
-        assert main(["control", "--results", str(tmp_path), *bad, "--quiet"]) == 2
+        assert main(["control", "--out", str(tmp_path), *bad, "--quiet"]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith("lagbench: error: ") and option in err
     assert not list(tmp_path.iterdir())

@@ -85,7 +85,7 @@ def test_scenes_in_two_workers_give_the_table_of_one_process(tiny_run, tmp_path)
     np.testing.assert_allclose(two[numbers].to_numpy(float), one[numbers].to_numpy(float), rtol=1e-4, atol=1e-8)
 
 
-@pytest.mark.parametrize("option, bad", [("--steps", "0"), ("--seeds", "x"), ("--framework", "tf"),
+@pytest.mark.parametrize("option, bad", [("--steps", "0"), ("--seeds", "x"), ("--frameworks", "tf"),
                                          ("--jobs", "0")])
 def test_bad_options_are_one_line_naming_the_option_and_write_nothing(tmp_path, capsys, option, bad):
     assert main(["robustness", "--out", str(tmp_path / "o"), option, bad, "--quiet"]) == 2

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from lagbench.models import ModelSpec
 from lagbench.replication.training.protocol import Data, Guard, Protocol, Scouting
-from lagbench.replication.training.schedules import Constant, OneCycle, StepDecay
+from lagbench.replication.training.schedules import Anneal, Constant, OneCycle, StepDecay
 
 # Relative differences allowed over the row's steps: loss, gradient norm, and the parameters as one vector
 # (`parity_kit._params_rel`). float32: about 10x the largest measured over F32_STEPS steps (`python
@@ -73,8 +73,9 @@ ARM = {"task": "inverse_dynamics", "loss": "mse", "n_train": 400}
 
 F64 = [
     Row("baseline_acc", _s("baseline", 1, activation="tanh", init="xavier"), _p("spring_iid", loss="mse")),
+    # the early stop's closing anneal (a half cosine from step `begin`)
     Row("baseline_invdyn", _s("baseline", 2, activation="softplus", init="xavier", extra_inputs=2),
-        _p("two_link_arm", **ARM, schedule=Constant(lr=1e-3), l2=1e-5)),
+        _p("two_link_arm", **ARM, schedule=Anneal(lr=1e-3, final=1e-4, begin=5), l2=1e-5)),
     Row("baseline_dp", _s("baseline", 2, activation="relu", init="xavier", angle_wrap=True),
         _p("double_pendulum_iid", **DP)),
     Row("lnn_fast", LNN, _p("double_pendulum_iid", **DP), **C),

@@ -38,9 +38,9 @@ def test_without_a_gpu_auto_takes_the_cpu_and_gpu_names_what_is_missing():
 @pytest.mark.parametrize("argv, framework", [
     (["run", "--profile", "smoke", "--frameworks", "torch", "--device", "gpu"], "PyTorch"),
     (["run", "--profile", "smoke", "--frameworks", "jax", "--device", "gpu"], "JAX"),
-    (["fit", "--data", "none.csv", "--model", "lnn", "--framework", "torch", "--device", "gpu"], "PyTorch"),
+    (["fit", "--data", "none.csv", "--model", "lnn", "--frameworks", "torch", "--device", "gpu"], "PyTorch"),
     (["train-target", "--device", "gpu"], "JAX"),
-    (["evaluate", "--fitted", "{fit}", "--data", "{data}", "--framework", "torch", "--device", "gpu"], "PyTorch"),
+    (["evaluate", "--fitted", "{fit}", "--data", "{data}", "--frameworks", "torch", "--device", "gpu"], "PyTorch"),
 ])
 def test_a_gpu_asked_for_where_none_is_seen_is_one_line_and_writes_nothing(tmp_path, argv, framework, fitted):
     out = tmp_path / "out"

@@ -8,6 +8,7 @@ from lagbench.replication.training.protocol import (
     KEY_VERSION,
     Adam,
     Data,
+    EarlyStop,
     Guard,
     Protocol,
     Scouting,
@@ -22,10 +23,12 @@ FULL = BASE.replace(guard=Guard(clip=100.0, skip=10.0), tracking=Tracking(every=
 
 def test_the_canonical_form_round_trips_and_holds_every_field():
     for p in (BASE, FULL, BASE.replace(cohort=3), BASE.replace(schedule=StepDecay(lr=1e-2, every=3, gamma=0.5)),
-              BASE.replace(schedule=Constant(lr=2e-3), optimiser=Adam(b2=0.99))):
+              BASE.replace(schedule=Constant(lr=2e-3), optimiser=Adam(b2=0.99)),
+              FULL.replace(early_stop=EarlyStop(every=5, patience=2))):
         d = p.to_dict()
         assert d["version"] == KEY_VERSION
-        assert set(d) == {"version", *(f for f in p.__dataclass_fields__)}   # no field dropped while off
+        # no field dropped while off, but the early stop (no claim has it: the claims' keys stay as they were)
+        assert set(d) == {"version", *(f for f in p.__dataclass_fields__)} - ({"early_stop"} if not p.early_stop else set())
         assert Protocol.from_dict(json.loads(json.dumps(d))) == p
     # a schedule holds only the values its shape uses
     assert set(BASE.replace(schedule=Constant(lr=1.0)).to_dict()["schedule"]) == {"kind", "lr"}

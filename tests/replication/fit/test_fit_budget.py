@@ -1,0 +1,94 @@
+"""`lagbench fit`'s budget follows the data (`kind_defaults.SMALL`): a system with fewer coordinates than the
+kind's claim trains without restarts, for the claim's steps, and stops early when its held-out error stops
+improving (`--patience`); the double pendulum keeps the claim's and the fit study's budget. One progress bar
+counts the restarts' steps and the main training's (`replication.fit.progress`)."""
+import json
+
+import pytest
+
+from lagbench.cli import main
+from lagbench.replication.fit import kind_defaults, progress
+from lagbench.replication.fit.task import fit, resolved
+from lagbench.replication.training.scouting import budget_samples
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("data")
+    out = {}
+    for system in ("pendulum", "double_pendulum"):
+        out[system] = folder / f"{system}.csv"
+        assert main(["simulate", "--system", system, "--trajectories", "10", "--duration", "2", "--rate", "20",
+                     "--out", str(out[system])]) == 0
+    return out
+
+
+def test_a_pendulum_gets_the_sized_budget_and_the_double_pendulum_the_studys(files):
+    claim = kind_defaults.defaults("lnn", "acceleration")
+    small, dp = resolved(files["pendulum"], {"model": "lnn"}), resolved(files["double_pendulum"], {"model": "lnn"})
+    assert (small.dof, dp.dof) == (1, 2) and kind_defaults.claim_dof("lnn", "acceleration") == 2
+    assert (small.options.steps, small.options.restarts, small.options.patience) == (claim["steps"], None,
+                                                                                   kind_defaults.SMALL["patience"])
+    factor = kind_defaults.ON_RECORDINGS[("lnn", "acceleration")]
+    assert (dp.options.steps, dp.options.restarts, dp.options.patience) == (factor * claim["steps"], claim["restarts"], 0)
+    assert kind_defaults.SMALL["patience"] > 0 and claim["restarts"]
+    same = ("hidden", "lr", "batch", "schedule", "loss", "guard_clip", "input_scale")
+    assert {k: getattr(small.options, k) for k in same} == {k: getattr(dp.options, k) for k in same}
+    # given options win; the HNN's claim is the pendulum's, so a pendulum is not smaller than it
+    given = resolved(files["pendulum"], {"model": "lnn", "patience": 0, "restarts": 4, "steps": 50}).options
+    assert (given.patience, given.restarts, given.steps) == (0, 4, 50)
+    assert not kind_defaults.small("hnn", "hamiltonian", 1) and kind_defaults.small("delan", "inverse_dynamics", 1)
+    assert "no restarts, an early stop" in kind_defaults.source("lnn", "acceleration", True, 1)
+    assert "early stop" not in kind_defaults.source("lnn", "acceleration", True, 2)
+
+
+def test_a_fit_stops_when_its_heldout_error_stops_improving(files, tmp_path):
+    """A rate too small to move the model: the held-out error cannot improve, so the fit stops `patience`
+    evaluations after its first and anneals over the steps its patience spans; the record says when, and
+    counts the samples it trained."""
+    d = fit(files["pendulum"], model="baseline", out=tmp_path / "a", steps=200, hidden=(8,), batch=16, lr=1e-9,
+            schedule="constant", patience=3)
+    every = 200 // kind_defaults.HELDOUT_CHECKS
+    assert d["protocol"]["early_stop"] == {"every": every, "patience": 3, "min_improvement": kind_defaults.MIN_IMPROVEMENT,
+                                           "anneal": 3 * every}
+    assert d["early_stop"]["stopped_at"] == 3 * every and d["train_steps"] == 3 * every + 1 + 3 * every
+    assert d["train_samples"] == d["train_steps"] * 16
+    stored = json.loads((tmp_path / "a" / "units" / "fit" / "jax" / "baseline" / "seed0" / "result.json").read_text())
+    assert stored["early_stop"] == d["early_stop"]
+    moving = fit(files["pendulum"], model="baseline", out=tmp_path / "b", steps=200, hidden=(8,), batch=16, patience=0)
+    assert "early_stop" not in moving["protocol"] and "early_stop" not in moving and moving["train_steps"] == 200
+
+
+def test_patience_without_heldout_rows_is_refused(files, tmp_path, capsys):
+    assert main(["fit", "--data", str(files["pendulum"]), "--model", "lnn", "--holdout", "none", "--patience", "5",
+                 "--out", str(tmp_path / "x")]) == 2
+    assert "--patience 5: the early stop reads held-out rows" in capsys.readouterr().err
+    # at the defaults (an early stop for a pendulum) a split without held-out rows trains to its steps
+    d = fit(files["pendulum"], model="baseline", out=tmp_path / "n", split="none", steps=20, hidden=(8,), batch=16)
+    assert "early_stop" not in d["protocol"] and d["train_steps"] == 20
+
+
+def test_the_bar_counts_the_restarts_steps_and_the_main_steps_in_one_total(files, tmp_path):
+    protocols, rows = [], []
+    fit(files["double_pendulum"], model="lnn", out=tmp_path / "r", steps=8, hidden=(8,), batch=16, restarts=4,
+        restart_steps=6, restart_keep=2, restart_batch=8, on_train=protocols.append, on_log=rows.append)
+    (p,) = protocols
+    assert progress.total_steps(p) == 6 + 8   # the restarts train side by side: 6 steps, then 8 main steps
+    done = [progress.position(p, r) for r in rows]
+    assert done == sorted(done) and done[-1] == progress.total_steps(p)
+    assert [progress.position(p, r) for r in rows if "restart_step" in r][-1] == 6
+    # the time left at one second a sample is the samples the whole training has: restarts (4, then 2 after the
+    # cut, at their batch) and the main training's
+    assert progress.seconds_left(p, 0, 1.0) == budget_samples(p) == (4 * 3 + 2 * 3) * 8 + 8 * 16
+    assert progress.seconds_left(p, 6, 1.0) == 8 * 16 and progress.seconds_left(p, 14, 1.0) == 0
+
+
+def test_the_bar_ends_at_its_total_or_says_where_the_training_ended(files, tmp_path, capsys):
+    assert main(["fit", "--data", str(files["pendulum"]), "--model", "baseline", "--steps", "200", "--hidden", "8",
+                 "--batch", "16", "--lr", "1e-9", "--schedule", "constant", "--patience", "3",
+                 "--out", str(tmp_path / "c")]) == 0
+    captured = capsys.readouterr()
+    # evaluations at steps 0, 2, 4, 6: it stops after the 7th step and anneals over 3 x 2 more
+    assert "ended at step 13 of 200" in captured.err
+    assert "early stop at step 7 of 200" in captured.err and "annealed over 6 more steps, 13 in all" in captured.err
+    assert captured.out.startswith("done: held-out L1 ")   # the result line alone on stdout (untrained: "done")
