@@ -12,6 +12,7 @@ from __future__ import annotations
 import pandas as pd
 
 from lagbench.replication.claims.published import Published
+from lagbench.replication.evaluation.diverged import SCALED, is_diverged
 from lagbench.reports.document import NOT_RUN
 from lagbench.reports.fmt import cell, num, seed_values, stat, summarise
 from lagbench.reports.glossary import unit
@@ -120,6 +121,20 @@ def metric_names(units: list[Unit]) -> list[str]:
     return list(names)
 
 
+def metric_cell(name: str, vals: list) -> str:
+    """One metric over a model's seeds: mean ± std, a yes/no metric as k/n seeds; an error against the data's
+    own scale (`diverged.SCALED`) that diverged on a seed is counted apart, never averaged in."""
+    scaled = name in SCALED or name.split("_", 1)[-1] in SCALED
+    blown = sum(map(is_diverged, vals)) if scaled else 0
+    s = summarise([v for v in vals if not (scaled and is_diverged(v))])
+    if unit(name) == "share":
+        return seed_values(vals, share=True) if s["n"] else "not recorded"
+    text = stat(s["mean"], s["std"]) if s["n"] else ""
+    if blown:
+        return "; ".join(x for x in (text, f"{blown} of {len(vals)} seeds diverged") if x)
+    return text or "not recorded"
+
+
 def metrics_table(res: Results, claim: dict, max_metrics: int = 7) -> pd.DataFrame | None:
     """Rows: (model, framework); columns: every recorded metric (mean ± std; a yes/no metric as k/n seeds),
     first ``max_metrics``."""
@@ -139,10 +154,7 @@ def metrics_table(res: Results, claim: dict, max_metrics: int = 7) -> pd.DataFra
                 continue
             row = {"model": model, "framework": fw, "n": str(len(group))}
             for name in names:
-                vals = [u.metric(name) for u in group]
-                s = summarise(vals)
-                row[name] = ("not recorded" if not s["n"] else seed_values(vals, share=True)
-                             if unit(name) == "share" else stat(s["mean"], s["std"]))
+                row[name] = metric_cell(name, [u.metric(name) for u in group])
             rows.append(row)
     return pd.DataFrame(rows) if rows else None
 
