@@ -72,7 +72,7 @@ def cmd_run(args):
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=frameworks, seeds=seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
-                  dry_run=args.dry_run, split=args.split, add_models=args.add_model)
+                  dry_run=args.dry_run, split=args.split, add_models=args.add_model, store=args.store)
     if summary.get("dry_run"):
         return 0
     from lagbench.reports.load import asked_claims
@@ -187,9 +187,13 @@ def build_parser():
                    "(default: start a local Ray instance on this machine's cores)")
     s.add_argument("--dry-run", action="store_true", help="print the units and an estimated duration (a few "
                    "probed steps of each training), then stop; writes nothing")
+    s.add_argument("--store", action="store_true", help="keep OUT as a store that git can carry (docs/store.md): "
+                   "each finished unit trimmed to what the verdicts, the report and a resumed run read, a .gitignore "
+                   "for the rest, a unit made under another registration redone, its size told at the end")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_run)
+    from lagbench.replication.run.verify_cli import add_command as add_verify
     from lagbench.replication.studies.control_cli import add_command as add_control
     from lagbench.replication.studies.online_cli import add_command as add_online
     from lagbench.replication.studies.robustness_cli import add_command as add_robustness
@@ -219,6 +223,7 @@ def build_parser():
     add_control(sub)
     add_online(sub)
     add_robustness(sub)
+    add_verify(sub)
     for command in sub.choices.values():   # "(default: X)" on every option that does not write its own
         options.show_defaults(command)
     return p

@@ -59,7 +59,8 @@ def cmd_table(args):
 def add_commands(sub) -> None:
     s = sub.add_parser("report", help="write REPORT.md, REPORT.pdf and figures from a results folder",
                        description="Write REPORT.md, REPORT.typ, REPORT.pdf and figures/*.png into --out from "
-                       "the result files in --results. Replaces only files an earlier report wrote there.")
+                       "the result files in --results, and APPENDIX.typ and APPENDIX.pdf (the long tables "
+                       "REPORT.md holds in full). Replaces only files an earlier report wrote there.")
     s.add_argument("--results", default="results/quick", help="a folder written by `lagbench run` (or bench, "
                    "stiff, train-target) (default: results/quick)")
     s.add_argument("--out", help="the report folder (default: report/<the results folder's name>, so that "

@@ -55,14 +55,16 @@ class Figure:
 
 @dataclass
 class Section:
-    """``page``: in the PDF, the section starts a page (a claim's page); ``appendix``: the section opens the
-    appendix (the PDF starts a page and numbers the sections from it A, B, ...)."""
+    """``page``: in the PDF, the section starts a page; ``appendix``: the section opens the appendix (the PDF
+    starts a page and numbers the sections from it A, B, ...); ``dump``: a long table dump that REPORT.md
+    keeps in its place and the PDF sends to APPENDIX.pdf (``reports.pdf``)."""
 
     title: str
     blocks: list = field(default_factory=list)
     level: int = 1
     page: bool = False
     appendix: bool = False
+    dump: bool = False
 
     def add(self, *blocks) -> Section:
         self.blocks.extend(b for b in blocks if b is not None)

@@ -202,17 +202,35 @@ def metric_names(sections: list[Section]) -> list[str]:
     return list(names)
 
 
-def glossary_section(sections: list[Section]) -> Section:
-    """The terms, then each metric name the report's tables show with its meaning and unit."""
-    s = Section("Glossary")
-    s.add(Para("The words the scorecard uses, then every metric name the tables show."))
-    s.add(Bullets([f"{term}: {text}." for term, text in TERMS]))
+def _metrics_table(names: list[str]) -> pd.DataFrame:
     rows = []
-    for name in metric_names(sections):
+    for name in names:
         d = define(name)
         rows.append({"metric": name, "meaning": d[0] if d else "recorded by the units; not defined in the suite's "
                                                                 "glossary (reports/glossary.py)",
                      "unit": d[1] if d else "–"})
-    if rows:
-        s.add(Table("Metric names", pd.DataFrame(rows), ["reports/glossary.py", "docs/RESULTS.md"]))
+    return pd.DataFrame(rows)
+
+
+def glossary_section(sections: list[Section]) -> Section:
+    """The terms, then each metric name the tables of ``sections`` show with its meaning and unit."""
+    s = Section("Glossary")
+    s.add(Para("The words the scorecard uses, then every metric name the tables show."))
+    s.add(Bullets([f"{term}: {text}." for term, text in TERMS]))
+    names = metric_names(sections)
+    if names:
+        s.add(Table("Metric names", _metrics_table(names), ["reports/glossary.py", "docs/RESULTS.md"]))
     return s
+
+
+def more_metric_names(sections: list[Section], defined: list[Section]) -> list[Section]:
+    """The metric names the tables of ``sections`` show that those of ``defined`` (the glossary's) do not, each
+    with its meaning and unit: the glossary's continuation for the appendix ([] when there are none)."""
+    known = set(metric_names(defined))
+    names = [n for n in metric_names(sections) if n not in known]
+    if not names:
+        return []
+    s = Section("Glossary: the appendix's metric names")
+    s.add(Para("Every metric name the appendix's tables show that the Glossary (after the scorecard) does not."))
+    return [s.add(Table("Metric names in the appendix", _metrics_table(names),
+                        ["reports/glossary.py", "docs/RESULTS.md"]))]

@@ -11,6 +11,11 @@ break points after ``_``, ``/``, ``,`` and ``=``, and every ``RUN`` characters w
 (``breakable``). Tables and figures carry the report's numbers (``document.label``); typst's own figure
 numbering is off, so the PDF and REPORT.md print the same "Figure 7". Figures are embedded from
 ``figures/`` relative to the output folder (the typst root), at a width from their size in inches.
+
+The body flows on from section to section (a level-1 section starts a page in the appendix, or where it asks
+to with ``page``). The long dumps (sections marked ``dump``) leave REPORT.pdf for a
+second PDF, ``APPENDIX.pdf`` (``APPENDIX.typ``), rendered from the same sections with the same numbers; the
+main PDF's appendix says in one line where they are (``write_pdf``).
 """
 
 from __future__ import annotations
@@ -27,20 +32,20 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 def figure_width(path: Path) -> str:
     """The share of the text width (7 in) a figure takes, from its width in inches at ``figures.DPI``: a single
-    panel (up to 7 in) 55 %, a wider one 80 %, a figure of many panels (over 10 in, or wider than 2.4 x its
-    height) the whole width, so that a figure's lettering stays about the size of the caption's."""
+    panel (up to 7 in) 45 %, a wider one 60 %, a figure of many panels (over 10 in, or wider than 2.4 x its
+    height) 80 %, so that a figure's lettering stays near the size of the caption's and the body stays short."""
     try:
         with open(path, "rb") as f:
             head = f.read(24)
         w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
     except OSError:
-        return "55%"
+        return "45%"
     if not head.startswith(PNG_SIGNATURE) or h == 0:
-        return "55%"
+        return "45%"
     inches = w / DPI
     if inches > 10 or w / h > 2.4:
-        return "100%"
-    return "80%" if inches > 7 else "55%"
+        return "80%"
+    return "60%" if inches > 7 else "45%"
 
 
 TEXT_WIDTH = 504.0   # pt: A4 (595 pt) less the 1.6 cm margins
@@ -99,7 +104,6 @@ PREAMBLE = """#set document(title: {title})
 #set text(size: 10pt)
 #set par(justify: false)
 #set heading(numbering: "1.1")
-#show heading.where(level: 1, outlined: true): it => {{ pagebreak(weak: true); it }}
 #show table.cell.where(y: 0): strong
 """
 
@@ -139,10 +143,12 @@ def render_typst(title: str, sections: list[Section], root: Path = Path(".")) ->
     out = [PREAMBLE.format(title=lit(title)),
            f"#align(center, text(size: 18pt, weight: \"bold\", {lit(title)}))\n",
            "#outline(depth: 1)\n"]
+    appendix = False
     for s in sections:
         if s.appendix:
+            appendix = True
             out.append('#pagebreak(weak: true)\n#counter(heading).update(0)\n#set heading(numbering: "A.1")\n')
-        elif s.page:
+        elif s.page or (s.level == 1 and appendix):
             out.append("#pagebreak(weak: true)\n")
         out.append(f"#heading(level: {s.level}, {lit(s.title)})\n")
         for b in s.blocks:
@@ -159,8 +165,30 @@ def render_typst(title: str, sections: list[Section], root: Path = Path(".")) ->
     return "\n".join(out)
 
 
-def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path, Path]:
-    """Write ``REPORT.typ`` and compile ``REPORT.pdf`` in ``out_dir``; returns both paths."""
+APPENDIX_PDF = "APPENDIX.pdf"
+
+
+def split(title: str, sections: list[Section]) -> tuple[list[Section], list[Section], str]:
+    """(REPORT.pdf's sections, APPENDIX.pdf's, APPENDIX.pdf's title): the sections marked ``dump`` go to the
+    second, and the main PDF's appendix opens with a line naming them and where they are."""
+    dumps = [s for s in sections if s.dump]
+    main = [s for s in sections if not s.dump]
+    if not dumps:
+        return main, [], ""
+    names = "; ".join(s.title for s in dumps if s.level == 1)
+    where = Para(f"In {APPENDIX_PDF}, beside this file (and in REPORT.md, in full): {names}.")
+    at = next((i for i, s in enumerate(main) if s.appendix), None)
+    if at is None:
+        main.append(Section("Appendix", appendix=True).add(where))
+    else:
+        opening = main[at]
+        main[at] = Section(opening.title, [*opening.blocks, where], opening.level, opening.page, True)
+    return main, dumps, f"{title}: appendix of long tables"
+
+
+def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path, ...]:
+    """Write ``REPORT.typ`` and compile ``REPORT.pdf`` in ``out_dir``, and ``APPENDIX.typ`` and
+    ``APPENDIX.pdf`` where sections are marked ``dump`` (`split`); returns the paths written."""
     try:
         import typst  # a core dependency, imported here so that importing `reports` stays light
     except ImportError as e:
@@ -168,11 +196,16 @@ def write_pdf(title: str, sections: list[Section], out_dir: Path) -> tuple[Path,
                          f"alone with `lagbench report --no-pdf`") from e
 
     out_dir = Path(out_dir)
-    typ = out_dir / "REPORT.typ"
-    pdf = out_dir / "REPORT.pdf"
-    write(typ, render_typst(title, sections, out_dir))
-    write(pdf, typst.compile(str(typ), root=str(out_dir.resolve())))  # bytes, written atomically
-    return typ, pdf
+    main, dumps, second = split(title, sections)
+    written: list[Path] = []
+    for name, heading, part in (("REPORT", title, main), ("APPENDIX", second, dumps)):
+        if not part:
+            continue
+        typ, pdf = out_dir / f"{name}.typ", out_dir / f"{name}.pdf"
+        write(typ, render_typst(heading, part, out_dir))
+        write(pdf, typst.compile(str(typ), root=str(out_dir.resolve())))  # bytes, written atomically
+        written += [typ, pdf]
+    return tuple(written)
 
 
 def page_count(pdf: Path) -> int:

@@ -175,7 +175,7 @@ READING = ("How to read a row. Verdict: the runner's own rule (replication/claim
            "rule's) or decided, each with its interval, level and seed counts. Key number: the key model's claim "
            "metric with its unit, seed mean (lowest to highest seed, n seeds), a yes/no metric as k/n seeds. "
            "Published: 'like for like' only for the same kind of number under the same conditions, else context "
-           "(in full, with ours beside it: the table after the checks). Flags: far from published (over 2x or "
+           "(in full, with ours beside it: the appendix's published numbers). Flags: far from published (over 2x or "
            "under half), near the threshold, did not learn, sizes differ (parameters). Every term and metric "
            "name: the Glossary, next page.")
 
@@ -192,16 +192,6 @@ def scorecard_section(res: Results) -> Section:
     checks = scorecard_table(res, "check")
     if "#" in checks.columns:
         s.add(Table("Checks", checks, ["claims.json", "units/*/*/*/seed*/result.json"]))
-    published = published_table(res)
-    if published is not None:
-        s.add(Table("Published numbers beside ours", published, ["claims.json", "units/*/*/*/seed*/result.json"],
-                    note="Each model's published value with where it is printed, our seed mean of the same metric "
-                         "(range over seeds) and the ratio of the two; far from published: over 2x or under half."))
-    variants = variants_table(res)
-    if variants is not None:
-        s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
-                    note="A variant is a model with a departure from the paper standing in for the paper's model; "
-                         "the claim is judged again with it, on this line only. A variant never decides a claim."))
     s.add(Para(sections_registration.summary(res)))
     flagged = [f"{cid}: {f}" for cid, v in res.verdicts.items() for f in (v or {}).get("flags") or []]
     s.add(Para("Defects to investigate (parts on which the two frameworks, started from the same weights and "
@@ -211,15 +201,25 @@ def scorecard_section(res: Results) -> Section:
 
 
 def scorecard_appendix(res: Results) -> Section:
-    """The appendix's scorecard tables: every part with its interval, the reasons in full, the registration
-    and tuning of each claim's protocol."""
+    """The appendix's scorecard tables: the published numbers beside ours, every part with its interval, the
+    variants (each claim's page names its own), the reasons in full, the registration and tuning of each claim's protocol."""
     s = Section("Parts, reasons and registrations")
+    published = published_table(res)
+    if published is not None:
+        s.add(Table("Published numbers beside ours", published, ["claims.json", "units/*/*/*/seed*/result.json"],
+                    note="Each model's published value with where it is printed, our seed mean of the same metric "
+                         "(range over seeds) and the ratio of the two; far from published: over 2x or under half."))
     for kind, title in (("claim", "Parts of the paper claims"), ("check", "Parts of the checks")):
         parts = all_parts_table(res, kind)
         if parts is not None:
             s.add(Table(title, parts, ["summary/verdicts.json", "units/*/*/*/seed*/result.json"],
                         note="Each part is decided per framework on the interval shown (point [low, high], its "
                              "confidence level and method; a bound reads the range over seeds)."))
+    variants = variants_table(res)
+    if variants is not None:
+        s.add(Table("Variants", variants, ["claims.json", "units/*/*/*/seed*/result.json"],
+                    note="A variant is a model with a departure from the paper standing in for the paper's model; "
+                         "the claim is judged again with it, on this line only. A variant never decides a claim."))
     why = reasons_table(res)
     if why is not None:
         s.add(Table("Reasons in full (parts not reproduced)", why, ["summary/verdicts.json"]))

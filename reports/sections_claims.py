@@ -1,6 +1,7 @@
 """Summary, run-status and per-claim sections (grouped by :mod:`reports.themes`), with their figures.
 
-``summary_sections(res)``, ``theme_sections(res, out_dir)`` (a page per claim) and ``claim_details(res)``
+``summary_sections(res)``, ``theme_sections(res, out_dir)`` (a section per claim; a table note repeated from
+claim to claim is said once) and ``claim_details(res)``
 (the appendix's tables behind the claims' pages) return ``list[Section]``; figures are written under
 ``out_dir/figures/`` as ``<claim>_<kind>.png`` only when their data exist.
 """
@@ -88,26 +89,29 @@ def _trainings(units) -> tuple:
 
 def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None,
                   details: dict | None = None) -> Section:
-    """The claim's page: what it says and where, its verdict with the category of each part's reason, its
+    """The claim's page: what it says and where, its verdict (the reasons in words are the scorecard's), its
     parts, the decisive numbers against the published ones, what the comparison does not control (the
-    compared models' sizes and budgets, every seed of a model below its bar), then the figures that answer
-    it. `drawn` maps the trainings whose work-precision figure is already in the report to its claim, so a
+    compared models' sizes and budgets and every seed of a model below its bar go to the claim's details
+    when `details` collects them), then the figures that answer it. `drawn` maps the trainings whose work-precision figure is already in the report to its claim, so a
     figure of the same trainings is drawn once. The competence and rollout tables are the claim's details in
     the appendix (`claim_details`); so are its training curves where no work-precision figure stands in for
     them and the page has another figure, when `details` ({claim: [Figure]}) collects them."""
     cid = claim["id"]
     units = res.usable(cid)
     src = RESULT_FILES.format(claim=cid)
-    s = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}", level=2, page=True)
+    s = Section(f"Claim {cell(claim.get('number'), '–')}: {cid}", level=2)
     s.add(Para(f"{cell(claim.get('title'), 'untitled')} — {cell(claim.get('paper'), 'paper unknown')} "
                f"{cell(claim.get('section'), '')}. System: {cell(claim.get('system'), 'unknown')}. "
                f"Metric: {cell(claim.get('metric'), 'unknown')} ({cell(claim.get('metric_label'), 'no label')}). "
                f"Verdict rule: {cell(claim.get('verdict_rule'), 'not stated')}. "
                f"Competence bars: {'; '.join(claim.get('bars') or []) or 'none (no learned model)'}."))
     v = res.verdicts.get(cid)
+    pt = parts_table(res, claim)
     if v is not None:
         kind = "check (not counted among the paper claims)" if v.get("kind") == "check" else "paper claim"
-        why = why_text(res, claim) if units else cell(v.get("reason"), "")
+        # the reasons in words are the scorecard's (its why column); the page gives each part's interval (parts table)
+        why = ("Why: the scorecard's row; each part with its interval: the table below." if units and pt is not None
+               else why_text(res, claim) if units else cell(v.get("reason"), ""))
         s.add(Para(f"Verdict ({kind}): {cell(v.get('verdict'))}. {why}"))
         far, dead = published_far(res, claim), did_not_learn(res, claim)
         if far or dead:
@@ -116,7 +120,6 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         for var in v.get("variants") or []:
             s.add(Para(f"Variant: {cell(var.get('name'))} ({cell(var.get('departure'))}): {cell(var.get('verdict'))}, "
                        f"{cell(str(var.get('reason') or '').split('. ', 1)[0], '')}. It does not decide the claim."))
-    pt = parts_table(res, claim)
     if pt is not None:
         s.add(Table(f"{cid}: parts per framework", pt, [src + "result.json"],
                     note="Each part is decided on the interval shown; the last column gives the part's verdict "
@@ -129,8 +132,9 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     s.add(Table(f"{cid}: {metric}{f' ({u})' if u and u != '–' else ''} per model and framework", claim_table(res, claim),
                 ["claims.json", src + "result.json"],
                 note="Seed mean (lowest to highest seed, n seeds); a yes/no metric as k/n seeds; every seed where "
-                     "a model is below its competence bar."))
-    _confounds(s, res, claim, src)
+                     "a model is below its competence bar. Published: like for like or context (what differs: "
+                     "the appendix's published numbers)."))
+    _confounds(s, res, claim, src, details)
     done = set()
     for kind, fn, caption, shows, file in figure_specs(res, claim):
         rel = f"figures/{slug(cid)}_{kind}.png"
@@ -167,24 +171,32 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
     return s
 
 
-def _confounds(s: Section, res: Results, claim: dict, src: str) -> None:
-    """What the comparison does not control: the compared models' sizes and budgets, the rule's blind spots,
-    and every seed of a model below its competence bar."""
+def _confounds(s: Section, res: Results, claim: dict, src: str, details: dict | None = None) -> None:
+    """What the comparison does not control: the rule's blind spots on the page, with the compared models'
+    sizes and budgets and every seed of a model below its competence bar (the page's claim table gives each
+    such seed's value), on the page or, when `details` ({claim: [block]}) collects them, in the claim's
+    details."""
     sizes = model_sizes(res, claim)
     table = sizes_table(res, claim, sizes)
-    if table is not None:
-        s.add(Table(f"{claim['id']}: the compared models' sizes and budgets", table, [src + "result.json"],
-                    note="Parameters counted from each unit's recorded model spec (median over seeds of training "
-                         "samples and seconds)."))
-    s.add(Para("Not tested by the rule: " + not_tested(res, claim, sizes)))
     seeds = failing_seeds(res, claim)
+    blocks = [Table(f"{claim['id']}: the compared models' sizes and budgets", table, [src + "result.json"],
+                    note="Parameters counted from each unit's recorded model spec (median over seeds of training "
+                         "samples and seconds).")] if table is not None else []
     if seeds is not None:
-        s.add(Table(f"{claim['id']}: every seed of a model below its competence bar", seeds, [src + "result.json"]))
+        blocks.append(Table(f"{claim['id']}: every seed of a model below its competence bar", seeds,
+                            [src + "result.json"]))
+    text = "Not tested by the rule: " + not_tested(res, claim, sizes)
+    if details is None or not blocks:
+        s.add(blocks[0] if table is not None else None, Para(text), *blocks[table is not None:])
+        return
+    details.setdefault(claim["id"], []).extend(blocks)
+    s.add(Para(text + " The models' sizes and budgets" + (" and every seed below its bar" if seeds is not None else "")
+               + ": the claim's details, in the appendix."))
 
 
 def claim_details(res: Results, figures: dict | None = None) -> list[Section]:
     """The appendix's tables behind each claim's page: competence bars per model and framework, and the
-    rollout metrics (mean over trajectories and seeds); `figures` {claim: [Figure]} moved off its page."""
+    rollout metrics (mean over trajectories and seeds); `figures` {claim: [Table or Figure]} moved off its page."""
     out = []
     for claim in res.claims:
         cid = claim["id"]
@@ -228,8 +240,11 @@ def theme_sections(res: Results, out_dir: Path, details: dict | None = None) -> 
         if not claims:
             s.add(Para(f"Result: {NOT_RUN} (no claim of this kind in claims.json)."))
         out.append(s)
-        pages = [claim_section(res, c, out_dir, drawn, details) for c in claims]
-        if pages:
-            pages[0].page = False   # the theme's first claim follows its heading on the same page
-        out.extend(pages)
+        out.extend(claim_section(res, c, out_dir, drawn, details) for c in claims)
+    seen: set = set()
+    for b in (b for s in out for b in s.blocks if isinstance(b, Table) and b.note):   # a note is said once
+        if b.note in seen:
+            b.note = ""
+        else:
+            seen.add(b.note)
     return out

@@ -3,7 +3,7 @@ its seeds) and predictors scored by `lagbench evaluate --predict`.
 
 ``systems_table(root) -> DataFrame``: columns system, profile (the profile the numbers were made under: a
 claim unit's, or the one a predictor was scored under), source ("claim" or "predictor"), claim, model,
-framework, status ("ok"; a predictor's "failed: <why>", shown beside its numbers), seeds, params (the checkpoint's numbers), train_samples and train_time_s (medians over seeds), and
+framework, status ("ok"; a predictor's "failed: <why>", shown beside its numbers), seeds, params (`params_of`), train_samples and train_time_s (medians over seeds), and
 for each of ``METRICS`` (errors, valid times against the chaos and float32 floors, rollout µs per step) its median, min and max over seeds (``<metric>``, ``<metric>_min``, ``<metric>_max``;
 NaN where the claim's evaluation does not compute it). `lagbench table` writes it to
 ``summary/systems.csv`` and prints a table per system and profile; the report shows it (``systems_sections``).
@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from lagbench.replication.evaluation.diverged import SCALED, is_diverged
+from lagbench.reports.confounds import parameters
 from lagbench.reports.document import Para, Section, Table
 from lagbench.reports.fmt import count, num
 from lagbench.reports.load import load_results, protocol_of
@@ -34,15 +35,10 @@ METRICS = ("heldout_l1", "null_heldout_l1", "rollout_gmean_err", "energy_err_fin
 
 
 def params_of(unit) -> float:
-    """The number of parameters in the unit's checkpoint (NaN if it has none)."""
-    path = unit.path / "checkpoint.npz"
-    if not path.is_file():
-        return np.nan
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            return float(sum(npz[k].size for k in npz.files))
-    except (ValueError, OSError):
-        return np.nan
+    """The number of parameters of the unit's model (`confounds.parameters`: from its recorded spec, else its
+    checkpoint, which a store keeps only where a later step loads it; NaN without either)."""
+    n = parameters(unit)
+    return np.nan if n is None else n
 
 
 def _spread(values) -> dict:

@@ -63,12 +63,15 @@ def like_for_like(p: dict, units) -> tuple[bool, str]:
     return True, ""
 
 
-def published_cell(claim: dict, model: str, units) -> str:
-    """The published value of ``model``, what it is, and whether ``units`` measured the same thing."""
+def published_cell(claim: dict, model: str, units, short: bool = False) -> str:
+    """The published value of ``model``, what it is, and whether ``units`` measured the same thing (``short``:
+    the value and "like for like" or "context" alone; the scorecard's published table says why)."""
     p = published_entry(claim, model)
     if p is None:
         return "none published"
     same, why = like_for_like(p, units)
+    if short:
+        return f"{num(p.get('value'))} ({'like for like' if same else 'context'})"
     note = f"; {p['note']}" if p.get("note") else ""
     return (f"{num(p.get('value'))} ({p.get('kind')}, like for like{note})" if same
             else f"{num(p.get('value'))} ({p.get('kind')}; context only: {why}{note})")
@@ -91,7 +94,8 @@ def verdict_text(res: Results, claim: dict) -> str:
 
 
 def claim_table(res: Results, claim: dict) -> pd.DataFrame:
-    """Rows: models; columns: published value and the claim metric per framework: the seed mean with the range
+    """Rows: models; columns: published value (in short: the scorecard's published table has it in full) and
+    the claim metric per framework: the seed mean with the range
     over seeds (a yes/no metric of a pooled claim as "k/n seeds"), every seed's value where a seed of the
     model is below its competence bar."""
     metric = claim.get("metric")
@@ -101,7 +105,7 @@ def claim_table(res: Results, claim: dict) -> pd.DataFrame:
         units = [u for u in res.usable(claim["id"]) if u.model == model]
         added = any((u.result.get("model_spec") or {}).get("kind") == "user" for u in units)
         row = {"model": f"{model} (added: --add-model; no verdict reads it)" if added else model,
-               "published": published_cell(claim, model, units)}
+               "published": published_cell(claim, model, units, short=True)}
         for fw in res.frameworks or ["any framework"]:
             mine = [u for u in units if u.framework == fw or fw == "any framework"]
             vals = [u.metric(metric) for u in mine] if metric else []

@@ -61,7 +61,7 @@ def test_each_name_means_one_thing_in_every_command():
     for name, command in commands.items():
         shown = _visible(command)
         assert "--framework" not in shown, name
-        assert "--results" not in shown or name in ("report", "table"), name   # readers: their input folder
+        assert "--results" not in shown or name in ("report", "table", "verify"), name   # readers: their input folder
         if "--seeds" in shown:
             assert shown["--seeds"].nargs == "+", name   # the seeds themselves
         if "--frameworks" in shown:
@@ -69,7 +69,7 @@ def test_each_name_means_one_thing_in_every_command():
     for name in ("run", "tune"):
         assert "--n-seeds" in _visible(commands[name])
     writes = {name for name, c in commands.items() if "--out" in _visible(c)}
-    assert writes == set(COMMANDS) - {"list", "table"}   # table writes into the results folder it reads
+    assert writes == set(COMMANDS) - {"list", "table", "verify"}   # table, verify: into the results folder read
     required = {name for name in writes if _visible(commands[name])["--out"].required}
     assert required == {"simulate"}   # a file, never assumed; every folder has a default
 

@@ -83,9 +83,10 @@ def _shape(framework, spec, protocol) -> str:
 def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: bool = False) -> dict:
     """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
     "probes": configurations timed, "probes_reused": of those, read from OUT's `PROBES` file, "by_claim":
-    {claim id: seconds}}. A training that several claims share (claims 1, 2 and 11 train the same
-    double-pendulum models) counts for the first claim planned with it. `keep`: write this machine's probes
-    to OUT/`PROBES`, so that a resumed run on the same machine reuses them rather than probing again."""
+    {claim id: seconds}, "by_group": {training program: seconds}}. A training that several claims share
+    (claims 1, 2 and 11 train the same double-pendulum models) counts for the first claim planned with it.
+    `keep`: write this machine's probes to OUT/`PROBES`, so that a resumed run on the same machine reuses them
+    rather than probing again."""
     threads = torch_threads if any(u.framework == "torch" for u in units) else None
     known = _read_probes(out, threads)
     with threads_of_torch(threads):
@@ -155,7 +156,8 @@ def _estimate(units, out, jobs: int, per_step: dict) -> dict:
     return {"train_s": total, "wall_s": scheduled_wall(in_order, jobs),
             "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached,
             "probes": len(used), "probes_reused": len(reused),
-            "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1]))}
+            "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1])),
+            "by_group": todo}   # seconds per training program (`training.group_key`): the progress bar's weights
 
 
 def _group(u):

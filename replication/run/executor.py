@@ -1,9 +1,13 @@
 """Running the units of a plan: one after another in this process, or in parallel worker processes.
 A full disk (`results.DiskFull`) stops either at once: every later unit would fail to store its result.
 
-`run_units(todo, out, profile, progress=True, jobs=1) -> (failures, errors)`; failures: "<unit>: <reason>"
-of units whose training failed (a result is written), errors: "<unit>: <exception>" of units that raised
-(no result; a rerun retries them).
+`run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None) -> (failures, errors)`;
+failures: "<unit>: <reason>" of units whose training failed (a result is written), errors: "<unit>:
+<exception>" of units that raised (no result; a rerun retries them).
+
+The run's progress bar advances by each unit's estimated seconds (`replication.run.unit_seconds`, given as
+`seconds`), so that its remaining time is the work left; `on_done(unit)` is told of each unit whose run ended
+(a store trims the unit's folder: `replication.run.store`).
 
 jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N worker processes (spawned,
 so each starts clean), each given one CPU thread for JAX (XLA's Eigen pool off) and for PyTorch and
@@ -38,25 +42,38 @@ from lagbench.replication.run.environment import one_thread_children, worker_sta
 from lagbench.replication.training.scouting import progress_steps
 
 
-def _serial(todo, out, profile, progress):
-    failures, errors = [], []
-    bar = tqdm(todo, desc=f"lagbench {profile}", unit="unit", disable=not progress)
-    for u in bar:
-        bar.set_postfix_str(u.name)
-        steps = progress_steps(u.protocol()) if u.entry.train else 0
-        inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
-        last = {"step": -1}
+def _bar(seconds, desc, progress):
+    """The run's bar: it advances by each unit's estimated seconds (`unit_seconds`), so that its remaining time
+    is the work left at the run's own pace; the units done are counted in its postfix."""
+    return tqdm(total=sum(seconds), desc=desc, disable=not progress, smoothing=0,
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
 
-        def on_log(row, inner=inner, last=last):
-            inner.update(row["step"] - last["step"])
-            last["step"] = row["step"]
-            inner.set_postfix(loss=f"{row['loss']:.3g}")
-        try:
-            failure, error = _one(u, out, on_log)
-        finally:
-            inner.close()
-        failures += [failure] if failure else []
-        errors += [error] if error else []
+
+def _serial(todo, out, profile, progress, seconds, on_done):
+    failures, errors = [], []
+    bar = _bar(seconds, f"lagbench {profile}", progress)
+    try:
+        for i, (u, weight) in enumerate(zip(todo, seconds, strict=True)):
+            bar.set_postfix_str(f"{i}/{len(todo)} units; {u.name}")
+            steps = progress_steps(u.protocol()) if u.entry.train else 0
+            inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
+            last = {"step": -1}
+
+            def on_log(row, inner=inner, last=last):
+                inner.update(row["step"] - last["step"])
+                last["step"] = row["step"]
+                inner.set_postfix(loss=f"{row['loss']:.3g}")
+            try:
+                failure, error = _one(u, out, on_log)
+            finally:
+                inner.close()
+            failures += [failure] if failure else []
+            errors += [error] if error else []
+            bar.update(weight)
+            on_done(u)
+        bar.set_postfix_str(f"{len(todo)}/{len(todo)} units")
+    finally:
+        bar.close()
     return failures, errors
 
 
@@ -127,22 +144,28 @@ class _Workers:
             proc.join(timeout=10 if wait else 2)
 
 
-def _parallel(todo, out, profile, progress, jobs):
+def _parallel(todo, out, profile, progress, jobs, seconds, on_done):
     work = chains(todo)
-    failures, errors = [], []
+    failures, errors, count = [], [], 0
+    weight = {id(u): w for u, w in zip(todo, seconds, strict=True)}
     # the spawned workers start on demand as chains are handed out, each on one thread
     with one_thread_children():
         workers = _Workers(jobs)
-        bar = tqdm(total=len(todo), desc=f"lagbench {profile} ({jobs} workers)", unit="unit", disable=not progress)
+        bar = _bar(seconds, f"lagbench {profile} ({jobs} workers)", progress)
         pending, held = list(enumerate(work)), {}
 
-        def record(done):
-            nonlocal failures, errors
-            for name, failure, error in done:
+        def record(done, chain):
+            """A chain's outcomes; its units' estimated seconds on the bar; `on_done` told of each unit (one
+            that finished before its worker stopped has its result)."""
+            nonlocal failures, errors, count
+            for _name, failure, error in done:
                 failures += [failure] if failure else []
                 errors += [error] if error else []
-                bar.update(1)
-                bar.set_postfix_str(name)
+            count += len(chain)
+            bar.update(sum(weight[id(u)] for u in chain))
+            bar.set_postfix_str(f"{count}/{len(todo)} units; {chain[-1].name}")
+            for u in chain:
+                on_done(u)
         try:
             while pending or held:
                 while pending and (slot := workers.idle()) is not None:
@@ -154,15 +177,17 @@ def _parallel(todo, out, profile, progress, jobs):
                 except queue.Empty:
                     # a worker that died loses the chain it held, not the run
                     for cid, code in workers.dead():
+                        lost = held.pop(cid)
                         record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
-                                for u in held.pop(cid)])
+                                for u in lost], lost)
                     continue
                 if full is not None:
                     raise DiskFull(*full)
                 chain = held.pop(cid, None)
                 workers.finished(cid)
                 if chain is not None:
-                    record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain])
+                    record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain],
+                           chain)
         except BaseException:
             workers.close(wait=False)
             raise
@@ -172,9 +197,13 @@ def _parallel(todo, out, profile, progress, jobs):
     return failures, errors
 
 
-def run_units(todo, out, profile, progress=True, jobs=1):
+def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None):
+    """`seconds`: each unit's estimated seconds (`unit_seconds`), what the bar advances by (default: one each);
+    `on_done(unit)`: called in this process once a unit's run has ended (its result written, or not)."""
     if jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1")
+    seconds = list(seconds) if seconds is not None else [1.0] * len(todo)
+    on_done = on_done or (lambda u: None)
     if jobs == 1 or len(todo) <= 1:
-        return _serial(todo, out, profile, progress)
-    return _parallel(todo, out, profile, progress, jobs)
+        return _serial(todo, out, profile, progress, seconds, on_done)
+    return _parallel(todo, out, profile, progress, jobs, seconds, on_done)

@@ -8,6 +8,9 @@ Nothing is silent or lost: every option is checked (`plan`) and the output folde
 work; a unit redone because its folder held a damaged or half-written result is named in a warning
 and in run.json's "repaired"; an earlier invocation's run.json is kept as `runs/run-<start>.json`;
 Ctrl-C records "interrupted" in run.json before it propagates.
+
+With `store=True` (`--store`) OUT is kept as a store that git can carry (`replication.run.store`): each
+finished unit trimmed, a .gitignore, a unit made under another registration of its claim redone.
 """
 from __future__ import annotations
 
@@ -27,8 +30,10 @@ from lagbench.replication.claims.verdicts import write_summary
 from lagbench.replication.evaluation.registry import EVALUATION_VERSION
 from lagbench.replication.run import added_models, splits
 from lagbench.replication.run import environment as env
+from lagbench.replication.run import store as S
 from lagbench.replication.run.estimate import PROBES, describe, estimate
 from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.unit_seconds import unit_seconds
 from lagbench.replication.run.units import Unit
 from lagbench.replication.training import device as dev
 from lagbench.validate import is_integer
@@ -102,12 +107,15 @@ def plan(profile: str, claims=None, frameworks=None, seeds: int | tuple | None =
     return units
 
 
-def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = True) -> bool:
+def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = True,
+               registration: dict | None = None) -> bool:
     """True if the unit's folder holds a verified result of this very protocol, model spec, evaluation
-    config and evaluation version. A folder that holds no verified result is redone; with `repairs`,
-    one that exists (damaged or interrupted) is logged and listed there. A verified result of another one (the claim or an evaluation routine
-    was edited) is kept, renamed `superseded-<time>-seed<k>`, and the unit is rerun (its training comes
-    from the cache when the protocol is unchanged): nothing finished is lost or silently overwritten."""
+    config and evaluation version; with `registration` (a store's run: `replication.run.store`), made under
+    its claim's registration of now too (the dict: the registration hashes computed so far). A folder that
+    holds no verified result is redone; with `repairs`, one that exists (damaged or interrupted) is logged
+    and listed there. A verified result of another one (the claim or an evaluation routine was edited) is
+    kept, renamed `superseded-<time>-seed<k>`, and the unit is rerun (its training comes from the cache when
+    the protocol is unchanged): nothing finished is lost or silently overwritten."""
     folder = unit.folder(out)
     try:
         d = R.load_result(folder)
@@ -123,7 +131,8 @@ def is_current(unit, out, repairs: list | None = None, set_stale_aside: bool = T
     same_eval = (content_only(d.get("eval_config")) == content_only(json.loads(json.dumps(cfg)))
                  and d.get("evaluation_version") == EVALUATION_VERSION)
     if (d.get("split", "dev") == unit.split and content_only(d.get("protocol")) == content_only(unit.protocol().to_dict())
-            and d.get("model_spec") == unit.spec().to_dict() and same_eval):
+            and d.get("model_spec") == unit.spec().to_dict() and same_eval
+            and (registration is None or S.same_registration(d, unit, registration))):
         return True
     if not set_stale_aside:   # a look only (--dry-run): nothing renamed
         return False
@@ -188,7 +197,7 @@ def executor_of(executor, jobs, address):
     if executor == "local":
         if address is not None:
             raise ValueError("--address is for --executor ray; the local executor runs on this machine")
-        return lambda todo, out, profile, progress: run_units(todo, out, profile, progress, jobs)
+        return lambda todo, out, profile, progress, **kw: run_units(todo, out, profile, progress, jobs, **kw)
     if executor == "ray":
         from lagbench.replication.run.executor_ray import check_address, require_ray, run_units_ray
 
@@ -197,15 +206,18 @@ def executor_of(executor, jobs, address):
                              "the Ray cluster's CPUs")
         require_ray()
         check_address(address)
-        return lambda todo, out, profile, progress: run_units_ray(todo, out, profile, progress, address)
+        # its units are trimmed for a store when the run ends (`runner.run`), not one by one
+        return lambda todo, out, profile, progress, **kw: run_units_ray(todo, out, profile, progress, address)
     raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
 
 
 @R.writes
 def run(profile="quick", out="results/quick", claims=None, frameworks=None, seeds=None, models=None,
         progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT,
-        add_models=()) -> dict:
-    """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`)."""
+        add_models=(), store=False) -> dict:
+    """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`). `store`: keep OUT as a
+    store git can carry (`replication.run.store`): trimmed units, a .gitignore, a unit made under another
+    registration redone; its size printed at the end."""
     if not is_integer(jobs) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
@@ -213,8 +225,9 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
         R.refuse_if_locked(out, "--out")
     added = added_models.parse(add_models, {e.label for c in CLAIMS.values() for e in c.models})
     units = plan(profile, claims, frameworks, seeds, models, split, added)
+    memo = {} if store else None   # a store's units: their registration hashes too
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
-        todo = [u for u in units if not is_current(u, out, set_stale_aside=False)]
+        todo = [u for u in units if not is_current(u, out, set_stale_aside=False, registration=memo)]
         if todo:
             estimate = announce(profile, units, todo, out, jobs, executor)
         else:   # said, not left to silence: a finished folder is an answer too
@@ -223,6 +236,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
                   "nothing to run", flush=True)
         return {"dry_run": True, "units": len(units), "todo": len(todo), "estimate": estimate}
     out = R.output_folder(out, "--out")
+    if store:
+        S.prepare(out)
     R.write_json(out / "claims.json", {"schema": R.SCHEMA, "claims": [catalogue(c, profile) for c in CLAIMS.values()]})
     manifest = {"schema": R.SCHEMA, "profile": profile, "split": split,
                 "frameworks": list(run_frameworks(profile, frameworks)), "seeds": seeds,
@@ -235,15 +250,18 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     keep_previous_record(out)
     R.write_json(out / "run.json", manifest)
     repairs: list = []
-    todo = [u for u in units if not is_current(u, out, repairs)]
+    todo = [u for u in units if not is_current(u, out, repairs, registration=memo)]
     manifest["repaired"] = repairs
+    by_group = None   # the estimate's seconds per training, what the progress bar advances by
     if profile in LONG_PROFILES and todo:
         manifest["estimate"] = announce(profile, units, todo, out, jobs, executor, keep=True)
+        by_group = manifest["estimate"].pop("by_group", None)
         R.write_json(out / "run.json", manifest)
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()
     try:
-        failures, errors = execute(todo, out, profile, progress)
+        failures, errors = execute(todo, out, profile, progress, seconds=unit_seconds(todo, out, by_group),
+                                   on_done=(lambda u: S.keep_unit(u.folder(out))) if store else None)
     except KeyboardInterrupt:
         manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
         R.write_json(out / "run.json", manifest)
@@ -256,8 +274,14 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
         except OSError:
             pass
         raise
+    finally:
+        if store:   # whatever ended the run, its finished units are trimmed before a commit can take them
+            S.prune(out)
     summary = write_summary(out, profile, split, registration.registrations(), tuned.records())
     manifest.update(finished=env.now(), wall_time_s=time.perf_counter() - t0, units=len(units),
                     units_run=len(todo), failures=failures, errors=errors)
+    if store:
+        manifest["store"] = {"bytes": S.size(out), "budget_mb": S.BUDGET_MB}
+        print(S.size_line(out), flush=True)
     R.write_json(out / "run.json", manifest)
     return dict(summary, errors=errors, repaired=repairs)

@@ -22,6 +22,7 @@ from lagbench.replication.evaluation.registry import EVALUATION_VERSION, EVALUAT
 from lagbench.replication.evaluation.routines import Context, heldout_of, system_of
 from lagbench.replication.run import environment as env
 from lagbench.replication.run import splits
+from lagbench.replication.run.store import registration_hash
 from lagbench.replication.training import device as dev
 from lagbench.replication.training import hessian_probe
 from lagbench.replication.training.objective import predict
@@ -125,6 +126,7 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         "cohort": outcome.cohort if outcome else None,
         "train_step_mode": outcome.step_mode if outcome else None,
         "train_device": outcome.device if outcome else None, "eval_device": dev.describe(unit.framework, where),
+        "protocol_hash": registration_hash(unit.claim, unit.profile),   # its claim's registration (`run.store`)
         "versions": env.versions(), "commit": env.commit(), "hardware": env.hardware(), "created": env.now(),
         "arrays": {"arrays.npz": sorted(ev.arrays)} if ev.arrays else {}, "files": files,
     }

@@ -63,7 +63,7 @@ def test_figures_written_and_referenced(built):
                  "dp_loss_speed_error.png", "bench_inference.png", "bench_scaling.png"):
         assert name in names
     md = built["markdown"].read_text()
-    typ = built["typst"].read_text()
+    typ = built["typst"].read_text() + (built["pdf"].parent / "APPENDIX.typ").read_text()   # the two PDFs
     for p in figs:
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert f"(figures/{p.name})" in md and f'"figures/{p.name}"' in typ
@@ -74,9 +74,10 @@ def test_pdf_opens_with_expected_pages_and_text(built):
     pdf = built["pdf"]
     data = pdf.read_bytes()
     assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF")
-    # each level-1 section starts a page, after the title/contents page
-    level1 = built["markdown"].read_text().count("\n## ")
-    assert page_count(pdf) >= level1 + 1 > 10
+    # the body flows on; each of the appendix's level-1 sections starts a page after it
+    typ = built["typst"].read_text()
+    appendix = typ[typ.index('#set heading(numbering: "A.1")'):]
+    assert page_count(pdf) >= appendix.count("#heading(level: 1,") + 1 > 3
     assert b"/FontFile" in data and data.count(b"/Subtype /Image") + data.count(b"/Subtype/Image") >= len(
         built["figures"])
     typ = built["typst"].read_text()
@@ -200,3 +201,28 @@ def test_the_metric_dumps_sit_in_an_appendix_and_shared_trainings_are_drawn_once
     again = claim_section(res, claim, tmp_path / "c", drawn)   # the same trainings a second time
     assert any("train" in getattr(b, "path", "") for b in first.blocks)   # its training figure
     assert any("the same trainings as dp_loss's" in getattr(b, "text", "") for b in again.blocks)
+
+
+# the long dumps: REPORT.md keeps them, REPORT.pdf names where they are, APPENDIX.pdf holds them
+LONG_DUMPS = ("Claim details", "Speed against error per unit", "Velocity-Hessian health (LNN and LGN)",
+              "Results by system", "Appendix: all recorded metrics", "Appendix: index of tables and figures")
+
+
+def test_the_long_dumps_leave_the_main_pdf_for_the_appendix_pdf_and_the_markdown_keeps_every_section(built, results_dir, tmp_path):
+    from lagbench.reports.build import body_and_appendix
+    from lagbench.reports.pdf import lit
+
+    md = built["markdown"].read_text()
+    main = built["typst"].read_text()
+    second = (built["pdf"].parent / "APPENDIX.typ").read_text()
+    assert built["appendix_pdf"].read_bytes().startswith(b"%PDF-") and page_count(built["appendix_pdf"]) > 1
+    headings = lambda typ: set(re.findall(r'^#heading\(level: \d, "(.*)"\)$', typ, re.M))  # noqa: E731
+    for title in LONG_DUMPS:
+        assert title not in headings(main) and title in headings(second), title
+        assert f"## {title}\n" in md, title
+    assert "APPENDIX.pdf" in main and "Results by system" in main[main.index("APPENDIX.pdf"):]
+    body, appendix = body_and_appendix(results_dir, tmp_path)
+    for s in body + appendix:   # REPORT.md: every section; the two PDFs: each section once, in one of them
+        assert f"{'#' * (s.level + 1)} {s.title}\n" in md, s.title
+        assert (lit(s.title)[1:-1] in headings(main)) != (lit(s.title)[1:-1] in headings(second)), s.title
+    assert not {t for t in headings(main) if any(t.startswith(d) for d in ("Claim details", "Appendix: all"))}

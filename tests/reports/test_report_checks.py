@@ -12,6 +12,10 @@ from result_fixtures import POOLED, SEEDS
 FIGURE = re.compile(r"^\*Figure (\d+): (.+)\*$", re.M)
 
 
+def _both_typst(built) -> str:
+    return built["typst"].read_text() + (built["typst"].parent / "APPENDIX.typ").read_text()
+
+
 def test_every_figure_caption_names_what_it_shows_the_paper_figure_and_its_source(built):
     md = built["markdown"].read_text()
     captions = FIGURE.findall(md)
@@ -21,7 +25,7 @@ def test_every_figure_caption_names_what_it_shows_the_paper_figure_and_its_sourc
         shows = re.search(r" Shows: (.+?)\. Paper figure: (.+?)\. Source: (.+)\.$", text)
         assert shows and all(len(g.strip()) > 3 for g in shows.groups()), (n, text)
         assert "units/" in shows[3] or "bench/" in shows[3] or "/" in shows[3], (n, text)
-    typ = built["typst"].read_text()
+    typ = _both_typst(built)   # REPORT.typ and APPENDIX.typ: every number in one PDF or the other
     assert {int(n) for n in re.findall(r'"Figure (\d+): ', typ)} == {int(n) for n, _ in captions}
     assert "numbering: none" in typ   # typst's own numbering is off: the PDF prints the report's numbers
 
@@ -69,10 +73,13 @@ def test_the_glossary_defines_every_metric_name_the_tables_show(built, results_d
     md = built["markdown"].read_text()
     metrics = _fixture_metric_names(results_dir)
     tables = md_tables(md)
-    glossary = md_table(md, "Metric names").set_index("metric")
+    # the body's metric names after the scorecard, those only the appendix shows at the appendix's end
+    names = [title for title in tables if title.startswith("Metric names")]
+    glossary = pd.concat([md_table(md, title) for title in names]).set_index("metric")
+    assert glossary.index.is_unique and len(names) == 2
     used = set()
     for title, df in tables.items():
-        if title == "Metric names":
+        if title in names:
             continue
         used |= {c for c in df.columns if c in metrics}
         used |= {t for t in re.findall(r"[a-z][a-z0-9_]*", title) if t in metrics}
@@ -115,5 +122,5 @@ def test_the_index_lists_every_table_and_figure_by_the_number_both_outputs_print
     listed = set(index["number"])
     assert {f"Figure {n}" for n in figures} <= listed
     assert {f"Table {n}" for n in tables} - listed == {f"Table {n}" for n in tables[-2:]}   # the index's own two
-    typ = built["typst"].read_text()
+    typ = _both_typst(built)   # REPORT.typ and APPENDIX.typ: every number in one PDF or the other
     assert {int(n) for n in re.findall(r'#strong\("Table (\d+): ', typ)} == set(tables)

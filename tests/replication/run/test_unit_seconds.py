@@ -1,0 +1,96 @@
+"""The run's progress bar advances by each unit's estimated seconds (`unit_seconds`), not by a unit count: its
+total is their sum, a training shared by two units counts once, a cached one not at all."""
+import pytest
+
+from lagbench.replication.run import executor, runner
+from lagbench.replication.run import unit_seconds as W
+from lagbench.replication.training.train import group_key, train_key
+
+
+class Bars:
+    """tqdm, recording each bar's total and what it advanced by."""
+    made: list = []
+
+    def __init__(self, *args, total=None, **kwargs):
+        self.total, self.n, self.kwargs = total, 0.0, kwargs
+        Bars.made.append(self)
+
+    def update(self, n=1):
+        self.n += n
+
+    def set_postfix_str(self, *a, **k):
+        pass
+
+    set_postfix = set_postfix_str
+
+    def close(self):
+        pass
+
+
+@pytest.fixture
+def bars(monkeypatch):
+    Bars.made = []
+    monkeypatch.setattr(executor, "tqdm", Bars)
+    monkeypatch.setattr(executor, "_one", lambda u, out, on_log=None: (None, None))   # no training here
+    return Bars.made
+
+
+def _outer(made):
+    (bar,) = [b for b in made if "bar_format" in b.kwargs]
+    return bar
+
+
+def test_a_shared_training_counts_once_and_a_cached_one_not_at_all(tmp_path):
+    todo = runner.plan("smoke", claims=["dp_loss", "dp_energy"], frameworks=("jax",), models=["baseline"])
+    assert [u.claim.id for u in todo] == ["dp_loss", "dp_energy"]   # claim 2 rolls out claim 1's models
+    first, second = W.unit_seconds(todo, tmp_path)
+    assert first == pytest.approx(W.proxy_seconds(todo[0]) + W.EVAL_S) and first > W.EVAL_S
+    assert second == W.EVAL_S
+    u = todo[0]
+    key = train_key(u.framework, u.spec(), u.protocol(), u.seed)
+    (tmp_path / "trained" / "jax" / key).mkdir(parents=True)
+    (tmp_path / "trained" / "jax" / key / "result.json").write_text("{}")
+    assert W.unit_seconds(todo, tmp_path) == [W.EVAL_S, W.EVAL_S]
+    group = group_key(u.framework, u.spec(), u.protocol(), u.seed)
+    assert W.unit_seconds(todo, tmp_path / "elsewhere", {group: 123.0}) == [123.0 + W.EVAL_S, W.EVAL_S]
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_the_bar_total_is_the_sum_of_the_estimates_and_it_ends_full(bars, tmp_path, jobs, monkeypatch):
+    todo = runner.plan("smoke", claims=["dp_loss", "appendix_b"], frameworks=("jax",))
+    seconds = [10.0 * (i + 1) for i in range(len(todo))]
+    if jobs == 2:   # the chains answered at once, in this process
+        monkeypatch.setattr(executor, "_Workers", _InlineWorkers)
+    executor.run_units(todo, tmp_path, "smoke", progress=False, jobs=jobs, seconds=seconds)
+    bar = _outer(bars)
+    assert bar.total == sum(seconds) and bar.n == pytest.approx(sum(seconds))
+
+
+def test_a_run_weighs_its_units_by_their_estimates(bars, tmp_path):
+    runner.run(profile="smoke", out=tmp_path, claims=["dp_loss", "dp_energy"], frameworks=("jax",),
+               models=["baseline"], progress=False)
+    todo = runner.plan("smoke", claims=["dp_loss", "dp_energy"], frameworks=("jax",), models=["baseline"])
+    assert _outer(bars).total == pytest.approx(sum(W.unit_seconds(todo, tmp_path)))
+    assert _outer(bars).total > len(todo) * W.EVAL_S   # the training's estimate is in it, not a unit count
+
+
+class _InlineWorkers:
+    def __init__(self, jobs):
+        import queue
+
+        self.results = queue.Queue()
+
+    def idle(self):
+        return object()
+
+    def assign(self, slot, cid, refs, out):
+        self.results.put((cid, [(f"u{i}", None, None) for i, _ in enumerate(refs)], None, None))
+
+    def finished(self, cid):
+        pass
+
+    def dead(self):
+        return []
+
+    def close(self, wait):
+        pass

@@ -1,0 +1,84 @@
+"""`lagbench verify`: units retrained from scratch match the stored ones bit for bit on the machine that made
+them; a stored value tampered with is shown as a difference (exit status 1); the report says how many units
+were re-verified, where and when."""
+import json
+import shutil
+
+import pandas as pd
+import pytest
+
+from lagbench.cli import main
+from lagbench.files import results as R
+from lagbench.replication.run import verify as V
+from lagbench.replication.run.runner import run
+
+
+@pytest.fixture(scope="module")
+def two_units(tmp_path_factory):
+    out = tmp_path_factory.mktemp("verify") / "results"
+    run(profile="smoke", out=out, claims=["dp_loss"], frameworks=("jax",), models=["baseline"], seeds=2,
+        progress=False)
+    assert len(list(out.glob("units/*/*/*/seed*/result.json"))) == 2
+    return out
+
+
+def test_two_retrained_units_are_identical_to_the_stored_ones(two_units, tmp_path):
+    out = tmp_path / "results"
+    shutil.copytree(two_units, out)
+    rows = V.verify(out, 2, seed=3, progress=False)
+    assert rows["unit"].nunique() == 2 and (rows["outcome"] == "identical").all()
+    assert rows["same_environment"].all() and (rows["tolerance"] == V.SAME_TOL).all()
+    stored = R.load_result(out / "units/dp_loss/jax/baseline/seed1000")
+    assert set(stored["metrics"]) | set(V.VALUES) == set(rows[rows["unit"].str.endswith("seed1000")]["value"])
+    written = pd.read_csv(out / V.FILE)
+    assert len(written) == len(rows)
+    assert "2 of 2 units retrained from scratch" in V.summary(rows) and "2 identical" in V.summary(rows)
+    V.verify(out, 1, seed=3, progress=False)   # a second verification adds its rows
+    assert len(pd.read_csv(out / V.FILE)) > len(rows)
+
+
+def test_a_wall_time_metric_is_shown_not_compared():
+    stored = {"metrics": {"rollout_us_per_step": 10.0, "heldout_l1": 1.0}, "status": "ok"}
+    new = {"metrics": {"rollout_us_per_step": 99.0, "heldout_l1": 1.0 + 1e-9}, "status": "ok"}
+    rows = {r["value"]: r["outcome"] for r in V.compare(stored, new)}
+    assert rows == {**{k: "identical" for k in V.VALUES}, "rollout_us_per_step": "timing", "heldout_l1": "within"}
+    assert {r["value"]: r["outcome"] for r in V.compare(stored, {**new, "status": "failed"})}["status"] == "differs"
+
+
+def test_the_same_seed_picks_the_same_units_and_another_can_pick_others():
+    units = list(range(10))
+    assert V.pick(units, 3, 1) == V.pick(units, 3, 1)
+    assert len({tuple(V.pick(units, 3, s)) for s in range(5)}) > 1
+
+
+def test_a_tampered_stored_metric_is_a_difference_and_the_report_shows_it(two_units, tmp_path, capsys):
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_verify import verify_sections
+
+    out = tmp_path / "results"
+    shutil.copytree(two_units, out)
+    folder = out / "units/dp_loss/jax/baseline/seed1001"
+    d = R.load_result(folder)
+    true = d["metrics"]["heldout_l1"]
+    R.write_json(folder / "result.json", {**d, "metrics": {**d["metrics"], "heldout_l1": true * 1.01}}, checksum=True)
+    code = main(["verify", "--results", str(out), "--units", "2", "--quiet"])
+    printed = capsys.readouterr().out
+    assert code == 1 and "1 identical" in printed and "1 differs" in printed
+    rows = pd.read_csv(out / V.FILE)
+    (bad,) = rows[rows["outcome"] != "identical"].itertuples(index=False)
+    assert (bad.unit, bad.value, bad.outcome) == ("dp_loss/jax/baseline/seed1001", "heldout_l1", "differs")
+    assert float(bad.recomputed) == true and bad.rel_diff == pytest.approx(0.01 / 1.01)   # a column of mixed values
+    assert "seed1001 heldout_l1" in printed
+    (section,) = verify_sections(load_results(out))
+    text = json.dumps([getattr(b, "text", "") for b in section.blocks])
+    assert "2 distinct units" in text
+    tables = [b.df for b in section.blocks if hasattr(b, "df")]
+    assert tables[0][["units", "identical", "differs"]].values.tolist() == [[2, 1, 1]]
+    assert tables[1]["value"].tolist() == ["heldout_l1"]
+
+
+def test_the_report_has_no_verification_section_without_a_verification(two_units):
+    from lagbench.reports.load import load_results
+    from lagbench.reports.sections_verify import verify_sections
+
+    assert verify_sections(load_results(two_units)) == []
