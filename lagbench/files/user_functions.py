@@ -3,7 +3,8 @@ importable from the working folder) or "path/to/file.py:function", and every cal
 factory and module, `--predict`'s and `--energy`'s function). Imported only when the user names it.
 
 `import_function(ref, option)`: the callable; a ValueError naming `option` and `ref` when it cannot be imported.
-A module named without a path is imported with the working folder first on sys.path; a file given by its path
+A module named without a path is imported with the working folder first on sys.path (one imported before from
+another file than the one found now is imported anew); a file given by its path
 runs with its own folder first, so the modules beside it import (an exception while either runs is a
 `UserCodeError`, as below). A module
 named without a path whose top-level name is the suite's package (`SUITE`, "lagbench") while the working folder
@@ -92,6 +93,21 @@ def _load_file(path: Path):
     return mod
 
 
+def _forget_stale(top: str) -> None:
+    """Drops the imported module `top` (and its submodules) when the working folder's sys.path now finds
+    `top` in another file than the one imported: a name is read from where it is found today."""
+    if top == SUITE or top not in sys.modules:
+        return
+    held = {k: sys.modules.pop(k) for k in list(sys.modules) if k == top or k.startswith(top + ".")}
+    try:
+        found = importlib.util.find_spec(top)
+    except (ImportError, ValueError):
+        found = None
+    was = getattr(held[top], "__file__", None)
+    if found is not None and found.origin and was and Path(found.origin).resolve() == Path(was).resolve():
+        sys.modules.update(held)
+
+
 def import_function(ref: str, option: str):
     """The callable `ref` names; a ValueError naming `option` and `ref` when it cannot be imported."""
     module, sep, attr = str(ref).rpartition(":")
@@ -109,6 +125,7 @@ def import_function(ref: str, option: str):
             cwd = str(Path.cwd())
             sys.path.insert(0, cwd)   # the console script's sys.path starts at its own folder, not the working one
             try:
+                _forget_stale(module.split(".")[0])
                 found = importlib.util.find_spec(module)
                 if found is None:
                     raise ImportError(f"no module named {module!r}")

@@ -115,6 +115,20 @@ def test_a_module_of_the_working_folder_is_imported_before_an_installed_one(tmp_
     assert import_function("lagbench_first_try:f", "--predict")() == "working folder"
 
 
+def test_a_module_name_imported_from_another_folder_is_read_from_the_working_folder_anew(tmp_path, monkeypatch):
+    for sub, body in (("one", "def f():\n    return 1\n"), ("two", "def f():\n    return 2\n\ndef g():\n    return 3\n")):
+        (tmp_path / sub).mkdir()
+        (tmp_path / sub / "lagbench_same_name.py").write_text(body)
+    monkeypatch.delitem(sys.modules, "lagbench_same_name", raising=False)
+    monkeypatch.chdir(tmp_path / "one")
+    assert import_function("lagbench_same_name:f", "--predict")() == 1
+    kept = sys.modules["lagbench_same_name"]
+    assert import_function("lagbench_same_name:f", "--predict")() == 1 and sys.modules["lagbench_same_name"] is kept
+    monkeypatch.chdir(tmp_path / "two")   # the same name, another file: its own functions, not the first one's
+    assert import_function("lagbench_same_name:f", "--predict")() == 2
+    assert import_function("lagbench_same_name:g", "--predict")() == 3
+
+
 def test_what_comes_back_is_checked_and_non_finite_rows_counted():
     with pytest.raises(UserCodeError, match="f\\(q, qdot\\) returned dict, not an array of numbers"):
         array_of("--predict", "m:f", "f(q, qdot)", {"a": 1})
