@@ -141,6 +141,8 @@ class Protocol:
             del d["tracking"]["keep"]   # only a kept tracking is stored: other protocols keep their keys
         if self.scouting is not None:
             d["scouting"] = {**dataclasses.asdict(self.scouting), "schedule": schedule_to_dict(self.scouting.schedule)}
+            if not self.scouting.fallback:
+                del d["scouting"]["fallback"]   # only a protocol with fallbacks stores it: others keep their keys
         return {"version": KEY_VERSION, **d}
 
     @classmethod

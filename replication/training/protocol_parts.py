@@ -104,13 +104,17 @@ class Scouting:
     scout's steps); with `keep` = k (successive halving, 1 <= k < count) all stop at half their steps and the
     k lowest by training loss go on to the end. The chosen scout is continued under the protocol's steps,
     batch and schedule. The budget is count x steps x batch (with a cut: (count x half + keep x (steps -
-    half)) x batch) plus the continuation's samples."""
+    half)) x batch) plus the continuation's samples. `fallback` = f: a continuation that ends with a higher
+    training loss than its scout had (it lost what the scout found) is followed by the next scout's, up to f
+    more; the lowest ends the run, and every continuation's samples count. Stored only when f > 0, so
+    protocols without it keep their keys."""
 
     count: int
     steps: int
     batch: int
     schedule: Schedule
     keep: int | None = None
+    fallback: int = 0
 
     def __post_init__(self):
         check(is_integer(self.count) and self.count >= 2,
@@ -124,7 +128,10 @@ class Scouting:
                   f"scouting keep {self.keep!r} must be an integer from 1 to below count {self.count} (the scouts "
                   f"that go on after the first half; None = every scout goes on)")
             check(self.steps >= 2, "scouting keep needs steps >= 2: the cut is at half the scouts' steps")
-        for name in ("count", "steps", "batch") + (("keep",) if self.keep is not None else ()):
+        check(is_integer(self.fallback) and 0 <= self.fallback < (self.keep or self.count),
+              f"scouting fallback {self.fallback!r} must be an integer from 0 to below the scouts that reach the "
+              f"end ({self.keep or self.count}): the further scouts continued when a continuation loses its scout's loss")
+        for name in ("count", "steps", "batch", "fallback") + (("keep",) if self.keep is not None else ()):
             object.__setattr__(self, name, int(getattr(self, name)))
 
 

@@ -17,15 +17,21 @@ with `scouting` (`protocol.Scouting`, K = its count):
   3. continues the chosen one for `protocol.steps` steps of `protocol.batch`: a new schedule over those
      steps (from `protocol.lr_start`: a fresh Adam's first steps at a high rate can throw a near-physical
      Lagrangian away, so a continuation may start lower than its scouts did), fresh Adam state, batches
-     from a stream of its own (seed + 1000).
-Every scout's samples count in the budget (`budget_samples`; the outcome's `samples`). The original code
+     from a stream of its own (seed + 1000);
+  4. with `fallback` = f: a continuation whose training loss over its last TAIL of steps ends above its
+     scout's tail loss lost what the scout found (a fresh Adam thrown off a near-physical L); the next scout
+     by tail loss is continued likewise, up to f more, until one ends at or below its scout's; the lowest
+     continuation tail is the run (`docs/decisions/double_pendulum_protocol.md`).
+Every scout's and every continuation's samples count (`budget_samples` before fallbacks; the outcome's
+`samples`). The original code
 has no restarts: the report says so where a claim uses them.
 
 `train_scouted(trainer, spec, protocol, seed, on_log=None) -> TrainOutcome` (trainer: `train_jax` or
 `train_torch`): the continuation's parameters and log (its steps shifted by the scouts' samples in
 continuation steps, `progress_steps`; `on_log` sees the first scout's rows so too, with the scouts' own
 step as `restart_step`), steps_done and samples counting every scout, its `scouting` record
-{init_seeds, tail_loss, chosen, scout_steps; with a cut also cut_step, cut_tail_loss, kept}. `scout(...)`,
+{init_seeds, tail_loss, chosen, scout_steps; with a cut also cut_step, cut_tail_loss, kept; with fallbacks
+also continued (the init seeds continued, in order) and continuation_tail_loss}. `scout(...)`,
 `choose` and `continuation_protocol` are its parts, for callers that watch them (`speedstudy.target_loop`).
 """
 from __future__ import annotations
@@ -108,6 +114,13 @@ class _Losses:
 
     def restore_snapshot(self, meta, arrays):
         self.losses = list(arrays["losses"])
+
+
+class _ScalarLosses(_Losses):
+    """`_Losses` for a one-model run (its hooks see a scalar loss)."""
+
+    def __call__(self, k, stepper, info):
+        self.losses.append(np.asarray([info["loss"]], np.float64))
 
 
 class _StopAt:
@@ -207,8 +220,6 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
     scouts' samples and step time count; `stop(protocol, offset_steps)` an early-stop hook for it
     (`training.stopper_for`). `snapshot` (`snapshots.Snapshots`): each phase snapshots under
     its own name ("scouts", "continuation"), so that a run killed in its continuation does not scout again."""
-    from lagbench.replication.training.data import BatchStream
-
     seeds, per = init_seeds(protocol, seed), scout_steps(protocol)
     done = progress_steps(protocol) - protocol.steps   # the scouts' samples, in continuation steps
 
@@ -227,24 +238,52 @@ def train_scouted(trainer, spec, protocol, seed: int, on_log=None, track=None, s
         o.samples = o.steps_done * o.batch
         return o
     p = continuation_protocol(protocol)
+    finite = sorted((i for i, t in enumerate(tails) if math.isfinite(t)), key=lambda i: tails[i])
+    fallback = protocol.scouting.fallback
+    runs, steps, samples, seconds = [], done, scouting_samples(protocol), outcomes[best].train_time_s
+    step_seconds = outcomes[best].step_seconds
+    for n, i in enumerate(finite[:1 + fallback]):
+        out, tail = _continue(trainer, spec, p, seeds[i], outcomes[i], n, steps, samples, step_seconds,
+                              on_log, track, stop, snapshot, watch=fallback > 0)
+        runs.append((tail, n, i, out))
+        steps, samples = steps + out.steps_done, samples + out.steps_done * out.batch
+        seconds, step_seconds = seconds + out.train_time_s, step_seconds + out.step_seconds
+        if not fallback or tail <= tails[i]:   # the continuation kept what its scout found
+            break
+    tail, _, i, out = min(runs, key=lambda r: (r[0], r[1]))
+    if fallback:
+        record.update({"chosen": seeds[i], "continued": [seeds[r[2]] for r in runs],
+                       "continuation_tail_loss": [r[0] for r in runs]})
+    out.samples = samples
+    out.steps_done = (samples - scouting_samples(protocol)) // out.batch + scouting_samples(protocol) // outcomes[0].batch
+    out.train_time_s = seconds
+    out.step_mode = joined_modes(outcomes[best].step_mode, *(r[3].step_mode for r in runs))
+    out.scouting = record
+    return out
+
+
+def _continue(trainer, spec, p, init_seed, scouted, n, steps, samples, seconds, on_log, track, stop, snapshot,
+              watch):
+    """The `n`-th continuation (0: the chosen scout's; then fallbacks), of the scout `scouted` trained from
+    init seed `init_seed`, after `steps` continuation steps, `samples` samples and `seconds` of optimiser
+    steps in the run so far: (its outcome, its tail training loss: inf when it failed, None unless `watch`).
+    Its log's steps are the run's; its tracking counts the run's samples and time before it."""
+    from lagbench.replication.training.data import BatchStream
+    from lagbench.replication.training.early_stop import train_stopping
 
     def shifted(row):
         if on_log:
-            on_log({**row, "step": row["step"] + done})
-    t = track(p, done, scouting_samples(protocol), outcomes[best].step_seconds) if track else None
-    s = stop(p, done) if stop else None
-    from lagbench.replication.training.early_stop import train_stopping
-    out = train_stopping(trainer, spec, outcomes[best].params, p, BatchStream(p, seeds[best] + CONTINUATION_STREAM),
-                         on_log=shifted, hooks=(t,) if t else (),
-                         snapshot=snapshot.phase("continuation") if snapshot else None, stop=s)
-    out.log = [{**row, "step": row["step"] + done} for row in out.log]
+            on_log({**row, "step": row["step"] + steps})
+    t = track(p, steps, samples, seconds) if track else None
+    s = stop(p, steps) if stop else None
+    losses = _ScalarLosses() if watch else None
+    phase = "continuation" if n == 0 else f"continuation-{n + 1}"
+    out = train_stopping(trainer, spec, scouted.params, p, BatchStream(p, init_seed + CONTINUATION_STREAM),
+                         on_log=shifted, hooks=tuple(h for h in (losses, t) if h is not None),
+                         snapshot=snapshot.phase(phase) if snapshot else None, stop=s)
+    out.log = [{**row, "step": row["step"] + steps} for row in out.log]
     if t:
         t.merge([out])
     if s:
         s.merge(out)
-    out.samples = out.steps_done * out.batch + scouting_samples(protocol)
-    out.steps_done += scouting_samples(protocol) // outcomes[0].batch
-    out.train_time_s += outcomes[best].train_time_s
-    out.step_mode = joined_modes(outcomes[best].step_mode, out.step_mode)
-    out.scouting = record
-    return out
+    return out, _tails(losses.losses, [out])[0] if watch else None

@@ -138,3 +138,68 @@ def test_a_cut_counts_its_budget():
             Scouting(**{**vars(PROTOCOL.scouting), **bad})
     assert PROTOCOL.scouting.keep is None and CUT.key() != PROTOCOL.key()
     assert scouting.scout_protocol(CUT).scouting is None and scouting.continuation_protocol(CUT).scouting is None
+
+
+# scouts that barely move (their tail is their init's loss) and continuations at 3e-3 (1e-3 for `SLOW`): on
+# seed 2 the first continuation ends below its scout, on seed 1 the second does, on seed 4 at 1e-3 none do
+STILL = PROTOCOL.replace(**{"scouting.schedule.lr": 1e-9, "schedule.lr": 3e-3})
+SLOW = STILL.replace(**{"schedule.lr": 1e-3})
+
+
+def _order(rec):
+    return [rec["init_seeds"][i] for i in np.argsort(rec["tail_loss"])]
+
+
+def _scout_tail(rec, init_seed):
+    return rec["tail_loss"][rec["init_seeds"].index(init_seed)]
+
+
+def test_a_continuation_that_keeps_its_scouts_loss_is_the_run_whatever_the_fallbacks():
+    """With fallbacks declared, a continuation that ends at or below its scout's tail loss ends the run: the
+    same weights and samples as without them; the record names it."""
+    plain = scouting.train_scouted(Recorder("jax"), SPEC, STILL, seed=2)
+    out = scouting.train_scouted(Recorder("jax"), SPEC, STILL.replace(**{"scouting.fallback": 2}), seed=2)
+    rec = out.scouting
+    assert "continued" not in plain.scouting and rec["continued"] == [rec["chosen"]] == [plain.scouting["chosen"]]
+    assert rec["continuation_tail_loss"][0] <= _scout_tail(rec, rec["chosen"])
+    assert out.samples == plain.samples == scouting.budget_samples(STILL) and out.steps_done == plain.steps_done
+    for k in out.params:
+        np.testing.assert_array_equal(out.params[k], plain.params[k])
+
+
+@pytest.mark.parametrize("framework", ["jax", "torch"])
+def test_a_continuation_that_loses_its_scout_is_followed_by_the_next_scouts(framework):
+    """A continuation that ends above its scout's tail loss: the next scout by tail loss is continued; a
+    continuation that keeps its scout's loss ends the run; every continuation's samples count; the run's log
+    goes on in order; the lowest continuation tail is kept."""
+    out = scouting.train_scouted(Recorder(framework), SPEC, STILL.replace(**{"scouting.fallback": 3}), seed=1)
+    rec = out.scouting
+    first, second = rec["continued"]
+    assert [first, second] == _order(rec)[:2]
+    assert rec["continuation_tail_loss"][0] > _scout_tail(rec, first)
+    assert rec["continuation_tail_loss"][1] <= _scout_tail(rec, second)
+    assert rec["chosen"] == rec["continued"][int(np.argmin(rec["continuation_tail_loss"]))]
+    assert out.samples == scouting.budget_samples(STILL) + STILL.steps * STILL.batch
+    steps = [r["step"] for r in out.log]
+    assert steps == sorted(steps) and steps[-1] == scouting.progress_steps(STILL) + STILL.steps - 1
+
+
+def test_the_fallbacks_stop_at_their_count_and_the_lowest_continuation_is_kept():
+    out = scouting.train_scouted(Recorder("jax"), SPEC, SLOW.replace(**{"scouting.fallback": 2}), seed=4)
+    rec, tails = out.scouting, out.scouting["continuation_tail_loss"]
+    assert rec["continued"] == _order(rec)[:3]
+    assert all(t > _scout_tail(rec, s) for s, t in zip(rec["continued"], tails, strict=True))
+    assert rec["chosen"] == rec["continued"][int(np.argmin(tails))]
+    assert out.samples == scouting.budget_samples(SLOW) + 2 * SLOW.steps * SLOW.batch
+
+
+def test_fallbacks_are_checked_and_stored_only_when_declared():
+    for bad in (-1, 4, 1.5):
+        with pytest.raises(ValueError, match="fallback"):
+            PROTOCOL.replace(**{"scouting.fallback": bad})
+    with pytest.raises(ValueError, match="fallback"):
+        CUT.replace(**{"scouting.fallback": 2})   # 2 scouts reach the end: one fallback at most
+    assert "fallback" not in PROTOCOL.to_dict()["scouting"]
+    more = PROTOCOL.replace(**{"scouting.fallback": 1})
+    assert more.to_dict()["scouting"]["fallback"] == 1 and more.key() != PROTOCOL.key()
+    assert Protocol.from_dict(more.to_dict()) == more
