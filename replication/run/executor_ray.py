@@ -1,8 +1,10 @@
 """Running the units of a plan on Ray (`lagbench run --executor ray [--address ADDR]`).
 
-`run_units_ray(todo, out, profile, progress=True, address=None, retries=RETRIES) -> (failures, errors)`,
-as `executor.run_units`. Without `address` it starts a local Ray instance on this machine's cores (or
-uses this process's Ray connection, if it has one); with one it joins that cluster (`ray start`).
+`run_units_ray(todo, out, profile, progress=True, address=None, retries=RETRIES, on_done=None) -> (failures,
+errors)`, as `executor.run_units`: `on_done(unit)` is told of each unit once its files are written (a store
+trims the unit's folder: `replication.run.store`). Without `address` it starts a local Ray instance on this
+machine's cores (or uses this process's Ray connection, if it has one); with one it joins that cluster
+(`ray start`).
 
 Every unit is one Ray task (`ray_task.run_unit_task`) asking for one CPU, and, where the cluster has GPUs,
 a unit of either framework for a share of one (`gpu_share`: a whole GPU for the paper-sized models, a
@@ -159,7 +161,7 @@ def _started(ray, board) -> list:
         return []
 
 
-def run_units_ray(todo, out, profile, progress=True, address=None, retries=None):
+def run_units_ray(todo, out, profile, progress=True, address=None, retries=None, on_done=None):
     from lagbench.files.results import CorruptResult
     from lagbench.replication.run.unit_files import write
 
@@ -193,6 +195,8 @@ def run_units_ray(todo, out, profile, progress=True, address=None, retries=None)
                         d["error"] = f"{u.name}: its files arrived damaged: {e}"
                     failures += [d["failure"]] if d["failure"] else []
                     errors += [d["error"]] if d["error"] else []
+                    if on_done:
+                        on_done(u)
                 bar.done(u.name, failed=d is None or bool(d["failure"] or d["error"]))
             bar.started(_started(ray, board))
     except BaseException:

@@ -12,10 +12,15 @@ that can stop at any point and go on from a fresh clone of a later commit, on an
   their sha256 under "store": {"removed": {...}}, and checksummed again, so that it verifies
   (`results.load_result`, the report's `integrity.verify_unit`) without them.
 - the run's records: run.json, claims.json, summary/, runs/ (each earlier invocation's run.json: the
-  sittings of the run) and verify/ (`lagbench verify`).
-- `.gitignore` (`gitignore()`, written by `prepare`), so that git ignores everything else: the training cache
-  `trained/`, the folder lock, the estimate's probes (this machine's timings), results set aside as
-  superseded, a checkpoint that is not kept.
+  sittings of the run) and verify/ (`lagbench verify`); predict/ (`lagbench evaluate --predict`: records
+  whose result.json lists their files).
+- the studies beside the claims that the report reads, each a folder of OUT (`STUDIES`: `lagbench control`,
+  `online --system four_joint_arm`, `robustness`, `stiff`, `bench`, `train-target`), only the files of it the
+  report reads (`reports/sections_*.py`, `reports/load.py`): a study's recordings (data/), fitted models
+  (fits/), the bench's stage checkpoints and trained weights stay out.
+- `.gitignore` (`gitignore()`, written by `prepare`, from `RULES`), so that git ignores everything else:
+  the training cache `trained/`, the folder locks and temporary files (hidden names), the estimate's probes
+  (this machine's timings), results set aside as superseded, a checkpoint that is not kept.
 
 A unit counts as finished in a store (`runner.is_current(..., registration=True)`) when it is current in any
 run (its split, protocol, model spec, evaluation config and version unchanged) and the registration hash it
@@ -23,12 +28,14 @@ records ("protocol_hash": `claims.registration.protocol_hash` of its claim and p
 the claim's now. The commit may differ; the registration may not: a unit made under another registration
 (another protocol, rule or bar of its claim) is set aside and redone, never mixed in.
 
-`kept_files(out)`: the files git keeps (the `.gitignore`'s rules, written out); `size(out)` their bytes;
+`kept_files(out)`: the files git keeps (`RULES` read as git reads them); `size(out)` their bytes;
 `size_line(out)` says it against `BUDGET_MB`, the budget a store is held to (a warning past it).
 """
 from __future__ import annotations
 
 import logging
+import os
+from fnmatch import fnmatchcase
 from pathlib import Path
 
 from lagbench.files import results as R
@@ -37,7 +44,18 @@ log = logging.getLogger("lagbench")
 BUDGET_MB = 150                      # what a committed store may weigh (`size_line` warns past it)
 CHECKPOINTS = ("delan_arm",)         # claims whose checkpoints a later step loads (claim 12's control study)
 REMOVED = ("checkpoint.npz",)        # what a finished unit of any other claim does without
-RECORDS = ("run.json", "claims.json", "summary", "runs", "verify")   # the run's records, beside units/
+# kept whole, beside units/: the run's records, `lagbench verify`'s and `lagbench evaluate --predict`'s
+RECORDS = ("run.json", "claims.json", "summary", "runs", "verify", "predict")
+STUDIES = {   # a study's folder: the files of it the report reads (what else the study writes stays out)
+    "control": ("tracking.csv", "traces.npz"),                                # lagbench control
+    "control_four_joint_arm": ("study.json", "tracking.csv", "traces.npz"),   # lagbench control --system ...
+    "online_four_joint_arm": ("setup.json", "summary.csv"),                   # lagbench online --system ...
+    "robustness": ("study.json", "scenes.csv", "recommendation.csv"),         # lagbench robustness
+    "stiff": ("solvers.csv", "choice.json"),                                  # lagbench stiff
+    "bench": ("*.csv", "machine.json", "targets.json"),                       # lagbench bench
+    "bench_gpu": ("*.csv", "machine.json", "targets.json"),                   # lagbench bench --gpu
+    "train_target": ("*.csv",),                                               # lagbench train-target
+}
 
 
 def registration_hash(source, profile: str) -> str | None:
@@ -58,12 +76,25 @@ def same_registration(d: dict, unit, memo: dict) -> bool:
     return d.get("protocol_hash") == memo[key]
 
 
+def _rules() -> tuple[str, ...]:
+    """The `.gitignore`'s patterns, in order (the last that matches a path decides; a folder ignored hides
+    all it holds): everything ignored, then the records, the units (less the checkpoints not kept) and the
+    studies' files taken back, then superseded results and hidden names (locks, temporary files) left out
+    wherever they are."""
+    records = tuple(f"!/{name}{'/' if '.' not in name else ''}" for name in RECORDS)
+    units = ("!/units/", *(f"/units/**/{name}" for name in REMOVED),
+             *(f"!/units/{claim}/**/{name}" for claim in CHECKPOINTS for name in REMOVED))
+    studies = tuple(line for folder, files in STUDIES.items()
+                    for line in (f"!/{folder}/", f"/{folder}/*", *(f"!/{folder}/{name}" for name in files)))
+    return ("/*", *records, *units, *studies, "**/superseded-*/", "**/.*", "!/.gitignore")
+
+
+RULES = _rules()
+
+
 def gitignore() -> str:
-    keep = "".join(f"!/{name}{'/' if '.' not in name else ''}\n" for name in RECORDS)
-    removed = "".join(f"/units/**/{name}\n" for name in REMOVED)
-    back = "".join(f"!/units/{claim}/**/{name}\n" for claim in CHECKPOINTS for name in REMOVED)
     return ("# a lagbench store (docs/store.md): git keeps what a resumed run, the verdicts and the report read\n"
-            f"/*\n!/.gitignore\n{keep}!/units/\nsuperseded-*/\n/units/**/.*\n{removed}{back}")
+            + "".join(f"{rule}\n" for rule in RULES))
 
 
 def prepare(out) -> int:
@@ -101,21 +132,35 @@ def prune(out) -> int:
     return sum(keep_unit(f.parent) for f in sorted(Path(out).glob("units/*/*/*/seed*/result.json")))
 
 
-def _kept(rel: Path) -> bool:
-    parts = rel.parts
-    if parts[0] == ".gitignore":
-        return len(parts) == 1
-    if parts[0] in RECORDS:
-        return len(parts) > 1 or "." in parts[0]
-    if parts[0] != "units" or any(p.startswith("superseded-") or p.startswith(".") for p in parts[1:]):
-        return False
-    return rel.name not in REMOVED or (len(parts) > 1 and parts[1] in CHECKPOINTS)
+def _match(pattern: list, parts: tuple) -> bool:
+    """Whether a path (its names) matches a pattern anchored at OUT (its names) as git matches it: `*` within
+    a name, `**` any number of names."""
+    if not pattern:
+        return not parts
+    if pattern[0] == "**":
+        return any(_match(pattern[1:], parts[k:]) for k in range(len(parts) + 1))
+    return bool(parts) and fnmatchcase(parts[0], pattern[0]) and _match(pattern[1:], parts[1:])
+
+
+def _ignored(parts: tuple, folder: bool) -> bool:
+    """Whether `RULES` ignore the path of OUT with these names (a folder's or a file's), its folders aside."""
+    verdict = False
+    for rule in RULES:
+        pattern = rule.removeprefix("!")
+        if (folder or not pattern.endswith("/")) and _match(pattern.strip("/").split("/"), parts):
+            verdict = not rule.startswith("!")
+    return verdict
 
 
 def kept_files(out) -> list[Path]:
-    """The files of OUT that its `.gitignore` keeps, relative to OUT, sorted."""
-    out = Path(out)
-    return sorted(p.relative_to(out) for p in out.rglob("*") if p.is_file() and _kept(p.relative_to(out)))
+    """The files of OUT that its `.gitignore` keeps, relative to OUT, sorted (an ignored folder is not
+    entered: git takes nothing under it)."""
+    out, kept = Path(out), []
+    for root, folders, files in os.walk(out):
+        rel = Path(root).relative_to(out).parts
+        folders[:] = [f for f in folders if not _ignored((*rel, f), folder=True)]
+        kept += [Path(*rel, f) for f in files if not _ignored((*rel, f), folder=False)]
+    return sorted(kept)
 
 
 def size(out) -> int:
