@@ -18,6 +18,13 @@ can take many times as long (measurements: `docs/decisions/run_estimate.md`). Wh
 out: two workers slow each other down, evaluation, and the first step of a PyTorch phase under
 torch.compile (`compile_torch.like`: the probe compiles as the phase will), which compiles.
 
+Where every framework of the run trains on a GPU, the estimate also holds "cohorts": the run with each model's
+seeds packed into programs of up to `gpu_cohorts.MAX_MEMBERS` (`gpu_cohorts.programs`). A packed program's
+seconds are the probed seconds per step of its k members side by side (one member: the plain probe) x its
+protocol's steps; a program whose protocol cannot be packed (`gpu_cohorts.blocker`) costs what the plain
+estimate gives its training program; their sum is "train_s", and "wall_s" hands the programs, longest first,
+each to the first of `jobs` workers to come free (`scheduled_wall`).
+
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
 """
 from __future__ import annotations
@@ -30,6 +37,7 @@ import numpy as np
 
 from lagbench.files import results as R
 from lagbench.replication.run import environment as env
+from lagbench.replication.run import gpu_cohorts
 from lagbench.replication.run.chains import chains
 from lagbench.replication.run.environment import torch_threads as threads_of_torch
 from lagbench.replication.training import compile_torch
@@ -91,6 +99,8 @@ def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: 
     known = _read_probes(out, threads)
     with threads_of_torch(threads):
         est = _estimate(units, out, jobs, known)
+        if _on_gpu(units):
+            est["cohorts"] = _packed(units, out, jobs, known, est["by_group"])
     if keep:
         R.write_json(Path(out) / PROBES, {"machine": _machine(threads), "per_step": {
             k: [plain, {str(m): s for m, s in members.items()}] for k, (plain, members) in known.items()}})
@@ -158,6 +168,32 @@ def _estimate(units, out, jobs: int, per_step: dict) -> dict:
             "probes": len(used), "probes_reused": len(reused),
             "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1])),
             "by_group": todo}   # seconds per training program (`training.group_key`): the progress bar's weights
+
+
+def _on_gpu(units) -> bool:
+    """Whether every framework that trains a unit trains on a GPU (`replication.training.device`)."""
+    fws = {u.framework for u in units if u.entry.train}
+    return bool(fws) and all(dev.resolve(dev.request(), fw) == "gpu" for fw in fws)
+
+
+def _packed(units, out, jobs: int, per_step: dict, alone: dict) -> dict:
+    """{"train_s", "wall_s", "programs", "members": the most seeds a program, "seconds": per program, longest
+    first} of the run with seeds packed (`gpu_cohorts.programs`); `per_step` as `_estimate`'s, the probes of
+    k members side by side added to each shape's members; `alone`: `_estimate`'s seconds per training program."""
+    seconds, most = [], 0
+    for prog in gpu_cohorts.programs(units, out):
+        if not prog.packed:
+            seconds.append(alone[group_key(prog.framework, prog.spec, prog.protocol, prog.seeds[0])])
+            continue
+        k, shape = len(prog.seeds), _shape(prog.framework, prog.spec, prog.protocol)
+        plain, members = per_step[shape]   # `_estimate` probed every shape of the run's trainings
+        if k > 1 and k not in members:
+            members[k] = _members_step(prog.framework, prog.spec, prog.protocol, k)
+        seconds.append((members[k] if k > 1 else plain) * prog.protocol.steps)
+        most = max(most, k)
+    seconds.sort(reverse=True)
+    return {"train_s": sum(seconds), "wall_s": scheduled_wall(seconds, jobs), "programs": len(seconds),
+            "members": most, "seconds": seconds}
 
 
 def _group(u):

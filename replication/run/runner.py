@@ -169,6 +169,12 @@ def announce(profile, units, todo, out, jobs, executor="local", keep=False) -> d
           f"{est['train_s'] / 3600:.1f} h of training, about {est['wall_s'] / 3600:.1f} h wall with {jobs} "
           f"worker{'s' if jobs != 1 else ''} (evaluation not included; {where}; {hw['cpu']}, GPU: {hw['gpu']}). "
           f"Interrupt at any time: the run resumes where it stopped.", flush=True)
+    if est.get("cohorts"):   # on a GPU: each model's seeds packed as one program (`run.gpu_cohorts`)
+        c = est["cohorts"]
+        print(f"lagbench: with each model's seeds packed as one program on the GPU ({c['programs']} programs of up "
+              f"to {c['members']} seeds; this run trains one seed a program): {c['train_s'] / 3600:.1f} h of "
+              f"training, about {c['wall_s'] / 3600:.1f} h wall with {jobs} worker{'s' if jobs != 1 else ''}",
+              flush=True)
     if len(est["by_claim"]) > 1:   # where the time goes, the costliest first (shared trainings: first claim)
         print("lagbench: training by claim: " + ", ".join(f"{c} {s / 3600:.2f} h" for c, s in est["by_claim"].items()
                                                         if s > 0), flush=True)
@@ -206,8 +212,8 @@ def executor_of(executor, jobs, address):
                              "the Ray cluster's CPUs")
         require_ray()
         check_address(address)
-        # its units are trimmed for a store when the run ends (`runner.run`), not one by one
-        return lambda todo, out, profile, progress, **kw: run_units_ray(todo, out, profile, progress, address)
+        return lambda todo, out, profile, progress, on_done=None, **kw: run_units_ray(todo, out, profile, progress,
+                                                                                  address, on_done=on_done)
     raise ValueError(f"--executor: unknown {executor!r}; valid: local, ray")
 
 
