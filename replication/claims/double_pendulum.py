@@ -50,11 +50,13 @@ PLAIN_QUICK = _base.replace(steps=4000, batch=128, data=_data.replace(n_train=12
 
 GUARD = Guard(clip=100.0, skip=10.0)   # the gradient-spike guard
 # 16 scouts (batch 32, peak 1e-3, one-cycle of 15 625 steps from phase 0.2), the best 4 at its half kept to its
-# end; the best continued at batch 256 for 6e6 samples (one-cycle at peak 1e-2 from phase 0.1, fresh Adam);
+# end; the best continued at batch 256 for 6e6 samples (one-cycle at peak 1e-2 from phase 0.1, fresh Adam), and
+# where that continuation ends above its scout's training loss, the next scout's, up to 3 more (`fallback`);
 # 1.1e7 samples in all; the held-out loss tracked with its checkpoints kept (claim 2 reads matched accuracy)
 RESTARTS = _base.replace(steps=6_000_000 // 256, batch=256, data=_data.replace(n_train=256 * 1000, n_heldout=20_000),
                          log_every=250, schedule=OneCycle(lr=1e-2, start=0.1),
-                         scouting=Scouting(count=16, steps=15_625, batch=32, schedule=OneCycle(lr=1e-3, start=0.2), keep=4),
+                         scouting=Scouting(count=16, steps=15_625, batch=32, schedule=OneCycle(lr=1e-3, start=0.2), keep=4,
+                                           fallback=3),
                          tracking=Tracking(every=1000, keep=True), guard=GUARD)
 SMOKE = _base.replace(scouting=Scouting(count=2, steps=10, batch=16, schedule=OneCycle(lr=1e-3, start=0.2)),
                       tracking=Tracking(every=5, keep=True), guard=GUARD)
