@@ -4,7 +4,8 @@
 ValueError naming the holder if another process holds it. Reentrant within a process.
 `refuse_if_locked(path, option)`: the same ValueError, asked before a command's long planning, so that a
 second writer hears it at once; nothing is created or held.
-`writing()`: the folders locked inside the block are let go at its end; `writes(fn)`: `fn` run inside it.
+`writing()`: the folders locked inside the block are let go at its end; one the command created (`made`) and
+left holding only its lock file, because the block failed, is removed; `writes(fn)`: `fn` run inside it.
 Every command, and every library call that writes a folder, runs in one: two commands never write into one
 folder at once.
 """
@@ -19,6 +20,7 @@ from lagbench.files.clock import now
 
 LOCK_NAME = ".lagbench.lock"
 _LOCKS: dict = {}   # resolved folder -> the open lock file this process holds on it
+_MADE: dict = {}    # resolved folder -> the folders this process created for it (`made`), itself first
 
 
 def _busy(fd: int, path: Path, option: str) -> ValueError:
@@ -70,11 +72,36 @@ def refuse_if_locked(path, option: str = "--out") -> None:
 @contextmanager
 def writing():
     before = set(_LOCKS)
+    failed = True
     try:
         yield
+        failed = False
     finally:
         for key in set(_LOCKS) - before:
-            os.close(_LOCKS.pop(key))
+            fd, folders = _LOCKS.pop(key), _MADE.pop(key, [])
+            if failed:
+                _unmake(key, folders)
+            os.close(fd)
+
+
+def made(path: Path) -> None:
+    """Notes that this process creates the folder `path` (and the parents it lists), so that a command that
+    fails before writing into it leaves no folder behind (`writing`)."""
+    _MADE[str(path.resolve())] = [str(p.resolve()) for p in (path, *path.parents) if not p.exists()]
+
+
+def _unmake(key: str, folders: list) -> None:
+    """Removes a folder this process created, and its created parents, where it holds nothing but its lock
+    file (a command refused before it wrote): a refused command leaves the file system as it found it."""
+    if not folders:
+        return
+    try:
+        if os.listdir(key) == [LOCK_NAME]:
+            os.unlink(os.path.join(key, LOCK_NAME))
+        for folder in folders:
+            os.rmdir(folder)
+    except OSError:
+        pass   # something else is there now: it stays
 
 
 def writes(fn):

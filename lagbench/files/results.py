@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 # the folder locks: `output_folder` takes one; every command runs inside `writing` (re-exported for callers)
-from lagbench.files.folder_lock import _LOCKS, LOCK_NAME, lock, refuse_if_locked, writes, writing  # noqa: F401
+from lagbench.files.folder_lock import _LOCKS, LOCK_NAME, lock, made, refuse_if_locked, writes, writing  # noqa: F401
 
 SCHEMA = 1
 
@@ -114,6 +114,8 @@ def output_folder(path, option: str = "--out") -> Path:
     if path.exists() and not path.is_dir():
         raise ValueError(f"{option} {path}: exists and is not a folder; give a folder path")
     try:
+        if not path.exists():
+            made(path)
         path.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise ValueError(f"{option} {path}: cannot create the folder ({e.strerror or e})") from None

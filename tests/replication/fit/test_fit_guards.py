@@ -112,4 +112,11 @@ def test_a_fit_whose_test_file_is_its_training_data_is_refused_before_any_work(f
                "baseline", "--steps", "3", "--hidden", "8", "--quiet", "--out", str(tmp_path / "f")])
     err = capsys.readouterr().err
     assert rc == 2 and "copy.csv: byte for byte the training data" in err, err
-    assert not (tmp_path / "f" / "units").exists()
+    assert not (tmp_path / "f").exists()   # the folder it made for its output is gone with its lock
+    (tmp_path / "mine").mkdir()            # a folder the user made stays, as it was
+    rc = main(["fit", "--data", str(fitted.dir / "train.csv"), "--test", str(tmp_path / "copy.csv"), "--model",
+               "baseline", "--steps", "3", "--hidden", "8", "--quiet", "--out", str(tmp_path / "mine")])
+    assert rc == 2 and (tmp_path / "mine").is_dir()
+    rc = main(["fit", "--data", str(fitted.dir / "train.csv"), "--test", str(tmp_path / "copy.csv"), "--model",
+               "baseline", "--steps", "3", "--hidden", "8", "--quiet", "--out", str(tmp_path / "a" / "b")])
+    assert rc == 2 and not (tmp_path / "a").exists()   # the parents it made too
