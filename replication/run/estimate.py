@@ -142,7 +142,7 @@ def _estimate(units, out, jobs: int, per_step: dict) -> dict:
         group = _group(u)   # a cohort of seeds trains as one program
         if group in todo:
             continue
-        owner[group] = u.claim.id
+        owner[group] = (u.claim.id, u.entry.label, u.framework)
         if (Path(out) / "trained" / u.framework / train_key(u.framework, spec, p, u.seed) / "result.json").exists():
             cached += 1
             todo[group] = 0.0
@@ -160,13 +160,16 @@ def _estimate(units, out, jobs: int, per_step: dict) -> dict:
         todo[group] = plain * p.steps + sum(members[m] * n for m, n in scout_parts(p))
     total = sum(todo.values())
     in_order = [todo.get(_group(c[0]), 0.0) for c in chains(units)]
-    by_claim: dict = {}
+    by_claim, by_model = {}, {}
     for group, seconds in todo.items():
-        by_claim[owner[group]] = by_claim.get(owner[group], 0.0) + seconds
+        claim, label, framework = owner[group]
+        by_claim[claim] = by_claim.get(claim, 0.0) + seconds
+        by_model[(claim, label, framework)] = by_model.get((claim, label, framework), 0.0) + seconds
     return {"train_s": total, "wall_s": scheduled_wall(in_order, jobs),
             "trainings": sum(1 for v in todo.values() if v > 0), "cached": cached,
             "probes": len(used), "probes_reused": len(reused),
             "by_claim": dict(sorted(by_claim.items(), key=lambda kv: -kv[1])),
+            "by_model": dict(sorted(by_model.items(), key=lambda kv: -kv[1])),   # (claim, model, framework)
             "by_group": todo}   # seconds per training program (`training.group_key`): the progress bar's weights
 
 

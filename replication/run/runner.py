@@ -178,6 +178,10 @@ def announce(profile, units, todo, out, jobs, executor="local", keep=False) -> d
     if len(est["by_claim"]) > 1:   # where the time goes, the costliest first (shared trainings: first claim)
         print("lagbench: training by claim: " + ", ".join(f"{c} {s / 3600:.2f} h" for c, s in est["by_claim"].items()
                                                         if s > 0), flush=True)
+    if len(est.get("by_model", {})) > 1:   # and within each claim, by model and framework
+        for claim in (c for c, s in est["by_claim"].items() if s > 0):
+            parts = [f"{m} {fw} {s / 3600:.2f} h" for (c, m, fw), s in est["by_model"].items() if c == claim and s > 0]
+            print(f"lagbench:   {claim}: {', '.join(parts)}", flush=True)
     return est
 
 

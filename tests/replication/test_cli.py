@@ -124,6 +124,11 @@ def test_estimate_says_where_the_time_goes_by_claim(tmp_path, monkeypatch):
     assert set(est["by_claim"]) == {"dp_loss", "hnn_energy"}   # dp_energy trains nothing of its own
     assert sum(est["by_claim"].values()) == pytest.approx(est["train_s"])
     assert list(est["by_claim"].values()) == sorted(est["by_claim"].values(), reverse=True)
+    # within a claim, by model and framework: the same seconds, split
+    assert {(c, fw) for c, _, fw in est["by_model"]} == {("dp_loss", "jax"), ("hnn_energy", "jax")}
+    assert {m for c, m, _ in est["by_model"] if c == "dp_loss"} == {"lnn", "baseline"}
+    for claim, seconds in est["by_claim"].items():
+        assert sum(s for (c, _, _), s in est["by_model"].items() if c == claim) == pytest.approx(seconds)
 
 
 def test_a_resumed_run_on_the_same_machine_reuses_its_probes_and_another_machine_probes_again(tmp_path, monkeypatch):
