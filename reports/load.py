@@ -13,177 +13,24 @@ the folder asked for (run.json's "claims", ``asked_claims``) and any other with 
 two-claim run's report speaks of two claims. ``run.json``'s planned units
 that have no result are listed in ``Results.planned_missing``, and ``Results.unfinished`` is true when
 the run has not recorded its end.
+
+The pieces: the types ``Unit`` and ``Results`` (``reports.loaded``, re-exported here), one file or unit folder
+read (``reports.folder_files``), the speed study's tables (``reports.bench_tables``; ``BENCH_COLUMNS``
+re-exported here).
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from lagbench.replication.training.protocol import Protocol
-from lagbench.reports.integrity import verify_unit
+from lagbench.reports.bench_tables import BENCH_COLUMNS, load_bench
+from lagbench.reports.folder_files import load_unit, read_json, seed_key
+from lagbench.reports.loaded import Results, Unit, protocol_of
 
-BENCH_COLUMNS = {
-    "inference": ["system", "model", "formulation", "framework", "dtype", "batch", "samples_per_s", "error"],
-    "training": ["system", "model", "framework", "mode", "dtype", "batch", "steps_per_s", "samples_per_s"],
-    "rollout": ["system", "solver", "rtol", "kind", "wall_s", "state_err", "energy_err"],
-    "scaling": ["study", "formulation", "framework", "n", "seconds_per_eval", "samples_per_s"],
-    "ratios": ["operation", "jax", "torch", "ratio", "note"],
-    "latency": ["system", "model", "method", "framework", "dtype", "mode", "dispatch", "evals_per_s"],
-    "control_rate": ["model", "framework", "mode", "ticks", "mean_us", "median_us", "p99_us", "rate_hz_mean",
-                     "rate_hz_p99", "fits_500hz_mean", "fits_500hz_p99"],
-    "train_target": ["protocol", "description", "budget", "threshold", "samples_to_reach", "reached", "best_l1",
-                     "samples_per_s", "extrapolated_samples", "extrapolation"],
-    "train_target_log": ["protocol", "samples", "heldout_l1"],
-    "members": ["framework", "members", "hidden", "batch", "steps", "wall_s", "step_s", "samples_per_s",
-                "cost_vs_one"],
-}
-# `lagbench bench --gpu --out ROOT` writes ROOT/bench_gpu/: the GPU preset's stages
-GPU_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("inference", "training", "scaling", "ratios")},
-               "fast_paper": ["dof", "framework", "formulation", "mode", "batch", "samples_per_s"]}
-# `lagbench train-target --out ROOT` writes ROOT/train_target/ with the bench stage's two files
-# and, with --runs N > 1, distribution.csv (one row per run at the target held-out L1)
-TRAIN_TARGET_COLUMNS = {**{k: BENCH_COLUMNS[k] for k in ("train_target", "train_target_log")},
-                        "distribution": ["protocol", "run", "init_seed", "split", "reached", "samples_to_reach",
-                                         "wall_s_to_reach", "final_l1"]}
-UNIT_KEYS = ("claim", "framework", "model", "seed", "status", "metrics")
-
-
-def protocol_of(result: dict) -> Protocol | None:
-    """A result's training protocol (any recorded version), or None where none is readable."""
-    try:
-        return Protocol.from_dict(result["protocol"])
-    except (KeyError, TypeError, ValueError):
-        return None
-
-
-@dataclass(frozen=True)
-class Unit:
-    """One claim x framework x model x seed. ``rel`` is the unit folder relative to the results root."""
-
-    claim: str
-    framework: str
-    model: str
-    seed: str
-    path: Path
-    rel: str
-    status: str
-    reason: str | None = None
-    result: dict = field(default_factory=dict, repr=False)
-
-    @property
-    def protocol(self) -> Protocol | None:
-        return protocol_of(self.result)
-
-    def metric(self, name: str) -> float | None:
-        value = (self.result.get("metrics") or {}).get(name)
-        return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
-
-    def table(self, name: str) -> pd.DataFrame | None:
-        """A CSV of this unit (``train_log.csv``, ``rollouts.csv``, ``timeseries.csv``), or None."""
-        path = self.path / name
-        if self.status == "corrupt" or not path.is_file():
-            return None
-        try:
-            return pd.read_csv(path)
-        except (ValueError, OSError):
-            return None
-
-    def arrays(self) -> dict[str, np.ndarray] | None:
-        """The arrays of ``arrays.npz`` (no pickles), or None."""
-        path = self.path / "arrays.npz"
-        if self.status == "corrupt" or not path.is_file():
-            return None
-        try:
-            with np.load(path, allow_pickle=False) as npz:
-                return {k: np.asarray(npz[k]) for k in npz.files}
-        except (ValueError, OSError):
-            return None
-
-
-@dataclass
-class Results:
-    root: Path
-    run: dict | None = None
-    claims: list[dict] = field(default_factory=list)
-    units: list[Unit] = field(default_factory=list)
-    verdicts: dict[str, dict] = field(default_factory=dict)          # recomputed from the unit files
-    stored_verdicts: dict[str, dict] = field(default_factory=dict)   # summary/verdicts.json as written
-    verdict_profile: str | None = None
-    verdict_split: str | None = None
-    split: str = "dev"   # the split judged (`replication.run.splits`): run.json's, else verdicts.json's
-    planned_missing: list[str] = field(default_factory=list)
-    unfinished: bool = False
-    units_csv: pd.DataFrame | None = None
-    listed_missing: list[str] = field(default_factory=list)
-    bench: dict[str, pd.DataFrame] = field(default_factory=dict)
-    train_target: dict[str, pd.DataFrame] = field(default_factory=dict)  # train_target/ (lagbench train-target)
-    bench_gpu: dict[str, pd.DataFrame] = field(default_factory=dict)  # bench_gpu/ (lagbench bench --gpu)
-    machine: dict | None = None
-    machine_gpu: dict | None = None
-    problems: list[str] = field(default_factory=list)
-
-    def usable(self, claim: str | None = None) -> list[Unit]:
-        return [u for u in self.units if u.status == "ok" and (claim is None or u.claim == claim)]
-
-    def claim_units(self, claim: str) -> list[Unit]:
-        return [u for u in self.units if u.claim == claim]
-
-    @property
-    def frameworks(self) -> list[str]:
-        declared = list((self.run or {}).get("frameworks") or [])
-        seen = sorted({u.framework for u in self.units} - set(declared))
-        return [str(f) for f in declared] + seen
-
-
-def _read_json(path: Path, problems: list[str], root: Path) -> dict | None:
-    if not path.is_file():
-        return None
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (ValueError, OSError) as exc:
-        problems.append(f"{path.relative_to(root)} unreadable: {exc}")
-        return None
-    if not isinstance(data, dict):
-        problems.append(f"{path.relative_to(root)} is not a JSON object")
-        return None
-    return data
-
-
-def _load_unit(root: Path, result_path: Path) -> Unit:
-    unit_dir = result_path.parent
-    rel = unit_dir.relative_to(root).as_posix()
-    parts = unit_dir.relative_to(root / "units").parts
-    claim, fw, model, seed = (list(parts) + ["?"] * 4)[:4]
-    seed = seed.removeprefix("seed")
-    try:
-        result = json.loads(result_path.read_text(encoding="utf-8"))
-        if not isinstance(result, dict):
-            raise ValueError("not a JSON object")
-    except (ValueError, OSError) as exc:
-        return Unit(claim, fw, model, seed, unit_dir, rel, "corrupt", f"result.json unreadable: {exc}")
-    reason = verify_unit(unit_dir, result)
-    if reason is None:
-        missing = [k for k in UNIT_KEYS if k not in result]
-        if missing:
-            reason = "missing keys: " + ", ".join(missing)
-        elif (str(result["claim"]), str(result["framework"]), str(result["model"]), str(result["seed"])) \
-                != (claim, fw, model, seed) or len(parts) != 4:
-            reason = "folder does not match claim/framework/model/seed in result.json"
-    if reason is not None:
-        return Unit(claim, fw, model, seed, unit_dir, rel, "corrupt", reason, result)
-    status = "ok" if result.get("status") == "ok" else "failed"
-    failure = result.get("failure") or {}
-    why = None if status == "ok" else str(failure.get("kind") or failure.get("message") or result.get("status"))
-    return Unit(claim, fw, model, seed, unit_dir, rel, status, why, result)
-
-
-def _seed_key(seed: str) -> tuple[int, str]:
-    return (int(seed), "") if seed.isdigit() else (1 << 30, seed)
+__all__ = ["BENCH_COLUMNS", "Results", "Unit", "asked_claims", "load_results", "protocol_of"]
 
 
 def asked_claims(root: Path, run: dict | None = None, earlier: bool = True) -> set[str] | None:
@@ -191,7 +38,7 @@ def asked_claims(root: Path, run: dict | None = None, earlier: bool = True) -> s
     when not given) and, with `earlier`, of every earlier invocation's record (runs/run-*.json); None where
     run.json records none (an older run, or a folder of another command): then every claim is the folder's."""
     root = Path(root)
-    run = run if run is not None else _read_json(root / "run.json", [], root)
+    run = run if run is not None else read_json(root / "run.json", [], root)
     if not isinstance((run or {}).get("claims"), list):
         return None
     asked = {c for c in run["claims"] if isinstance(c, str)}
@@ -223,33 +70,6 @@ def _catalogue(res: Results, claims_json: dict | None) -> list[dict]:
     return sorted(claims, key=lambda c: (c.get("number") if isinstance(c.get("number"), int) else 1 << 30, c["id"]))
 
 
-def _load_csvs(res: Results, folder: str, wanted: dict, into: dict) -> None:
-    """ROOT/folder/<name>.csv for each name of `wanted` that exists and has its columns, into `into`."""
-    for name, columns in wanted.items():
-        path = res.root / folder / f"{name}.csv"
-        if not path.is_file():
-            continue
-        try:
-            df = pd.read_csv(path)
-        except (ValueError, OSError) as exc:
-            res.problems.append(f"{folder}/{name}.csv unreadable: {exc}")
-            continue
-        missing = [c for c in columns if c not in df.columns]
-        if missing:
-            res.problems.append(f"{folder}/{name}.csv lacks columns {missing}; not used")
-            continue
-        into[name] = df
-
-
-def _load_bench(res: Results) -> None:
-    res.machine = _read_json(res.root / "bench" / "machine.json", res.problems, res.root)
-    _load_csvs(res, "bench", BENCH_COLUMNS, res.bench)
-    _load_csvs(res, "train_target", TRAIN_TARGET_COLUMNS, res.train_target)
-    if (res.root / "bench_gpu").is_dir():
-        res.machine_gpu = _read_json(res.root / "bench_gpu" / "machine.json", res.problems, res.root)
-        _load_csvs(res, "bench_gpu", GPU_COLUMNS, res.bench_gpu)
-
-
 def load_results(root: str | Path) -> Results:
     """Read everything under ``root``; a missing or empty folder gives an empty :class:`Results`."""
     root = Path(root)
@@ -257,9 +77,9 @@ def load_results(root: str | Path) -> Results:
     if not root.is_dir():
         res.problems.append(f"results folder {root} does not exist")
         return res
-    res.run = _read_json(root / "run.json", res.problems, root)
-    claims_json = _read_json(root / "claims.json", res.problems, root)
-    verdicts = _read_json(root / "summary" / "verdicts.json", res.problems, root) or {}
+    res.run = read_json(root / "run.json", res.problems, root)
+    claims_json = read_json(root / "claims.json", res.problems, root)
+    verdicts = read_json(root / "summary" / "verdicts.json", res.problems, root) or {}
     res.verdict_profile = verdicts.get("profile")
     res.verdict_split = verdicts.get("split")
     res.split = (res.run or {}).get("split") or res.verdict_split or "dev"
@@ -269,14 +89,14 @@ def load_results(root: str | Path) -> Results:
     units_dir = root / "units"
     if units_dir.is_dir():
         # results superseded by a later protocol (folders "superseded-<time>-seed<k>") are history, not units
-        found = [_load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))
+        found = [load_unit(root, p) for p in sorted(units_dir.rglob("result.json"))
                  if not p.parent.name.startswith("superseded-")]
         mine = [u for u in found if not u.result or (u.result.get("split") or "dev") == res.split]
         if len(mine) < len(found):   # one split a report: the other's seeds are neither shown nor judged
             res.problems.append(f"{len(found) - len(mine)} unit(s) of another split than this run's ({res.split}) "
                                 f"are in this folder and left out of this report")
         found = mine
-        res.units = sorted(found, key=lambda u: (u.claim, u.framework, u.model, _seed_key(u.seed)))
+        res.units = sorted(found, key=lambda u: (u.claim, u.framework, u.model, seed_key(u.seed)))
     csv_path = root / "summary" / "units.csv"
     if csv_path.is_file():
         try:
@@ -292,7 +112,7 @@ def load_results(root: str | Path) -> Results:
     res.claims = _catalogue(res, claims_json)
     _recompute_verdicts(res)
     _check_plan(res)
-    _load_bench(res)
+    load_bench(res)
     return res
 
 

@@ -4,7 +4,7 @@ than the one the kind's protocol was chosen on (`SMALL`).
 
 A fit trains as the claim that tuned its kind does: the registered protocol of that claim's model under the
 `quick` profile with its adopted `lagbench tune` choice (`replication.claims.get` applies it), so the LNN
-gets the double-pendulum claims' restarts over initialisations with halving, their gradient-spike guard,
+gets the double-pendulum claims' restarts over initialisations with halving and fallbacks, their gradient-spike guard,
 schedule, width and budget, and a change of a claim's protocol or tuning moves these defaults with it.
 
 `SOURCES`: (kind, task) -> (claim id, model label): the LNN and an acceleration baseline from claim 1 (the
@@ -48,7 +48,8 @@ SMALL = {"restarts": None, "patience": 10}   # and the claim's steps: see `small
 HELDOUT_CHECKS = 100   # a fit logs, and its early stop evaluates the held-out rows, this many times over its steps
 MIN_IMPROVEMENT = 0.01   # the early stop's least improvement, a fraction of the best held-out error so far
 FROM_PROTOCOL = ("steps", "batch", "hidden", "activation", "lr", "schedule", "lr_start", "lr_min_ratio", "weight_decay",
-                 "loss", "restarts", "restart_keep", "restart_batch", "guard_clip", "guard_skip", "input_scale")
+                 "loss", "restarts", "restart_keep", "restart_fallback", "restart_batch", "guard_clip", "guard_skip",
+                 "input_scale")
 
 
 def _entry(kind: str, task: str):
@@ -93,6 +94,7 @@ def _defaults(kind: str, task: str, recording: bool, dof: int | None) -> tuple:
            "lr_min_ratio": p.schedule.min_ratio if one_cycle else OneCycle.min_ratio,
            "weight_decay": p.l2, "loss": p.loss,
            "restarts": s.count if s else None, "restart_keep": s.keep if s else None,
+           "restart_fallback": s.fallback if s else None,
            "restart_batch": s.batch if s else None,
            # the restarts' length and peak rate as fractions of the fit's --steps and --lr
            "restart_fraction": s.steps / p.steps if s else None, "restart_lr_ratio": s.schedule.lr / p.schedule.lr if s else None,
@@ -138,9 +140,12 @@ def fill(o, task: str, recording: bool = False, dof: int | None = None):
         if v[k] == 0:
             v[k] = None
     if not v["restarts"]:
-        v.update(restarts=None, restart_keep=None if "restart_keep" not in given else v["restart_keep"])
+        v.update(restarts=None, restart_keep=None if "restart_keep" not in given else v["restart_keep"],
+                 restart_fallback=None if "restart_fallback" not in given else v["restart_fallback"])
     elif "restart_keep" not in given and v["restart_keep"] is not None and v["restart_keep"] >= v["restarts"]:
         v["restart_keep"] = None   # the kind's halving does not fit fewer restarts than it keeps
+    if v["restarts"] and "restart_fallback" not in given and v["restart_fallback"]:
+        v["restart_fallback"] = min(v["restart_fallback"], (v["restart_keep"] or v["restarts"]) - 1)   # as many as fit
     if v["restarts"]:
         v["restart_steps"] = v["restart_steps"] or max(2, round(v["steps"] * (d["restart_fraction"] or 1 / 8)))
         v["restart_batch"] = v["restart_batch"] or v["batch"]

@@ -143,6 +143,9 @@ OPTIONS = (
            lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
     Option("restart_keep", BY_KIND, "successive halving: at half their steps only this many restarts (the lowest "
            "training losses) go on" + KIND, lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
+    Option("restart_fallback", BY_KIND, "where the chosen restart's main training ends above that restart's "
+           "training loss (it lost what the restart found), the next restart's goes on instead, up to this many more "
+           "(0: none)" + KIND, lambda v: v is None or count(0)(v), "an integer >= 0", kind=int),
     Option("restart_batch", BY_KIND, "batch size of the restarts" + KIND + "; --batch where the kind has none",
            lambda v: v is None or count(1)(v), "an integer >= 1", kind=int),
     Option("restart_lr", None, "peak rate of the restarts' one-cycle (default: --lr x the kind's ratio, or --lr)",
@@ -202,6 +205,10 @@ def check(values: dict) -> None:
     if BY_KIND not in (keep, restarts) and keep is not None and (not restarts or keep >= restarts):
         raise ValueError(f"--restart-keep: {keep!r} needs --restarts above it (the restarts that go on after the "
                          f"first half)")
+    fallback = values.get("restart_fallback")
+    if BY_KIND not in (keep, restarts, fallback) and fallback and (not restarts or fallback >= (keep or restarts)):
+        raise ValueError(f"--restart-fallback: {fallback!r} needs more restarts that reach the end "
+                         f"({keep or restarts or 0} do): each fallback goes on from another of them")
     if values.get("dissipation") and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
         raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
                          "function); the baseline's q-double-dot is free-form already")

@@ -11,7 +11,9 @@ The time left is measured, not assumed from the count: the seconds per training 
 way (from this process's clock between its log rows, from its second row on: its first step compiles, and
 so does the first held-out evaluation of an early stop, after the first row)
 times the samples each part still has (`scouting.scout_parts`: restarts x their batch per step, then the
-main batch). Before a part starts, its time per sample is the part before's; once it runs, its own (the
+main batch). A restarts' fallback (`Scouting.fallback`: the next restart's main training, where the first
+lost its restart's loss) lengthens the bar by a main training as it starts, and a bar that may still see one
+is closed by its caller, and its time shown as the most it takes ("<="). Before a part starts, its time per sample is the part before's; once it runs, its own (the
 first step of each part compiles, which no estimate foresees). With an early stop (`Protocol.early_stop`) the
 main training may end sooner (it stops and anneals), so the time shown is the most it takes ("<="); where it
 ends before its total, the bar says at which step.
@@ -45,6 +47,13 @@ def position(protocol, row: dict) -> int:
     before = progress_steps(protocol) - protocol.steps   # the restarts' samples, in main steps
     restarts = protocol.scouting.steps if protocol.scouting else 0
     return restarts + int(row["step"]) - before + 1
+
+
+def fallbacks(protocol, at: int) -> int:
+    """The fallbacks under way at position `at` (`Scouting.fallback`: a main training after the first, each
+    `protocol.steps` more): 0 until the first main training's end."""
+    over = at - total_steps(protocol)
+    return -(-over // protocol.steps) if over > 0 else 0
 
 
 def seconds_left(protocol, done: int, per_sample: float) -> float:
@@ -81,13 +90,17 @@ class TrainingBar:
     def row(self, row: dict) -> None:
         if self.protocol is None:
             return
+        p, at = self.protocol, position(self.protocol, row)
+        extra = fallbacks(p, at)
+        total = total_steps(p) + extra * p.steps
         if self.bar is None:
             from tqdm.auto import tqdm
 
-            self.bar = tqdm(total=total_steps(self.protocol), desc=self.desc, unit="step", bar_format=FORMAT,
-                            disable=self.quiet)
-        done, now = min(position(self.protocol, row), self.bar.total), time.perf_counter()
-        part = self._part(done)
+            self.bar = tqdm(total=total, desc=self.desc, unit="step", bar_format=FORMAT, disable=self.quiet)
+        elif self.bar.total != total:   # a fallback's main training goes on past the first one's end
+            self.bar.total = total
+        done, now = min(at, total), time.perf_counter()
+        part = self._part(done - extra * p.steps)
         self.rows = self.rows + 1 if part == self.part else 1
         self.part = part
         if self.rows <= 2:   # a part's first two rows: its steps until then include compiling
@@ -95,13 +108,13 @@ class TrainingBar:
         elif done > self.mark[0]:
             samples = parts(self.protocol)[part][0] * (done - self.mark[0])
             self.per_sample = (now - self.mark[1]) / samples
-        left = seconds_left(self.protocol, done, self.per_sample) if self.per_sample is not None else None
-        early = "<=" if self.protocol.early_stop else "about"
-        phase = "restarts" if part < len(parts(self.protocol)) - 1 else "main"
+        left = seconds_left(p, done - extra * p.steps, self.per_sample) if self.per_sample is not None else None
+        early = "<=" if p.early_stop or (p.scouting and p.scouting.fallback and not extra) else "about"
+        phase = "restarts" if part < len(parts(p)) - 1 else f"fallback {extra}" if extra else "main"
         self.bar.set_postfix_str(f"{phase}, {'estimating' if left is None else f'{early} {_clock(left)} left'}, "
                                  f"training loss {row['loss']:.4g}", refresh=False)
         self.bar.update(done - self.bar.n)
-        if done >= self.bar.total:
+        if done >= self.bar.total and not (p.scouting and p.scouting.fallback):   # else the caller closes it
             self.close()
 
     def close(self) -> None:

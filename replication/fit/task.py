@@ -119,7 +119,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     batch = min(o.batch, n_train)
     scouting = Scouting(count=o.restarts, steps=o.restart_steps, batch=min(o.restart_batch, n_train),
                         schedule=OneCycle(lr=o.restart_lr, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle"
-                        else Constant(lr=o.restart_lr), keep=o.restart_keep) if o.restarts else None
+                        else Constant(lr=o.restart_lr), keep=o.restart_keep,
+                        fallback=o.restart_fallback or 0) if o.restarts else None
     guard = Guard(clip=o.guard_clip, skip=o.guard_skip) if (o.guard_clip or o.guard_skip) else None
     log_every = max(1, o.steps // kind_defaults.HELDOUT_CHECKS)
     patience = o.patience if prep.counts.get("heldout") else 0

@@ -71,7 +71,8 @@ def test_patience_without_heldout_rows_is_refused(files, tmp_path, capsys):
 def test_the_bar_counts_the_restarts_steps_and_the_main_steps_in_one_total(files, tmp_path):
     protocols, rows = [], []
     fit(files["double_pendulum"], model="lnn", out=tmp_path / "r", steps=8, hidden=(8,), batch=16, restarts=4,
-        restart_steps=6, restart_keep=2, restart_batch=8, on_train=protocols.append, on_log=rows.append)
+        restart_steps=6, restart_keep=2, restart_batch=8, restart_fallback=0, on_train=protocols.append,
+        on_log=rows.append)
     (p,) = protocols
     assert progress.total_steps(p) == 6 + 8   # the restarts train side by side: 6 steps, then 8 main steps
     done = [progress.position(p, r) for r in rows]
@@ -81,6 +82,16 @@ def test_the_bar_counts_the_restarts_steps_and_the_main_steps_in_one_total(files
     # cut, at their batch) and the main training's
     assert progress.seconds_left(p, 0, 1.0) == budget_samples(p) == (4 * 3 + 2 * 3) * 8 + 8 * 16
     assert progress.seconds_left(p, 6, 1.0) == 8 * 16 and progress.seconds_left(p, 14, 1.0) == 0
+    # a fallback (the next restart's main training) goes on past the first one's end, 8 steps each
+    assert [progress.fallbacks(p, at) for at in (6, 14, 15, 22, 23)] == [0, 0, 1, 1, 2]
+    bar = progress.TrainingBar("t")
+    bar.start(p.replace(**{"scouting.fallback": 1}))
+    for r in rows:
+        bar.row(r)
+    assert bar.bar.total == bar.bar.n == progress.total_steps(p)   # open: a fallback may follow
+    bar.row({**rows[-1], "step": rows[-1]["step"] + 1})             # the fallback's first step
+    assert bar.bar.total == progress.total_steps(p) + 8 and bar.bar.n == progress.total_steps(p) + 1
+    bar.close()
 
 
 def test_the_bar_ends_at_its_total_or_says_where_the_training_ended(files, tmp_path, capsys):

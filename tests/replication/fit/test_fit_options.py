@@ -59,7 +59,7 @@ def test_a_fit_at_its_defaults_trains_as_the_claim_that_tuned_its_kind(tmp_path,
     assert o.hidden == entry.widths("quick") and o.activation == entry.spec_fields("quick")["activation"]
     assert (Guard(o.guard_clip, o.guard_skip) if o.guard_clip else None) == p.guard
     scouting = Scouting(o.restarts, o.restart_steps, o.restart_batch, OneCycle(lr=o.restart_lr, min_ratio=o.lr_min_ratio),
-                        o.restart_keep) if o.restarts else None
+                        o.restart_keep, o.restart_fallback or 0) if o.restarts else None
     assert scouting == p.scouting
     assert (o.input_scale == "auto") == ("input_scale" in entry.spec_fields("quick"))
     assert fit_task.LOSS_NAMES[o.loss]
