@@ -115,9 +115,11 @@ def run_unit(unit: Unit, out, on_log=None, on_progress=None) -> dict:
         "protocol": protocol.to_dict(), "eval_config": ctx.cfg, "evaluation_version": EVALUATION_VERSION, "dtype": protocol.dtype, "wall_time_s": time.perf_counter() - t0,
         "train_time_s": outcome.train_time_s if outcome else 0.0,
         "train_steps": outcome.steps_done if outcome else 0,
-        # the budget; a run its early stop ended: the samples it trained (`Protocol.early_stop`)
+        # the budget; a run its early stop ended, or that continued a fallback scout: the samples it trained
+        # (`Protocol.early_stop`, `Scouting.fallback`)
         "train_samples": (outcome.samples or outcome.steps_done * outcome.batch
-                          if outcome.early_stop and outcome.early_stop["stopped_at"] is not None
+                          if (outcome.early_stop and outcome.early_stop["stopped_at"] is not None)
+                          or len((outcome.scouting or {}).get("continued", ())) > 1
                           else budget_samples(protocol)) if outcome else 0,
         **({"early_stop": outcome.early_stop} if outcome and outcome.early_stop else {}),
         "train_samples_per_s": outcome.samples_per_s if outcome else None,

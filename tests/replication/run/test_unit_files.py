@@ -41,3 +41,22 @@ def test_paths_outside_the_results_folder_are_refused(tmp_path, path):
     with pytest.raises(ValueError, match="refused"):
         unit_files.write(tmp_path / "out", {path: b"{}"})
     assert not (tmp_path / "out").exists()
+
+
+def test_a_run_that_continued_a_fallback_scout_records_the_samples_it_trained(tmp_path, monkeypatch):
+    """A restarts' fallback (`Scouting.fallback`) trains a second continuation: the unit's train_samples are
+    the samples trained, not the protocol's budget."""
+    from lagbench.replication.run import runner, units
+    from lagbench.replication.training.scouting import budget_samples
+
+    (u,) = runner.plan("smoke", claims=["dp_loss"], frameworks=("jax",), models=["baseline"], seeds=1)
+    real, budget = units.train_cached, budget_samples(u.protocol())
+
+    def fell_back(*args, **kwargs):
+        o = real(*args, **kwargs)
+        o.scouting = {**o.scouting, "continued": [2, 3], "continuation_tail_loss": [9.0, 1.0]}
+        o.samples = budget + 7
+        return o
+    assert units.run_unit(u, tmp_path)["train_samples"] == budget   # as planned
+    monkeypatch.setattr(units, "train_cached", fell_back)
+    assert units.run_unit(u, tmp_path / "b")["train_samples"] == budget + 7
