@@ -5,14 +5,16 @@ registration line it matches, how its models were tuned (`tuning_text`) and its 
 `tuning_table(res)`: per claim and trained model, the configurations its protocol was chosen among by
 `lagbench tune`, the split they were scored on and the choice (knobs as multiples of the registered
 setting); a model chosen among fewer configurations than a rival of its claim is flagged.
-`add_to(section, res)`: both tables, with their notes; `summary(res)`: one paragraph of both for the scorecard.
+`disclosed(res)`: the claims registered anew after a look at test-split numbers, with the note that says so.
+`add_to(section, res)`: both tables, with their notes, and each disclosure in full; `summary(res)`: one
+paragraph of both for the scorecard, naming the disclosed claims.
 """
 from __future__ import annotations
 
 import pandas as pd
 
 from lagbench.replication.tuning.search import SIZE as SEARCH_SIZE
-from lagbench.reports.document import Section, Table
+from lagbench.reports.document import Para, Section, Table
 from lagbench.reports.fmt import cell
 from lagbench.reports.load import Results
 
@@ -70,6 +72,13 @@ def tuning_table(res: Results) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+def disclosed(res: Results) -> list[tuple[str, str]]:
+    """(claim, note) of each claim whose matching registration was made after a look at test-split numbers:
+    its note says so ("disclosed")."""
+    return [(str(claim.get("number", claim["id"])), r["note"]) for claim in res.claims
+            for r in [_prereg(res, claim)] if r.get("registered") and "disclosed" in (r.get("note") or "")]
+
+
 def summary(res: Results) -> str:
     """How the claims' protocols were chosen and registered, in one paragraph (the tables are in the appendix)."""
     by = {}
@@ -86,6 +95,9 @@ def summary(res: Results) -> str:
     return (f"How each claim's protocol was chosen: {text}. "
             + (f"NOT REGISTERED (changed since their registration): {', '.join(unregistered)}. " if unregistered
                else "Every protocol matches its registration. ")
+            + (f"Registered anew after a look at test-split numbers, disclosed: claim"
+               f"{'s' if len(disclosed(res)) > 1 else ''} {', '.join(c for c, _ in disclosed(res))}. "
+               if disclosed(res) else "")
             + "The registrations, the tuning ledger and the seed rule per claim: appendix, 'Parts, reasons and "
               "registrations'.")
 
@@ -100,6 +112,12 @@ def add_to(s: Section, res: Results) -> None:
                          "test-split run; a change after one is a new dated registration, never a silent edit. "
                          "'tuning' says how the models' protocols were chosen: by `lagbench tune` (the same "
                          "configurations for every model, scored on the development split) or by hand."))
+    by_note: dict = {}
+    for claim, note in disclosed(res):
+        by_note.setdefault(note, []).append(claim)
+    for note, claims in by_note.items():
+        s.add(Para(f"Claim{'s' if len(claims) > 1 else ''} {', '.join(claims)}: registered anew after a look at "
+                   f"test-split numbers (disclosed): {note.rstrip('.')}."))
     ledger = tuning_table(res)
     if ledger is not None:
         s.add(Table("Tuning ledger", ledger, ["replication/claims/tuned.json", "docs/lab/search/*/ledger.json"],
