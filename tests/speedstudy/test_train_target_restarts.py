@@ -104,11 +104,13 @@ def test_the_halved_restarts_scout_twice_the_inits_and_count_every_sample():
 
 
 def test_the_full_profiles_double_pendulum_trains_what_restarts_halved_measured():
-    """full's claims 1-2 train what restarts_halved trains at FULL_SAMPLES (4e7): the same protocol."""
+    """full's claims 1-2 train what restarts_halved trains at FULL_SAMPLES (4e7): the same protocol, but for
+    full's fallback (`Scouting.fallback`), which acts only where a continuation loses its scout's loss."""
     from lagbench.replication.claims.double_pendulum import FULL_SAMPLES, PROTOCOLS, VELOCITY_SCALE
     full = PROTOCOLS["full"]
     entry = TT.protocols(FULL_SAMPLES, full.data.n_heldout)["restarts_halved"]
-    logging_only = {"log_every": 1, "tracking": None}
+    assert full.scouting.fallback == 3 and entry.protocol.scouting.fallback == 0
+    logging_only = {"log_every": 1, "tracking": None, "scouting.fallback": 0}
     assert full.schedule.kind == "onecycle"
     assert full.replace(**logging_only) == entry.protocol.replace(**logging_only)
     assert scouting.scouting_samples(full) + full.steps * full.batch <= FULL_SAMPLES
