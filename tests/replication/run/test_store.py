@@ -169,6 +169,7 @@ def test_a_clone_of_a_store_with_a_study_gives_the_report_of_the_folder_it_was_m
     assert report == _report(out, tmp_path / "report_folder")
 
 
+@pytest.mark.slow   # a Ray instance's start-up (tox -e slow)
 @pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="Ray is an optional extra")
 def test_on_ray_each_unit_is_trimmed_as_it_finishes(tmp_path, monkeypatch):
     """The end of the run's trimming left out (as when the driver stops): the unit is trimmed all the same."""
