@@ -66,7 +66,8 @@ def cmd_run(args):
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=frameworks, seeds=seeds, models=_csv(args.models),
                   progress=not args.quiet, jobs=args.jobs, executor=args.executor, address=args.address,
-                  dry_run=args.dry_run, split=args.split, add_models=args.add_model, store=args.store)
+                  dry_run=args.dry_run, split=args.split, add_models=args.add_model, store=args.store,
+                  pack_seeds=args.pack_seeds)
     if summary.get("dry_run"):
         return 0
     from lagbench.reports.load import asked_claims

@@ -93,6 +93,12 @@ def build_parser():
                    "for the rest, a unit made under another registration redone, its size told at the end")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
+    s.add_argument("--pack-seeds", type=int, metavar="N", help="train up to N seeds of a model side by side as one "
+                   "vectorised program, each with its own init and batches and stored under the training key of its "
+                   "run alone (docs/gpu.md); it changes float32 rounding, not the protocol, so registrations are "
+                   "made with it off; a protocol with restarts, an early stop or a cohort of its own trains as it "
+                   "registers; local executor only (default: 8 where a framework trains on a GPU, 1 = each seed "
+                   "alone on the CPU)")
     s.set_defaults(func=cmd_run)
     from lagbench.replication.run.verify_cli import add_command as add_verify
     from lagbench.replication.studies.control_cli import add_command as add_control

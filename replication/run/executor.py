@@ -1,9 +1,11 @@
 """Running the units of a plan: one after another in this process, or in parallel worker processes.
 A full disk (`results.DiskFull`) stops either at once: every later unit would fail to store its result.
 
-`run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None) -> (failures, errors)`;
-failures: "<unit>: <reason>" of units whose training failed (a result is written), errors: "<unit>:
-<exception>" of units that raised (no result; a rerun retries them).
+`run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None, members=None) -> (failures,
+errors)`; failures: "<unit>: <reason>" of units whose training failed (a result is written), errors: "<unit>:
+<exception>" of units that raised (no result; a rerun retries them). `members` ({framework: N},
+`replication.run.packing.members`): a model's seeds packed N to a program (`--pack-seeds`), trained as one
+before the first of its units runs; None or 1: each seed alone.
 
 The run's progress bar advances by each unit's estimated seconds (`replication.run.unit_seconds`, given as
 `seconds`), so that its remaining time is the work left; `on_done(unit)` is told of each unit whose run ended
@@ -13,7 +15,9 @@ jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N w
 so each starts clean), each given one CPU thread for JAX (XLA's Eigen pool off) and for PyTorch and
 OpenMP, so that N workers share N cores instead of each spreading over all of them. Units that train the
 same model (a claim pair sharing a trained model; a cohort of seeds trained as one program: `training.group_key`)
-form one *chain* (`replication.run.chains`, shared with the Ray executor, `replication.run.executor_ray`) run by one worker in order, so the model is trained once and the others read it from the cache; chains go out
+form one *chain* (`replication.run.chains`, shared with the Ray executor, `replication.run.executor_ray`; a packed
+program's units one chain too, `replication.run.packing.chains`) run by one worker in order, so the model is
+trained once and the others read it from the cache; chains go out
 longest first (estimated from the training budget in samples, the model's width and the framework), so
 that the long ones do not start last. Every unit writes its own files as in a serial run, so a run is
 resumable and gives the same numbers either way (training is deterministic given the seed; only wall
@@ -33,10 +37,10 @@ from multiprocessing import get_context
 from tqdm.auto import tqdm
 
 from lagbench.files.results import DiskFull
-from lagbench.replication.run.chains import TORCH_COST, chains, release_compiled  # noqa: F401 - TORCH_COST, release_compiled: re-exported
+from lagbench.replication.run import packing
+from lagbench.replication.run.chains import TORCH_COST, chains, release_compiled  # noqa: F401 - TORCH_COST, chains, release_compiled: re-exported
 from lagbench.replication.run.chains import cost as _cost  # noqa: F401 - re-exported for the tests
 from lagbench.replication.run.chains import ref as _ref
-from lagbench.replication.run.chains import run_chain as _run_chain
 from lagbench.replication.run.chains import run_one as _one
 from lagbench.replication.run.environment import one_thread_children, worker_start
 from lagbench.replication.training.scouting import progress_steps
@@ -49,8 +53,9 @@ def _bar(seconds, desc, progress):
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
 
 
-def _serial(todo, out, profile, progress, seconds, on_done):
+def _serial(todo, out, profile, progress, seconds, on_done, members):
     failures, errors = [], []
+    packs = packing.by_unit(todo, out, members)
     bar = _bar(seconds, f"lagbench {profile}", progress)
     try:
         for i, (u, weight) in enumerate(zip(todo, seconds, strict=True)):
@@ -64,7 +69,8 @@ def _serial(todo, out, profile, progress, seconds, on_done):
                 last["step"] = row["step"]
                 inner.set_postfix(loss=f"{row['loss']:.3g}")
             try:
-                failure, error = _one(u, out, on_log)
+                error = packing.program_error(u, out, packs.get(u.name), on_log)
+                failure, error = (None, error) if error else _one(u, out, on_log)
             finally:
                 inner.close()
             failures += [failure] if failure else []
@@ -79,13 +85,13 @@ def _serial(todo, out, profile, progress, seconds, on_done):
 
 def _worker_loop(driver: int, tasks, results):
     """A worker process: chains from `tasks` (None: stop), each answered on `results` as (chain id, done,
-    error)."""
+    error); a chain's packed programs (`members`) train before its first unit that reads them."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the driver's: it stops the workers
     worker_start(driver)
     while (item := tasks.get()) is not None:
-        cid, refs, out = item
+        cid, refs, out, members = item
         try:
-            results.put((cid, _run_chain(refs, out), None, None))
+            results.put((cid, packing.run_chain(refs, out, members), None, None))
         except DiskFull as e:   # the driver stops the run
             results.put((cid, None, None, (e.errno, e.strerror, e.filename)))
         except Exception as e:  # noqa: BLE001 - reported for this chain; the worker goes on
@@ -113,9 +119,9 @@ class _Workers:
             free = [self.slots[-1]]
         return free[0] if free else None
 
-    def assign(self, slot, cid, refs, out):
+    def assign(self, slot, cid, refs, out, members=None):
         slot[2] = cid
-        slot[1].put((cid, refs, out))
+        slot[1].put((cid, refs, out, members))
 
     def busy(self) -> bool:
         return any(s[2] is not None for s in self.slots)
@@ -144,8 +150,8 @@ class _Workers:
             proc.join(timeout=10 if wait else 2)
 
 
-def _parallel(todo, out, profile, progress, jobs, seconds, on_done):
-    work = chains(todo)
+def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
+    work = packing.chains(todo, out, members)
     failures, errors, count = [], [], 0
     weight = {id(u): w for u, w in zip(todo, seconds, strict=True)}
     # the spawned workers start on demand as chains are handed out, each on one thread
@@ -171,7 +177,7 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done):
                 while pending and (slot := workers.idle()) is not None:
                     cid, chain = pending.pop(0)
                     held[cid] = chain
-                    workers.assign(slot, cid, [_ref(u) for u in chain], out)
+                    workers.assign(slot, cid, [_ref(u) for u in chain], out, members)
                 try:
                     cid, done, error, full = workers.results.get(timeout=0.5)
                 except queue.Empty:
@@ -197,7 +203,7 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done):
     return failures, errors
 
 
-def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None):
+def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None, members=None):
     """`seconds`: each unit's estimated seconds (`unit_seconds`), what the bar advances by (default: one each);
     `on_done(unit)`: called in this process once a unit's run has ended (its result written, or not)."""
     if jobs < 1:
@@ -205,5 +211,5 @@ def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=N
     seconds = list(seconds) if seconds is not None else [1.0] * len(todo)
     on_done = on_done or (lambda u: None)
     if jobs == 1 or len(todo) <= 1:
-        return _serial(todo, out, profile, progress, seconds, on_done)
-    return _parallel(todo, out, profile, progress, jobs, seconds, on_done)
+        return _serial(todo, out, profile, progress, seconds, on_done, members)
+    return _parallel(todo, out, profile, progress, jobs, seconds, on_done, members)

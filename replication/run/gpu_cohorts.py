@@ -8,13 +8,15 @@ registrations and training keys are those of every device, and each seed's numbe
 alone (float64, to rounding: `tests/replication/training/test_paper_cohorts.py`, every `paper` protocol at
 a small size, in both frameworks).
 
-`blocker(protocol) -> str | None`: why a protocol's seeds cannot train side by side (None: they can).
+`blocker(protocol, spec=None) -> str | None`: why a protocol's seeds (of `spec`'s model, where given) cannot
+train side by side (None: they can).
 `programs(units, out, members=MAX_MEMBERS) -> [Program]`: the training programs `units` still need (a seed
 whose training OUT/trained holds needs none): a packable model's seeds in ascending order, up to `members`
 a program; a protocol with a `blocker` keeps its own programs (`training.group_key`: one seed, or the
 protocol's own cohort). Units sharing a training (claims 1 and 2 train the same models) share its program.
 
-The estimate (`replication.run.estimate`) times these programs on the device with `--device gpu`. Memory
+The estimate (`replication.run.estimate`) times these programs on the device with `--device gpu`, and the run
+trains them so (`replication.run.packing`, `lagbench run --pack-seeds`). Memory
 does not bound `MAX_MEMBERS` for the `paper` protocols: their largest model, the 3 x 600 LNN at batch 512,
 holds about 12 MB of parameters and Adam state and under 0.1 GB of activations a member in float32.
 """
@@ -23,6 +25,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
+
+from lagbench.models.spec import USER_KIND
 
 MAX_MEMBERS = 8   # seeds a program: every `paper` model's seeds (at most 8) train as one
 
@@ -43,8 +47,10 @@ class Program:
         return len(self.seeds) if self.packed else (self.protocol.cohort or 1)
 
 
-def blocker(protocol) -> str | None:
-    """Why `protocol`'s seeds cannot be packed into a cohort; None where they can."""
+def blocker(protocol, spec=None) -> str | None:
+    """Why `protocol`'s seeds (of `spec`'s model, where given) cannot be packed into a cohort; None where they can."""
+    if spec is not None and spec.kind == USER_KIND:
+        return "a user's model (`--add-model`): its code is not known to train stacked, so each seed trains alone"
     if protocol.scouting:
         return "restarts (scouting): its scouts already train side by side, and a Protocol refuses both"
     if protocol.early_stop:
@@ -75,7 +81,7 @@ def programs(units, out, members: int = MAX_MEMBERS) -> list[Program]:
     for seeds in by_model.values():
         u0 = next(iter(seeds.values()))[0]
         p, spec = u0.protocol(), u0.spec()
-        if blocker(p):   # its own programs, as `training.group_key` groups them
+        if blocker(p, spec):   # its own programs, as `training.group_key` groups them
             groups: dict = {}
             for s, us in seeds.items():
                 groups.setdefault(group_key(u0.framework, spec, p, s), []).append((s, us))

@@ -9,6 +9,9 @@ work; a unit redone because its folder held a damaged or half-written result is 
 and in run.json's "repaired"; an earlier invocation's run.json is kept as `runs/run-<start>.json`;
 Ctrl-C records "interrupted" in run.json before it propagates.
 
+With `pack_seeds` (`--pack-seeds`; on a GPU by default) a model's seeds train as one program and each is stored
+under its own training key (`replication.run.packing`).
+
 With `store=True` (`--store`) OUT is kept as a store that git can carry (`replication.run.store`): each
 finished unit trimmed, a .gitignore, a unit made under another registration of its claim redone.
 """
@@ -28,7 +31,7 @@ from lagbench.replication.claims.base import FRAMEWORKS, run_frameworks
 from lagbench.replication.claims.resolved import catalogue, resolved
 from lagbench.replication.claims.verdicts import write_summary
 from lagbench.replication.evaluation.registry import EVALUATION_VERSION
-from lagbench.replication.run import added_models, splits
+from lagbench.replication.run import added_models, packing, splits
 from lagbench.replication.run import environment as env
 from lagbench.replication.run import store as S
 from lagbench.replication.run.estimate import PROBES, describe, estimate
@@ -153,10 +156,10 @@ def set_aside(folder: Path) -> Path:
     raise FileExistsError(f"{folder}: no free superseded-{stamp}.* name")
 
 
-def announce(profile, units, todo, out, jobs, executor="local", keep=False) -> dict:
+def announce(profile, units, todo, out, jobs, executor="local", keep=False, members=None) -> dict:
     """Print the units a long profile will run and its estimated duration (`replication.run.estimate`),
     its probes timed at the thread setting the units will train with; `keep`: the probes are written to
-    OUT for a resumed run on this machine to reuse."""
+    OUT for a resumed run on this machine to reuse. `members`: the run's packing (`packing.members`)."""
     print(f"lagbench: profile {profile}: {len(units)} units, {len(todo)} to run:\n{describe(units, todo)}", flush=True)
     print("lagbench: timing a few steps of each training to estimate the duration...", flush=True)
     est = estimate(todo, out, jobs, env.worker_torch_threads(executor, jobs), keep=keep)
@@ -170,9 +173,10 @@ def announce(profile, units, todo, out, jobs, executor="local", keep=False) -> d
           f"worker{'s' if jobs != 1 else ''} (evaluation not included; {where}; {hw['cpu']}, GPU: {hw['gpu']}). "
           f"Interrupt at any time: the run resumes where it stopped.", flush=True)
     if est.get("cohorts"):   # on a GPU: each model's seeds packed as one program (`run.gpu_cohorts`)
-        c = est["cohorts"]
+        c, most = est["cohorts"], max((members or {}).values(), default=1)
+        this = f"this run packs up to {most}" if most > 1 else "this run trains one seed a program"
         print(f"lagbench: with each model's seeds packed as one program on the GPU ({c['programs']} programs of up "
-              f"to {c['members']} seeds; this run trains one seed a program): {c['train_s'] / 3600:.1f} h of "
+              f"to {c['members']} seeds; {this}): {c['train_s'] / 3600:.1f} h of "
               f"training, about {c['wall_s'] / 3600:.1f} h wall with {jobs} worker{'s' if jobs != 1 else ''}",
               flush=True)
     if len(est["by_claim"]) > 1:   # where the time goes, the costliest first (shared trainings: first claim)
@@ -224,10 +228,11 @@ def executor_of(executor, jobs, address):
 @R.writes
 def run(profile="quick", out="results/quick", claims=None, frameworks=None, seeds=None, models=None,
         progress=True, jobs=1, executor="local", address=None, dry_run=False, split=splits.RUN_DEFAULT,
-        add_models=(), store=False) -> dict:
+        add_models=(), store=False, pack_seeds=None) -> dict:
     """`add_models`: "NAME=module:factory" strings (`replication.run.added_models`). `store`: keep OUT as a
     store git can carry (`replication.run.store`): trimmed units, a .gitignore, a unit made under another
-    registration redone; its size printed at the end."""
+    registration redone; its size printed at the end. `pack_seeds`: up to that many seeds of a model trained
+    as one program (`replication.run.packing`; None: `gpu_cohorts.MAX_MEMBERS` on a GPU, 1 on the CPU)."""
     if not is_integer(jobs) or jobs < 1:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
     execute = executor_of(executor, jobs, address)
@@ -235,11 +240,12 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
         R.refuse_if_locked(out, "--out")
     added = added_models.parse(add_models, {e.label for c in CLAIMS.values() for e in c.models})
     units = plan(profile, claims, frameworks, seeds, models, split, added)
+    members = packing.members(pack_seeds, sorted({u.framework for u in units}), executor)
     memo = {} if store else None   # a store's units: their registration hashes too
     if dry_run:   # the plan and the estimate only; nothing is written (the probes train in memory)
         todo = [u for u in units if not is_current(u, out, set_stale_aside=False, registration=memo)]
         if todo:
-            estimate = announce(profile, units, todo, out, jobs, executor)
+            estimate = announce(profile, units, todo, out, jobs, executor, members=members)
         else:   # said, not left to silence: a finished folder is an answer too
             estimate = None
             print(f"lagbench: profile {profile}: {len(units)} units, every one finished in {out}: "
@@ -255,7 +261,8 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
                 "added_models": [{"name": a.name, "factory": a.ref, "factory_source": a.source,
                                   "framework": a.framework} for a in added],
                 # the units this run plans: the report names any that have no result (an unfinished run)
-                "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor, "versions": env.versions(),
+                "planned_units": [u.name for u in units], "jobs": jobs, "executor": executor,
+                "pack_seeds": members, "versions": env.versions(),
                 "hardware": env.hardware(), "commit": env.commit(), "started": env.now(), "finished": None}
     keep_previous_record(out)
     R.write_json(out / "run.json", manifest)
@@ -264,14 +271,15 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     manifest["repaired"] = repairs
     by_group = None   # the estimate's seconds per training, what the progress bar advances by
     if profile in LONG_PROFILES and todo:
-        manifest["estimate"] = announce(profile, units, todo, out, jobs, executor, keep=True)
+        manifest["estimate"] = announce(profile, units, todo, out, jobs, executor, keep=True, members=members)
         by_group = manifest["estimate"].pop("by_group", None)
         R.write_json(out / "run.json", manifest)
     log.info("%d units, %d finished, %d to run", len(units), len(units) - len(todo), len(todo))
     t0 = time.perf_counter()
     try:
         failures, errors = execute(todo, out, profile, progress, seconds=unit_seconds(todo, out, by_group),
-                                   on_done=(lambda u: S.keep_unit(u.folder(out))) if store else None)
+                                   on_done=(lambda u: S.keep_unit(u.folder(out))) if store else None,
+                                   members=members)
     except KeyboardInterrupt:
         manifest.update(interrupted=env.now(), wall_time_s=time.perf_counter() - t0)
         R.write_json(out / "run.json", manifest)

@@ -84,10 +84,15 @@ def pick(units: list, n: int, seed: int) -> list:
 
 
 def same_environment(a: dict, b: dict) -> bool:
-    """Whether two results were computed on the same kind of machine with the same libraries."""
+    """Whether two results were computed on the same kind of machine with the same libraries, both packed with
+    other seeds or both alone (a packed training's products run stacked: other rounding, `run.packing`)."""
     ha, hb = a.get("hardware") or {}, b.get("hardware") or {}
     return (all(ha.get(k) == hb.get(k) for k in SAME_HARDWARE) and a.get("versions") == b.get("versions")
-            and a.get("train_device") == b.get("train_device"))
+            and a.get("train_device") == b.get("train_device") and _packed(a) == _packed(b))
+
+
+def _packed(record: dict) -> bool:
+    return bool((record.get("cohort") or {}).get("packed")) if isinstance(record.get("cohort"), dict) else False
 
 
 def _number(v) -> bool:

@@ -76,7 +76,7 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
             seen.update({k: os.environ.get(k) for k in one_thread_env({})})
             return object()
 
-        def assign(self, slot, cid, refs, out):
+        def assign(self, slot, cid, refs, out, members=None):
             self.results.put((cid, fake_chain(refs, out), None, None))
 
         def finished(self, cid):

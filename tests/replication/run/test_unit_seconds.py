@@ -83,7 +83,7 @@ class _InlineWorkers:
     def idle(self):
         return object()
 
-    def assign(self, slot, cid, refs, out):
+    def assign(self, slot, cid, refs, out, members=None):
         self.results.put((cid, [(f"u{i}", None, None) for i, _ in enumerate(refs)], None, None))
 
     def finished(self, cid):

@@ -82,3 +82,13 @@ def test_the_report_has_no_verification_section_without_a_verification(two_units
     from lagbench.reports.sections_verify import verify_sections
 
     assert verify_sections(load_results(two_units)) == []
+
+
+def test_a_packed_training_retrained_alone_is_held_to_the_tolerance_of_another_environment():
+    """Packed seeds (`run --pack-seeds`) multiply stacked: another rounding than the unit's run alone."""
+    env = {"hardware": {"cpu": "x"}, "versions": {"jax": "1"}, "train_device": "cpu", "metrics": {"m": 1.0}}
+    packed = {**env, "cohort": {"seeds": [0, 1], "packed": True}}
+    assert V.same_environment(env, {**env, "cohort": None})
+    assert not V.same_environment(packed, env)
+    assert {r["tolerance"] for r in V.compare(packed, {**env, "metrics": {"m": 1.01}})} == {V.OTHER_TOL}
+    assert V.same_environment(packed, dict(packed))
