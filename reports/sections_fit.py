@@ -55,6 +55,15 @@ def _schedule(protocol) -> str:
     return f"{protocol.schedule.kind}, peak {num(protocol.schedule.lr)}" if protocol else cell(None)
 
 
+def _loss(p: dict) -> str:
+    """The training loss in words: the task's target, or positions over windows (`--loss-target trajectory`)."""
+    t = p.get("trajectory_loss")
+    if not isinstance(t, dict):
+        return cell(p.get("loss"))
+    return (f"{cell(p.get('loss'))} on positions over {t.get('frames')} frames "
+            f"({t.get('substeps')} RK4 substeps a frame)")
+
+
 def _models_table(units) -> pd.DataFrame:
     rows = []
     for u in units:
@@ -62,7 +71,7 @@ def _models_table(units) -> pd.DataFrame:
         cfg = r.get("eval_config") or {}
         # a fit's --test rows are recorded apart from its own split's
         counts = {**(cfg.get("rows") or {}), **({"test": cfg["test_rows"]} if cfg.get("test_rows") is not None else {})}
-        rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": cell(p.get("loss")),
+        rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": _loss(p),
                      "steps": count(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
                      "weight decay (l2)": num(p.get("l2")), "schedule": _schedule(protocol_of(r)),
@@ -190,6 +199,7 @@ def _path(ref) -> str:
 
 
 def _data_para(units) -> Para:
+    from lagbench.replication.fit.derivative_window import describe
     from lagbench.replication.fit.rows import Overlap
 
     seen: dict[str, list[str]] = {}
@@ -203,9 +213,11 @@ def _data_para(units) -> Para:
         whole = " / ".join(f"{traj[k]}" for k in SETS if traj.get(k))
         text = (f"{cell(src, 'unknown file')}: {split} rows"
                 + (f" ({whole} whole trajectories); derivatives the file lacked estimated by Savitzky–Golay "
-                   f"(window {d.get('window')}, degree {d.get('polyorder')})" if any(traj.values()) else "")
+                   f"({describe(d)})" if any(traj.values()) else "")
                 + (f"; test file {_path(cfg['test_source'])}: {cfg.get('test_rows')} rows"
                    + (f" ({cfg['test_trajectories']} whole trajectories)" if cfg.get("test_trajectories") else "")
+                   + (f", its derivatives by the same rule ({describe(cfg['test_derivatives'])})"
+                      if cfg.get("test_derivatives") else "")
                    if cfg.get("test_source") else "")
                 + (f"; WARNING: {Overlap(**cfg['training_rows']).words()} are training rows of the fit evaluated, "
                    f"so its errors there are not predictions of unseen data" if cfg.get("training_rows") else "")

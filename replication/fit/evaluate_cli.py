@@ -13,6 +13,7 @@ from lagbench.replication.claims.base import PROFILES
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit.fit_cli import DATA_HELP
 from lagbench.replication.fit.rollout_bars import RolloutBars
+from lagbench.replication.fit.trajectories import window_value
 
 
 def _fitted_folder(args) -> str:
@@ -142,7 +143,8 @@ def add_evaluate(sub) -> None:
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help="where the fitted models "
                    "predict and roll out (not used with --predict): auto (a GPU where the framework sees one, else "
                    "the CPU), cpu, or gpu (an error if the framework sees none) (default: auto)")
-    s.add_argument("--window", type=int, help="Savitzky-Golay window (default: the fit's)")
+    s.add_argument("--window", type=window_value, help="Savitzky-Golay window: auto (chosen from this file's noise "
+                   "and motion) or an odd number of samples (default: the fit's)")
     s.add_argument("--polyorder", type=int, help="Savitzky-Golay degree (default: the fit's)")
     s.add_argument("--time-unit", choices=tuple(fit_options.TIME_UNITS), help="the unit of --data's t column: s or "
                    "ms (default: the fit's)")

@@ -5,7 +5,8 @@ energy=None, device="auto", horizon=None, on_progress=None, time_unit=None)`
 -> [result dict]. `model` is a fit's unit folder or a `lagbench fit` results folder (every fitted model
 in it, side by side). Each model is loaded by `load.load_fitted` (checksums verified; in `framework`,
 default the one it was trained in: parameters load in either), the data file is prepared as a test file
-(`rows.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window and
+(`rows.prepare(kind="test")`, derivatives of a trajectory file by the fit's own window rule (a fit that
+chose its window from its data, `--window auto`, has this file's chosen from this file's data the same way),
 polyorder and time unit unless given; with a system, the step checked against its time scale,
 `replication.fit.time_base`) and evaluated by the fit routine (`evaluate.eval_fit`: one-step errors per
 component, rollouts, energies with `system` or `energy` ("module:function"), DeLaN's decomposition). Written as units of a claim
@@ -28,7 +29,7 @@ from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.fit import time_base, trajectories
 from lagbench.replication.fit.load import fitted_folders, load_fitted
-from lagbench.replication.fit.task import LOSS_NAMES
+from lagbench.replication.fit.task import LOSS_NAMES, file_derivatives
 from lagbench.replication.run.units import Unit, run_unit
 
 
@@ -36,7 +37,7 @@ def _check(framework, system, substeps, window, polyorder, horizon, time_unit):
     given = {"framework": framework, "substeps": substeps, "system": system, "horizon": horizon, "time_unit": time_unit}
     fit_options.check({k: v for k, v in given.items() if v is not None})
     if window is not None or polyorder is not None:
-        trajectories.check_options(window or trajectories.WINDOW, polyorder or trajectories.POLYORDER)
+        trajectories.check_options(window or trajectories.AUTO, polyorder or trajectories.POLYORDER)
 
 
 @R.writes
@@ -74,11 +75,11 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
     for f in fits:
         r = f.result
         deriv = (r.get("eval_config") or {}).get("derivatives") or {}
-        w = window or deriv.get("window", trajectories.WINDOW)
         p = polyorder or deriv.get("polyorder", trajectories.POLYORDER)
         g = deriv.get("gaps", "interpolate")
         unit = time_unit or deriv.get("time_unit", "s")
-        prep = fit_data.prepare(out, path, window=w, polyorder=p, dtype=f.spec.dtype, kind="test", gaps=g,
+        used = file_derivatives(path, window or trajectories.rule_of(deriv), p, g, unit)   # "auto": this file's own
+        prep = fit_data.prepare(out, path, window=used["window"], polyorder=p, dtype=f.spec.dtype, kind="test", gaps=g,
                                 time_unit=unit)
         if prep.dof != f.spec.dof:
             raise ValueError(f"--data {data}: has {prep.dof} degrees of freedom, the model in {f.folder} {f.spec.dof}")
@@ -88,7 +89,7 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
         cfg = {"heldout": False, "test": prep.reference, "system": system or fcfg.get("system"),
                "energy": energy or fcfg.get("energy"),
                "substeps": substeps or (r.get("eval_config") or {}).get("substeps", 2), "model": str(f.folder.resolve()),
-               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {"window": w, "polyorder": p, **({"gaps": g} if g != "interpolate" else {}),
+               "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {**used, **({"gaps": g} if g != "interpolate" else {}),
                                                                      **({"time_unit": unit} if unit != "s" else {})},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
         if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys

@@ -1,6 +1,6 @@
 """`lagbench fit`: train one model on a user's data file. `add_fit(sub)` registers the command and its options
 (`replication.fit.options`); `cmd_fit` runs it with a training bar and rollout bars, prints the defaults
-taken, an early stop and the verdict line, and returns 1 where the fit failed (or, with --strict, learned
+taken, an early stop, the derivative window chosen from the data (`--window auto`) and the verdict line, and returns 1 where the fit failed (or, with --strict, learned
 nothing). `DATA_HELP` describes a data file, for `evaluate` as well."""
 from __future__ import annotations
 
@@ -74,6 +74,12 @@ def cmd_fit(args):
               f"at step {stop['best_step'] + 1}, then {stop['last_heldout_loss']:.4g})"
               + (f"; the rate then annealed over {anneal} more steps, {at + anneal} in all" if anneal else ""),
               file=sys.stderr)
+    from lagbench.replication.fit import derivative_window
+
+    cfg = d.get("eval_config") or {}
+    for what, key in (("derivatives", "derivatives"), ("test file's derivatives", "test_derivatives")):
+        if (cfg.get(key) or {}).get("rule") == derivative_window.AUTO:   # the window chosen from the data, and why
+            print(f"lagbench fit: {what}: {derivative_window.describe(cfg[key])}", file=sys.stderr)
     again = " (unchanged data and options: the earlier fit)" if d.get("reused") else ""
     value = d.get("final_train_loss") if d["metric"] == "final_train_loss" else d["metrics"].get(d["metric"])
     c = competence(d["metrics"], d["metric"])

@@ -18,8 +18,10 @@ from lagbench.models.spec import CAPABILITIES
 from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
-from lagbench.replication.fit.trajectories import GAPS, MAX_GAP, POLYORDER, WINDOW
+from lagbench.replication.fit.trajectories import AUTO, GAPS, MAX_GAP, POLYORDER, window_value
+from lagbench.replication.fit.windows import FRAMES, LOSS_TARGETS, SUBSTEPS
 from lagbench.replication.renamed import renamed
+from lagbench.replication.training.protocol_parts import TRAJECTORY_SCALES
 from lagbench.validate import is_integer, is_real
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
@@ -107,7 +109,9 @@ OPTIONS = (
     Option("time_unit", "s", "the unit of a trajectory file's t column: s (seconds) or ms (milliseconds, read as "
            "t / 1000); with --system, a time step longer than the system's time scale is refused, naming the unit "
            "it looks like", one_of(TIME_UNITS), f"one of {', '.join(TIME_UNITS)}"),
-    Option("window", WINDOW, "Savitzky-Golay window (odd, samples) for the derivatives of a trajectory file", kind=int),
+    Option("window", AUTO, "Savitzky-Golay window for the derivatives a trajectory file lacks: auto (chosen from the "
+           "recording's own noise and motion, for the q-double-dot the loss trains on; docs/fit.md) or an odd number "
+           "of samples", parse=window_value, text=AUTO),
     Option("polyorder", POLYORDER, "Savitzky-Golay polynomial degree (>= 2)", kind=int),
     Option("framework", "jax", "jax | torch", one_of(FRAMEWORKS), f"one of {', '.join(FRAMEWORKS)}"),
     Option("steps", BY_KIND, "optimiser steps, >= 1" + KIND, count(1), "an integer >= 1", kind=int),
@@ -129,6 +133,19 @@ OPTIONS = (
            lambda v: is_real(v) and v >= 0, "a finite number >= 0", kind=float),
     Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
            one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
+    Option("loss_target", "acceleration", "what the loss compares: acceleration (the model's q-double-dot with the "
+           "estimated one, row by row) or trajectory (a trajectory file only: the model's motion integrated by RK4 from "
+           "each recorded frame over the next --horizon-frames frames, with the recorded positions; "
+           "docs/lab/trajectory_loss.md); the held-out rows are scored by the q-double-dot error either way",
+           one_of(LOSS_TARGETS), f"one of {', '.join(LOSS_TARGETS)}"),
+    Option("horizon_frames", FRAMES, "trajectory loss: the frames each window integrates over, >= 1", count(1),
+           "an integer >= 1", kind=int),
+    Option("horizon_substeps", SUBSTEPS, "trajectory loss: RK4 steps per frame, >= 1", count(1), "an integer >= 1",
+           kind=int),
+    Option("horizon_scale", "acceleration", "trajectory loss: acceleration (each window's position errors divided by "
+           "those a constant q-double-dot error of 1 gives over it: the loss in q-double-dot units, as the "
+           "acceleration loss) or none (positions as recorded)", one_of(TRAJECTORY_SCALES),
+           f"one of {', '.join(TRAJECTORY_SCALES)}"),
     Option("patience", BY_KIND, f"early stop: the held-out rows are evaluated {HELDOUT_CHECKS} times over --steps, and "
            f"the training stops after this many evaluations in a row that do not improve on the best so far by "
            f"{MIN_IMPROVEMENT:g} of it, then anneals its rate over the steps the patience spans, keeping the last "

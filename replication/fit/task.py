@@ -8,7 +8,10 @@ the evaluation's tables like every other unit; `replication.fit.load.load_fitted
 Data: a state file or a trajectory file (`lagbench.files.user_data`); derivatives a trajectory file lacks are
 estimated (`replication.fit.trajectories`), rows are split into train / held-out (`replication.fit.rows`:
 `split` by-trajectory, the default for trajectory files, random, the default for state files, or none;
-fraction `heldout`), and an optional `test` file is evaluated as a whole. The prepared rows are written
+fraction `heldout`), and an optional `test` file is evaluated as a whole. With `window` "auto" (the default)
+each file's derivative window is chosen from its own noise and motion (`replication.fit.derivative_window`),
+recorded with the estimated noise and predicted errors in eval_config["derivatives"] (the test file's in
+"test_derivatives"). The prepared rows are written
 to OUT/data/ and the protocol records the sha256 of that file's bytes, so the training cache and the
 unit's result are keyed by the data's content and every option: an edited file or option is trained
 afresh, never served a stale model. A verified earlier fit of the same data and options is returned as
@@ -18,6 +21,12 @@ Budget: the model kind's defaults, sized to the data's coordinates (`replication
 with `patience` (a small system's default, or given) the training stops early when its held-out error stops
 improving (`replication.training.early_stop`: evaluated at each of the log's rows, `HELDOUT_CHECKS` over
 the steps), the record's `early_stop` saying when.
+
+Loss target: `loss_target` "trajectory" (a trajectory file) trains on windows of the training trajectories
+(`replication.fit.windows`: the model's motion integrated over `horizon_frames` frames from each recorded
+frame, against the recorded positions; the protocol's `trajectory_loss` records it, so a fit says which loss
+trained it), while the early stop and the evaluation score the held-out rows as every fit does; the
+`horizon_*` options, set to other than their defaults, are refused without it.
 
 Torques: with tau columns, delan and baseline learn the inverse dynamics tau(q, qdot, qddot); an LNN or
 HNN here learns unforced dynamics, so a file with tau is refused for them (a ValueError saying so)
@@ -39,11 +48,11 @@ from lagbench.files import results as R
 from lagbench.files import user_data
 from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.claims.base import ModelEntry
-from lagbench.replication.fit import kind_defaults, time_base, trajectories
+from lagbench.replication.fit import kind_defaults, time_base, trajectories, windows
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.run.units import Unit, run_unit
-from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting
+from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting, TrajectoryLoss
 from lagbench.replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
@@ -107,13 +116,19 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     o, task, _, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
-    prep = fit_data.prepare(out, path, o.split, o.heldout, o.window, o.polyorder, dtype, gaps=o.gaps,
+    deriv = file_derivatives(path, o.window, o.polyorder, o.gaps, o.time_unit)
+    prep = fit_data.prepare(out, path, o.split, o.heldout, deriv["window"], o.polyorder, dtype, gaps=o.gaps,
                             time_unit=o.time_unit)
-    tprep = fit_data.prepare(out, o.test, window=o.window, polyorder=o.polyorder, dtype=dtype, kind="test",
+    tderiv = file_derivatives(o.test, o.window, o.polyorder, o.gaps, o.time_unit) if o.test else None
+    tprep = fit_data.prepare(out, o.test, window=tderiv["window"], polyorder=o.polyorder, dtype=dtype, kind="test",
                              gaps=o.gaps, time_unit=o.time_unit) if o.test else None
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     n_train = prep.counts["train"]
+    trajectory_loss = TrajectoryLoss(frames=o.horizon_frames, substeps=o.horizon_substeps, scale=o.horizon_scale) \
+        if o.loss_target == "trajectory" else None
+    if trajectory_loss is not None:   # the training rows are the recording's windows
+        n_train = len(windows.training_windows(prep.reference, trajectory_loss, o.loss)["q"])
     data = Data(recipe=prep.reference, n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)))  # the file's split
     schedule = OneCycle(lr=o.lr, start=o.lr_start, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
     batch = min(o.batch, n_train)
@@ -132,18 +147,19 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
                            anneal=patience * log_every) if patience else None
     protocol = Protocol(data=data, task=task, steps=o.steps, batch=batch, loss=o.loss, l2=o.weight_decay,
                         schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=log_every,
-                        early_stop=early_stop)
+                        early_stop=early_stop, trajectory_loss=trajectory_loss)
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
-           "derivatives": {"window": o.window, "polyorder": o.polyorder,
-                           **({"gaps": o.gaps} if o.gaps != "interpolate" else {}),
+           "derivatives": {**deriv, **({"gaps": o.gaps} if o.gaps != "interpolate" else {}),
                            **({"time_unit": o.time_unit} if o.time_unit != "s" else {})}, "rows": prep.counts,
            "trajectories": prep.trajectories}
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
     if tprep is not None:  # the user's test file and its rows, for the report
         cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
+        if tderiv.get("rule") == trajectories.AUTO:   # its own window, by the same rule
+            cfg["test_derivatives"] = tderiv
     # a dissipative fit has its own folder beside the conservative one of the same kind: the two compare
     entry = ModelEntry(o.model + ("_dissipative" if o.dissipation else ""), _model_spec(o, prep, task), hidden=o.hidden)
     unit = Unit(FitSource(protocol, cfg), entry, o.framework, o.seed, "quick")
@@ -154,6 +170,14 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     if on_train:
         on_train(protocol)
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
+
+
+def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:
+    """What a fit records of the derivatives of the data file `path` (`trajectories.derivative_record`): with
+    `window` "auto", the window chosen from that file's own noise and motion, and why."""
+    path = str(Path(path).resolve())
+    d = time_base.in_seconds(user_data.read(path)[1], time_unit)
+    return trajectories.derivative_record(d, path, window, polyorder, gaps)
 
 
 class Resolved(NamedTuple):
@@ -183,6 +207,14 @@ def resolved(data, options: dict) -> Resolved:
     time_base.check_unit(path, raw, o.system, o.time_unit)
     task, recording, dof = task_of(o.model, "tau" in raw, path), "traj" in raw, raw["q"].shape[1]
     o = kind_defaults.fill(o, task, recording=recording, dof=dof)
+    if o.loss_target == "trajectory":
+        windows.check_fit(path, task, recording)
+    else:
+        given = [k for k in ("horizon_frames", "horizon_substeps", "horizon_scale")
+                 if options.get(k, fit_options.BY_NAME[k].default) != fit_options.BY_NAME[k].default]
+        if given:
+            raise ValueError(f"{fit_options.BY_NAME[given[0]].cli}: an option of the trajectory loss; give it with "
+                             f"--loss-target trajectory")
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from lagbench.models import ModelSpec
         try:

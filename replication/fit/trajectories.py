@@ -17,8 +17,12 @@ degree <= polyorder; with white noise of standard deviation s on q at spacing h,
 scales as s / h^k / window^(k + 1/2): a wider window averages more noise away, but biases the estimate
 where q curves on the window's time scale (window * h well below the motion's shortest period).
 Checked against analytic trajectories with noise in tests/replication/fit/test_fit_trajectories.py.
+`window` `AUTO` ("auto", `lagbench fit`'s default) reads the window off the recording: its noise and the
+motion's own curvature give the window of least predicted error for the derivative the loss trains on, one
+for the whole file (`choose_window`; the rule and its bounds: `replication.fit.derivative_window`).
+`derivative_record` is what a fit records of it, `rule_of` reads a record back as a `--window`.
 
-Requirements (a ValueError naming the problem otherwise): an odd window >= polyorder + 2 >= 3 (so
+Requirements (a ValueError naming the problem otherwise): "auto" or an odd window >= polyorder + 2 >= 3 (so
 that the second derivative exists and the fit is overdetermined), at least window + 1 samples per
 trajectory (two are left after the ends are dropped), strictly increasing times within a trajectory (a
 file without a traj column is one trajectory, its rows in time order: times that repeat or go back there
@@ -39,6 +43,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from lagbench.replication.fit import derivative_window
+from lagbench.replication.fit.derivative_window import AUTO, Choice
 from lagbench.validate import is_integer
 
 WINDOW = 15
@@ -49,9 +55,26 @@ GAPS = ("interpolate", "split", "refuse")
 
 
 def check_options(window, polyorder) -> None:
-    if not (is_integer(window) and is_integer(polyorder)) or polyorder < 2 or window % 2 == 0 or window < polyorder + 2:
-        raise ValueError(f"--window {window!r} / --polyorder {polyorder!r}: not valid; expected an odd window >= "
-                         f"polyorder + 2 and a polyorder >= 2 (defaults {WINDOW} and {POLYORDER})")
+    fixed = window != AUTO
+    if not ((is_integer(window) or not fixed) and is_integer(polyorder)) or polyorder < 2 or \
+            (fixed and (window % 2 == 0 or window < polyorder + 2)):
+        raise ValueError(f"--window {window!r} / --polyorder {polyorder!r}: not valid; expected {AUTO} or an odd window "
+                         f">= polyorder + 2, and a polyorder >= 2 (defaults {AUTO} and {POLYORDER})")
+
+
+def _check_gaps(gaps) -> None:
+    if gaps not in GAPS:
+        raise ValueError(f"--gaps: {gaps!r} is not valid; expected one of {', '.join(GAPS)}")
+
+
+def window_value(text: str):
+    """--window's text: `AUTO` or an integer (checked by `check_options`)."""
+    if text == AUTO:
+        return AUTO
+    try:
+        return int(text)
+    except ValueError:
+        raise ValueError(f"--window takes {AUTO} or an odd number of samples such as 31; got {text!r}") from None
 
 
 def derivative(x, h: float, order: int, window: int = WINDOW, polyorder: int = POLYORDER):
@@ -126,17 +149,12 @@ def _pieces(part: dict, frame: np.ndarray, h: float, gaps: str) -> list[dict]:
             for s, (a, b) in enumerate(bounds)]
 
 
-def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = POLYORDER,
-                     gaps: str = "interpolate") -> dict:
-    """State samples (q, qdot, qddot[, tau], traj, t) from a trajectory file's arrays `d` (see module doc)."""
-    check_options(window, polyorder)
-    if gaps not in GAPS:
-        raise ValueError(f"--gaps: {gaps!r} is not valid; expected one of {', '.join(GAPS)}")
+def _trajectories(d: dict, path: str, gaps: str) -> list[tuple[str, float, list[dict]]]:
+    """(where, h, pieces) of each trajectory of the arrays `d`, its rows sorted by time (see the module doc)."""
     if "traj" not in d:
         _one_trajectory(d["t"], path)
     traj = d.get("traj", np.zeros(len(d["q"])))
-    estimate = "qdot" not in d or "qddot" not in d
-    parts = []
+    out = []
     for k in np.unique(traj):
         rows = np.flatnonzero(traj == k)
         rows = rows[np.argsort(d["t"][rows], kind="stable")]
@@ -144,7 +162,65 @@ def with_derivatives(d: dict, path: str, window: int = WINDOW, polyorder: int = 
         h, frame = grid(d["t"][rows], where, gaps)
         whole = {"traj": np.full(rows.size, float(k)), **{key: d[key][rows] for key in ("t", "q", "qdot", "qddot", "tau")
                                                           if key in d}}
-        pieces = _pieces(whole, frame, h, gaps)
+        out.append((where, h, _pieces(whole, frame, h, gaps)))
+    return out
+
+
+def _estimated(d: dict) -> tuple[int, str] | None:
+    """(order, signal) of the derivative the loss trains on where the file lacks it: q̈ from q, q̈ from the given
+    q̇, or q̇ from q (the file gives q̈); None where the file gives both."""
+    if "qddot" not in d:
+        return (1, "qdot") if "qdot" in d else (2, "q")
+    return None if "qdot" in d else (1, "q")
+
+
+def choose_window(d: dict, path: str, polyorder: int = POLYORDER, gaps: str = "interpolate") -> Choice | None:
+    """The window `--window auto` takes for a trajectory file's arrays `d` (times in seconds), one for the whole
+    file (`derivative_window.choose` over its trajectories' pieces, at most `MAX_SHARE` of its shortest
+    trajectory); None where the file gives both derivatives (nothing is estimated)."""
+    check_options(AUTO, polyorder)
+    _check_gaps(gaps)
+    what = _estimated(d)
+    if what is None:
+        return None
+    order, signal = what
+    found = _trajectories(d, path, gaps)
+    high = derivative_window.highest(min(sum(p["t"].size for p in pieces) for _, _, pieces in found), polyorder)
+    low = derivative_window.smallest(polyorder)
+    pieces = [(p[signal], h, ~p.get("filled", np.zeros(p["t"].size, bool))) for _, h, ps in found for p in ps
+              if p["t"].size >= low + 1]
+    if not pieces:
+        where, _, ps = found[0]
+        raise ValueError(f"{where} has {max(p['t'].size for p in ps)} samples; estimating its derivatives needs at "
+                         f"least {low + 1}")
+    return derivative_window.choose(pieces, polyorder, order, high, derivative_window.TARGETS[what])
+
+
+def derivative_record(d: dict, path: str, window, polyorder: int = POLYORDER, gaps: str = "interpolate") -> dict:
+    """What a fit records of the derivatives of the arrays `d` (times in seconds) and estimates them with:
+    {"window", "polyorder"}, the window an integer given or, for `AUTO`, the one chosen with its reasons
+    (`derivative_window.Choice.record`); "auto" where nothing is estimated (a state file, or both given)."""
+    choice = choose_window(d, path, polyorder, gaps) if window == AUTO and "t" in d else None
+    return choice.record() if choice is not None else {"window": window, "polyorder": polyorder}
+
+
+def rule_of(record: dict):
+    """The `--window` a fit's derivative record (eval_config["derivatives"]) stands for: `AUTO` where the fit chose
+    it from its data, else the window it used (`WINDOW` where it recorded none)."""
+    return AUTO if AUTO in (record.get("rule"), record.get("window")) else record.get("window", WINDOW)
+
+
+def with_derivatives(d: dict, path: str, window: int | str = WINDOW, polyorder: int = POLYORDER,
+                     gaps: str = "interpolate") -> dict:
+    """State samples (q, qdot, qddot[, tau], traj, t) from a trajectory file's arrays `d` (see module doc);
+    `window` `AUTO`: the one `choose_window` takes."""
+    check_options(window, polyorder)
+    _check_gaps(gaps)
+    estimate = "qdot" not in d or "qddot" not in d
+    if window == AUTO:
+        window = choose_window(d, path, polyorder, gaps).window if estimate else WINDOW
+    parts = []
+    for where, h, pieces in _trajectories(d, path, gaps):
         long_enough = [p for p in pieces if not estimate or p["t"].size >= window + 1]
         if not long_enough:
             n = max(p["t"].size for p in pieces)

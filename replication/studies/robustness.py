@@ -75,8 +75,10 @@ def fit_model(name: str, data, folder, framework: str, seed: int, steps: int):
     from lagbench.files import results as R
     from lagbench.replication.fit.load import load_fitted
     from lagbench.replication.fit.task import fit
+    from lagbench.replication.fit.trajectories import WINDOW
 
-    fit(str(data), out=str(folder), framework=framework, seed=int(seed), **budget(steps), **MODELS[name])
+    # the study's fixed Savitzky-Golay window (docs/robustness.md), not fit's data-chosen default
+    fit(str(data), out=str(folder), framework=framework, seed=int(seed), window=WINDOW, **budget(steps), **MODELS[name])
     return load_fitted(R.unit_dir(folder, "fit", framework, UNIT_LABEL[name], seed))
 
 

@@ -7,6 +7,8 @@ A *recipe* (`RECIPES[name]`) turns (system, n, rng) into a batch dict of float64
   "target"     what the model must predict, (N, k)
   "weight"     optional per-sample loss weight (N,)
   "qddot"      the true acceleration (N, dof), kept for evaluation
+  "h", "scale" a window's frame step and scale (N, 1), with `protocol.trajectory_loss` (whose "target" is then
+               the window's scaled displacements: `replication.fit.windows`)
 `BatchStream` draws the pools and the batch order once from the seed, so the JAX and the PyTorch
 loop given the same protocol and seed see the same batches in the same order. With `data.resample` a pool is
 drawn every epoch; the state entries `data.fixed` names are those of the epoch-0 draw in every epoch.
@@ -124,10 +126,16 @@ RECIPES = {"iid": recipe_iid, "arm": recipe_arm}
 
 
 def recipe_file(protocol, n, rng, kind="train"):
-    """A user's data file (see `lagbench.files.user_data`): the train or held-out rows, as a batch dict."""
+    """A user's data file (see `lagbench.files.user_data`): the train or held-out rows, as a batch dict; with
+    `protocol.trajectory_loss`, the training rows are windows of the recording (`replication.fit.windows`)."""
     from lagbench.files.user_data import split_rows
 
-    return split_rows(protocol.data.recipe.removeprefix("file:"), protocol.task, kind)
+    ref = protocol.data.recipe.removeprefix("file:")
+    if protocol.trajectory_loss is not None and kind == "train":
+        from lagbench.replication.fit.windows import training_windows
+
+        return training_windows(ref, protocol.trajectory_loss, protocol.loss)
+    return split_rows(ref, protocol.task, kind)
 
 
 def recipe_for(protocol):

@@ -1,20 +1,26 @@
 """The prediction and the loss, written once for both frameworks.
 
-Both functions use only operations that JAX arrays and PyTorch tensors share (`.sum(-1)`,
-`.mean()`, `abs`, arithmetic), plus a `cat(list, axis)` function the caller passes in, so the JAX
-and the PyTorch training loops evaluate literally the same expression.
+The functions use only operations that JAX arrays and PyTorch tensors share (`.sum(-1)`, `.mean()`,
+`clip`, slicing, arithmetic), plus a `cat(list, axis)` function the caller passes in, so the JAX
+and the PyTorch training loops evaluate literally the same expression. The trajectory loss's RK4 step is
+the evaluation's own (`replication.evaluation.rollout.rk4_step`, plain arithmetic).
 """
 from __future__ import annotations
 
+from lagbench.replication.evaluation.rollout import rk4_step
 
-def predict(model, kind: str, task: str, batch: dict, cat):
+
+def predict(model, kind: str, task: str, batch: dict, cat, trajectory_loss=None):
     """The model's prediction of batch["target"].
 
     acceleration:     q-double-dot from (q, qdot[, extra]); DeLaN's forward model takes extra = tau.
     hamiltonian:      concat(dH/dy, -dH/dx) from (x, y[, extra]) = (q, p) or (q, qdot).
     inverse_dynamics: tau from (q, qdot, qddot = extra): DeLaN's inverse model, or a feed-forward
                       baseline given qddot as its extra input.
+    With a `TrajectoryLoss` (the protocol's `trajectory_loss`; a batch of windows): `positions`.
     """
+    if trajectory_loss is not None:
+        return positions(model, task, batch, trajectory_loss.substeps, cat)
     q, qdot, extra = batch["q"], batch["qdot"], batch.get("extra")
     if task == "acceleration":
         return model.acceleration(q, qdot, extra)
@@ -26,6 +32,35 @@ def predict(model, kind: str, task: str, batch: dict, cat):
             return model.inverse_dynamics(q, qdot, extra)
         return model.acceleration(q, qdot, extra)
     raise ValueError(f"unknown task {task!r}")
+
+
+def positions(model, task: str, batch: dict, substeps: int, cat):
+    """The model's motion over each window of a batch of windows (`replication.fit.windows`), as the window's
+    target holds the recorded one: (B, K*dof), frame k's displacement (q(t0 + k h) - q0) times the window's
+    scale in columns (k - 1)*dof .. k*dof - 1, for k = 1..K.
+
+    batch: q, qdot (B, dof) the start state (q recorded, qdot estimated), extra (optional), h (B, 1) the frame
+    step, scale (B, 1) or (B, dof), target (B, K*dof) (its width gives K); stacked members add a leading axis.
+    The state (d, v) = (q - q0, qdot) starts at (0, qdot) and takes `substeps` RK4 steps of h / substeps a
+    frame under the model's own vector field: (v, model.acceleration(q0 + d, v, extra)) for the acceleration
+    task (the call the one-step loss makes, so dissipation and periodic inputs included), the model's
+    time_derivative of (q0 + d, v) for the hamiltonian task. Displacements rather than positions keep float32
+    rounding at the scale of the motion within a window, not of q itself."""
+    q0, extra, h = batch["q"], batch.get("extra"), batch["h"]
+    dof = q0.shape[-1]
+
+    def field(z):
+        d, v = z[..., :dof], z[..., dof:]
+        if task == "hamiltonian":
+            return cat(list(model.time_derivative(q0 + d, v, extra)), -1)
+        return cat([v, model.acceleration(q0 + d, v, extra)], -1)
+
+    z, dt, out = cat([0.0 * q0, batch["qdot"]], -1), h / substeps, []
+    for _ in range(batch["target"].shape[-1] // dof):
+        for _ in range(substeps):
+            z = rk4_step(field, z, dt)
+        out.append(z[..., :dof] * batch["scale"])
+    return cat(out, -1)
 
 
 def loss_value(pred, target, weight, loss: str, axis=None):

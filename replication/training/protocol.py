@@ -7,10 +7,12 @@ the batch size, the dtype and the seed. The batch order is drawn once in NumPy f
 (`replication.training.data.BatchStream`) and fed to both frameworks, so two frameworks given one protocol
 see the same numbers in the same order. The optional parts, each `None` when the run does without it:
 `guard` (`Guard`), `scouting` (`Scouting`), `cohort` (seeds trained side by side), `tracking`
-(`Tracking`) and `early_stop` (`EarlyStop`).
+(`Tracking`), `early_stop` (`EarlyStop`) and `trajectory_loss` (`TrajectoryLoss`: train on positions over
+windows of a recording; the held-out rows stay the task's).
 
 `to_dict()` is the canonical form: every field (but `data.fixed` while empty, `tracking.keep` while off and
-`early_stop` while None, so the protocols without them keep their keys), records as nested dicts, and `version` (`KEY_VERSION`), so
+`early_stop`, `trajectory_loss` while None, so the protocols without them keep their keys), records as nested
+dicts, and `version` (`KEY_VERSION`), so
 every cache key built from it changes when the form does; `from_dict` reads it, and the forms of earlier
 versions (`replication.training.protocol_versions`), so that older result folders still load.
 """
@@ -29,6 +31,7 @@ from lagbench.replication.training.protocol_parts import (
     Guard,
     Scouting,
     Tracking,
+    TrajectoryLoss,
 )
 from lagbench.replication.training.schedules import (
     SCHEDULES,
@@ -40,13 +43,15 @@ from lagbench.replication.training.schedules import (
 from lagbench.validate import check, integer, is_integer, one_of, real
 
 __all__ = ["LOSSES", "DTYPES", "TASKS", "COORDS", "KEY_VERSION", "Protocol", "Data", "Adam", "Guard", "Scouting",
-           "Tracking", "EarlyStop", "canonical_hash"]
+           "Tracking", "EarlyStop", "TrajectoryLoss", "canonical_hash"]
 
 LOSSES = ("l1", "mse", "l1_gamma")
 DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 KEY_VERSION = 3
-PARTS = {"guard": Guard, "tracking": Tracking, "early_stop": EarlyStop}   # optional parts stored as their fields
+PARTS = {"guard": Guard, "tracking": Tracking, "early_stop": EarlyStop,   # optional parts stored as their fields
+         "trajectory_loss": TrajectoryLoss}
+UNSTORED_WHEN_OFF = ("early_stop", "trajectory_loss")   # parts no claim has: out of `to_dict` while None
 
 
 @dataclass(frozen=True)
@@ -62,6 +67,9 @@ class Protocol:
     optimiser: `Adam`'s constants; schedule: the learning rate (`Constant`, `StepDecay`, `OneCycle`).
     guard, scouting, tracking, early_stop: the optional parts (`Guard`, `Scouting`, `Tracking`, `EarlyStop`),
                None when off.
+    trajectory_loss: a `TrajectoryLoss` (None: off): the training loss compares positions integrated over
+               windows of a recording (a user's file, task acceleration or hamiltonian) instead of the task's
+               target; the held-out rows and everything evaluated stay the task's.
     cohort:    train the seeds in groups of `cohort` (>= 2) as one vectorised program
                (`replication.training.train`: seeds g*cohort .. g*cohort + cohort - 1 side by side, each its
                own init, batches, guard and stop); each seed's numbers are those of its own run (up to
@@ -83,6 +91,7 @@ class Protocol:
     dtype: str = "float32"
     log_every: int = 50
     early_stop: EarlyStop | None = None   # out of `to_dict` while None: the protocols without it keep their keys
+    trajectory_loss: TrajectoryLoss | None = None   # likewise
 
     def __post_init__(self):
         for name, valid in (("loss", LOSSES), ("dtype", DTYPES), ("task", TASKS)):
@@ -111,14 +120,23 @@ class Protocol:
             if part and part.every % self.log_every:
                 raise ValueError(f"protocol {name.replace('_', ' ')} every {part.every} is not a multiple of log_every "
                                  f"{self.log_every}")
+        if self.trajectory_loss is not None:
+            check(self.task in ("acceleration", "hamiltonian"),
+                  f"protocol trajectory_loss integrates the model's motion: a task of acceleration or hamiltonian, "
+                  f"got {self.task}")
+            check(self.data.recipe.startswith("file:"),
+                  f"protocol trajectory_loss trains on windows of a recording: a file recipe, got {self.data.recipe!r}")
+            check(self.data.coords == "qqdot", "protocol trajectory_loss starts each window from (q, qdot): coords qqdot, "
+                                               f"got {self.data.coords}")
         if self.cohort and self.early_stop:
             raise ValueError(f"protocol cohort {self.cohort} with early_stop: the seeds of a cohort train as one "
                              f"program and stop together; give each seed its own run")
 
     def objective_key(self) -> tuple:
-        """What one optimiser step depends on besides the model: the loss and its target (task, loss, l2),
-        Adam's constants, the clip, the dtype (a compiled step serves every protocol sharing them)."""
-        return self.task, self.loss, self.l2, self.optimiser, self.grad_clip, self.dtype
+        """What one optimiser step depends on besides the model: the loss and its target (task, loss, l2, the
+        trajectory loss), Adam's constants, the clip, the dtype (a compiled step serves every protocol sharing
+        them)."""
+        return self.task, self.loss, self.l2, self.optimiser, self.grad_clip, self.dtype, self.trajectory_loss
 
     @property
     def grad_clip(self) -> float | None:
@@ -135,8 +153,9 @@ class Protocol:
         d["schedule"] = schedule_to_dict(self.schedule)
         for name in PARTS:
             d[name] = dataclasses.asdict(d[name]) if d[name] is not None else None
-        if d["early_stop"] is None:
-            del d["early_stop"]   # only a protocol that stops early stores it: other protocols keep their keys
+        for name in UNSTORED_WHEN_OFF:
+            if d[name] is None:
+                del d[name]   # only a protocol that has the part stores it: other protocols keep their keys
         if d["tracking"] is not None and not d["tracking"]["keep"]:
             del d["tracking"]["keep"]   # only a kept tracking is stored: other protocols keep their keys
         if self.scouting is not None:

@@ -3,7 +3,9 @@
 Always there: `Data` (what is trained on), `Adam` (the optimiser's constants) and a schedule
 (`replication.training.schedules`). Optional, `None` when a run does without them: `Guard` (the
 gradient-spike guard), `Scouting` (restarts over initialisations), `Tracking` (held-out error during
-training) and `EarlyStop` (stop when the held-out error stops improving; `lagbench fit` only). Every value a part uses is written in it: nothing is inherited from the protocol.
+training), `EarlyStop` (stop when the held-out error stops improving; `lagbench fit` only) and
+`TrajectoryLoss` (train on positions integrated over windows of a recording; `lagbench fit` only). Every value
+a part uses is written in it: nothing is inherited from the protocol.
 """
 from __future__ import annotations
 
@@ -173,3 +175,30 @@ class EarlyStop:
         object.__setattr__(self, "min_improvement", float(real("early stop min_improvement", self.min_improvement,
                                                                low=0, below=1)))
         object.__setattr__(self, "anneal", integer("early stop anneal", self.anneal, low=0))
+
+
+TRAJECTORY_SCALES = ("acceleration", "none")
+
+
+@dataclass(frozen=True)
+class TrajectoryLoss:
+    """The trajectory loss: the training rows are windows of a recording (`replication.fit.windows`), each a
+    start state, its frame step h and the recorded positions of the next `frames` frames; the model's motion
+    from the start state, integrated by RK4 with `substeps` steps a frame, is compared with them by the
+    protocol's loss (`replication.training.objective.positions`). The held-out rows stay the task's own (the
+    one-step error), so early stops and evaluations read what they read without it.
+
+    frames:   K >= 1, the frames a window spans after its start.
+    substeps: S >= 1, RK4 steps per frame.
+    scale:    "acceleration": each window's displacements divided by those that a constant q-double-dot error
+              of 1 gives over it, so that the loss reads in q-double-dot units, as the acceleration loss does;
+              "none": the displacements as recorded."""
+
+    frames: int
+    substeps: int
+    scale: str = "acceleration"
+
+    def __post_init__(self):
+        for name in ("frames", "substeps"):
+            object.__setattr__(self, name, integer(f"trajectory loss {name}", getattr(self, name), low=1))
+        one_of("trajectory loss scale", self.scale, TRAJECTORY_SCALES)

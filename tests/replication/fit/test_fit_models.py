@@ -47,7 +47,8 @@ def test_delan_fits_torques_and_loads_in_both_frameworks(tmp_path):
     p, s = d["protocol"], d["model_spec"]
     assert (s["activation"], p["l2"], p["schedule"]["kind"], s["delan_eps"], s["delan_diag_offset"]) == ("tanh", 1e-5,
                                                                                                  "constant", 0.1, 1.0)
-    t = np.arange(40)[7:33] * 0.02  # the samples with a centred derivative window (15) of each trajectory
+    half = d["eval_config"]["derivatives"]["window"] // 2   # the window chosen from the data (--window auto)
+    t = np.arange(40)[half:40 - half] * 0.02  # the samples with a centred derivative window of each trajectory
     q_train = np.concatenate([np.stack([np.sin(t + k), np.cos(2 * t + k)], 1) for k in range(3)])
     np.testing.assert_allclose(s["input_scale"], 1 / q_train.std(0), rtol=1e-5)  # auto: 1 / std of DeLaN's input q
     assert {"test_l1", "test_rollout_gmean_err", "test_mass_matrix_min_eig"} <= set(d["metrics"])
