@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from inline_workers import inline_workers
 
 from lagbench.replication.run import executor, runner
 from lagbench.replication.run.environment import one_thread_env
@@ -63,32 +64,8 @@ def test_workers_run_on_one_thread_and_the_parent_keeps_its_settings(monkeypatch
     monkeypatch.delenv("XLA_FLAGS", raising=False)
     seen = {}
 
-    def fake_chain(refs, out):
-        return [(f"u{i}", None, None) for i, _ in enumerate(refs)]
-
-    class Workers:   # answers each chain at once, noting the environment a worker would start with
-        def __init__(self, jobs):
-            import queue
-
-            self.results = queue.Queue()
-
-        def idle(self):
-            seen.update({k: os.environ.get(k) for k in one_thread_env({})})
-            return object()
-
-        def assign(self, slot, cid, refs, out, members=None):
-            self.results.put((cid, fake_chain(refs, out), None, None))
-
-        def finished(self, cid):
-            pass
-
-        def dead(self):
-            return []
-
-        def close(self, wait):
-            pass
-
-    monkeypatch.setattr(executor, "_Workers", Workers)
+    monkeypatch.setattr(executor, "_Workers",   # noting the environment a worker would start with
+                        inline_workers(lambda: seen.update({k: os.environ.get(k) for k in one_thread_env({})})))
     todo = runner.plan("smoke", claims=["appendix_b", "dp_loss"], frameworks=("jax",))
     failures, errors = executor.run_units(todo, "unused", "smoke", progress=False, jobs=2)
     assert failures == [] and errors == []

@@ -1,6 +1,7 @@
 """The run's progress bar advances by each unit's estimated seconds (`unit_seconds`), not by a unit count: its
 total is their sum, a training shared by two units counts once, a cached one not at all."""
 import pytest
+from inline_workers import inline_workers
 
 from lagbench.replication.run import executor, runner
 from lagbench.replication.run import unit_seconds as W
@@ -60,7 +61,7 @@ def test_the_bar_total_is_the_sum_of_the_estimates_and_it_ends_full(bars, tmp_pa
     todo = runner.plan("smoke", claims=["dp_loss", "appendix_b"], frameworks=("jax",))
     seconds = [10.0 * (i + 1) for i in range(len(todo))]
     if jobs == 2:   # the chains answered at once, in this process
-        monkeypatch.setattr(executor, "_Workers", _InlineWorkers)
+        monkeypatch.setattr(executor, "_Workers", inline_workers())
     executor.run_units(todo, tmp_path, "smoke", progress=False, jobs=jobs, seconds=seconds)
     bar = _outer(bars)
     assert bar.total == sum(seconds) and bar.n == pytest.approx(sum(seconds))
@@ -74,23 +75,3 @@ def test_a_run_weighs_its_units_by_their_estimates(bars, tmp_path):
     assert _outer(bars).total > len(todo) * W.EVAL_S   # the training's estimate is in it, not a unit count
 
 
-class _InlineWorkers:
-    def __init__(self, jobs):
-        import queue
-
-        self.results = queue.Queue()
-
-    def idle(self):
-        return object()
-
-    def assign(self, slot, cid, refs, out, members=None):
-        self.results.put((cid, [(f"u{i}", None, None) for i, _ in enumerate(refs)], None, None))
-
-    def finished(self, cid):
-        pass
-
-    def dead(self):
-        return []
-
-    def close(self, wait):
-        pass
