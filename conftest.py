@@ -1,9 +1,11 @@
 """Shared fixtures for every test: the default cache is kept per session in a temp dir
 unless LAGBENCH_CACHE is set (tox sets it), so repeated runs reuse generated code."""
 
+import json
 import os
 import shutil
 import tempfile
+from pathlib import Path
 
 import pytest
 
@@ -71,12 +73,46 @@ def worker_group(nodeid: str) -> str:
     return WORKER_GROUP.get(path, path)
 
 
+GROUP_SECONDS = Path(__file__).parent / "tests" / "timing" / "group_seconds.json"
+
+
+def group_seconds() -> dict:
+    """The measured seconds of each worker group (`tests/timing/group_seconds.py` makes the table); {} where the
+    table is missing or unreadable (the run then keeps pytest's order)."""
+    try:
+        table = json.loads(GROUP_SECONDS.read_text())
+    except (OSError, ValueError):
+        return {}
+    return {str(g): float(s) for g, s in table.items()} if isinstance(table, dict) else {}
+
+
+def longest_first(groups, seconds: dict) -> list:
+    """`groups` ordered by their measured seconds, longest first (a group not measured counts as the median of
+    those measured): handed out so, the last groups a worker takes are short, and the two workers end together."""
+    known = sorted(seconds.values())
+    default = known[len(known) // 2] if known else 0.0
+    return sorted(groups, key=lambda g: -seconds.get(g, default))
+
+
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
     from xdist.scheduler import LoadScopeScheduling
 
     class ByWorkerGroup(LoadScopeScheduling):
+        """Groups whole on one worker, handed out longest first by `tests/timing/group_seconds.json`."""
+
+        ordered = False
+
         def _split_scope(self, nodeid: str) -> str:
             return worker_group(nodeid)
+
+        def _assign_work_unit(self, node) -> None:
+            if not self.ordered:   # the queue is whole at the first assignment
+                queue = dict(self.workqueue)
+                self.workqueue.clear()
+                for group in longest_first(queue, group_seconds()):
+                    self.workqueue[group] = queue[group]
+                self.ordered = True
+            super()._assign_work_unit(node)
 
     return ByWorkerGroup(config, log)

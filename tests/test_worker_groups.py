@@ -23,3 +23,18 @@ def test_other_tests_group_by_file_and_the_listed_files_exist(request):
     assert root.worker_group("tests/speedstudy/test_speed_study.py::T::test_z") == "bench_dir"
     for paths in root.SHARED_SESSION_FIXTURES.values():
         assert all(Path(request.config.rootpath, p).is_file() for p in paths), paths
+
+
+def test_groups_are_handed_out_longest_first_and_an_unmeasured_one_as_the_median(request):
+    root = _root_conftest(request.config)
+    seconds = {"a": 30.0, "b": 5.0, "c": 90.0}
+    assert root.longest_first(["b", "new", "a", "c"], seconds) == ["c", "a", "new", "b"]
+    assert root.longest_first(["b", "a"], {}) == ["b", "a"]   # no table: pytest's order
+
+
+def test_the_committed_timing_table_names_only_groups_that_exist(request):
+    root = _root_conftest(request.config)
+    table = root.group_seconds()
+    assert table, f"{root.GROUP_SECONDS} is missing or unreadable: python tests/timing/group_seconds.py JUNIT_XML"
+    stale = [g for g in table if g not in root.SHARED_SESSION_FIXTURES and not Path(request.config.rootpath, g).is_file()]
+    assert not stale, f"{stale}: remake tests/timing/group_seconds.json (python tests/timing/group_seconds.py JUNIT_XML)"
