@@ -27,8 +27,8 @@ def test_other_tests_group_by_file_and_the_listed_files_exist(request):
 
 def test_groups_are_handed_out_longest_first_and_an_unmeasured_one_as_the_median(request):
     root = _root_conftest(request.config)
-    seconds = {"a": 30.0, "b": 5.0, "c": 90.0}
-    assert root.longest_first(["b", "new", "a", "c"], seconds) == ["c", "a", "new", "b"]
+    seconds = {"a": 40.0, "b": 5.0, "c": 90.0, "d": 20.0, "e": 30.0}   # median 30
+    assert root.longest_first(["b", "new", "a", "c", "d"], seconds) == ["c", "a", "new", "d", "b"]
     assert root.longest_first(["b", "a"], {}) == ["b", "a"]   # no table: pytest's order
 
 
