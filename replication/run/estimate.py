@@ -18,12 +18,14 @@ can take many times as long (measurements: `docs/decisions/run_estimate.md`). Wh
 out: two workers slow each other down, evaluation, and the first step of a PyTorch phase under
 torch.compile (`compile_torch.like`: the probe compiles as the phase will), which compiles.
 
-Where every framework of the run trains on a GPU, the estimate also holds "cohorts": the run with each model's
-seeds packed into programs of up to `gpu_cohorts.MAX_MEMBERS` (`gpu_cohorts.programs`). A packed program's
-seconds are the probed seconds per step of its k members side by side (one member: the plain probe) x its
-protocol's steps; a program whose protocol cannot be packed (`gpu_cohorts.blocker`) costs what the plain
-estimate gives its training program; their sum is "train_s", and "wall_s" hands the programs, longest first,
-each to the first of `jobs` workers to come free (`scheduled_wall`).
+Where the run packs seeds (`members`: {framework: seeds a program}, `replication.run.packing.members`, more than
+one for some framework), or where every framework of the run trains on a GPU (then at up to
+`gpu_cohorts.MAX_MEMBERS`, what `--pack-seeds` gives there by default), the estimate also holds "cohorts": the
+run with each model's seeds packed into programs (`gpu_cohorts.programs`). A packed program's seconds are the
+probed seconds per step of its k members side by side (one member: the plain probe) x its protocol's steps; a
+program whose protocol cannot be packed (`gpu_cohorts.blocker`) costs what the plain estimate gives its training
+program; their sum is "train_s", and "wall_s" hands the programs, longest first, each to the first of `jobs`
+workers to come free (`scheduled_wall`).
 
 `describe(units, todo)`: one line per claim, with its models, seeds and how many units remain.
 """
@@ -88,19 +90,21 @@ def _shape(framework, spec, protocol) -> str:
     return json.dumps([framework, {**spec.to_dict(), "init": ""}, p], sort_keys=True, default=str)
 
 
-def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: bool = False) -> dict:
+def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: bool = False,
+             members: dict | None = None) -> dict:
     """{"train_s": summed seconds, "wall_s": with `jobs` workers, "trainings": to do, "cached": reused,
     "probes": configurations timed, "probes_reused": of those, read from OUT's `PROBES` file, "by_claim":
     {claim id: seconds}, "by_group": {training program: seconds}}. A training that several claims share
     (claims 1, 2 and 11 train the same double-pendulum models) counts for the first claim planned with it.
     `keep`: write this machine's probes to OUT/`PROBES`, so that a resumed run on the same machine reuses them
-    rather than probing again."""
+    rather than probing again. `members`: {framework: seeds a program} of a packed run (module docstring)."""
     threads = torch_threads if any(u.framework == "torch" for u in units) else None
     known = _read_probes(out, threads)
     with threads_of_torch(threads):
         est = _estimate(units, out, jobs, known)
-        if _on_gpu(units):
-            est["cohorts"] = _packed(units, out, jobs, known, est["by_group"])
+        packs = _packs(units, members)
+        if packs:
+            est["cohorts"] = _packed(units, out, jobs, known, est["by_group"], packs)
     if keep:
         R.write_json(Path(out) / PROBES, {"machine": _machine(threads), "per_step": {
             k: [plain, {str(m): s for m, s in members.items()}] for k, (plain, members) in known.items()}})
@@ -179,12 +183,23 @@ def _on_gpu(units) -> bool:
     return bool(fws) and all(dev.resolve(dev.request(), fw) == "gpu" for fw in fws)
 
 
-def _packed(units, out, jobs: int, per_step: dict, alone: dict) -> dict:
+def _packs(units, members: dict | None) -> dict:
+    """{framework: seeds a program} the estimate packs: the run's own where it packs more than one seed of
+    some framework, else `gpu_cohorts.MAX_MEMBERS` where every framework trains on a GPU, else none."""
+    fws = sorted({u.framework for u in units if u.entry.train})
+    if members and any(members.get(fw, 1) > 1 for fw in fws):
+        return {fw: members.get(fw, 1) for fw in fws}
+    return {fw: gpu_cohorts.MAX_MEMBERS for fw in fws} if _on_gpu(units) else {}
+
+
+def _packed(units, out, jobs: int, per_step: dict, alone: dict, packs: dict) -> dict:
     """{"train_s", "wall_s", "programs", "members": the most seeds a program, "seconds": per program, longest
-    first} of the run with seeds packed (`gpu_cohorts.programs`); `per_step` as `_estimate`'s, the probes of
-    k members side by side added to each shape's members; `alone`: `_estimate`'s seconds per training program."""
+    first} of the run with seeds packed (`gpu_cohorts.programs`, each framework at its `packs` seeds a
+    program); `per_step` as `_estimate`'s, the probes of k members side by side added to each shape's members;
+    `alone`: `_estimate`'s seconds per training program."""
     seconds, most = [], 0
-    for prog in gpu_cohorts.programs(units, out):
+    progs = [p for fw, k in packs.items() for p in gpu_cohorts.programs([u for u in units if u.framework == fw], out, k)]
+    for prog in progs:
         if not prog.packed:
             seconds.append(alone[group_key(prog.framework, prog.spec, prog.protocol, prog.seeds[0])])
             continue

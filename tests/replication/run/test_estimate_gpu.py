@@ -1,13 +1,14 @@
-"""On a GPU each model's seeds pack into one training program (`run.gpu_cohorts.programs`), and the estimate
-adds what the run takes so: per program, the probed seconds per step of its members side by side x its steps,
-summed, and handed to the workers longest first (`run.estimate`). The probes are faked here: no training."""
+"""On a GPU (or with `--pack-seeds`) each model's seeds pack into training programs (`run.gpu_cohorts.programs`),
+and the estimate adds what the run takes so: per program, the probed seconds per step of its members side by
+side x its steps, summed, and handed to the workers longest first (`run.estimate`), printed by
+`run.announce`. The probes are faked here: no training."""
 import pytest
 
 from lagbench.replication.claims import CLAIMS
 from lagbench.replication.claims.resolved import resolved
 from lagbench.replication.run import estimate as E
 from lagbench.replication.run import gpu_cohorts as G
-from lagbench.replication.run import runner
+from lagbench.replication.run.announce import announce
 from lagbench.replication.run.runner import plan
 from lagbench.replication.training import device as dev
 from lagbench.replication.training.train import train_key
@@ -89,7 +90,7 @@ def test_the_gpu_estimate_is_the_docstrings_sum_and_the_run_prints_it(tmp_path, 
     # a claim sharing these trainings adds no program
     again = E.estimate(plan("paper", claims=[*CLAIM_IDS, "dp_energy"], frameworks=("jax",)), tmp_path, jobs=jobs)
     assert again["cohorts"]["train_s"] == pytest.approx(c["train_s"])
-    runner.announce("paper", units, units, tmp_path, jobs)
+    announce("paper", units, units, tmp_path, jobs)
     printed = capsys.readouterr().out
     assert (f"{c['programs']} programs of up to 8 seeds; this run trains one seed a program): "
             f"{sum(seconds) / 3600:.1f} h of training, about {E.scheduled_wall(seconds, jobs) / 3600:.1f} h wall "
@@ -117,5 +118,21 @@ def test_a_blocked_protocol_costs_what_the_plain_estimate_gives_it(tmp_path, pro
 def test_on_the_cpu_nothing_is_packed(tmp_path, probes, monkeypatch, capsys):
     monkeypatch.setattr(dev, "resolve", lambda req, fw: "cpu")
     units = plan("paper", claims=["dp_loss"], frameworks=("jax",), models=["lnn"])
-    est = runner.announce("paper", units, units, tmp_path, 1)
+    est = announce("paper", units, units, tmp_path, 1)
     assert "cohorts" not in est and "packed" not in capsys.readouterr().out
+
+
+def test_on_the_cpu_a_run_that_packs_seeds_is_estimated_at_its_own_packing(tmp_path, probes, monkeypatch, capsys):
+    monkeypatch.setattr(dev, "resolve", lambda req, fw: "cpu")
+    units = plan("paper", claims=["dp_loss"], frameworks=("jax",), models=["lnn"])
+    n = len(units)
+    est = announce("paper", units, units, tmp_path, 1, members={"jax": 3})
+    c, steps = est["cohorts"], units[0].protocol().steps
+    assert c["members"] == 3 and c["programs"] == -(-n // 3)
+    sizes = [3] * (n // 3) + ([n % 3] if n % 3 else [])
+    assert c["train_s"] == pytest.approx(sum((MEMBERS[k] if k > 1 else PLAIN) * steps for k in sizes))
+    printed = capsys.readouterr().out
+    assert f"packed as one program ({c['programs']} programs of up to 3 seeds; as this run packs them)" in printed
+    # the same run on a GPU: still at the run's own packing, not at MAX_MEMBERS
+    monkeypatch.setattr(dev, "resolve", lambda req, fw: "gpu")
+    assert E.estimate(units, tmp_path, members={"jax": 3})["cohorts"]["members"] == 3
