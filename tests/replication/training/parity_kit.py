@@ -31,8 +31,7 @@ _JAX_STEPS: dict = {}
 
 
 def _jax_step(spec, protocol, members: bool):
-    key = (spec, protocol.task, protocol.loss, protocol.l2, protocol.optimiser,
-           protocol.grad_clip, members)
+    key = (spec, protocol.objective_key(), members)   # what the compiled step depends on, as train_jax keys it
     if key not in _JAX_STEPS:
         _JAX_STEPS[key] = (train_jax.make_members_step if members else train_jax.make_step)(spec, protocol)
     return _JAX_STEPS[key]
