@@ -4,7 +4,8 @@
 sections in place of the claim sections, scorecard and findings, which speak of papers' claims).
 ``fit_sections(res, out_dir) -> list[Section]``: the data and the models side by side (what each was
 trained on and how: task, loss, steps, widths, activation, weight decay, schedule, time), one-step errors
-per component (``one_step.csv``), rollout and energy metrics (``result.json``, ``rollouts.csv``), and the
+per component (``one_step.csv``), the periodic inputs and dissipation each fit chose from its data and why
+(``eval_config``), rollout and energy metrics (``result.json``, ``rollouts.csv``), and the
 figures: prediction against data (``arrays.npz`` ``<set>_target``/``<set>_pred``), a test trajectory,
 energy against truth, DeLaN's terms and the training curves (the drawing functions of ``reports.figures``).
 Failed or corrupt units are listed with their reason and left out of every number.
@@ -227,6 +228,24 @@ def _data_para(units) -> Para:
     return Para("Data: " + " | ".join(f"{text} ({', '.join(names)})" for text, names in seen.items()) + ".")
 
 
+def _choices_para(units) -> Para | None:
+    """What each fit chose from its data and system: its periodic inputs (`--periodic`) and whether it learns a
+    dissipation (`--dissipation`), with the reasons; None where no fit recorded either."""
+    from lagbench.replication.fit import energy_trend, periodic_coords
+
+    seen: dict[str, list[str]] = {}
+    for u in units:
+        cfg = u.result.get("eval_config") or {}
+        parts = ([f"periodic inputs {periodic_coords.describe(cfg['periodic'])}"] if cfg.get("periodic") else []) + \
+            ([f"dissipation {energy_trend.describe(cfg['dissipation'])}"] if cfg.get("dissipation") else [])
+        if u.claim == "fit" and parts:
+            seen.setdefault("; ".join(parts), []).append(_name(u))
+    if not seen:
+        return None
+    return Para("Chosen for the data: " + " | ".join(f"{', '.join(names)}: {text}" for text, names in seen.items())
+                + ".")
+
+
 def fit_sections(res: Results, out_dir: Path) -> list[Section]:
     units = res.usable()
     s = Section("Fitted models")
@@ -239,7 +258,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
         s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))
     if not units:
         return [s]
-    s.add(_data_para(units), _competence_para(units), _recommendation_para(units))
+    s.add(_data_para(units), _choices_para(units), _competence_para(units), _recommendation_para(units))
     s.add(Table("The models side by side", _models_table(units), [SRC.format(claim="*") + "result.json"]))
     out = [s]
     e = Section("Errors", level=2)

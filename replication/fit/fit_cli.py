@@ -1,7 +1,8 @@
 """`lagbench fit`: train one model on a user's data file. `add_fit(sub)` registers the command and its options
-(`replication.fit.options`); `cmd_fit` runs it with a training bar and rollout bars, prints the defaults
-taken, an early stop, the derivative window chosen from the data (`--window auto`) and the verdict line, and returns 1 where the fit failed (or, with --strict, learned
-nothing). `DATA_HELP` describes a data file, for `evaluate` as well."""
+(`replication.fit.options`); `cmd_fit` runs it with a training bar and rollout bars, prints the defaults taken,
+the periodic inputs and dissipation chosen (`--periodic`, `--dissipation`; before the training), an early stop,
+the derivative window chosen from the data (`--window auto`) and the verdict line, and returns 1 where the fit
+failed (or, with --strict, learned nothing). `DATA_HELP` describes a data file, for `evaluate` as well."""
 from __future__ import annotations
 
 import sys
@@ -27,7 +28,7 @@ def cmd_fit(args):
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
-    o, task, recording, dof = resolved(args.data, given)   # a refused option: one line, nothing written
+    o, task, recording, dof, _ = resolved(args.data, given)   # a refused option: one line, nothing written
     if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
         print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, recording, dof)} "
               f"where not given ({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
@@ -48,18 +49,19 @@ def cmd_fit(args):
 
             d, ledger = tune_fit(args.data, out=args.out, n_configs=args.tune, on_log=bar.row, on_progress=on_progress,
                                  on_train=bar.start, **fit_options.from_args(args))
+            choices_line(d.get("eval_config") or {})
             scores = ", ".join(f"{k}: {'-' if v is None else f'{v:.4g}'}" for k, v in ledger["scores"].items())
             print(f"tune: chose configuration {ledger['chosen']} of {len(ledger['configs'])} "
                   f"(--lr {ledger['options']['lr']:.4g} --hidden {','.join(map(str, ledger['options']['hidden']))}; "
                   f"held-out {scores}), ledger in {Path(args.out) / 'tune'}")
         else:
             d = fit(args.data, out=args.out, on_log=bar.row, on_progress=on_progress, on_train=bar.start,
-                    **fit_options.from_args(args))
+                    on_choices=choices_line, **fit_options.from_args(args))
     finally:
         bar.close()
         rollouts.close()
-    label = args.model + ("_dissipative" if args.dissipation else "")   # a dissipative fit's own folder
-    folder = Path(args.out) / "units" / "fit" / args.framework / label / f"seed{args.seed}"
+    # a dissipative fit's own folder (lnn_dissipative), where --dissipation chose that form
+    folder = Path(args.out) / "units" / "fit" / args.framework / d.get("model", args.model) / f"seed{args.seed}"
     if d["status"] != "ok":
         print(f"lagbench: fit failed: {d['failure']['message']} (record in {folder})", file=sys.stderr)
         return 1
@@ -87,6 +89,17 @@ def cmd_fit(args):
     print(f"{'ok' if c is None or c['learned'] else 'done'}: {d['metric_label']} {shown}"
           f"{f' ({describe(c)})' if c else ''}{diverged_note(d['metrics'])}, written to {folder}{again}")
     return 1 if args.strict and c is not None and not c["learned"] else 0
+
+
+def choices_line(records: dict) -> None:
+    """The periodic inputs and the dissipation a fit chose (`--periodic`, `--dissipation`), and why: one line
+    each, printed as the derivative window is, also under --quiet."""
+    from lagbench.replication.fit import energy_trend, periodic_coords
+
+    if records.get("periodic"):
+        print(f"lagbench fit: periodic inputs: {periodic_coords.describe(records['periodic'])}", file=sys.stderr)
+    if records.get("dissipation"):
+        print(f"lagbench fit: dissipation: {energy_trend.describe(records['dissipation'])}", file=sys.stderr)
 
 
 def add_fit(sub) -> None:

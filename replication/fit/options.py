@@ -15,6 +15,7 @@ from types import SimpleNamespace
 
 from lagbench.models import ACTIVATIONS
 from lagbench.models.spec import CAPABILITIES
+from lagbench.replication.fit.energy_trend import MODES as DISSIPATION_MODES
 from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
@@ -73,6 +74,17 @@ def scale(text: str):
                          f"{text!r}") from None
 
 
+def periodic_value(text: str):
+    """--periodic: "auto", () for none, or a tuple of indices (a non-digit left for `valid_periodic` to refuse)."""
+    if text in (AUTO, "none"):
+        return AUTO if text == AUTO else ()
+    return tuple(int(x) if x.strip().isdigit() else x for x in text.split(","))
+
+
+def valid_periodic(v) -> bool:
+    return v == AUTO or (isinstance(v, tuple | list) and all(count(0)(k) for k in v))
+
+
 @dataclass(frozen=True)
 class Option:
     name: str                      # fit()'s keyword
@@ -87,6 +99,7 @@ class Option:
     switch: bool = False           # a flag without a value (store_true)
     required: bool = False         # on the command line
     old: str = ""                  # an earlier spelling, still read with a deprecation notice
+    const: str | None = None       # the value of the flag given without one (argparse nargs="?")
 
     @property
     def cli(self) -> str:
@@ -176,13 +189,16 @@ OPTIONS = (
            "a finite number >= 0", kind=float),
     Option("delan_offset", 2.0, "DeLaN: diag(L) = softplus(raw + offset)", is_real, "a finite number", kind=float),
     Option("angle_wrap", False, "input feature: wrap q to [-pi, pi) before the MLP", switch=True),
-    Option("periodic", (), "input feature: coordinates fed to the network as cos and sin (angles recorded unwrapped); "
-           "e.g. 0,1 (default: none)", lambda v: isinstance(v, tuple | list) and all(count(0)(k) for k in v),
-           "none or comma-separated coordinate indices >= 0 such as 0,1", text="none",
-           parse=lambda t: () if t == "none" else tuple(int(x) if x.strip().isdigit() else x for x in t.split(","))),
-    Option("dissipation", False, "lnn, hnn, delan: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: "
-           "viscous friction per coordinate) beside the Lagrangian or Hamiltonian, for data that lose energy",
-           switch=True),
+    Option("periodic", AUTO, "input feature: coordinates fed to the network as cos and sin (angles recorded "
+           "unwrapped): auto (with --system and without --angle-wrap, those in which the system's Lagrangian is "
+           "2 pi-periodic; otherwise none), none, or indices such as 0,1", valid_periodic,
+           "auto, none or comma-separated coordinate indices >= 0 such as 0,1", text=AUTO, parse=periodic_value),
+    Option("dissipation", AUTO, "lnn, hnn, delan: learn a Rayleigh dissipation D = 1/2 sum b_k qdot_k^2 (b_k >= 0: "
+           "viscous friction per coordinate) beside the Lagrangian or Hamiltonian, for data that lose energy: auto "
+           "(on where the training trajectories lose energy by the true energy of --system or --energy, off otherwise "
+           "and for the baseline; docs/fit.md), on (also --dissipation alone) or off",
+           lambda v: v in DISSIPATION_MODES or isinstance(v, bool), f"one of {', '.join(DISSIPATION_MODES)}",
+           text=AUTO, parse=str, const="on"),
     Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q (cos, sin for --periodic), "
            "qdot(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as 1,1,0.3,0.3"
            + KIND,
@@ -208,6 +224,8 @@ def resolve(given: dict) -> SimpleNamespace:
         values["hidden"] = tuple(values["hidden"])
     if isinstance(values["input_scale"], list):
         values["input_scale"] = tuple(values["input_scale"])
+    if isinstance(values["dissipation"], bool):   # fit(dissipation=True) as --dissipation on
+        values["dissipation"] = "on" if values["dissipation"] else "off"
     return SimpleNamespace(**values)
 
 
@@ -226,7 +244,7 @@ def check(values: dict) -> None:
     if BY_KIND not in (keep, restarts, fallback) and fallback and (not restarts or fallback >= (keep or restarts)):
         raise ValueError(f"--restart-fallback: {fallback!r} needs more restarts that reach the end "
                          f"({keep or restarts or 0} do): each fallback goes on from another of them")
-    if values.get("dissipation") and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
+    if values.get("dissipation") in ("on", True) and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
         raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
                          "function); the baseline's q-double-dot is free-form already")
     system = values.get("system")
@@ -246,6 +264,8 @@ def add_arguments(parser) -> None:
                                 help=argparse.SUPPRESS)
         if o.switch:
             parser.add_argument(o.cli, action="store_true", help=o.help)
+        elif o.const is not None:
+            parser.add_argument(o.cli, nargs="?", const=o.const, default=o.text, help=o.help)
         elif o.parse is not None:
             parser.add_argument(o.cli, default=None if o.default is BY_KIND else o.text, help=o.help)
         elif o.name == "split":   # no default: the file's kind decides

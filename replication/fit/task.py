@@ -28,6 +28,11 @@ frame, against the recorded positions; the protocol's `trajectory_loss` records 
 trained it), while the early stop and the evaluation score the held-out rows as every fit does; the
 `horizon_*` options, set to other than their defaults, are refused without it.
 
+Choices from the data and the system, recorded in eval_config["periodic"] and ["dissipation"] and passed to
+`on_choices` before any training: `periodic` "auto" takes the coordinates in which the `system`'s Lagrangian is
+2 pi-periodic (`replication.fit.periodic_coords`); `dissipation` "auto" learns a dissipation where the training
+trajectories lose energy (`replication.fit.energy_trend`), its folder then `<model>_dissipative` as with "on".
+
 Torques: with tau columns, delan and baseline learn the inverse dynamics tau(q, qdot, qddot); an LNN or
 HNN here learns unforced dynamics, so a file with tau is refused for them (a ValueError saying so)
 rather than its torques silently ignored.
@@ -48,12 +53,20 @@ from lagbench.files import results as R
 from lagbench.files import user_data
 from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.claims.base import ModelEntry
-from lagbench.replication.fit import kind_defaults, time_base, trajectories, windows
+from lagbench.replication.fit import (
+    energy_trend,
+    kind_defaults,
+    periodic_coords,
+    time_base,
+    trajectories,
+    windows,
+)
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.run.units import Unit, run_unit
 from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting, TrajectoryLoss
 from lagbench.replication.training.schedules import Constant, OneCycle
+from lagbench.systems.registry import definition
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
 SET_NAMES = {"heldout": "held-out", "test": "test"}
@@ -109,11 +122,13 @@ class FitSource:
 
 
 @R.writes
-def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, on_train=None, **options) -> dict:
+def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, on_train=None, on_choices=None,
+        **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
-    their defaults where not given). `on_train(protocol)`: called before a training starts (not when an
+    their defaults where not given). `on_choices({"periodic": record, "dissipation": record})`: called once both
+    are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
     earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
-    o, task, _, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
+    o, task, _, _, periodic = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     deriv = file_derivatives(path, o.window, o.polyorder, o.gaps, o.time_unit)
@@ -124,6 +139,10 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
                              gaps=o.gaps, time_unit=o.time_unit) if o.test else None
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
+    dissipation = dissipation_choice(o, prep)
+    o.dissipation = dissipation["chosen"]   # the form trained (and its folder's label) follows the choice
+    if on_choices:
+        on_choices({"periodic": periodic, "dissipation": dissipation})
     n_train = prep.counts["train"]
     trajectory_loss = TrajectoryLoss(frames=o.horizon_frames, substeps=o.horizon_substeps, scale=o.horizon_scale) \
         if o.loss_target == "trajectory" else None
@@ -153,7 +172,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,
            "derivatives": {**deriv, **({"gaps": o.gaps} if o.gaps != "interpolate" else {}),
                            **({"time_unit": o.time_unit} if o.time_unit != "s" else {})}, "rows": prep.counts,
-           "trajectories": prep.trajectories}
+           "trajectories": prep.trajectories, "periodic": periodic, "dissipation": dissipation}
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
     if tprep is not None:  # the user's test file and its rows, for the report
@@ -172,6 +191,21 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
 
 
+def dissipation_choice(o, prep) -> dict:
+    """`energy_trend.choose` for the options `o` on the prepared rows `prep`: the training rows of a trajectory
+    file, read with the true energy of `--system` or `--energy` (measured only for `auto` on a kind with a
+    dissipation, on data without torques)."""
+    capable = CAPABILITIES[o.model].dissipation
+    if o.dissipation != "auto" or not capable:
+        return energy_trend.choose(o.dissipation, capable)
+    from lagbench.replication.fit.evaluate import energy_function
+
+    energy = energy_function({"energy": o.energy, "system": o.system}, prep.dof)
+    recording = any(prep.trajectories.values())
+    rows = user_data.rows(prep.reference, "train") if recording and energy is not None else None
+    return energy_trend.choose("auto", True, rows, energy, forced=prep.has_tau)
+
+
 def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:
     """What a fit records of the derivatives of the data file `path` (`trajectories.derivative_record`): with
     `window` "auto", the window chosen from that file's own noise and motion, and why."""
@@ -181,13 +215,15 @@ def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:
 
 
 class Resolved(NamedTuple):
-    """`resolved`'s answer: the options with the model kind's defaults filled in, the task the data and model
-    give, whether the data are a trajectory file (a recording) rather than a file of state samples, and the
-    data's coordinates (the kind's defaults follow them: `kind_defaults.small`)."""
+    """`resolved`'s answer: the options with the model kind's defaults filled in (`periodic` the indices chosen),
+    the task the data and model give, whether the data are a trajectory file (a recording) rather than a file of
+    state samples, the data's coordinates (the kind's defaults follow them: `kind_defaults.small`) and what
+    the fit records of its periodic inputs (`periodic_coords.choose`)."""
     options: SimpleNamespace
     task: str
     recording: bool
     dof: int
+    periodic: dict
 
 
 def resolved(data, options: dict) -> Resolved:
@@ -207,6 +243,10 @@ def resolved(data, options: dict) -> Resolved:
     time_base.check_unit(path, raw, o.system, o.time_unit)
     task, recording, dof = task_of(o.model, "tau" in raw, path), "traj" in raw, raw["q"].shape[1]
     o = kind_defaults.fill(o, task, recording=recording, dof=dof)
+    if o.system is not None and definition(o.system).dof != dof:   # its energy and angles are not the data's
+        raise ValueError(f"--system {o.system}: has {definition(o.system).dof} coordinates, the data {path} {dof}")
+    periodic = periodic_coords.choose(o.periodic, o.system, bool(o.angle_wrap))
+    o.periodic = tuple(periodic["chosen"])
     if o.loss_target == "trajectory":
         windows.check_fit(path, task, recording)
     else:
@@ -227,9 +267,9 @@ def resolved(data, options: dict) -> Resolved:
         width += len(o.periodic)
         if len(o.input_scale) != width:
             names = "q" if o.model == "delan" else "q, qdot, qddot" if task == "inverse_dynamics" else "q, qdot"
-            periodic = f"; cos and sin of q_{', q_'.join(map(str, o.periodic))} in place of each" if o.periodic else ""
+            trig = f"; cos and sin of q_{', q_'.join(map(str, o.periodic))} in place of each" if o.periodic else ""
             raise ValueError(f"--input-scale: {len(o.input_scale)} numbers given; this {o.model}'s MLP takes {width} "
-                             f"inputs ({names}, {dof} each{periodic})")
+                             f"inputs ({names}, {dof} each{trig})")
     if o.energy:  # importable and of the right shape, before any work
         from lagbench.replication.fit.evaluate import energy_function
 
@@ -245,7 +285,7 @@ def resolved(data, options: dict) -> Resolved:
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return Resolved(o, task, recording, dof)
+    return Resolved(o, task, recording, dof, periodic)
 
 
 def _model_spec(o, prep, task: str) -> dict:

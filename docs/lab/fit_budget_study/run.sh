@@ -11,7 +11,7 @@ sim="lagbench simulate --system double_pendulum --set friction=0.2 --rate 100 --
 fit="lagbench fit --data $out/data/train.csv --test $out/data/test.csv --system double_pendulum --angle-wrap --quiet"
 for s in 10 11; do
   $fit --model baseline --seed "$s" --out "$out/s$s-baseline"
-  $fit --model lnn --seed "$s" --out "$out/s$s-lnn"
+  $fit --model lnn --dissipation off --seed "$s" --out "$out/s$s-lnn"
   $fit --model lnn --dissipation --seed "$s" --out "$out/s$s-lnn_dissipative"
 done
 $fit --model lnn --steps 5 --restarts 0 --seed 10 --out "$out/starved" || true

@@ -13,7 +13,7 @@ $sim --trajectories 8 --duration 4 --seed 1 --out "$out/data/test.csv"
 fit="lagbench fit --data $out/data/train.csv --test $out/data/test.csv --system double_pendulum --angle-wrap --quiet"
 for ((s = 0; s < seeds; s++)); do
   $fit --model baseline --seed "$s" --out "$out/s$s-baseline"
-  $fit --model lnn --steps 23437 --seed "$s" --out "$out/s$s-lnn"
+  $fit --model lnn --dissipation off --steps 23437 --seed "$s" --out "$out/s$s-lnn"
   $fit --model lnn --dissipation --steps 23437 --seed "$s" --out "$out/s$s-lnn_dissipative"
 done
 python "$(dirname "$0")/summary.py" "$out" "$b"

@@ -60,7 +60,7 @@ def test_an_lnn_fits_unwrapped_angles_as_cos_and_sin(tmp_path):
     assert np.abs(a - truth).mean() < 0.5 * np.abs(truth).mean()
 
 
-@pytest.mark.parametrize("flag, match", [("0,a", "--periodic: .* expected none or comma-separated coordinate indices"),
+@pytest.mark.parametrize("flag, match", [("0,a", "--periodic: .* expected auto, none or comma-separated coordinate indices"),
                                          ("1", r"--periodic: periodic must be indices .*\[0, 1\)")])
 def test_bad_periodic_values_are_refused_before_any_work(tmp_path, capsys, flag, match):
     data = _spinning_pendulum(tmp_path / "spin.csv", n_traj=2, n=40)
