@@ -23,8 +23,8 @@ the claim's keeps the claim's budget and no early stop.
 `defaults(kind, task, recording=False, dof=None) -> dict`: fit option name -> value for every option in
 `FROM_PROTOCOL` and `patience`, and the restarts' `restart_fraction` (their steps / the protocol's) and
 `restart_lr_ratio` (their peak / the protocol's); `dof`: the data's coordinates (None: as the claim's).
-`small(kind, task, dof) -> bool`: whether `SMALL` applies. `source(kind, task, recording=False, dof=None) -> str`:
-where the defaults come from, for the console.
+`small(kind, task, dof) -> bool`: whether `SMALL` applies. `source(kind, task, recording=False, dof=None, given=()) -> str`:
+where the defaults come from, for the console (`given`: the options set by the user, whose defaults it does not name).
 
 What the claims set for their system rather than for training stays the user's choice: wrapping angles
 (the double pendulum's q are angles; a user's may not be), and the claims' fixed input scale becomes
@@ -113,9 +113,9 @@ def defaults(kind: str, task: str, recording: bool = False, dof: int | None = No
     return dict(_defaults(kind, task, recording, dof))
 
 
-def source(kind: str, task: str, recording: bool = False, dof: int | None = None) -> str:
+def source(kind: str, task: str, recording: bool = False, dof: int | None = None, given=()) -> str:
     claim, entry, _ = _entry(kind, task)
-    factor = _steps_factor(kind, task, recording, dof)
+    factor = 1 if "steps" in given else _steps_factor(kind, task, recording, dof)
     sized = (f", sized for {dof} coordinate{'s' if dof != 1 else ''} (the claim's system has {claim_dof(kind, task)}): "
              f"{'no restarts, ' if SMALL['restarts'] is None else ''}an early stop at patience {SMALL['patience']} "
              f"(docs/decisions/fit_budget.md)" if small(kind, task, dof) else "")

@@ -40,6 +40,9 @@ def test_a_pendulum_gets_the_sized_budget_and_the_double_pendulum_the_studys(fil
     assert not kind_defaults.small("hnn", "hamiltonian", 1) and kind_defaults.small("delan", "inverse_dynamics", 1)
     assert "no restarts, an early stop" in kind_defaults.source("lnn", "acceleration", True, 1)
     assert "early stop" not in kind_defaults.source("lnn", "acceleration", True, 2)
+    # the steps' factor is named only where the steps are the default's
+    assert "x its steps on a trajectory file" in kind_defaults.source("lnn", "acceleration", True, 2)
+    assert "x its steps" not in kind_defaults.source("lnn", "acceleration", True, 2, given={"steps"})
 
 
 def test_a_fit_stops_when_its_heldout_error_stops_improving(files, tmp_path):
