@@ -12,7 +12,7 @@ is below `-DROP` and at least `MAJORITY` of the trajectories have a negative slo
 trajectories either way; friction moves them all one way). `choose(mode, capable, r, energy, forced)` is
 what a fit records (eval_config["dissipation"]): mode, chosen, why and the figures; `auto` is off without an
 energy function or trajectories, for a kind without a dissipation, and on data with torques (their work changes
-the energy as friction does).
+the energy as friction does). `for_fit(o, prep)`: `choose` for a fit's options `o` on its prepared rows `prep`.
 
 Calibration (`lagbench simulate --system S --set friction=F`, seeds 0-3; the rows a fit prepares, at its
 `--window auto` derivatives; the median relative change over a file's trajectories, lowest to highest over the seeds):
@@ -40,6 +40,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lagbench.files import user_data
+from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.fit.trajectories import starts
 
 DROP = 0.03       # the median relative change below -DROP ...
@@ -121,3 +123,18 @@ def choose(mode, capable: bool, rows=None, energy=None, forced: bool = False) ->
 def describe(record: dict) -> str:
     """A fit's dissipation record (eval_config["dissipation"]) in words."""
     return f"{'on' if record.get('chosen') else 'off'} (--dissipation {record.get('mode')}): {record.get('why')}"
+
+
+def for_fit(o, prep) -> dict:
+    """`choose` for the options `o` of a fit on its prepared rows `prep`: the training rows of a trajectory file,
+    read with the true energy of `--system` or `--energy` (measured only for `auto` on a kind with a
+    dissipation, on data without torques)."""
+    capable = CAPABILITIES[o.model].dissipation
+    if o.dissipation != "auto" or not capable:
+        return choose(o.dissipation, capable)
+    from lagbench.replication.fit.evaluate import energy_function
+
+    energy = energy_function({"energy": o.energy, "system": o.system}, prep.dof)
+    recording = any(prep.trajectories.values())
+    rows = user_data.rows(prep.reference, "train") if recording and energy is not None else None
+    return choose("auto", True, rows, energy, forced=prep.has_tau)

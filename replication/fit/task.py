@@ -139,7 +139,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
                              gaps=o.gaps, time_unit=o.time_unit) if o.test else None
     if tprep is not None and tprep.dof != prep.dof:
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
-    dissipation = dissipation_choice(o, prep)
+    dissipation = energy_trend.for_fit(o, prep)
     o.dissipation = dissipation["chosen"]   # the form trained (and its folder's label) follows the choice
     if on_choices:
         on_choices({"periodic": periodic, "dissipation": dissipation})
@@ -189,21 +189,6 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     if on_train:
         on_train(protocol)
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
-
-
-def dissipation_choice(o, prep) -> dict:
-    """`energy_trend.choose` for the options `o` on the prepared rows `prep`: the training rows of a trajectory
-    file, read with the true energy of `--system` or `--energy` (measured only for `auto` on a kind with a
-    dissipation, on data without torques)."""
-    capable = CAPABILITIES[o.model].dissipation
-    if o.dissipation != "auto" or not capable:
-        return energy_trend.choose(o.dissipation, capable)
-    from lagbench.replication.fit.evaluate import energy_function
-
-    energy = energy_function({"energy": o.energy, "system": o.system}, prep.dof)
-    recording = any(prep.trajectories.values())
-    rows = user_data.rows(prep.reference, "train") if recording and energy is not None else None
-    return energy_trend.choose("auto", True, rows, energy, forced=prep.has_tau)
 
 
 def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:

@@ -27,8 +27,8 @@ def announce(profile, units, todo, out, jobs, executor="local", keep=False, memb
     if est.get("cohorts"):   # each model's seeds packed as one program (`replication.run.packing`)
         c, most = est["cohorts"], max((members or {}).values(), default=1)
         this = "as this run packs them" if most > 1 else "this run trains one seed a program"
-        where = " on the GPU" if most < 2 else ""
-        print(f"lagbench: with each model's seeds packed as one program{where} ({c['programs']} programs of up "
+        on_gpu = " on the GPU" if most < 2 else ""
+        print(f"lagbench: with each model's seeds packed as one program{on_gpu} ({c['programs']} programs of up "
               f"to {c['members']} seeds; {this}): {c['train_s'] / 3600:.1f} h of "
               f"training, about {c['wall_s'] / 3600:.1f} h wall with {jobs} worker{'s' if jobs != 1 else ''}",
               flush=True)
