@@ -4,8 +4,10 @@
 (``lagbench.models.param_shapes``: NumPy only; a user's model, or a spec this code cannot read, by its
 checkpoint's arrays; None without either). ``sizes_table(res, claim)``: per compared model (the models the
 claim's parts read, else its models) its parameters, hidden widths, training samples and training time
-(medians over seeds). ``sizes_differ(res, claim)``: "lnn 3.4e+04 vs baseline 8.7e+03 parameters" where the
-largest and smallest compared models differ by more than ``SIZE_RATIO``, else "". ``failing_seeds(res, claim)``:
+(medians over seeds). ``sizes_differ(res, claim)``: "lnn 33,793 vs baseline 8,706 parameters" where the
+largest and smallest models one part compares differ by more than ``SIZE_RATIO`` (each such part's pair, "; "
+between them; models of different parts, e.g. one system's against another's, are never set against each
+other), else "". ``failing_seeds(res, claim)``:
 every seed of a model below its competence bar, with its value (per framework). ``not_tested(res, claim)``: what
 the claim's rule leaves out, in words.
 """
@@ -65,15 +67,33 @@ def model_sizes(res: Results, claim: dict) -> dict[str, dict]:
     return out
 
 
+def compared_groups(res: Results, claim: dict, models) -> list[list[str]]:
+    """The sets of models each counted part compares (of `models`, at least two, each set once), else
+    `models` as one set where no part names two of them."""
+    v = res.verdicts.get(claim["id"]) or {}
+    groups = []
+    for p in v.get("parts") or []:
+        g = [m for m in dict.fromkeys(p.get("reads") or []) if m in models]
+        if not p.get("check") and len(g) > 1 and g not in groups:
+            groups.append(g)
+    return groups or ([list(models)] if len(models) > 1 else [])
+
+
+def _differ(res: Results, claim: dict, values: dict[str, float]) -> list[tuple[str, str]]:
+    """(larger, smaller) per compared set whose values differ by more than `SIZE_RATIO`, each pair once."""
+    out = []
+    for g in compared_groups(res, claim, [m for m, x in values.items() if x]):
+        big, small = max(g, key=values.get), min(g, key=values.get)
+        if values[big] > SIZE_RATIO * values[small] and (big, small) not in out:
+            out.append((big, small))
+    return out
+
+
 def sizes_differ(res: Results, claim: dict, sizes: dict | None = None) -> str:
     sizes = model_sizes(res, claim) if sizes is None else sizes
     known = {m: s["params"] for m, s in sizes.items() if s["params"]}
-    if len(known) < 2:
-        return ""
-    big, small = max(known, key=known.get), min(known, key=known.get)
-    if known[big] <= SIZE_RATIO * known[small]:
-        return ""
-    return f"{big} {count(known[big])} vs {small} {count(known[small])} parameters"
+    return "; ".join(f"{big} {count(known[big])} vs {small} {count(known[small])} parameters"
+                     for big, small in _differ(res, claim, known))
 
 
 def sizes_table(res: Results, claim: dict, sizes: dict | None = None) -> pd.DataFrame | None:
@@ -111,10 +131,12 @@ def not_tested(res: Results, claim: dict, sizes: dict | None = None) -> str:
     diff = sizes_differ(res, claim, sizes)
     if diff:
         out.append(f"it does not control model size ({diff})")
-    for key, what in (("samples", "training samples"), ("seconds", "training time")):
+    for key, what in (("samples", "training samples"), ("seconds", "training time (s)")):
         vals = {m: s[key] for m, s in sizes.items() if s[key]}
-        if len(vals) > 1 and max(vals.values()) > SIZE_RATIO * min(vals.values()):
-            out.append(f"it does not control {what} (" + ", ".join(f"{m} {num(x, 2)}" for m, x in vals.items()) + ")")
+        pairs = _differ(res, claim, vals)
+        if pairs:
+            out.append(f"it does not control {what} (" + "; ".join(f"{big} {num(vals[big], 2)} vs {small} "
+                                                                   f"{num(vals[small], 2)}" for big, small in pairs) + ")")
     seeds = (res.verdicts.get(claim["id"]) or {}).get("seeds") or []
     if seeds:
         out.append(f"it rests on {len(seeds)} seed{'s' * (len(seeds) != 1)} per model")

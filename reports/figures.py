@@ -78,10 +78,11 @@ def save(fig: Figure, path: Path) -> bool:
     return True
 
 
-# colour-blind safe: Okabe and Ito's eight colours less black (the truth is drawn in black or grey), then Tol's
-# muted wine, teal, olive and indigo for figures of more models
-PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#882255", "#44AA99", "#999933",
-           "#332288", "#F0E442"]
+# colour-blind safe: Okabe and Ito's colours less black (the truth is drawn in black or grey) and Tol's muted
+# wine, olive, indigo and teal; the first six are the model kinds', the rest (yellow last: faint on white)
+# a sweep's further arms'
+PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#882255", "#999933", "#332288",
+           "#44AA99", "#F0E442"]
 
 
 def colour(i: int) -> str:
@@ -100,15 +101,20 @@ KIND_COLOURS = {"baseline": PALETTE[0], "lnn": PALETTE[1], "hnn": PALETTE[2], "d
 
 def model_colours(labels: list[str]) -> dict[str, str]:
     """A colour per model: its kind's (`KIND_COLOURS`) when the figure's models are of different kinds, so a
-    kind keeps its colour from figure to figure; where two share a kind (an ablation, a data sweep), a label
-    that is a kind's own name keeps its kind's colour and the others take the palette's remaining colours in
-    order."""
+    kind keeps its colour from figure to figure; where two share a kind (an ablation, a data sweep), the
+    kind's own name, else its first label, keeps the kind's colour and the other arms take colours no kind
+    owns, then those of kinds the figure does not show, so that no arm wears another kind's colour."""
     labels = list(dict.fromkeys(labels))
-    kinds = [x.split("_", 1)[0] for x in labels]
-    if len(set(kinds)) == len(kinds) and all(k in KIND_COLOURS for k in kinds):
-        return {x: KIND_COLOURS[k] for x, k in zip(labels, kinds, strict=True)}
+    kinds = {x: x.split("_", 1)[0] for x in labels}
+    if len(set(kinds.values())) == len(labels) and all(k in KIND_COLOURS for k in kinds.values()):
+        return {x: KIND_COLOURS[k] for x, k in kinds.items()}
     out = {x: KIND_COLOURS[x] for x in labels if x in KIND_COLOURS}
-    rest = iter([c for c in PALETTE if c not in out.values()] * (len(labels) // len(PALETTE) + 1))
+    for x, k in kinds.items():
+        if x not in out and k in KIND_COLOURS and KIND_COLOURS[k] not in out.values():
+            out[x] = KIND_COLOURS[k]
+    shown = {KIND_COLOURS[k] for k in kinds.values() if k in KIND_COLOURS}
+    spare = [c for c in PALETTE if c not in KIND_COLOURS.values()] + [c for c in KIND_COLOURS.values() if c not in shown]
+    rest = iter(spare * (len(labels) // len(spare) + 1))
     return {x: out[x] if x in out else next(rest) for x in labels}
 
 

@@ -15,10 +15,32 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from lagbench.reports.figures import LINESTYLES, _groups, model_colours, new_figure, save, style_index
+from lagbench.reports.figures import (
+    LINESTYLES,
+    _groups,
+    model_colours,
+    new_figure,
+    save,
+    style_index,
+)
 from lagbench.reports.load import Unit
+
+MINOR_LABELS = (2, 3, 5, 7)   # mantissas labelled on a log axis within one decade: at least 0.14 decade apart
+
+
+def label_minor_log(ax, axis: str = "x") -> None:
+    """On a log axis spanning less than a decade (where the minor ticks carry the only labels), label the
+    minor ticks at `MINOR_LABELS` x a power of ten alone, so that no two labels run into each other."""
+    def text(v: float, _pos) -> str:
+        if not (np.isfinite(v) and v > 0):
+            return ""
+        e = int(np.floor(np.log10(v) + 1e-9))
+        m = int(round(v / 10.0 ** e))
+        return f"${m}\\times10^{{{e}}}$" if m in MINOR_LABELS and abs(v - m * 10.0 ** e) < 1e-6 * v else ""
+    (ax.xaxis if axis == "x" else ax.yaxis).set_minor_formatter(FuncFormatter(text))
+
 
 COLUMNS = {"samples", "train_s", "heldout_loss"}
 
@@ -63,6 +85,8 @@ def work_precision(units: list[Unit], path: Path) -> float:
         ax.set_yscale("log")
         if xs and max(xs) >= 10 * min(xs):   # within one decade the minor ticks carry the only labels
             ax.xaxis.set_minor_formatter(NullFormatter())
+        else:
+            label_minor_log(ax)
         ax.set_xlabel(label)
     axes[0].set_ylabel("model's own training loss,\non held-out states")
     axes[0].legend(fontsize=7)

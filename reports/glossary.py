@@ -52,8 +52,8 @@ TERMS = [
                                 "measured under the same conditions (widths, samples, evaluation); otherwise it "
                                 "is context, never a target"),
     ("far from published", "a seed mean more than 2x, or under half, the published value of the same metric"),
-    ("sizes differ", "the compared models' parameter counts differ by more than 1.5x (a confound the rule does "
-                     "not control)"),
+    ("sizes differ", "the parameter counts of the models one part compares differ by more than 1.5x (a confound "
+                     "the rule does not control)"),
     ("development draw / split", "seeds from 0 and data draws that protocols were tuned on; the test split "
                                  "(seeds from 1000, draws no choice read) decides the verdicts of record"),
     ("diverged", f"a rollout whose error against the data's own scale (energy error over the mean kinetic energy, "
@@ -141,6 +141,18 @@ METRICS = {
     "steps_per_s": ("optimiser steps per second", "steps/s"),
     "seconds_per_eval": ("wall time of one evaluation", "s"),
     "wall_s": ("wall time", "s"),
+    "n_steps": ("accepted integration steps per trajectory, mean over the trajectories", "count"),
+    "mean_us": ("mean compute per control tick (the measured ticks, after the warm-up)", "µs"),
+    "median_us": ("median compute per control tick", "µs"),
+    "p99_us": ("99th percentile of the compute per control tick", "µs"),
+    "rate_hz_mean": ("control ticks per second the mean compute sustains (1e6 / mean_us)", "Hz"),
+    "rate_hz_p99": ("control ticks per second the 99th-percentile compute sustains (1e6 / p99_us)", "Hz"),
+    "fits_500hz_mean": ("whether the mean compute per tick is below the 2 ms period of a 500 Hz loop", "yes/no"),
+    "learning_us_mean": ("mean time of the learning step per control tick (0 where the model only infers)", "µs"),
+    "jax_dispatch": ("JAX's dispatch during the timing: async (the default) or sync", "–"),
+    "us_per_sample": ("microseconds per sample of the fastest call on a batch of random states", "µs"),
+    "fits_500hz_p99": ("whether the 99th-percentile compute per tick is below the 2 ms period of a 500 Hz loop",
+                       "yes/no"),
     "error": ("the speed study's error of the model (its inference metric)", "as the model's metric"),
 }
 FAMILIES = {"train": "on training-family trajectories", "test": "on unseen (test-family) trajectories",

@@ -131,7 +131,7 @@ def interval_words(iv: dict) -> str:
         return f"{what}, range {span} over {seeds_words(seeds)}"
     if not (0 < float(iv.get("lo", 0)) or math.isfinite(float(iv.get("hi", math.inf)))):
         return f"{what}, no interval ({iv.get('method')}) over {seeds_words(seeds)}"
-    return f"{what}, {100 * float(level):g} % confidence interval {span} over {seeds_words(seeds)}"
+    return f"{what}, {num(100 * float(level))} % confidence interval {span} over {seeds_words(seeds)}"
 
 
 def _threshold_words(iv: dict) -> str:

@@ -15,6 +15,8 @@ each part per framework with its interval and its verdict at half and twice the 
 
 from __future__ import annotations
 
+import re
+
 import pandas as pd
 
 from lagbench.reports import glossary, sections_registration
@@ -238,6 +240,11 @@ def competence_table(res: Results, claim: dict) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+def round_numbers(text: str) -> str:
+    """`text` with every decimal number to `num`'s 3 significant digits ("within 1.22474" -> "within 1.22")."""
+    return re.sub(r"(?<![\w.])\d+\.\d+(?![\w.])", lambda m: num(float(m[0])), str(text))
+
+
 def parts_table(res: Results, claim: dict) -> pd.DataFrame | None:
     """Each part (and check) of the claim and of its variants, per framework: verdict, interval, and the
     verdict at half and twice the suite's own threshold."""
@@ -253,5 +260,6 @@ def parts_table(res: Results, claim: dict) -> pd.DataFrame | None:
                          "framework": fw, "verdict": cell(verdict),
                          "interval": (f"{iv.get('what')}: {num(iv.get('point'))} [{num(iv.get('lo'))}, "
                                       f"{num(iv.get('hi'))}] ({iv.get('method')})") if iv else "none",
-                         "at half / twice the threshold": "; ".join(f"{k}: {x}" for k, x in sens.items()) or "none"})
+                         "at half / twice the threshold": "; ".join(f"{round_numbers(k)}: {x}" for k, x in sens.items())
+                                                 or "none"})
     return pd.DataFrame(rows) if rows else None

@@ -87,6 +87,19 @@ def _trainings(units) -> tuple:
     return tuple(sorted((u.framework, u.model, u.seed, u.result.get("final_train_loss")) for u in units))
 
 
+def scouting_note(units) -> str:
+    """Why a training log starts mid-budget: the models whose units scouted (several initialisations trained
+    briefly, the best continued) log from the continuation on; "" where none did."""
+    scouted = [u for u in units if isinstance(u.result.get("scouting"), dict)]
+    if not scouted:
+        return ""
+    tried = len(scouted[0].result["scouting"].get("init_seeds") or [])
+    models = ", ".join(dict.fromkeys(u.model for u in scouted))
+    return (f" {models}: the log starts where the protocol's scouting ends ({tried or 'several'} initialisations "
+            f"trained briefly, the best continued; the scouts' steps and samples count in the budget but are "
+            f"not drawn), so their curves start mid-budget.")
+
+
 def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None = None,
                   details: dict | None = None) -> Section:
     """The claim's page: what it says and where, its verdict (the reasons in words are the scorecard's), its
@@ -156,12 +169,13 @@ def claim_section(res: Results, claim: dict, out_dir: Path, drawn: dict | None =
         s.add(Figure(rel, f"{cid}: Work-precision: each model's own training loss measured on held-out states, "
                           f"against training samples and against training time (line: mean over seeds, band: seed "
                           f"range). Both axes are logarithmic, so they start at the first tracked point "
-                          f"({num(first)} samples), not at zero.", [src + "train_log.csv"],
+                          f"({num(first)} samples), not at zero.{scouting_note(units)}", [src + "train_log.csv"],
                      shows="held-out value of each model's own training loss (not comparable across model kinds) "
                            "against training samples and training time (s)"))
     elif F.training_curves(units, out_dir / (rel := f"figures/{slug(cid)}_training.png")):
         drawn[key] = cid
-        fig = Figure(rel, f"{cid}: Training curves (mean over seeds), from the first logged step.",
+        fig = Figure(rel, f"{cid}: Training curves (mean over seeds), from the first logged step."
+                          f"{scouting_note(units)}",
                      [src + "train_log.csv"], shows="training loss (each model's own loss function) against step")
         if details is None or not done:   # the page's only figure stays on it
             s.add(fig)

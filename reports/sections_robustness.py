@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from lagbench.reports.document import Figure, Para, Section, Table
+from lagbench.reports.figures import model_colours
 from lagbench.reports.fmt import num
 from lagbench.reports.load import Results
 
@@ -50,11 +51,11 @@ def _references(df: pd.DataFrame) -> str:
 
 def _figure(df: pd.DataFrame, path: Path) -> bool:
     """The study's figure drawn from the table; False (the section goes on without it) where it cannot be."""
-    from lagbench.replication.studies.robustness_figure import advantage_figure
+    from lagbench.replication.studies.robustness_figure import VARIANTS, advantage_figure
 
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        advantage_figure(df, path)
+        advantage_figure(df, path, model_colours(list(VARIANTS)))   # the report's colour per model
     except (KeyError, ValueError, TypeError, OSError):
         return False
     return path.exists()

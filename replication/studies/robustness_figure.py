@@ -2,7 +2,10 @@
 (`robustness.COLUMNS`), DeLaN's error over the feed-forward net's against the violation's magnitude, one
 column per scene kind (the nominal scene is each kind's magnitude 0), torque error above, tracking error
 below; one line per DeLaN variant and framework (the median over seeds), log ratio axis shared along a
-row, the line ratio 1 where DeLaN has no advantage left. matplotlib without pyplot (Agg via savefig)."""
+row, the line ratio 1 where DeLaN has no advantage left. ``colours`` ({variant: colour}, e.g. the report's
+colour per model) gives each variant its colour, else matplotlib's first two (blue, orange: told apart
+under the common colour-vision deficiencies, and by line style and marker). matplotlib without pyplot (Agg
+via savefig)."""
 from __future__ import annotations
 
 import io
@@ -18,7 +21,7 @@ VARIANTS = {"delan": ("DeLaN / ff", "-", "o"), "delan_dissipation": ("DeLaN + di
 ROWS = (("torque_ratio_to_ff", "torque nMSE ratio"), ("track_ratio_to_ff", "tracking MSE ratio"))
 
 
-def advantage_figure(df: pd.DataFrame, path) -> None:
+def advantage_figure(df: pd.DataFrame, path, colours: dict[str, str] | None = None) -> None:
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(3.0 * len(KINDS), 5.6))
@@ -31,7 +34,8 @@ def advantage_figure(df: pd.DataFrame, path) -> None:
             for (model, fw), m in g[g["model"].isin(list(VARIANTS))].groupby(["model", "framework"]):
                 med = m.groupby("magnitude")[col].median()
                 name, style, marker = VARIANTS[model]
-                ax.plot(med.index, med.to_numpy(), style, marker=marker, label=f"{name} ({fw})")
+                ax.plot(med.index, med.to_numpy(), style, marker=marker, label=f"{name} ({fw})",
+                        color=(colours or {}).get(model, f"C{list(VARIANTS).index(model)}"))
             ax.axhline(1.0, color="0.5", lw=0.8)
             if np.isfinite(g[col]).any() and (g[col] > 0).any():
                 ax.set_yscale("log")

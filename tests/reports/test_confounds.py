@@ -47,3 +47,26 @@ def test_every_seed_of_a_model_below_its_bar_is_on_the_claims_page(report):
     lnn = seeds[seeds["model"] == "lnn"]   # the fixture's rollouts record no divergence count: no seed passes
     assert sorted(lnn["seed"]) == sorted(str(s) for s in SEEDS * 2) and set(lnn["bar"]) == {"FAILED"}
     assert set(lnn["framework"]) == {"jax", "torch"}
+
+
+def test_sizes_are_set_against_each_other_only_within_a_part():
+    """A claim of two systems (a part each): the larger system's pair never against the smaller system's."""
+    from types import SimpleNamespace
+
+    from lagbench.reports.confounds import SIZE_RATIO, sizes_differ
+
+    parts = [{"name": "spring", "reads": ["hnn_spring", "baseline_spring"]},
+             {"name": "pendulum", "reads": ["hnn_pendulum", "baseline_pendulum"]},
+             {"name": "positive", "reads": ["hnn_spring"], "check": True}]
+    res = SimpleNamespace(verdicts={"c": {"parts": parts}})
+    small = 1000.0
+    params = {"hnn_spring": 10 * small, "baseline_spring": 10 * small * SIZE_RATIO * 0.9,   # within the ratio
+              "hnn_pendulum": small, "baseline_pendulum": small * SIZE_RATIO * 2}
+    sizes = {m: {"params": p} for m, p in params.items()}
+    assert sizes_differ(res, {"id": "c"}, sizes) == (f"baseline_pendulum {int(small * SIZE_RATIO * 2):,} vs "
+                                                     f"hnn_pendulum {int(small):,} parameters")
+    sizes["baseline_spring"]["params"] = 10 * small * SIZE_RATIO * 3   # both parts' pairs differ: each named
+    assert sizes_differ(res, {"id": "c"}, sizes).count(" vs ") == 2
+    res.verdicts["c"]["parts"] = []   # no parts: the claim's models as one set
+    assert sizes_differ(res, {"id": "c"}, sizes).startswith(f"baseline_spring {int(10 * small * SIZE_RATIO * 3):,} "
+                                                           f"vs hnn_pendulum")

@@ -6,6 +6,7 @@ import json
 import re
 
 import pandas as pd
+import pytest
 from markdown_tables import claim_rows, md_table, md_tables
 from result_fixtures import POOLED, SEEDS
 
@@ -124,3 +125,98 @@ def test_the_index_lists_every_table_and_figure_by_the_number_both_outputs_print
     assert {f"Table {n}" for n in tables} - listed == {f"Table {n}" for n in tables[-2:]}   # the index's own two
     typ = _both_typst(built)   # REPORT.typ and APPENDIX.typ: every number in one PDF or the other
     assert {int(n) for n in re.findall(r'#strong\("Table (\d+): ', typ)} == set(tables)
+
+
+def test_the_glossary_defines_every_column_the_speed_study_tables_can_show():
+    """The bench's control-rate and DeLaN-per-dof tables (not in the fixtures' results) are named in full too."""
+    from lagbench.reports.glossary import IDENTIFIER, define
+    from lagbench.speedstudy import control_rate, delan_dof
+
+    names = [c for c in [*control_rate.COLUMNS, *delan_dof.COLUMNS] if IDENTIFIER.match(c)]
+    assert {"rate_hz_mean", "fits_500hz_p99", "us_per_sample"} <= set(names)
+    assert not [c for c in names if define(c) is None]
+
+
+def test_an_interval_level_and_a_threshold_print_to_three_significant_digits():
+    from lagbench.reports.reasons import interval_words
+    from lagbench.reports.scorecard import round_numbers
+
+    level = 1 - 0.05 / 3   # a Bonferroni level over three rivals
+    words = interval_words({"what": "a/b", "point": 0.9, "lo": 0.6, "hi": 1.5, "level": level, "seeds": [8, 8]})
+    assert f"{100 * level:.1f} % confidence interval" in words and f"{100 * level:.4f}" not in words
+    assert round_numbers(f"within {1.5 ** 0.5}: reproduced; factor 6: reproduced") == (
+        "within 1.22: reproduced; factor 6: reproduced")
+
+
+def test_the_robustness_figure_draws_each_delan_variant_in_the_reports_colour(tmp_path):
+    """One colour per model across the report: the study's figure takes the report's (colour-blind safe)
+    colours, drawn exactly in its markers; matplotlib's default pair is not left in it."""
+    from matplotlib.colors import to_rgb
+    from matplotlib.image import imread
+
+    from lagbench.replication.studies.robustness_figure import VARIANTS, advantage_figure
+    from lagbench.replication.studies.robustness_scenes import KINDS
+    from lagbench.reports.figures import model_colours
+
+    rows = [{"kind": kind, "magnitude": mag, "model": m, "framework": "jax", "seed": s,
+             "torque_ratio_to_ff": 0.1 * (1 + mag) * (2 if m == "delan" else 1), "track_ratio_to_ff": 0.2 * (1 + mag)}
+            for kind, mags in [("nominal", [0.0])] + [(k, [0.5, 2.0]) for k in KINDS]
+            for mag in mags for m in [*VARIANTS, "ff"] for s in (0, 1)]
+    colours = model_colours(list(VARIANTS))
+    advantage_figure(pd.DataFrame(rows), tmp_path / "a.png", colours)
+    pixels = {tuple(p) for p in (imread(tmp_path / "a.png")[..., :3] * 255).round().astype(int).reshape(-1, 3)}
+    rgb = {name: tuple(round(255 * c) for c in to_rgb(x)) for name, x in
+           {**colours, "default 0": "C0", "default 1": "C1"}.items()}
+    assert len(set(colours.values())) == len(VARIANTS)
+    assert {n for n, c in rgb.items() if c in pixels} == set(VARIANTS), rgb
+
+
+@pytest.mark.parametrize("lo, hi", [(5.2e6, 1.15e7), (360.0, 800.0), (2e6, 9e6)])
+def test_a_log_axis_within_a_decade_prints_labels_that_do_not_run_into_each_other(lo, hi):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from lagbench.reports.figures import new_figure
+    from lagbench.reports.figures_precision import label_minor_log
+
+    fig, (ax, _) = new_figure(ncols=2, width=9.0, height=3.6)   # the work-precision figure's panels
+    ax.plot([lo, hi], [1.0, 2.0])
+    ax.set_xscale("log")
+    label_minor_log(ax)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes = sorted((t.get_window_extent(renderer) for t in [*ax.get_xticklabels(), *ax.get_xticklabels(minor=True)]
+                    if t.get_text() and min(ax.get_xlim()) <= t.get_position()[0] <= max(ax.get_xlim())),
+                   key=lambda b: b.x0)
+    assert len(boxes) >= 1
+    assert all(a.x1 < b.x0 for a, b in zip(boxes, boxes[1:], strict=False)), [(b.x0, b.x1) for b in boxes]
+
+
+def test_a_training_figure_of_scouted_units_says_why_it_starts_mid_budget(small_results_dir, tmp_path):
+    import shutil
+
+    from result_fixtures import checksum, write_json
+
+    from lagbench.reports import build_report
+
+    shutil.copytree(small_results_dir, tmp_path / "res")
+    for f in (tmp_path / "res" / "units" / "dp_loss").glob("*/lnn/seed*/result.json"):
+        r = json.loads(f.read_text())
+        r["scouting"] = {"init_seeds": [16000 + i for i in range(16)], "chosen": 16003}
+        r["checksum"] = checksum(r)
+        write_json(f, r)
+    md = build_report(tmp_path / "res", tmp_path / "out", pdf=False)["markdown"].read_text()
+    # the fixture's logs track no held-out loss: its training figure is the training curves
+    (caption,) = [text for _, text in FIGURE.findall(md) if text.startswith("dp_loss: Training curves")]
+    said = caption.split("Shows:")[0]
+    assert " lnn: the log starts where the protocol's scouting ends (16 initialisations" in said, caption
+    assert "baseline" not in said   # its units did not scout
+
+
+def test_a_speed_figure_says_higher_is_better_for_a_share_of_seeds_and_lower_for_an_error(built):
+    md = built["markdown"].read_text()
+    speed = {text.split(":", 1)[0]: text for _, text in FIGURE.findall(md) if ": speed against " in text}
+    assert POOLED in speed and len(speed) > 1
+    for claim, text in speed.items():
+        way = "higher" if claim == POOLED else "lower"
+        assert f"({way} is better)" in text, text

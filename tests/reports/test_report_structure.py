@@ -75,6 +75,15 @@ def test_a_model_kind_keeps_its_colour_from_figure_to_figure():
     assert len(set(a.values())) == 2 and len(set(b.values())) == 2
     ablation = model_colours(["lnn_act-softplus", "lnn_act-relu", "lnn_act-tanh"])   # one kind: by order
     assert len(set(ablation.values())) == 3
+    kinds = model_colours(["baseline", "lnn", "hnn", "delan", "lgn", "ff"])
+    for sweep in (["hnn_spring", "baseline_spring", "hnn_pendulum", "baseline_pendulum"],
+                  ["baseline_f32", "baseline_f64"], ["delan", "delan_n1024", "delan_n256", "ff", "ff_n1024", "ff_n256"],
+                  [*ablation]):
+        got = model_colours(sweep)
+        assert len(set(got.values())) == len(sweep), got   # one colour per arm
+        for arm, c in got.items():   # its own kind's colour or one no kind of the figure owns
+            assert c == kinds[arm.split("_", 1)[0]] or c not in kinds.values(), (arm, c)
+        assert set(got.values()) >= {kinds[x.split("_", 1)[0]] for x in sweep}   # each kind keeps its colour
 
 
 def test_no_figure_keeps_a_linear_axis_over_more_than_three_decades(results_dir, tmp_path, monkeypatch):
