@@ -9,7 +9,7 @@ largest and smallest models one part compares differ by more than ``SIZE_RATIO``
 between them; models of different parts, e.g. one system's against another's, are never set against each
 other), else "". ``failing_seeds(res, claim)``:
 every seed of a model below its competence bar, with its value (per framework). ``not_tested(res, claim)``: what
-the claim's rule leaves out, in words.
+the claim's rule leaves out, in words (`WORDS_UNTESTED`: what a claim says that no part tests).
 """
 from __future__ import annotations
 
@@ -122,12 +122,23 @@ def failing_seeds(res: Results, claim: dict) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
+# what a claim's words say that none of its parts tests (the parts as registered in `replication/claims/`)
+WORDS_UNTESTED = {
+    "delan_arm": "\"most on unseen trajectories and few samples\": each part asks only that DeLaN is better (by 3x on "
+                 "unseen trajectories, at all at each pool size); no part compares the size of its advantage "
+                 "across them",
+}
+
+
 def not_tested(res: Results, claim: dict, sizes: dict | None = None) -> str:
     """What the claim's rule does not test, from the data: model size, training budget and time, the
-    metrics it does not read, and the seed count it rests on."""
+    metrics it does not read, the seed count it rests on, and the words of the claim no part tests
+    (`WORDS_UNTESTED`)."""
     sizes = model_sizes(res, claim) if sizes is None else sizes
     metric = claim.get("metric") or "its metric"
     out = [f"the rule reads {metric} on this split's held-out draw only (other metrics and other data are not tested)"]
+    if claim.get("id") in WORDS_UNTESTED:
+        out.append(f"the claim's words {WORDS_UNTESTED[claim['id']]}")
     diff = sizes_differ(res, claim, sizes)
     if diff:
         out.append(f"it does not control model size ({diff})")

@@ -70,3 +70,19 @@ def test_sizes_are_set_against_each_other_only_within_a_part():
     res.verdicts["c"]["parts"] = []   # no parts: the claim's models as one set
     assert sizes_differ(res, {"id": "c"}, sizes).startswith(f"baseline_spring {int(10 * small * SIZE_RATIO * 3):,} "
                                                            f"vs hnn_pendulum")
+
+
+def test_words_of_a_claim_that_no_part_tests_are_named_on_its_page_and_only_there():
+    """Claim 9 says DeLaN's advantage is largest ("most") on unseen trajectories and few samples; its parts ask
+    only that DeLaN is better: its page says so, another claim's does not."""
+    from types import SimpleNamespace
+
+    from lagbench.replication.claims import CLAIMS
+    from lagbench.reports.confounds import WORDS_UNTESTED, not_tested
+
+    assert set(WORDS_UNTESTED) <= set(CLAIMS)
+    assert "most" in CLAIMS["delan_arm"].title
+    res = SimpleNamespace(verdicts={})
+    said = not_tested(res, {"id": "delan_arm", "metric": "torque_mse_test"}, sizes={})
+    assert '"most on unseen trajectories and few samples"' in said and "no part compares" in said
+    assert "no part" not in not_tested(res, {"id": "dp_loss", "metric": "heldout_l1"}, sizes={})
