@@ -133,6 +133,10 @@ METRICS = {
     "dissipation_scale": ("least-squares factor of the learned Hessian against the true mass matrix", "–"),
     "dissipation_hessian_residual": ("relative residual of that fit", "–"),
     "dissipation_ablation": ("one-step error without the learned dissipation over that with it", "–"),
+    "dissipation_bracket_half": ("rollout error with every learned friction coefficient halved over that with the "
+                                 "learned ones", "–"),
+    "dissipation_bracket_double": ("rollout error with every learned friction coefficient doubled over that with "
+                                   "the learned ones", "–"),
     "mass_matrix_rel_err": ("mean relative error of the learned mass matrix", "–"),
     "coriolis_rel_err": ("mean relative error of the learned Coriolis term", "–"),
     "gravity_rel_err": ("mean relative error of the learned gravity term", "–"),

@@ -41,7 +41,9 @@ ROLLOUT_METRICS = [("n_diverged", f"rollouts diverged (state error over {DIVERGE
                    *((f"dissipation_coefficient_{k}", f"friction q{k} in the system's units (--dissipation)")
                      for k in range(4)),
                    ("dissipation_hessian_residual", "--dissipation: learned velocity Hessian against c M, residual"),
-                   ("dissipation_ablation", "--dissipation: one-step error without the learned friction / with it")]
+                   ("dissipation_ablation", "--dissipation: one-step error without the learned friction / with it"),
+                   ("dissipation_bracket_half", "--dissipation: rollout error with the friction halved / as learned"),
+                   ("dissipation_bracket_double", "--dissipation: rollout error with the friction doubled / as learned")]
 
 
 def is_fit_results(res: Results) -> bool:

@@ -29,7 +29,8 @@ energy     (no torques) the model's own energy along its rollout (`Fitted.energy
            rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
 dissipation (spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; an LNN's with a system, and a
-           DeLaN's fitted to torques, S_dissipation_coefficient_<k> in the system's units (`_dissipation`).
+           DeLaN's fitted to torques, S_dissipation_coefficient_<k> in the system's units where the checks of
+           `replication.fit.dissipation` read it (on the set's rollouts where it has them).
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
            of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig. Trained on
            accelerations, a Lagrangian is fixed only up to a constant factor: the terms are then compared at
@@ -55,7 +56,7 @@ from lagbench.replication.evaluation.routines import Evaluation
 from lagbench.replication.evaluation.valid_time import VPT_NMSE, VPT_NRMSE, normalised_rmse, valid_time
 from lagbench.replication.fit.dissipation import dissipation_metrics
 from lagbench.replication.fit.load import Fitted, Padded, load_fitted
-from lagbench.replication.fit.trajectories import starts
+from lagbench.replication.fit.rollout_groups import by_time_grid
 
 KEEP = 2000   # rows kept for the parity and decomposition figures
 
@@ -114,25 +115,10 @@ def energy_function(cfg, dof):
     return energy
 
 
-def _groups(r, horizon=None) -> dict:
-    """Trajectories by their time grid (from 0; to `horizon` seconds when given): {grid: [row indices]}."""
-    groups: dict = {}
-    for idx in starts(r["traj"]):
-        t = r["t"][idx] - r["t"][idx[0]]
-        if horizon is not None:
-            keep = t <= horizon * (1 + 1e-12)
-            if keep.sum() < 2:
-                raise ValueError(f"--horizon {horizon}: shorter than the first sample interval ({t[1]:.6g} s) of "
-                                 f"trajectory {r['traj'][idx[0]]}")
-            idx, t = idx[keep], t[keep]
-        groups.setdefault(tuple(np.round(t, 9)), []).append(idx)
-    return groups
-
-
 def _rollouts(f: Fitted, r, name, cfg, out: Evaluation, rows: list, series: list, true_energy):
     d = f.spec.dof
     forced = f.task == "inverse_dynamics"
-    groups = _groups(r, cfg.get("horizon"))
+    groups = by_time_grid(r, cfg.get("horizon"))
     total, done = sum(len(g) - 1 for g in groups), [0]
     progress = cfg.get("progress")
 
@@ -272,8 +258,9 @@ def eval_fit(ctx) -> Evaluation:
             out.counters[f"{name}_rollouts"] = f"not run: {why}"
         if f.spec.kind == "delan":
             _decomposition(f, r, name, system, out)
-        if f.spec.dissipation:
-            dissipation_metrics(f, r, name, system, out)
+        if f.spec.dissipation:   # its friction checked on the rollouts where the set has them
+            rolled = {"horizon": cfg.get("horizon"), "substeps": cfg["substeps"]}
+            dissipation_metrics(f, r, name, system, out, rolled if why is None and f.task != "inverse_dynamics" else None)
     if one:
         out.tables["one_step.csv"] = pd.DataFrame(one)
     if roll:

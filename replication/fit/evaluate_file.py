@@ -25,9 +25,9 @@ from pathlib import Path
 from lagbench.files import results as R
 from lagbench.files import user_data
 from lagbench.replication.claims.base import Claim, ModelEntry
+from lagbench.replication.fit import dissipation, time_base, trajectories
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
-from lagbench.replication.fit import time_base, trajectories
 from lagbench.replication.fit.load import fitted_folders, load_fitted
 from lagbench.replication.fit.task import LOSS_NAMES, file_derivatives
 from lagbench.replication.run.units import Unit, run_unit
@@ -92,6 +92,8 @@ def evaluate(model, data, out="results/evaluate", framework=None, system=None, s
                "model_checksum": r["checksum"], "trained_in": r["framework"], "derivatives": {**used, **({"gaps": g} if g != "interpolate" else {}),
                                                                      **({"time_unit": unit} if unit != "s" else {})},
                "rows": prep.counts, "trajectories": prep.trajectories, "source": prep.source}
+        if r["model_spec"].get("dissipation"):   # as a fit records it (`replication.fit.task`)
+            cfg["friction_gate"] = dissipation.GATE
         if (horizon or fcfg.get("horizon")) is not None:   # recorded only when set: the others keep their keys
             cfg["horizon"] = float(horizon or fcfg["horizon"])
         if shared[f.folder] is not None:   # recorded only when the file holds some training rows

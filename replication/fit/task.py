@@ -63,6 +63,7 @@ from lagbench.replication.fit import (
 )
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
+from lagbench.replication.fit.dissipation import GATE as FRICTION_GATE
 from lagbench.replication.run.units import Unit, run_unit
 from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting, TrajectoryLoss
 from lagbench.replication.training.schedules import Constant, OneCycle
@@ -175,6 +176,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
            "trajectories": prep.trajectories, "periodic": periodic, "dissipation": dissipation}
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
+    if o.dissipation:   # how its friction is checked: a fit checked by another rule is evaluated again
+        cfg["friction_gate"] = FRICTION_GATE
     if tprep is not None:  # the user's test file and its rows, for the report
         cfg.update(test_source=tprep.source, test_rows=tprep.counts["test"], test_trajectories=tprep.trajectories["test"])
         if tderiv.get("rule") == trajectories.AUTO:   # its own window, by the same rule

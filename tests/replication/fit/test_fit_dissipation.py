@@ -18,9 +18,12 @@ from lagbench.replication.evaluation.adapters import adapter
 from lagbench.replication.evaluation.routines import Evaluation
 from lagbench.replication.fit.dissipation import (
     ABLATION_MIN,
+    BRACKET_MIN,
     HESSIAN_RESIDUAL_MAX,
     OFF,
     dissipation_metrics,
+    softplus,
+    with_coefficients,
     without_dissipation_l1,
 )
 from lagbench.replication.fit.load import Padded, load_fitted
@@ -74,6 +77,8 @@ def test_the_dissipative_lnn_recovers_the_friction(dissipative_folder):
     m = _metrics(dissipative_folder)["lnn_dissipative"]
     assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
     assert m["test_dissipation_ablation"] >= ABLATION_MIN   # the friction carries its accuracy
+    # ... and the test file's rollouts single it out: less friction and more each roll out worse
+    assert m["test_dissipation_bracket_half"] >= BRACKET_MIN and m["test_dissipation_bracket_double"] >= BRACKET_MIN
     assert m["test_l1"] < 0.1 * m["null_test_l1"]
 
 
@@ -83,7 +88,7 @@ def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
     params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
     g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
-    rows = user_data.rows(str(next(dissipative_folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
+    rows = _test_rows(dissipative_folder)
     out = Evaluation()
     out.metrics.update({"test_l1": without_dissipation_l1(f, rows), "null_test_l1": f.result["metrics"]["null_test_l1"]})
     dissipation_metrics(g, rows, "test", systems.get("pendulum"), out)
@@ -91,6 +96,38 @@ def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     assert out.metrics["test_dissipation_hessian_residual"] <= HESSIAN_RESIDUAL_MAX
     assert "test_dissipation_coefficient_0" not in out.metrics
     assert out.counters["test_dissipation_coefficient"].startswith("not estimated: the friction does not carry")
+
+
+def _test_rows(folder):
+    return user_data.rows(str(next(folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
+
+
+@pytest.mark.parametrize("scale", [0.0, 0.3, 3.0])
+def test_rollouts_refuse_a_friction_the_data_do_not_single_out(dissipative_folder, scale):
+    """The fitted model with its coefficients removed, at 0.3 and at 3 times their learned values: each still
+    learned (one-step) and keeps its velocity Hessian, but the test file's rollouts do not bracket its friction
+    (removed: halving or doubling nothing changes nothing; too little: more rolls out better; too much: less
+    does), so no friction is read, where the fit's own is (the test above)."""
+    f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
+    g = with_coefficients(f, scale * softplus(f.params["dissipation.raw"]))
+    rows = _test_rows(dissipative_folder)
+    out = Evaluation()
+    b, pred = g.one_step(rows)
+    out.metrics.update({"test_l1": float(np.mean(np.sum(np.abs(pred - b["target"]), -1))),
+                        "null_test_l1": f.result["metrics"]["null_test_l1"]})
+    dissipation_metrics(g, rows, "test", systems.get("pendulum"), out, {"horizon": None, "substeps": 2})
+    half, double = out.metrics["test_dissipation_bracket_half"], out.metrics["test_dissipation_bracket_double"]
+    assert min(half, double) < BRACKET_MIN, (half, double)
+    if scale == 0:
+        assert half == pytest.approx(1.0) and double == pytest.approx(1.0)
+    else:   # the side of the truth rolls out better
+        assert (double if scale < 1 else half) < 1.0
+    assert "test_dissipation_coefficient_0" not in out.metrics
+    assert out.counters["test_dissipation_coefficient"].startswith("not estimated: the rollouts do not single out")
+    own = Evaluation()   # the fit's own coefficients, through the same call: read
+    own.metrics.update({k: f.result["metrics"][k] for k in ("test_l1", "null_test_l1")})
+    dissipation_metrics(f, rows, "test", systems.get("pendulum"), own, {"horizon": None, "substeps": 2})
+    assert own.metrics["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
 
 
 @pytest.mark.slow   # slow: two more fits and a report (about a minute on 2 cores)
