@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The registered study of docs/lab/recording_defaults.md on the development files (the recordings:
+# friction 0.2, 100 Hz, 0.5 degree of noise, 2 % dropped frames; simulate seeds 30 and 31): for fit seeds
+# SEEDS, the LNN at the kind's default budget (3 x steps on a trajectory file, its restarts and fallback), the
+# LNN at a third of it (--steps 23437 --restart-fallback 0) and the baseline at its defaults, each with
+# periodic inputs and dissipation chosen by default; one folder per arm and seed (a rerun reuses finished fits).
+#   bash docs/lab/recording_defaults/run.sh OUT "0 1 2" [ARMS]     ARMS: any of lnn_1x lnn_3x baseline
+set -euo pipefail
+out=${1:?give a results folder}
+seeds=${2:-0 1 2}
+arms=${3:-lnn_1x baseline lnn_3x}
+sim="lagbench simulate --system double_pendulum --set friction=0.2 --rate 100 --noise 0.0087 --dropped 0.02"
+[ -f "$out/data/train.csv" ] || $sim --trajectories 400 --duration 1 --seed 30 --out "$out/data/train.csv"
+[ -f "$out/data/val.csv" ] || $sim --trajectories 8 --duration 4 --seed 31 --out "$out/data/val.csv"
+fit="lagbench fit --data $out/data/train.csv --test $out/data/val.csv --system double_pendulum --quiet"
+for s in $seeds; do
+  for arm in $arms; do
+    case $arm in
+      lnn_1x) $fit --model lnn --steps 23437 --restart-fallback 0 --seed "$s" --out "$out/s$s-lnn_1x" ;;
+      lnn_3x) $fit --model lnn --seed "$s" --out "$out/s$s-lnn_3x" ;;
+      baseline) $fit --model baseline --seed "$s" --out "$out/s$s-baseline" ;;
+    esac
+  done
+done
