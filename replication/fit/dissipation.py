@@ -39,7 +39,7 @@ ABLATION_MIN = 1.1
 # there the friction is read only where it is bracketed, the rollout error (S_rollout_gmean_err) with every
 # coefficient halved and with every coefficient doubled each at least `BRACKET_MIN` x the error with the learned
 # ones. Measured on that recording's two fits (docs/lab/friction_gate/README.md): their own frictions, within
-# 11 % and 13 % of the truth, read 1.13-1.28 (halved) and 1.37-1.42 (doubled) on the 4 s test trajectories; the
+# 14 % of the truth, read 1.13-1.28 (halved) and 1.37-1.42 (doubled) on the 4 s test trajectories; the
 # same models with their coefficients scaled by 0.3, 0.5, 0.7, 2 or 3, or to 0.02 and 0.42 of their own (as a
 # fit that read 0.004 and 0.084 against the true 0.2), read under 1 on the side of the truth; a model whose
 # dissipation is removed reads 1.000 both ways. The bracket checks the friction's overall scale: one
