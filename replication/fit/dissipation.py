@@ -90,17 +90,23 @@ def dissipation_metrics(f, r, name, system, out, rollouts: dict | None = None) -
 def _unbracketed(f, r, name, out, rollouts) -> str | None:
     """Why the rollouts do not bracket the learned friction (None: they do); the ratios into `out`."""
     base = out.metrics.get(f"{name}_rollout_gmean_err")
-    if base is None:
-        base = mean_state_error(f, r, rollouts.get("horizon"), rollouts["substeps"])
-    b = softplus(f.params["dissipation.raw"])
-    ratios = [mean_state_error(with_coefficients(f, k * b), r, rollouts.get("horizon"), rollouts["substeps"]) / base
-              if base > 0 else float("nan") for k in BRACKET]
+    ratios = bracket_ratios(f, r, softplus(f.params["dissipation.raw"]), rollouts.get("horizon"), rollouts["substeps"],
+                            base)
     out.metrics[f"{name}_dissipation_bracket_half"], out.metrics[f"{name}_dissipation_bracket_double"] = ratios
     if all(x >= BRACKET_MIN for x in ratios):
         return None
     return (f"the rollouts do not single out the learned friction (their error with its coefficients x "
             f"{BRACKET[0]:g} is {ratios[0]:.3g} x, x {BRACKET[1]:g} {ratios[1]:.3g} x that with them; both must be "
             f"at least {BRACKET_MIN:g})")
+
+
+def bracket_ratios(f, r, b, horizon=None, substeps=2, base=None) -> list[float]:
+    """The rollout error on the rows `r` of the fitted model `f` with coefficients b x each of `BRACKET`, over
+    its error with b (`base` where already measured, as the evaluation's S_rollout_gmean_err with b as learned)."""
+    if base is None:
+        base = mean_state_error(with_coefficients(f, b), r, horizon, substeps)
+    return [mean_state_error(with_coefficients(f, k * b), r, horizon, substeps) / base if base > 0 else float("nan")
+            for k in BRACKET]
 
 
 def softplus(raw) -> np.ndarray:

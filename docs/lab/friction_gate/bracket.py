@@ -12,7 +12,7 @@ import sys
 import numpy as np
 
 from lagbench.files import user_data
-from lagbench.replication.fit.dissipation import BRACKET, softplus, with_coefficients
+from lagbench.replication.fit.dissipation import BRACKET, bracket_ratios, softplus, with_coefficients
 from lagbench.replication.fit.load import load_fitted
 from lagbench.replication.fit.rollout_groups import mean_state_error
 
@@ -26,7 +26,7 @@ def main(folder: str, scales: list[str]) -> None:
         for name, r in sets.items():
             base = mean_state_error(with_coefficients(f, b), r)
             row = {"err": base, "off": mean_state_error(with_coefficients(f, 0 * b), r) / base}
-            row.update({f"x{k}": mean_state_error(with_coefficients(f, b * k), r) / base for k in BRACKET})
+            row.update({f"x{k}": x for k, x in zip(BRACKET, bracket_ratios(f, r, b, base=base), strict=True)})
             print(scale, name, {k: round(v, 3) for k, v in row.items()}, flush=True)
 
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from lagbench import systems
 from lagbench.files import user_data
+from lagbench.replication.evaluation.metrics import heldout_errors
 
 _floor: dict = {}
 
@@ -25,7 +26,7 @@ def exact_l1(reference: str, friction: float) -> float:
     if reference not in _floor:
         r = user_data.rows(reference, "test")
         pred = np.asarray(systems.registry.get("double_pendulum", friction=friction).acceleration(r["q"], r["qdot"]))
-        _floor[reference] = float(np.mean(np.sum(np.abs(pred - r["qddot"]), -1)))
+        _floor[reference] = heldout_errors(pred, r["qddot"])["l1"]
     return _floor[reference]
 
 
