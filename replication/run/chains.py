@@ -103,19 +103,33 @@ def cost(chain) -> float:
 
 def ref(u) -> tuple:
     """What names a unit across processes (a claim's rules are closures: they do not pickle); a user's model
-    (`replication.run.added_models`) is not in its claim's list, so its entry travels with it."""
+    (`replication.run.added_models`) is not in its claim's list, so its entry travels with it, and so do the
+    models of a claim whose models are not the written ones (a search's configuration, `lagbench tune`)."""
+    from lagbench.replication.claims import get as get_claim
+
     user = u.entry if u.entry.spec.get("kind") == USER_KIND else None
-    return u.claim.id, u.entry.label, u.framework, u.seed, u.profile, user
+    models = None if u.claim.models == get_claim(u.claim.id).models else u.claim.models
+    return u.claim.id, u.entry.label, u.framework, u.seed, u.profile, user, models
 
 
 def unit_of(r):
+    """The unit a `ref` names: with models carried, the claim with those models and the entry among them;
+    else the model as the claim resolves it under the profile (its adopted choice applied)."""
+    import dataclasses
+
     from lagbench.replication.claims import get as get_claim
     from lagbench.replication.claims.resolved import resolved
     from lagbench.replication.run.units import Unit
 
-    claim_id, label, framework, seed, profile, user = r
+    claim_id, label, framework, seed, profile, user, *rest = r
+    models = rest[0] if rest else None
     claim = get_claim(claim_id)
-    return Unit(claim, user or resolved(claim, profile).model(label).entry, framework, seed, profile)
+    if models is not None:
+        claim = dataclasses.replace(claim, models=models)
+        entry = user or next(m for m in models if m.label == label)
+    else:
+        entry = user or resolved(claim, profile).model(label).entry
+    return Unit(claim, entry, framework, seed, profile)
 
 
 def run_chain(refs, out):

@@ -17,7 +17,7 @@ def cmd_tune(args):
     ledger = tune(args.claim, profile=args.profile, n_configs=args.configs,
                   n_seeds=seeds if isinstance(seeds, int) else None, seeds=None if isinstance(seeds, int) else seeds,
                   frameworks=frameworks, out=args.out or f"results/tune/{args.claim}_{args.profile}",
-                  progress=not args.quiet, record=args.record, confirm=args.confirm, dry_run=args.dry_run,
+                  progress=not args.quiet, record=args.record, jobs=args.jobs, confirm=args.confirm, dry_run=args.dry_run,
                   widths=[x for x in args.widths.split(",") if x.strip()] if args.widths else None)
     if ledger is None:
         return 0
@@ -60,6 +60,9 @@ def add_command(sub) -> None:
                    help="development seeds the chosen and the registered configuration are compared on (default: 3)")
     s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")
     s.add_argument("--out", help="results folder (default: results/tune/<claim>_<profile>)")
+    s.add_argument("--jobs", type=int, default=1, help="worker processes: the models of a configuration (and a "
+                   "framework's or seed's units) train side by side, one CPU thread each; the scores are the same "
+                   "(default: 1)")
     s.add_argument("--dry-run", action="store_true", help="print the first stage's trainings and their estimated "
                    "time, and stop")
     s.add_argument("--quiet", action="store_true", help="no progress bars")

@@ -15,7 +15,8 @@ search") and `widths=[...]` a width sweep (`kind` "width sweep"): lab tools that
 
 Units go to OUT/config<k>/units/... (a rerun into the same OUT reads back what is finished). With `record`,
 each finished unit is also appended to that CSV as one small row (`records`): a search that resumes from a
-committed record trains only what is missing, on any machine. Before each stage `lagbench tune` prints the
+committed record trains only what is missing, on any machine. With `jobs` > 1 the models of a configuration
+train side by side in worker processes (`run.executor`), each unit recorded as it ends. Before each stage `lagbench tune` prints the
 trainings left and their estimated time (`replication.run.estimate`); `dry_run` prints the first stage's
 and stops. The ledger goes to OUT/ledger.json and OUT/ledger.csv: per model the configurations tried, their
 scores, the confirmation, the chosen one, and the compute the search took; with `record`, beside the record
@@ -48,9 +49,9 @@ STAGES = ("grid", "edge", "confirmation")
 class _Runner:
     """Trains the units of a stage (or reads them back from OUT or the record) and keeps every row."""
 
-    def __init__(self, claim, profile, labels, frameworks, out, record, progress):
+    def __init__(self, claim, profile, labels, frameworks, out, record, progress, jobs=1):
         self.claim, self.profile, self.labels, self.frameworks = claim, profile, labels, frameworks
-        self.out, self.record, self.progress = out, record, progress
+        self.out, self.record, self.progress, self.jobs = out, record, progress, jobs
         scored_by = {choose.PACE} if claim.pooled else {claim.metric, "heldout_l1"}
         # a row scored by another metric (the claim's metric changed) is not this search's: redone
         self.known = {k: r for k, r in (records.read(record) if record else {}).items() if r["metric"] in scored_by}
@@ -86,17 +87,22 @@ class _Runner:
         """`plan`: [(config index, knobs, labels, seeds)]; each model's units of a configuration as one run."""
         self.tell(stage, plan)
         for k, knobs, labels, seeds in plan:
-            for label in labels:   # one model at a time, so that the record grows as each one finishes
-                keyed = [(records.unit_key(u), u) for u in self.units(knobs, [label], seeds)]
+            # one model at a time, or with jobs > 1 a configuration's models side by side; each unit's row
+            # joins the record as soon as its run ends, so that the record grows as units finish
+            for group in ([[label] for label in labels] if self.jobs == 1 else [list(labels)]):
+                keyed = [(records.unit_key(u), u) for u in self.units(knobs, group, seeds)]
                 todo = [(key, u) for key, u in keyed if key not in self.known]
                 train = [u for _, u in todo if not is_current(u, self.folder(k))]
                 if train:
-                    run_units(train, self.folder(k), self.profile, self.progress, jobs=1)
-                new = [self._row(key, u, k, knobs) for key, u in todo]
-                if self.record:
-                    records.append(self.record, new)
-                self.known.update({r["key"]: r for r in new})
+                    run_units(train, self.folder(k), self.profile, self.progress, jobs=self.jobs,
+                              on_done=lambda u, k=k, knobs=knobs: self._keep(self._row(records.unit_key(u), u, k, knobs)))
+                self._keep(*[self._row(key, u, k, knobs) for key, u in todo if key not in self.known])
                 self.rows += [{**self.known[key], "stage": stage, "config": k} for key, _ in keyed]
+
+    def _keep(self, *rows) -> None:
+        if rows and self.record:
+            records.append(self.record, list(rows))
+        self.known.update({r["key"]: r for r in rows})
 
     def _row(self, key: str, u: Unit, k: int, knobs: dict) -> dict:
         try:
@@ -139,8 +145,10 @@ def _compute(df: pd.DataFrame, pooled: bool) -> dict:
 @R.writes
 def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="results/tune", progress: bool = True,
          n_configs: int | None = None, n_seeds: int | None = None, widths=None, record=None,
-         confirm: int = CONFIRM_SEEDS, dry_run: bool = False, seeds=None) -> dict | None:
-    """`n_seeds`: the first development seeds each configuration trains on; `seeds`: those seeds themselves."""
+         confirm: int = CONFIRM_SEEDS, dry_run: bool = False, seeds=None, jobs: int = 1) -> dict | None:
+    """`n_seeds`: the first development seeds each configuration trains on; `seeds`: those seeds themselves;
+    `jobs`: worker processes, each a unit of one configuration at a time (`run.executor`; the scores are the
+    same either way, only wall time differs)."""
     claim = get(claim_id)   # the search is around the claim as written, never around an adopted choice
     if seeds is not None:
         seeds = list(dict.fromkeys(seeds))
@@ -155,6 +163,8 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
         raise ValueError(f"--n-seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     if not is_integer(confirm) or not 1 <= confirm <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--confirm: {confirm!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
+    if not is_integer(jobs) or jobs < 1:
+        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1")
     kind = "width sweep" if widths else "partial search" if n_configs else "search"
     configs = search.sweep(widths) if widths else search.configs(n_configs) if n_configs else search.grid()
     labels = [e.label for e in claim.models if tuned.searched(claim, e, profile)]
@@ -164,7 +174,7 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
     if record is not None:
         record = Path(record)
         R.output_folder(record.parent, "--record")
-    runner = _Runner(claim, profile, labels, tuple(frameworks), out, record, progress)
+    runner = _Runner(claim, profile, labels, tuple(frameworks), out, record, progress, jobs)
     seeds = splits.DEV.seeds(n_seeds) if seeds is None else seeds
     if dry_run:
         runner.tell("grid", _plan(configs, labels, seeds))

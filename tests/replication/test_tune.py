@@ -136,6 +136,13 @@ def test_tune_searches_every_model_alike_on_the_development_split_only(tmp_path,
         assert m["chosen"] == min(finite, key=finite.get)
     assert json.loads((tmp_path / "ledger.json").read_text())["models"] == json.loads(json.dumps(models))
     assert protocol_hash(get("dp_loss"), "smoke") == before   # the claim is untouched
+    # two worker processes train a configuration's models side by side: the same units, each trained at its
+    # own configuration (not the claim's registered one), the same scores up to the rounding of one thread
+    par = tune("dp_loss", profile="smoke", n_configs=2, n_seeds=1, out=tmp_path / "jobs2", progress=False,
+               record=tmp_path / "jobs2.csv", jobs=2)
+    scores = {k: r["score"] for k, r in records.read(tmp_path / "jobs2.csv").items()}
+    assert scores == pytest.approx({k: r["score"] for k, r in rows.items()}, rel=1e-4)
+    assert {m["chosen"] for m in par["models"].values()} == {m["chosen"] for m in ledger["models"].values()}
     # a rerun into the same folder reads the finished units back: nothing trained or evaluated again
     ran = []
     monkeypatch.setattr("lagbench.replication.tuning.tune.run_units", lambda units, *a, **k: ran.append(units))
@@ -154,6 +161,9 @@ def test_tune_command_refuses_a_bad_count_in_one_line(tmp_path, capsys):
     assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--configs", "99", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--configs" in err
+    assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--jobs", "0", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--jobs" in err
 
 
 def test_a_width_sweep_gives_every_model_the_registered_setting_then_each_width():

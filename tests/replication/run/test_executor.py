@@ -28,6 +28,28 @@ def test_units_sharing_a_model_form_one_chain():
     assert [executor._cost(c) for c in chains] == sorted((executor._cost(c) for c in chains), reverse=True)
 
 
+def test_a_unit_named_across_processes_keeps_its_own_models():
+    """A search's configuration (a claim whose models are not the written ones) reaches a worker as itself; a
+    run's unit as the claim resolves it."""
+    import dataclasses
+
+    from lagbench.replication.claims import get
+    from lagbench.replication.run.chains import ref, unit_of
+    from lagbench.replication.run.units import Unit
+    from lagbench.replication.tuning import search
+
+    todo = runner.plan("smoke", claims=["dp_loss"], frameworks=("jax",))
+    u = todo[0]
+    back = unit_of(ref(u))
+    assert ref(u)[-1] is None and back.entry == u.entry and back.name == u.name
+    claim = get("dp_loss")
+    models = tuple(search.apply(e, claim.protocol("smoke"), "smoke", {"lr": 3.0, "width": 2.0}) for e in claim.models)
+    variant = Unit(dataclasses.replace(claim, models=models), models[0], "jax", 0, "smoke")
+    back = unit_of(ref(variant))
+    assert back.entry == models[0] != claim.models[0] and back.claim.models == models
+    assert back.protocol() == variant.protocol() and back.entry.widths("smoke") == models[0].widths("smoke")
+
+
 # a scouted training and untrained evaluations: two kinds of chain, three chains for two workers
 CLAIMS_2, MODELS_2 = ["dp_loss", "appendix_b"], ["baseline", "lnn_exact_fast", "lnn_exact_paper"]
 
