@@ -9,14 +9,16 @@
 #   bash docs/lab/recording_defaults/run.sh OUT "0 1 2" [ARMS]
 #   ARMS: any of lnn_1x lnn_3x baseline lnn_1x_p5 baseline_p5
 #   NOISE=0.001 bash ... : the same recordings at another position noise in radians (default 0.0087, 0.5 degree)
+#   DATA_SEEDS="40 41" bash ... : other simulate seeds for the training and the test file (default: 30 31)
 set -euo pipefail
 out=${1:?give a results folder}
 seeds=${2:-0 1 2}
 arms=${3:-lnn_1x baseline lnn_3x}
 noise=${NOISE:-0.0087}
 sim="lagbench simulate --system double_pendulum --set friction=0.2 --rate 100 --noise $noise --dropped 0.02"
-[ -f "$out/data/train.csv" ] || $sim --trajectories 400 --duration 1 --seed 30 --out "$out/data/train.csv"
-[ -f "$out/data/val.csv" ] || $sim --trajectories 8 --duration 4 --seed 31 --out "$out/data/val.csv"
+read -r train_seed test_seed <<< "${DATA_SEEDS:-30 31}"
+[ -f "$out/data/train.csv" ] || $sim --trajectories 400 --duration 1 --seed "$train_seed" --out "$out/data/train.csv"
+[ -f "$out/data/val.csv" ] || $sim --trajectories 8 --duration 4 --seed "$test_seed" --out "$out/data/val.csv"
 fit="lagbench fit --data $out/data/train.csv --test $out/data/val.csv --system double_pendulum --quiet"
 for s in $seeds; do
   for arm in $arms; do
