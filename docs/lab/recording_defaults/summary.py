@@ -44,6 +44,31 @@ def row(r: dict, friction: float) -> dict:
             "training s (wall)": r.get("train_time_s")}
 
 
+def done_means(arms: dict, friction: float, lnn: str = "lnn_1x", baseline: str = "baseline") -> None:
+    """The issue's bars on the seeds both arms have: the LNN's one-step L1 / null (at most 0.3), its rollout
+    error / the baseline's (at most 1.2; median over seeds), each friction within 10 % of the truth (where read)
+    and each fit's training within 10 minutes."""
+    seeds = sorted(set(arms.get(lnn, {})) & set(arms.get(baseline, {})))
+    if not seeds:
+        return
+    one = [arms[lnn][s]["one-step / null"] for s in seeds]
+    ratio = [arms[lnn][s]["rollout error"] / arms[baseline][s]["rollout error"] for s in seeds]
+    off = []
+    for s in seeds:
+        read = arms[lnn][s]["friction"]
+        try:
+            off.append(max(abs(float(x) / friction - 1) for x in read.split(",")))
+        except ValueError:   # not read: the reason instead of numbers
+            off.append(None)
+    times = [arms[a][s]["training s (wall)"] for a in (lnn, baseline) for s in seeds]
+    print(f"\ndone-means, {lnn} against {baseline}, seeds {', '.join(map(str, seeds))}:")
+    print(f"- one-step / null: {', '.join(f'{x:.3g}' for x in one)}; median {np.median(one):.3g} (bar 0.3)")
+    print(f"- rollout error / baseline's: {', '.join(f'{x:.3g}' for x in ratio)}; median {np.median(ratio):.3g} (bar 1.2)")
+    print("- friction, largest relative miss per seed: "
+          + ", ".join("not read" if x is None else f"{x:.1%}" for x in off) + " (bar 10 %)")
+    print(f"- training s (wall), every fit: {', '.join('-' if t is None else f'{t:.0f}' for t in times)} (bar 600)")
+
+
 def main(out: str, friction: float = 0.2) -> None:
     arms: dict = defaultdict(dict)
     for f in sorted(glob.glob(f"{out}/s*-*/units/fit/*/*/seed*/result.json")):
@@ -57,6 +82,9 @@ def main(out: str, friction: float = 0.2) -> None:
         for s in sorted(seeds):
             cells = [v if isinstance(v, str) else "-" if v is None else f"{v:.3g}" for v in seeds[s].values()]
             print("| " + " | ".join([str(s), *cells]) + " |")
+        numeric = [k for k in keys if all(isinstance(seeds[s][k], float | int) for s in seeds)]
+        print("median over seeds: " + ", ".join(f"{k} {np.median([seeds[s][k] for s in seeds]):.3g}" for k in numeric))
+    done_means(arms, friction)
 
 
 if __name__ == "__main__":
