@@ -61,8 +61,8 @@ def add_command(sub) -> None:
     s.add_argument("--frameworks", default="jax", help="comma-separated: jax, torch (default: jax)")
     s.add_argument("--out", help="results folder (default: results/tune/<claim>_<profile>)")
     s.add_argument("--jobs", type=int, default=1, help="worker processes: the models of a configuration (and a "
-                   "framework's or seed's units) train side by side, one CPU thread each; the scores are the same "
-                   "(default: 1)")
+                   "framework's or seed's units) train side by side, one CPU thread each; their scores differ from one "
+                   "process's in float32 rounding only (default: 1)")
     s.add_argument("--dry-run", action="store_true", help="print the first stage's trainings and their estimated "
                    "time, and stop")
     s.add_argument("--quiet", action="store_true", help="no progress bars")

@@ -147,8 +147,9 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
          n_configs: int | None = None, n_seeds: int | None = None, widths=None, record=None,
          confirm: int = CONFIRM_SEEDS, dry_run: bool = False, seeds=None, jobs: int = 1) -> dict | None:
     """`n_seeds`: the first development seeds each configuration trains on; `seeds`: those seeds themselves;
-    `jobs`: worker processes, each a unit of one configuration at a time (`run.executor`; the scores are the
-    same either way, only wall time differs)."""
+    `jobs`: worker processes, each a unit of one configuration at a time (`run.executor`; a worker's one CPU
+    thread rounds float32 otherwise than a multithreaded process, so its scores differ from `jobs` = 1's at the
+    level of rounding)."""
     claim = get(claim_id)   # the search is around the claim as written, never around an adopted choice
     if seeds is not None:
         seeds = list(dict.fromkeys(seeds))
