@@ -10,6 +10,7 @@ before the first of its units runs; None or 1: each seed alone.
 The run's progress bar advances by each unit's estimated seconds (`replication.run.unit_seconds`, given as
 `seconds`), so that its remaining time is the work left; `on_done(unit)` is told of each unit whose run ended
 (a store trims the unit's folder: `replication.run.store`).
+`check_jobs(jobs)`: the one check of a worker count (`lagbench run`, `tune`, `verify`).
 
 jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N worker processes (spawned,
 so each starts clean), each given one CPU thread for JAX (XLA's Eigen pool off) and for PyTorch and
@@ -203,11 +204,18 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
     return failures, errors
 
 
+def check_jobs(jobs) -> None:
+    """Refuse a worker count that is not an integer >= 1, in one line naming --jobs."""
+    from lagbench.validate import is_integer
+
+    if not is_integer(jobs) or jobs < 1:
+        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
+
+
 def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None, members=None):
     """`seconds`: each unit's estimated seconds (`unit_seconds`), what the bar advances by (default: one each);
     `on_done(unit)`: called in this process once a unit's run has ended (its result written, or not)."""
-    if jobs < 1:
-        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1")
+    check_jobs(jobs)
     seconds = list(seconds) if seconds is not None else [1.0] * len(todo)
     on_done = on_done or (lambda u: None)
     if jobs == 1 or len(todo) <= 1:

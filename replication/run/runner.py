@@ -35,7 +35,7 @@ from lagbench.replication.run import added_models, packing, splits
 from lagbench.replication.run import environment as env
 from lagbench.replication.run import store as S
 from lagbench.replication.run.announce import announce
-from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.executor import check_jobs, run_units
 from lagbench.replication.run.unit_seconds import unit_seconds
 from lagbench.replication.run.units import Unit
 from lagbench.validate import is_integer
@@ -199,8 +199,7 @@ def run(profile="quick", out="results/quick", claims=None, frameworks=None, seed
     store git can carry (`replication.run.store`): trimmed units, a .gitignore, a unit made under another
     registration redone; its size printed at the end. `pack_seeds`: up to that many seeds of a model trained
     as one program (`replication.run.packing`; None: `gpu_cohorts.MAX_MEMBERS` on a GPU, 1 on the CPU)."""
-    if not is_integer(jobs) or jobs < 1:
-        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
+    check_jobs(jobs)
     execute = executor_of(executor, jobs, address)
     if not dry_run:   # a folder another command is writing into is refused before the planning, not after it
         R.refuse_if_locked(out, "--out")

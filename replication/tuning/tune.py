@@ -35,7 +35,7 @@ from lagbench.files import results as R
 from lagbench.replication.claims import get, tuned
 from lagbench.replication.run import splits
 from lagbench.replication.run.estimate import estimate
-from lagbench.replication.run.executor import run_units
+from lagbench.replication.run.executor import check_jobs, run_units
 from lagbench.replication.run.runner import is_current
 from lagbench.replication.run.units import Unit
 from lagbench.replication.tuning import choose, records, search
@@ -164,8 +164,7 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
         raise ValueError(f"--n-seeds: {n_seeds!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
     if not is_integer(confirm) or not 1 <= confirm <= splits.SEEDS_PER_SPLIT:
         raise ValueError(f"--confirm: {confirm!r} is not valid; expected an integer from 1 to {splits.SEEDS_PER_SPLIT}")
-    if not is_integer(jobs) or jobs < 1:
-        raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1")
+    check_jobs(jobs)
     kind = "width sweep" if widths else "partial search" if n_configs else "search"
     configs = search.sweep(widths) if widths else search.configs(n_configs) if n_configs else search.grid()
     labels = [e.label for e in claim.models if tuned.searched(claim, e, profile)]
