@@ -71,6 +71,19 @@ def test_two_workers_give_the_serial_numbers(smoke_results, tmp_path):
     assert len(a) == len(runner.plan("smoke", claims=CLAIMS_2, frameworks=("jax",), models=MODELS_2)) == 3
 
 
+def test_a_lone_unit_at_two_jobs_trains_in_a_worker(monkeypatch, tmp_path):
+    """A single unit left at jobs 2 (a resumed search's last one) keeps the workers' one-thread rounding."""
+    seen = []
+    monkeypatch.setattr(executor, "_serial", lambda *a: pytest.fail("trained in this process"))
+    monkeypatch.setattr(executor, "_parallel", lambda todo, *a: seen.append(len(todo)) or ([], []))
+    unit = runner.plan("smoke", claims=["appendix_b"], frameworks=("jax",))[:1]
+    assert executor.run_units(unit, tmp_path, "smoke", progress=False, jobs=2) == ([], [])
+    assert seen == [1]
+    monkeypatch.setattr(executor, "_serial", lambda *a: seen.append("serial") or ([], []))
+    executor.run_units(unit, tmp_path, "smoke", progress=False, jobs=1)
+    assert seen == [1, "serial"]
+
+
 def test_jobs_must_be_a_positive_integer(tmp_path):
     with pytest.raises(ValueError, match="--jobs"):
         runner.run(profile="smoke", out=tmp_path, claims=["appendix_b"], jobs=0)
