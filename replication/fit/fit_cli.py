@@ -28,9 +28,10 @@ def cmd_fit(args):
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
-    o, task, recording, dof, _ = resolved(args.data, given)   # a refused option: one line, nothing written
+    o, task, recording, dof, _, noise = resolved(args.data, given)   # a refused option: one line, nothing written
     if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
-        print(f"lagbench fit: {args.model}'s defaults from {kind_defaults.source(args.model, task, recording, dof, given)} "
+        print(f"lagbench fit: {args.model}'s defaults from "
+              f"{kind_defaults.source(args.model, task, recording, dof, given, noise)} "
               f"where not given ({o.steps} steps, batch {o.batch}, hidden {','.join(map(str, o.hidden))}, lr {o.lr:g}"
               f"{f', {o.restarts} restarts' if o.restarts else ''}{', spike guard' if o.guard_clip or o.guard_skip else ''}"
               f"{f', early stop at patience {o.patience}' if o.patience else ''})", file=sys.stderr)

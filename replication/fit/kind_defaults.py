@@ -13,6 +13,11 @@ inverse-dynamics baseline (data with tau) from the two-link arm's claim.
 `ON_RECORDINGS`: (kind, task) -> the factor on the claim's steps for a trajectory file, where a registered fit
 study chose a longer budget for recorded trajectories than the claim's i.i.d. states need
 (`docs/decisions/fit_budget.md`: every form got the same candidates; the LNN's held-out error chose 3 x).
+`NOISY_RECORDINGS`: (kind, task) -> the position noise (`trajectories.position_noise`: what `--window auto`
+estimates on q, the mean over coordinates, in q's units) at and above which a trajectory file whose
+q-double-dot is estimated from q trains the claim's steps without restart fallbacks instead of
+`ON_RECORDINGS`'s budget: on noisy recordings the longer budget rolls out worse (a registered study on
+simulated double-pendulum recordings at three noise levels, `docs/decisions/fit_budget.md`).
 `SMALL`: data with fewer coordinates than the system of the kind's claim (the LNN's and the q-double-dot
 baseline's: the double pendulum's 2; DeLaN's and the torque baseline's: the two-link arm's 2; the HNN's: the
 pendulum's 1, so never) train without restarts, for the claim's steps (no `ON_RECORDINGS` factor) and stop
@@ -20,11 +25,13 @@ early: when `SMALL["patience"]` held-out evaluations in a row (`HELDOUT_CHECKS` 
 improvement of `MIN_IMPROVEMENT`, then anneal over the steps the patience spans (`replication.fit.task`
 builds the `EarlyStop`; `docs/decisions/fit_budget.md` has the measurements). A system as large as
 the claim's keeps the claim's budget and no early stop.
-`defaults(kind, task, recording=False, dof=None) -> dict`: fit option name -> value for every option in
-`FROM_PROTOCOL` and `patience`, and the restarts' `restart_fraction` (their steps / the protocol's) and
-`restart_lr_ratio` (their peak / the protocol's); `dof`: the data's coordinates (None: as the claim's).
-`small(kind, task, dof) -> bool`: whether `SMALL` applies. `source(kind, task, recording=False, dof=None, given=()) -> str`:
-where the defaults come from, for the console (`given`: the options set by the user, whose defaults it does not name).
+`defaults(kind, task, recording=False, dof=None, noise=None) -> dict`: fit option name -> value for every option
+in `FROM_PROTOCOL` and `patience`, and the restarts' `restart_fraction` (their steps / the protocol's) and
+`restart_lr_ratio` (their peak / the protocol's); `dof`: the data's coordinates (None: as the claim's); `noise`:
+the recording's position noise (None: not estimated). `small(kind, task, dof) -> bool`: whether `SMALL` applies;
+`noisy(kind, task, noise) -> bool`: whether `NOISY_RECORDINGS` does. `source(kind, task, recording=False,
+dof=None, given=(), noise=None) -> str`: where the defaults come from, for the console (`given`: the options
+set by the user, whose defaults it does not name).
 
 What the claims set for their system rather than for training stays the user's choice: wrapping angles
 (the double pendulum's q are angles; a user's may not be), and the claims' fixed input scale becomes
@@ -44,6 +51,9 @@ SOURCES = {("lnn", "acceleration"): ("dp_loss", "lnn"), ("baseline", "accelerati
            ("hnn", "hamiltonian"): ("hnn_energy", "hnn_pendulum"), ("delan", "inverse_dynamics"): ("delan_arm", "delan"),
            ("delan", "acceleration"): ("delan_arm", "delan"), ("baseline", "inverse_dynamics"): ("delan_arm", "ff")}
 ON_RECORDINGS = {("lnn", "acceleration"): 3}
+# the geometric mean of the estimated position noise of the study's 0.001 rad recording (3 x won) and of its
+# 0.003 rad one (1 x won): docs/lab/recording_defaults/switch.py
+NOISY_RECORDINGS = {("lnn", "acceleration"): 0.00172}
 SMALL = {"restarts": None, "patience": 10}   # and the claim's steps: see `small`
 HELDOUT_CHECKS = 100   # a fit logs, and its early stop evaluates the held-out rows, this many times over its steps
 MIN_IMPROVEMENT = 0.01   # the early stop's least improvement, a fraction of the best held-out error so far
@@ -75,19 +85,25 @@ def small(kind: str, task: str, dof: int | None) -> bool:
     return dof is not None and dof < claim_dof(kind, task)
 
 
-def _steps_factor(kind: str, task: str, recording: bool, dof: int | None = None) -> int:
-    return ON_RECORDINGS.get((kind, task), 1) if recording and not small(kind, task, dof) else 1
+def noisy(kind: str, task: str, noise: float | None) -> bool:
+    """A recording's estimated position noise `noise` is at or above the kind's `NOISY_RECORDINGS` switch."""
+    return noise is not None and (kind, task) in NOISY_RECORDINGS and noise >= NOISY_RECORDINGS[(kind, task)]
+
+
+def _steps_factor(kind: str, task: str, recording: bool, dof: int | None = None, is_noisy: bool = False) -> int:
+    return ON_RECORDINGS.get((kind, task), 1) if recording and not small(kind, task, dof) and not is_noisy else 1
 
 
 @cache
-def _defaults(kind: str, task: str, recording: bool, dof: int | None) -> tuple:
+def _defaults(kind: str, task: str, recording: bool, dof: int | None, is_noisy: bool) -> tuple:
     _, entry, p = _entry(kind, task)
     one_cycle = isinstance(p.schedule, OneCycle)
     s = p.scouting
     if s is not None and isinstance(s.schedule, OneCycle) and s.schedule.start != OneCycle.start:
         raise ValueError(f"{kind}: the claim's restarts start their one-cycle at phase {s.schedule.start}; fit's start at "
                          f"{OneCycle.start}")
-    out = {"steps": p.steps * _steps_factor(kind, task, recording, dof), "batch": p.batch, "hidden": entry.widths(PROFILE),
+    out = {"steps": p.steps * _steps_factor(kind, task, recording, dof, is_noisy), "batch": p.batch,
+           "hidden": entry.widths(PROFILE),
            "activation": entry.spec_fields(PROFILE).get("activation", "softplus"),
            "lr": p.schedule.lr, "schedule": "onecycle" if one_cycle else "constant",
            "lr_start": p.schedule.start if one_cycle else OneCycle.start,
@@ -103,38 +119,46 @@ def _defaults(kind: str, task: str, recording: bool, dof: int | None) -> tuple:
            "patience": 0}
     if small(kind, task, dof):   # the restarts' other settings stay the claim's, for a --restarts given
         out.update(SMALL)
+    elif is_noisy and recording and s and s.fallback:   # the claim's steps, their restarts without a fallback
+        out["restart_fallback"] = 0
     return tuple(out.items())
 
 
-def defaults(kind: str, task: str, recording: bool = False, dof: int | None = None) -> dict:
+def defaults(kind: str, task: str, recording: bool = False, dof: int | None = None, noise: float | None = None) -> dict:
     """Fit option -> value, as the claim that tuned this kind trains it under `quick`; with `recording` (a
-    trajectory file), the steps times the kind's `ON_RECORDINGS` factor; for data of `dof` coordinates, fewer
-    than the claim's system has, `SMALL`."""
-    return dict(_defaults(kind, task, recording, dof))
+    trajectory file), the steps times the kind's `ON_RECORDINGS` factor, or, where its position noise `noise`
+    is at or above the kind's `NOISY_RECORDINGS` switch, the claim's steps without restart fallbacks; for data
+    of `dof` coordinates, fewer than the claim's system has, `SMALL`."""
+    return dict(_defaults(kind, task, recording, dof, noisy(kind, task, noise) and not small(kind, task, dof)))
 
 
-def source(kind: str, task: str, recording: bool = False, dof: int | None = None, given=()) -> str:
+def source(kind: str, task: str, recording: bool = False, dof: int | None = None, given=(),
+           noise: float | None = None) -> str:
     claim, entry, _ = _entry(kind, task)
-    factor = 1 if "steps" in given else _steps_factor(kind, task, recording, dof)
+    factor = 1 if "steps" in given else _steps_factor(kind, task, recording, dof, noisy(kind, task, noise))
+    noisy_file = recording and not small(kind, task, dof) and noisy(kind, task, noise)
     sized = (f", sized for {dof} coordinate{'s' if dof != 1 else ''} (the claim's system has {claim_dof(kind, task)}): "
              f"{'no restarts, ' if SMALL['restarts'] is None else ''}an early stop at patience {SMALL['patience']} "
              f"(docs/decisions/fit_budget.md)" if small(kind, task, dof) else "")
     return (f"claim {claim.number} ({claim.id}) model {entry.label}, {PROFILE} profile with its adopted tuning"
             + (f", {factor} x its steps on a trajectory file (docs/decisions/fit_budget.md)" if factor != 1 else "")
+            + (f", {'its steps and ' if 'steps' not in given else ''}restarts without a fallback on a noisy "
+               f"trajectory file (position noise {noise:.3g}, at or above {NOISY_RECORDINGS[(kind, task)]:.3g}: "
+               f"docs/decisions/fit_budget.md)" if noisy_file else "")
             + sized)
 
 
-def fill(o, task: str, recording: bool = False, dof: int | None = None):
+def fill(o, task: str, recording: bool = False, dof: int | None = None, noise: float | None = None):
     """The options `o` (`options.resolve`'s namespace) with every BY_KIND value set from `defaults(o.model,
-    task, recording, dof)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch
+    task, recording, dof, noise)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch
     and peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
     from types import SimpleNamespace
 
     from lagbench.replication.fit import options as fit_options
 
-    d, v = defaults(o.model, task, recording, dof), dict(vars(o))
+    d, v = defaults(o.model, task, recording, dof, noise), dict(vars(o))
     given = {k for k, x in v.items() if x is not fit_options.BY_KIND}
-    fit_options.check({k: v[k] for k in given})   # the given values (the defaults are valid)
+    fit_options.check(v)   # the given values, those the kind sets still BY_KIND (the defaults are valid)
     v.update({k: d[k] for k in (*FROM_PROTOCOL, "patience") if k not in given})
     for k in ("restarts", "guard_clip", "guard_skip"):
         if v[k] == 0:

@@ -129,7 +129,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     their defaults where not given). `on_choices({"periodic": record, "dissipation": record})`: called once both
     are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
     earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
-    o, task, _, _, periodic = resolved(data, options)   # every check that needs no work, before the output folder is made
+    o, task, _, _, periodic, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     deriv = file_derivatives(path, o.window, o.polyorder, o.gaps, o.time_unit)
@@ -205,13 +205,15 @@ def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:
 class Resolved(NamedTuple):
     """`resolved`'s answer: the options with the model kind's defaults filled in (`periodic` the indices chosen),
     the task the data and model give, whether the data are a trajectory file (a recording) rather than a file of
-    state samples, the data's coordinates (the kind's defaults follow them: `kind_defaults.small`) and what
-    the fit records of its periodic inputs (`periodic_coords.choose`)."""
+    state samples, the data's coordinates (the kind's defaults follow them: `kind_defaults.small`), what
+    the fit records of its periodic inputs (`periodic_coords.choose`) and the recording's position noise where
+    the kind's budget follows it (`kind_defaults.NOISY_RECORDINGS`; None otherwise)."""
     options: SimpleNamespace
     task: str
     recording: bool
     dof: int
     periodic: dict
+    noise: float | None = None
 
 
 def resolved(data, options: dict) -> Resolved:
@@ -230,7 +232,10 @@ def resolved(data, options: dict) -> Resolved:
     digest, raw = user_data.read(path)
     time_base.check_unit(path, raw, o.system, o.time_unit)
     task, recording, dof = task_of(o.model, "tau" in raw, path), "traj" in raw, raw["q"].shape[1]
-    o = kind_defaults.fill(o, task, recording=recording, dof=dof)
+    noise = None
+    if recording and (o.model, task) in kind_defaults.NOISY_RECORDINGS and o.loss_target != "trajectory":
+        noise = trajectories.position_noise(time_base.in_seconds(raw, o.time_unit), path, o.polyorder, o.gaps)
+    o = kind_defaults.fill(o, task, recording=recording, dof=dof, noise=noise)
     if o.system is not None and definition(o.system).dof != dof:   # its energy and angles are not the data's
         raise ValueError(f"--system {o.system}: has {definition(o.system).dof} coordinates, the data {path} {dof}")
     periodic = periodic_coords.choose(o.periodic, o.system, bool(o.angle_wrap))
@@ -273,7 +278,7 @@ def resolved(data, options: dict) -> Resolved:
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return Resolved(o, task, recording, dof, periodic)
+    return Resolved(o, task, recording, dof, periodic, noise)
 
 
 def _model_spec(o, prep, task: str) -> dict:

@@ -20,7 +20,9 @@ Checked against analytic trajectories with noise in tests/replication/fit/test_f
 `window` `AUTO` ("auto", `lagbench fit`'s default) reads the window off the recording: its noise and the
 motion's own curvature give the window of least predicted error for the derivative the loss trains on, one
 for the whole file (`choose_window`; the rule and its bounds: `replication.fit.derivative_window`).
-`derivative_record` is what a fit records of it, `rule_of` reads a record back as a `--window`.
+`derivative_record` is what a fit records of it, `rule_of` reads a record back as a `--window`;
+`position_noise` the noise it estimates on q, which a noisy recording's fit budget follows
+(`replication.fit.kind_defaults.NOISY_RECORDINGS`).
 
 Requirements (a ValueError naming the problem otherwise): "auto" or an odd window >= polyorder + 2 >= 3 (so
 that the second derivative exists and the fit is overdetermined), at least window + 1 samples per
@@ -184,6 +186,13 @@ def choose_window(d: dict, path: str, polyorder: int = POLYORDER, gaps: str = "i
     if what is None:
         return None
     order, signal = what
+    pieces, high = _signal_pieces(d, path, signal, polyorder, gaps)
+    return derivative_window.choose(pieces, polyorder, order, high, derivative_window.TARGETS[what])
+
+
+def _signal_pieces(d: dict, path: str, signal: str, polyorder: int, gaps: str) -> tuple[list, int]:
+    """([(x, h, real)] of the file's trajectory pieces long enough for the smallest window, `signal` their x;
+    the longest window the file allows): what `derivative_window` reads."""
     found = _trajectories(d, path, gaps)
     high = derivative_window.highest(min(sum(p["t"].size for p in pieces) for _, _, pieces in found), polyorder)
     low = derivative_window.smallest(polyorder)
@@ -193,7 +202,17 @@ def choose_window(d: dict, path: str, polyorder: int = POLYORDER, gaps: str = "i
         where, _, ps = found[0]
         raise ValueError(f"{where} has {max(p['t'].size for p in ps)} samples; estimating its derivatives needs at "
                          f"least {low + 1}")
-    return derivative_window.choose(pieces, polyorder, order, high, derivative_window.TARGETS[what])
+    return pieces, high
+
+
+def position_noise(d: dict, path: str, polyorder: int = POLYORDER, gaps: str = "interpolate") -> float | None:
+    """The noise on the positions of a trajectory file's arrays `d` where its q-double-dot is estimated from q
+    (the file gives neither derivative): the mean over coordinates of what `--window auto` estimates
+    (`derivative_window.noise`, the record's "noise"), in q's units; None where the file gives a derivative."""
+    _check_gaps(gaps)
+    if _estimated(d) != (2, "q"):
+        return None
+    return float(np.mean(derivative_window.noise(_signal_pieces(d, path, "q", polyorder, gaps)[0])))
 
 
 def derivative_record(d: dict, path: str, window, polyorder: int = POLYORDER, gaps: str = "interpolate") -> dict:

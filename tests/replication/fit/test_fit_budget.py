@@ -1,6 +1,7 @@
 """`lagbench fit`'s budget follows the data (`kind_defaults.SMALL`): a system with fewer coordinates than the
 kind's claim trains without restarts, for the claim's steps, and stops early when its held-out error stops
-improving (`--patience`); the double pendulum keeps the claim's and the fit study's budget. One progress bar
+improving (`--patience`); the double pendulum keeps the claim's and the fit study's budget, and on a noisy
+recording (`kind_defaults.NOISY_RECORDINGS`) the claim's steps without restart fallbacks. One progress bar
 counts the restarts' steps and the main training's (`replication.fit.progress`)."""
 import json
 
@@ -18,8 +19,13 @@ def files(tmp_path_factory):
     out = {}
     for system in ("pendulum", "double_pendulum"):
         out[system] = folder / f"{system}.csv"
-        assert main(["simulate", "--system", system, "--trajectories", "10", "--duration", "2", "--rate", "20",
-                     "--out", str(out[system])]) == 0
+        assert main(["simulate", "--system", system, "--trajectories", "10", "--duration", "2", "--rate", "100",
+                     "--noise", "0", "--out", str(out[system])]) == 0
+    for noise in ("0.001", "0.01", "0.01 velocities"):   # quiet and noisy recordings of the double pendulum
+        out[noise] = folder / f"double_pendulum_{noise.replace(' ', '_')}.csv"
+        assert main(["simulate", "--system", "double_pendulum", "--trajectories", "10", "--duration", "2", "--rate",
+                     "100", "--noise", noise.split()[0], "--out", str(out[noise])]
+                    + (["--velocities"] if "velocities" in noise else [])) == 0
     return out
 
 
@@ -43,6 +49,62 @@ def test_a_pendulum_gets_the_sized_budget_and_the_double_pendulum_the_studys(fil
     # the steps' factor is named only where the steps are the default's
     assert "x its steps on a trajectory file" in kind_defaults.source("lnn", "acceleration", True, 2)
     assert "x its steps" not in kind_defaults.source("lnn", "acceleration", True, 2, given={"steps"})
+
+
+def test_a_noisy_recording_trains_the_claims_steps_without_fallbacks(files):
+    """The switch reads the position noise `--window auto` estimates on q (within 5 % of the simulated noise at
+    100 Hz): a recording at or above it trains the claim's steps and restarts without a fallback, one below it
+    and a clean one the study's longer budget; a given --steps or --restart-fallback wins, and a file that gives
+    its velocities (nothing estimated from q alone) keeps the longer budget."""
+    claim, switch = kind_defaults.defaults("lnn", "acceleration"), kind_defaults.NOISY_RECORDINGS[("lnn", "acceleration")]
+    factor = kind_defaults.ON_RECORDINGS[("lnn", "acceleration")]
+    got = {k: resolved(files[k], {"model": "lnn"}) for k in ("double_pendulum", "0.001", "0.01")}
+    assert got["0.001"].noise == pytest.approx(0.001, rel=0.05) and got["0.01"].noise == pytest.approx(0.01, rel=0.05)
+    assert got["double_pendulum"].noise < 1e-4 < 0.001 < switch <= 0.01
+    for k in ("double_pendulum", "0.001"):
+        o = got[k].options
+        assert (o.steps, o.restarts, o.restart_fallback) == (factor * claim["steps"], claim["restarts"],
+                                                              claim["restart_fallback"])
+    o = got["0.01"].options
+    assert (o.steps, o.restarts, o.restart_fallback) == (claim["steps"], claim["restarts"], 0) and claim["restart_fallback"]
+    assert o.restart_steps == max(2, round(claim["steps"] * claim["restart_fraction"]))
+    given = resolved(files["0.01"], {"model": "lnn", "steps": 500, "restart_fallback": 1}).options
+    assert (given.steps, given.restart_fallback) == (500, 1)
+    with_velocities = resolved(files["0.01 velocities"], {"model": "lnn"})
+    assert with_velocities.noise is None and with_velocities.options.steps == factor * claim["steps"]
+    # the baseline's budget does not follow the noise; a sized-down system's neither
+    assert resolved(files["0.01"], {"model": "baseline"}).noise is None
+    assert not kind_defaults.noisy("baseline", "acceleration", 1.0) and kind_defaults.noisy("lnn", "acceleration", switch)
+    assert kind_defaults.defaults("lnn", "acceleration", True, 1, noise=1.0) == kind_defaults.defaults("lnn", "acceleration", True, 1)
+    line = kind_defaults.source("lnn", "acceleration", True, 2, noise=got["0.01"].noise)
+    assert "its steps and restarts without a fallback on a noisy trajectory file" in line and "x its steps" not in line
+    assert "noisy" not in kind_defaults.source("lnn", "acceleration", True, 2, noise=got["0.001"].noise)
+
+
+def test_the_switch_sits_between_the_studys_recordings(tmp_path):
+    """The switch is the geometric mean of the position noise estimated on the registered study's training
+    recordings at 0.001 rad (where 3 x rolled out better) and 0.003 rad (where 1 x did):
+    docs/lab/recording_defaults.md, item 5."""
+    from lagbench.files import user_data
+    from lagbench.replication.fit import trajectories
+
+    noise = []
+    for level in ("0.001", "0.003"):
+        path = tmp_path / f"{level}.csv"
+        assert main(["simulate", "--system", "double_pendulum", "--set", "friction=0.2", "--rate", "100", "--dropped",
+                     "0.02", "--trajectories", "400", "--duration", "1", "--seed", "30", "--noise", level,
+                     "--out", str(path)]) == 0
+        noise.append(trajectories.position_noise(user_data.read(str(path))[1], str(path)))
+    assert noise[0] == pytest.approx(0.001, rel=0.02) and noise[1] == pytest.approx(0.003, rel=0.02)
+    assert kind_defaults.NOISY_RECORDINGS[("lnn", "acceleration")] == pytest.approx((noise[0] * noise[1]) ** 0.5, rel=5e-3)
+
+
+def test_a_restart_fallback_or_keep_given_alone_is_checked_against_the_kinds_restarts(files):
+    claim = kind_defaults.defaults("lnn", "acceleration")
+    assert resolved(files["double_pendulum"], {"model": "lnn", "restart_fallback": 1}).options.restart_fallback == 1
+    assert resolved(files["double_pendulum"], {"model": "lnn", "restart_keep": 2}).options.restart_keep == 2
+    with pytest.raises(ValueError, match=f"--restart-fallback: {claim['restarts']}.*{claim['restart_keep']} do"):
+        resolved(files["double_pendulum"], {"model": "lnn", "restart_fallback": claim["restarts"]})
 
 
 def test_a_fit_stops_when_its_heldout_error_stops_improving(files, tmp_path):

@@ -33,7 +33,9 @@ def test_a_row_says_what_the_kind_gets(label):
     claim, entry, _ = kind_defaults._entry(kind, task)
     assert source.startswith(f"claim {claim.number}, {entry.label}")
     factor = kind_defaults.ON_RECORDINGS.get((kind, task), 1)
-    on_file = f" ({factor} x the steps on a trajectory file)" if factor != 1 else ""
+    switch = kind_defaults.NOISY_RECORDINGS.get((kind, task))
+    below = f" with position noise below {switch:g} rad" if switch is not None else ""
+    on_file = f" ({factor} x the steps on a trajectory file{below})" if factor != 1 else ""
     assert budget == f"{d['steps']:,} x {d['batch']}".replace(",", " ") + on_file
     w = d["hidden"]
     assert len(set(w)) == 1 and widths == f"{w[0]} x {len(w)}, {d['activation']}"
