@@ -25,9 +25,10 @@ resumable and gives the same numbers either way up to float32 rounding (training
 seed and the thread count; a worker's one thread sums in another order than this process's threads), and at
 N > 1 every unit trains in a worker, a lone one too, so that a run keeps one rounding. Each worker holds one
 chain at a time; one that dies (the out-of-memory killer, a `kill`) loses that chain's units alone, each named
-as an error (no result; a rerun retries it), and a new worker takes the next chain. Ctrl-C cancels the chains not yet started and stops the workers. A worker whose driver is
-gone (killed, SIGTERM from a scheduler or `timeout`) exits within a second: it would otherwise finish its
-chain, hours in the long profiles, writing into a folder that a resumed run may be writing too.
+as an error (no result; a rerun retries it), and a new worker takes the next chain. Ctrl-C cancels the chains
+not yet started and stops the workers. A worker whose driver is gone (killed, SIGTERM from a scheduler or
+`timeout`) exits within a second: it would otherwise finish its chain, hours in the long profiles, writing into
+a folder that a resumed run may be writing too.
 """
 from __future__ import annotations
 
@@ -220,7 +221,8 @@ def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=N
     seconds = list(seconds) if seconds is not None else [1.0] * len(todo)
     on_done = on_done or (lambda u: None)
     # jobs > 1 trains even a single unit in a worker: its one CPU thread rounds float32 otherwise than this
-    # process's threads, and a search or run at N workers keeps one rounding for every unit
-    if jobs == 1:
+    # process's threads, and a search or run at N workers keeps one rounding for every unit (nothing to train
+    # opens no workers)
+    if jobs == 1 or not todo:
         return _serial(todo, out, profile, progress, seconds, on_done, members)
     return _parallel(todo, out, profile, progress, jobs, seconds, on_done, members)
