@@ -7,7 +7,7 @@ answers for the user's kind ("user", `USER_CAPABILITY`) as well.
 
 Each kind's own fields are a frozen record that checks itself (`ModelSpec.own`):
   `Baseline()`                                           none: its output width is the spec's n_out
-  `Lnn(formulation, lorentz_factor, dissipation, scale_q_before_grad)`
+  `Lnn(formulation, lorentz_factor, dissipation, scale_q_before_grad, even_velocity)`
   `Hnn(lorentz_factor, dissipation)`
   `Delan(eps, diag_offset, dissipation)`
   `Lgn(formulation, radius)`
@@ -64,16 +64,22 @@ class Lnn(OwnFields):
         scaled q part x_q = s_q f(q), not q, so neither dL/dq = (df/dq)^T dL/dx_q nor the mixed term's tangent
         (df/dq) qdot carries the chain-rule factor s_q; H, qdot and the velocity side are unchanged. With s_q the
         same on every slot, qddot is the differentiated-through one divided by s_q. The model's `lagrangian` has
-        the same value; its q-derivative is dL/dx_q chained through f only."""
+        the same value; its q-derivative is dL/dx_q chained through f only.
+    even_velocity: L(q, qdot) = (N(q, qdot) + N(q, -qdot)) / 2 with N the MLP: even in qdot by construction, the
+        time-reversal symmetry of a mechanical system without magnetic or gyroscopic forces. The conservative
+        part then has no force odd in qdot, so where the data lose energy the dissipation is the only odd force
+        (an MLP of qdot itself learns spurious odd forces that take a share of the friction). Its Euler-Lagrange
+        terms (H, dL/dq - J qdot) are the average of N's at (q, qdot) and (q, -qdot): twice the MLP's work."""
 
     formulation: str = "fast"
     lorentz_factor: bool = False
     dissipation: bool = False
     scale_q_before_grad: bool = False
+    even_velocity: bool = False
 
     def __post_init__(self):
         one_of("lnn formulation", self.formulation, CAPABILITIES["lnn"].formulations)
-        for name in ("lorentz_factor", "dissipation", "scale_q_before_grad"):
+        for name in ("lorentz_factor", "dissipation", "scale_q_before_grad", "even_velocity"):
             flag(name, getattr(self, name))
         check(not self.dissipation or self.formulation == "fast",
               f"dissipation is for the LNN in its fast formulation, not {self.formulation!r}")

@@ -50,8 +50,9 @@ COMMON = ("kind", "dof", "hidden", "activation", "init", "dtype", "extra_inputs"
 # the flat form's keys, in the order it writes them
 FLAT_KEYS = ("kind", "dof", "hidden", "activation", "init", "dtype", "extra_inputs", "formulation", "n_out",
              "angle_wrap", "input_scale", "delan_eps", "delan_diag_offset", "lgn_radius", "lorentz_factor",
-             "dissipation", "periodic", "factory", "factory_source", "scale_q_before_grad")
-WHEN_SET = ("lorentz_factor", "dissipation", "periodic", "factory", "factory_source", "scale_q_before_grad")
+             "dissipation", "periodic", "factory", "factory_source", "scale_q_before_grad", "even_velocity")
+WHEN_SET = ("lorentz_factor", "dissipation", "periodic", "factory", "factory_source", "scale_q_before_grad",
+            "even_velocity")
 
 
 @dataclass(frozen=True, init=False)

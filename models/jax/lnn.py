@@ -122,13 +122,20 @@ def _scaled_q_part(x, f, nq):
 
 
 class LNN(Model):
-    """L = MLP([f(q), qdot, extra]) (f: `q_features`); q, qdot (..., dof), extra (..., extra_inputs) or None.
+    """L = MLP([f(q), qdot, extra]) (f: `q_features`), or with spec.own.even_velocity its average over qdot and
+    -qdot; q, qdot (..., dof), extra (..., extra_inputs) or None.
 
     The fast formulation and velocity_hessian differentiate the model's own MLP by hand
     (`models.jax.mlp_derivatives`): same values as `fast_terms(self._lagrangian, ...)`, fewer FLOPs
     (XLA's forward-over-reverse also pushes the d + 1 tangents back through the network)."""
 
     def _lagrangian(self, q, qdot, extra=None):
+        if self.spec.own.even_velocity:   # (N(q, qdot) + N(q, -qdot)) / 2
+            return (self._network(q, qdot, extra) + self._network(q, -qdot, extra)) / 2
+        return self._network(q, qdot, extra)
+
+    def _network(self, q, qdot, extra=None):
+        """N(q, qdot), the MLP's output."""
         spec, f = self.spec, q_features(self.spec, q)
         x = mlp_input(spec, [f, *velocity_parts(spec, qdot), *self._parts(extra)])
         if spec.own.scale_q_before_grad:   # the original's convention: q-derivatives in the scaled x_q = s_q f(q)
@@ -136,7 +143,19 @@ class LNN(Model):
         return mlp(self.params, x, spec)[..., 0]
 
     def _fast_terms(self, q, qdot, extra=None):
-        """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them.
+        """On flat (B, d): (H (B, d, d), rhs = dL/dq - J qdot (B, d)), as `fast_terms` gives them. With
+        spec.own.even_velocity, L = (N(q, qdot) + N(q, -qdot)) / 2 and both terms are the average of N's at
+        (q, qdot) and (q, -qdot) (the sign flips of the mixed term cancel: J_L qdot = (J_N(+) - J_N(-)) qdot / 2),
+        from one pass over the doubled batch."""
+        if not self.spec.own.even_velocity:
+            return self._network_terms(q, qdot, extra)
+        n = q.shape[0]
+        hess, rhs = self._network_terms(jnp.concatenate([q, q]), jnp.concatenate([qdot, -qdot]),
+                                        None if extra is None else jnp.concatenate([extra, extra]))
+        return (hess[:n] + hess[n:]) / 2, (rhs[:n] + rhs[n:]) / 2
+
+    def _network_terms(self, q, qdot, extra=None):
+        """N's (H, dL/dq - J qdot) on flat (B, d), N the MLP.
         MLP input x = scale * [f(q), qdot, extra], f the q part (`q_features`, p = q_width - d slots wider with
         periodic coordinates; extra is not differentiated): tangents s_qd[k] e_(p+d+k) give the Hessian columns,
         s_q * (df/dq) qdot in the q part's slots the mixed term J qdot, and dL/dq = (df/dq)^T (s_q g_q) (f has

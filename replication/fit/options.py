@@ -199,6 +199,9 @@ OPTIONS = (
            "and for the baseline; docs/fit.md), on (also --dissipation alone) or off",
            lambda v: v in DISSIPATION_MODES or isinstance(v, bool), f"one of {', '.join(DISSIPATION_MODES)}",
            text=AUTO, parse=str, const="on"),
+    Option("even_velocity", False, "lnn: a Lagrangian even in qdot, L = (N(q, qdot) + N(q, -qdot)) / 2 with N the "
+           "network (the time-reversal symmetry of a mechanical system without magnetic forces: the dissipation is "
+           "then the model's only force odd in qdot); twice the network's work a step", switch=True),
     Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q (cos, sin for --periodic), "
            "qdot(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as 1,1,0.3,0.3"
            + KIND,
@@ -247,6 +250,8 @@ def check(values: dict) -> None:
     if values.get("dissipation") in ("on", True) and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
         raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
                          "function); the baseline's q-double-dot is free-form already")
+    if values.get("even_velocity") and values.get("model") in MODELS and values["model"] != "lnn":
+        raise ValueError("--even-velocity: for --model lnn (a network of q-dot whose Lagrangian it makes even)")
     system = values.get("system")
     if system is not None:
         from lagbench import systems

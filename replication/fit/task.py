@@ -289,6 +289,8 @@ def _model_spec(o, prep, task: str) -> dict:
         spec.update(delan_eps=float(o.delan_eps), delan_diag_offset=float(o.delan_offset))
     if o.dissipation:
         spec["dissipation"] = True
+    if o.even_velocity:
+        spec["even_velocity"] = True
     if task == "inverse_dynamics" and o.model == "baseline":
         spec["extra_inputs"] = prep.dof
     if o.periodic:

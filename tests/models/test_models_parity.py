@@ -1,7 +1,7 @@
 """JAX against PyTorch on identical parameters: outputs and the gradients of the L1 training loss with
 respect to every parameter, to TOL[dtype] relative (float64 1e-10, float32 dtype-appropriate); every kind
 that takes periodic angle features has a row with them, and the LNN has rows with its q-derivatives in the
-scaled q (`Lnn.scale_q_before_grad`)."""
+scaled q (`Lnn.scale_q_before_grad`) and made even in qdot (`Lnn.even_velocity`)."""
 import jax
 import jax.numpy as jnp
 import pytest
@@ -48,8 +48,11 @@ CASES = [
              "input_scale": (0.1, 0.5, 1.0, 1.0, 0.1)}),
     ("lnn", {"formulation": "fast", "periodic": (0,), "dissipation": True, "scale_q_before_grad": True,
              "input_scale": (0.5, 2.0, 0.1, 1.5, 0.3)}),
+    # a Lagrangian even in qdot (`Lnn.even_velocity`)
+    ("lnn", {"formulation": "fast", "periodic": (0, 1), "dissipation": True, "even_velocity": True}),
+    ("lnn", {"formulation": "paper", "extra_inputs": 1, "even_velocity": True}),
 ]
-FLOAT32 = [0, 2, 4, 6, 8, 13, 16, 19]
+FLOAT32 = [0, 2, 4, 6, 8, 13, 16, 19, 22]
 
 
 def _check(kind, kw, dtype):

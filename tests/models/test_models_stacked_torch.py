@@ -26,6 +26,7 @@ CASES = {
     "baseline_periodic": dict(kind="baseline", dof=2, periodic=(1,)),
     "lnn_scale_before_grad": dict(kind="lnn", dof=2, extra_inputs=1, scale_q_before_grad=True,
                                   input_scale=(0.1, 0.5, 1.0, 1.0, 0.1)),
+    "lnn_even_velocity": dict(kind="lnn", dof=2, periodic=(0, 1), dissipation=True, even_velocity=True),
 }
 
 

@@ -7,7 +7,8 @@
 # the default 3 (the window chosen for each alike), as lnn_1x_p5 and baseline_p5; one folder per arm and seed
 # (a rerun reuses finished fits).
 #   bash docs/lab/recording_defaults/run.sh OUT "0 1 2" [ARMS]
-#   ARMS: any of lnn_1x lnn_3x baseline lnn_1x_p5 baseline_p5
+#   ARMS: any of lnn_1x lnn_3x baseline lnn_1x_p5 baseline_p5 lnn_1x_even lnn_half_even (the last two: the
+#   Lagrangian even in qdot, --even-velocity, at the 1 x steps and at half of them, the 1 x arm's network work)
 #   NOISE=0.001 bash ... : the same recordings at another position noise in radians (default 0.0087, 0.5 degree)
 #   DATA_SEEDS="40 41" bash ... : other simulate seeds for the training and the test file (default: 30 31)
 set -euo pipefail
@@ -28,6 +29,8 @@ for s in $seeds; do
       baseline) $fit --model baseline --seed "$s" --out "$out/s$s-baseline" ;;
       lnn_1x_p5) $fit --model lnn --steps 23437 --restart-fallback 0 --polyorder 5 --seed "$s" --out "$out/s$s-lnn_1x_p5" ;;
       baseline_p5) $fit --model baseline --polyorder 5 --seed "$s" --out "$out/s$s-baseline_p5" ;;
+      lnn_1x_even) $fit --model lnn --steps 23437 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_1x_even" ;;
+      lnn_half_even) $fit --model lnn --steps 11719 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_half_even" ;;
     esac
   done
 done
