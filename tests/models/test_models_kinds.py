@@ -11,7 +11,8 @@ from lagbench.models.spec import COMMON, FLAT_KEYS, WHEN_SET
 
 # a valid value other than the default for each own field, by flat name
 OTHER = {"formulation": "paper", "delan_eps": 0.5, "delan_diag_offset": 1.0, "lgn_radius": 2, "lorentz_factor": True,
-         "dissipation": True, "scale_q_before_grad": True, "factory": "mine:make", "factory_source": "0" * 16}
+         "dissipation": True, "scale_q_before_grad": True, "even_velocity": True, "factory": "mine:make",
+         "factory_source": "0" * 16}
 ALL_KINDS = (*KINDS, USER_KIND)
 
 

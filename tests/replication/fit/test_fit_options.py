@@ -129,3 +129,17 @@ def test_the_console_line_names_where_a_recordings_defaults_come_from(tmp_path, 
         lines[name] = next(ln for ln in capsys.readouterr().err.splitlines() if "defaults from" in ln)
     assert f"{factor} x its steps on a trajectory file" in lines["traj"]
     assert "on a trajectory file" not in lines["states"]
+
+
+def test_even_velocity_is_for_the_lnn_and_reaches_its_spec():
+    with pytest.raises(ValueError, match="^--even-velocity: for --model lnn"):
+        fit_options.check({"model": "hnn", "even_velocity": True})
+    fit_options.check({"model": "lnn", "even_velocity": True})
+    from types import SimpleNamespace
+
+    from lagbench.replication.fit.task import _model_spec
+    o = fit_options.resolve({"model": "lnn", "even_velocity": True, "input_scale": None, "periodic": ()})
+    prep = SimpleNamespace(dof=2)
+    assert _model_spec(o, prep, "acceleration")["even_velocity"] is True
+    o.even_velocity = False
+    assert "even_velocity" not in _model_spec(o, prep, "acceleration")
