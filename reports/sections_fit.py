@@ -231,15 +231,18 @@ def _data_para(units) -> Para:
 
 
 def _choices_para(units) -> Para | None:
-    """What each fit chose from its data and system: its periodic inputs (`--periodic`) and whether it learns a
-    dissipation (`--dissipation`), with the reasons; None where no fit recorded either."""
-    from lagbench.replication.fit import energy_trend, periodic_coords
+    """What each fit chose from its data and system: its periodic inputs (`--periodic`), whether it learns a
+    dissipation (`--dissipation`) and whether its Lagrangian is even in q-dot (`--even-velocity`, recorded where
+    on), with the reasons; None where no fit recorded any."""
+    from lagbench.replication.fit import energy_trend, even_velocity, periodic_coords
 
     seen: dict[str, list[str]] = {}
     for u in units:
         cfg = u.result.get("eval_config") or {}
         parts = ([f"periodic inputs {periodic_coords.describe(cfg['periodic'])}"] if cfg.get("periodic") else []) + \
-            ([f"dissipation {energy_trend.describe(cfg['dissipation'])}"] if cfg.get("dissipation") else [])
+            ([f"dissipation {energy_trend.describe(cfg['dissipation'])}"] if cfg.get("dissipation") else []) + \
+            ([f"Lagrangian even in q-dot {even_velocity.describe(cfg['even_velocity'])}"] if cfg.get("even_velocity")
+             else [])
         if u.claim == "fit" and parts:
             seen.setdefault("; ".join(parts), []).append(_name(u))
     if not seen:

@@ -93,14 +93,18 @@ def cmd_fit(args):
 
 
 def choices_line(records: dict) -> None:
-    """The periodic inputs and the dissipation a fit chose (`--periodic`, `--dissipation`), and why: one line
-    each, printed as the derivative window is, also under --quiet."""
-    from lagbench.replication.fit import energy_trend, periodic_coords
+    """The periodic inputs, the dissipation and, for an LNN, the even Lagrangian a fit chose (`--periodic`,
+    `--dissipation`, `--even-velocity`), and why: one line each, printed as the derivative window is, also
+    under --quiet."""
+    from lagbench.replication.fit import energy_trend, even_velocity, periodic_coords
 
     if records.get("periodic"):
         print(f"lagbench fit: periodic inputs: {periodic_coords.describe(records['periodic'])}", file=sys.stderr)
     if records.get("dissipation"):
         print(f"lagbench fit: dissipation: {energy_trend.describe(records['dissipation'])}", file=sys.stderr)
+    if records.get("even_velocity"):
+        print(f"lagbench fit: Lagrangian even in q-dot: {even_velocity.describe(records['even_velocity'])}",
+              file=sys.stderr)
 
 
 def add_fit(sub) -> None:

@@ -42,6 +42,7 @@ claims' restarts do.
 """
 from __future__ import annotations
 
+import math
 from functools import cache
 
 from lagbench.replication.training.schedules import OneCycle
@@ -148,10 +149,12 @@ def source(kind: str, task: str, recording: bool = False, dof: int | None = None
             + sized)
 
 
-def fill(o, task: str, recording: bool = False, dof: int | None = None, noise: float | None = None):
+def fill(o, task: str, recording: bool = False, dof: int | None = None, noise: float | None = None,
+         steps_factor: float = 1.0):
     """The options `o` (`options.resolve`'s namespace) with every BY_KIND value set from `defaults(o.model,
-    task, recording, dof, noise)`, 0 (off) turned into None for the restarts and the guard, the restarts' steps, batch
-    and peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
+    task, recording, dof, noise)`, the default steps times `steps_factor` (rounded up; an even Lagrangian's on a
+    noisy recording, `even_velocity.steps_factor`), 0 (off) turned into None for the restarts and the guard, the
+    restarts' steps, batch and peak rate from --steps, --batch and --lr where not given; then checked as a whole."""
     from types import SimpleNamespace
 
     from lagbench.replication.fit import options as fit_options
@@ -160,6 +163,8 @@ def fill(o, task: str, recording: bool = False, dof: int | None = None, noise: f
     given = {k for k, x in v.items() if x is not fit_options.BY_KIND}
     fit_options.check(v)   # the given values, those the kind sets still BY_KIND (the defaults are valid)
     v.update({k: d[k] for k in (*FROM_PROTOCOL, "patience") if k not in given})
+    if "steps" not in given and steps_factor != 1:
+        v["steps"] = max(1, math.ceil(v["steps"] * steps_factor))
     for k in ("restarts", "guard_clip", "guard_skip"):
         if v[k] == 0:
             v[k] = None

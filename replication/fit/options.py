@@ -16,6 +16,7 @@ from types import SimpleNamespace
 from lagbench.models import ACTIVATIONS
 from lagbench.models.spec import CAPABILITIES
 from lagbench.replication.fit.energy_trend import MODES as DISSIPATION_MODES
+from lagbench.replication.fit.even_velocity import MODES as EVEN_VELOCITY_MODES
 from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
@@ -199,9 +200,13 @@ OPTIONS = (
            "and for the baseline; docs/fit.md), on (also --dissipation alone) or off",
            lambda v: v in DISSIPATION_MODES or isinstance(v, bool), f"one of {', '.join(DISSIPATION_MODES)}",
            text=AUTO, parse=str, const="on"),
-    Option("even_velocity", False, "lnn: a Lagrangian even in qdot, L = (N(q, qdot) + N(q, -qdot)) / 2 with N the "
+    Option("even_velocity", AUTO, "lnn: a Lagrangian even in qdot, L = (N(q, qdot) + N(q, -qdot)) / 2 with N the "
            "network (the time-reversal symmetry of a mechanical system without magnetic forces: the dissipation is "
-           "then the model's only force odd in qdot); twice the network's work a step", switch=True),
+           "then the model's only force odd in qdot; twice the network's work a step): auto (on for an LNN that "
+           "learns a dissipation on a trajectory file whose estimated position noise is at or above the budget's "
+           "switch, with half the steps there; off otherwise; docs/fit.md), on (also --even-velocity alone) or off",
+           lambda v: v in EVEN_VELOCITY_MODES or isinstance(v, bool), f"one of {', '.join(EVEN_VELOCITY_MODES)}",
+           text=AUTO, parse=str, const="on"),
     Option("input_scale", BY_KIND, "input feature: multipliers of the MLP inputs [q (cos, sin for --periodic), "
            "qdot(, qddot)]: none, auto (1 / standard deviation over the training rows) or numbers such as 1,1,0.3,0.3"
            + KIND,
@@ -227,8 +232,9 @@ def resolve(given: dict) -> SimpleNamespace:
         values["hidden"] = tuple(values["hidden"])
     if isinstance(values["input_scale"], list):
         values["input_scale"] = tuple(values["input_scale"])
-    if isinstance(values["dissipation"], bool):   # fit(dissipation=True) as --dissipation on
-        values["dissipation"] = "on" if values["dissipation"] else "off"
+    for name in ("dissipation", "even_velocity"):   # fit(dissipation=True) as --dissipation on
+        if isinstance(values[name], bool):
+            values[name] = "on" if values[name] else "off"
     return SimpleNamespace(**values)
 
 
@@ -250,7 +256,7 @@ def check(values: dict) -> None:
     if values.get("dissipation") in ("on", True) and values.get("model") in MODELS and not CAPABILITIES[values["model"]].dissipation:
         raise ValueError("--dissipation: for --model lnn, hnn or delan (a structured model with a Rayleigh "
                          "function); the baseline's q-double-dot is free-form already")
-    if values.get("even_velocity") and values.get("model") in MODELS and values["model"] != "lnn":
+    if values.get("even_velocity") in ("on", True) and values.get("model") in MODELS and values["model"] != "lnn":
         raise ValueError("--even-velocity: for --model lnn (a network of q-dot whose Lagrangian it makes even)")
     system = values.get("system")
     if system is not None:

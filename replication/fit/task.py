@@ -31,7 +31,10 @@ trained it), while the early stop and the evaluation score the held-out rows as 
 Choices from the data and the system, recorded in eval_config["periodic"] and ["dissipation"] and passed to
 `on_choices` before any training: `periodic` "auto" takes the coordinates in which the `system`'s Lagrangian is
 2 pi-periodic (`replication.fit.periodic_coords`); `dissipation` "auto" learns a dissipation where the training
-trajectories lose energy (`replication.fit.energy_trend`), its folder then `<model>_dissipative` as with "on".
+trajectories lose energy (`replication.fit.energy_trend`), its folder then `<model>_dissipative` as with "on";
+`even_velocity` "auto" makes an LNN's Lagrangian even in q-dot where it learns a dissipation on a noisy
+recording, with half the default steps (`replication.fit.even_velocity`; recorded in eval_config["even_velocity"]
+where on, and passed to `on_choices` for an LNN).
 
 Torques: with tau columns, delan and baseline learn the inverse dynamics tau(q, qdot, qddot); an LNN or
 HNN here learns unforced dynamics, so a file with tau is refused for them (a ValueError saying so)
@@ -55,6 +58,7 @@ from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.claims.base import ModelEntry
 from lagbench.replication.fit import (
     energy_trend,
+    even_velocity,
     kind_defaults,
     periodic_coords,
     time_base,
@@ -129,7 +133,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     their defaults where not given). `on_choices({"periodic": record, "dissipation": record})`: called once both
     are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
     earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
-    o, task, _, _, periodic, _ = resolved(data, options)   # every check that needs no work, before the output folder is made
+    o, task, recording, dof, periodic, noise = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     deriv = file_derivatives(path, o.window, o.polyorder, o.gaps, o.time_unit)
@@ -142,8 +146,10 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     dissipation = energy_trend.for_fit(o, prep)
     o.dissipation = dissipation["chosen"]   # the form trained (and its folder's label) follows the choice
+    o, even = _even_velocity(o, options, task, recording, dof, noise)
     if on_choices:
-        on_choices({"periodic": periodic, "dissipation": dissipation})
+        on_choices({"periodic": periodic, "dissipation": dissipation} | ({"even_velocity": even} if o.model == "lnn"
+                                                                         else {}))
     n_train = prep.counts["train"]
     trajectory_loss = TrajectoryLoss(frames=o.horizon_frames, substeps=o.horizon_substeps, scale=o.horizon_scale) \
         if o.loss_target == "trajectory" else None
@@ -174,6 +180,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
            "derivatives": {**deriv, **({"gaps": o.gaps} if o.gaps != "interpolate" else {}),
                            **({"time_unit": o.time_unit} if o.time_unit != "s" else {})}, "rows": prep.counts,
            "trajectories": prep.trajectories, "periodic": periodic, "dissipation": dissipation}
+    if even["chosen"]:   # recorded only when on: the other fits keep their keys
+        cfg["even_velocity"] = even
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
     if o.dissipation:   # how its friction is checked: a fit checked by another rule is evaluated again
@@ -192,6 +200,21 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     if on_train:
         on_train(protocol)
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
+
+
+def _even_velocity(o, options: dict, task: str, recording: bool, dof: int, noise) -> tuple:
+    """(the options with `even_velocity` chosen (`replication.fit.even_velocity`) and, where that changes the
+    default steps, the kind's defaults filled again with its factor; the choice's record)."""
+    noisy = recording and kind_defaults.noisy(o.model, task, noise) and not kind_defaults.small(o.model, task, dof)
+    record = even_velocity.choose(o.even_velocity, o.model, noisy, bool(o.dissipation))
+    factor = even_velocity.steps_factor(record, noisy)
+    if factor != 1 and "steps" not in options:
+        filled = kind_defaults.fill(fit_options.resolve(options), task, recording, dof, noise, steps_factor=factor)
+        filled.periodic, filled.dissipation = o.periodic, o.dissipation
+        o = filled
+        record["steps"] = o.steps
+    o.even_velocity = record["chosen"]
+    return o, record
 
 
 def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:
