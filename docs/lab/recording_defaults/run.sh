@@ -9,6 +9,7 @@
 #   bash docs/lab/recording_defaults/run.sh OUT "0 1 2" [ARMS]
 #   ARMS: any of lnn_1x lnn_3x baseline lnn_1x_p5 baseline_p5 lnn_1x_even lnn_half_even (the last two: the
 #   Lagrangian even in qdot, --even-velocity, at the 1 x steps and at half of them, the 1 x arm's network work)
+#   and lnn (the LNN at the fit's defaults, whatever they are)
 #   NOISE=0.001 bash ... : the same recordings at another position noise in radians (default 0.0087, 0.5 degree)
 #   DATA_SEEDS="40 41" bash ... : other simulate seeds for the training and the test file (default: 30 31)
 set -euo pipefail
@@ -29,6 +30,7 @@ for s in $seeds; do
       baseline) $fit --model baseline --seed "$s" --out "$out/s$s-baseline" ;;
       lnn_1x_p5) $fit --model lnn --steps 23437 --restart-fallback 0 --polyorder 5 --seed "$s" --out "$out/s$s-lnn_1x_p5" ;;
       baseline_p5) $fit --model baseline --polyorder 5 --seed "$s" --out "$out/s$s-baseline_p5" ;;
+      lnn) $fit --model lnn --seed "$s" --out "$out/s$s-lnn" ;;
       lnn_1x_even) $fit --model lnn --steps 23437 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_1x_even" ;;
       lnn_half_even) $fit --model lnn --steps 11719 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_half_even" ;;
     esac
