@@ -130,8 +130,8 @@ class FitSource:
 def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None, on_train=None, on_choices=None,
         **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
-    their defaults where not given). `on_choices({"periodic": record, "dissipation": record})`: called once both
-    are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
+    their defaults where not given). `on_choices({"periodic": record, "dissipation": record})` (and for an LNN
+    "even_velocity"): called once they are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
     earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
     o, task, recording, dof, periodic, noise = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
