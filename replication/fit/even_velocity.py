@@ -10,9 +10,12 @@ noise an MLP of q-dot put half to three quarters of its odd force outside the fr
 half the steps, the same network work, read the friction on every seed, the larger per-angle error 9.5 % on
 the median seed against the plain LNN's 14 %, and rolled out with 0.82 x its error); off otherwise. With it on and the steps not given, a noisy recording trains
 `STEPS_FACTOR` x the kind's steps (`kind_defaults.fill`). `describe(record)` in words for the console and the
-report; `steps_factor(record, noisy)` the factor on the default steps.
+report; `steps_factor(record, noisy)` the factor on the default steps; `for_fit(o, options, task, recording,
+dof, noise)` the choice for a fit's resolved options once its dissipation is chosen.
 """
 from __future__ import annotations
+
+from lagbench.replication.fit import kind_defaults
 
 MODES = ("auto", "on", "off")
 # the even Lagrangian's steps on a noisy recording, as a fraction of the plain LNN's there: the same network work
@@ -43,3 +46,20 @@ def describe(record: dict) -> str:
     return (f"{'on' if record.get('chosen') else 'off'} (--even-velocity {record.get('mode')}): {record.get('why')}"
             + (f"; {record['steps']} steps, {STEPS_FACTOR:g} x the plain LNN's: the same network work"
                if record.get("steps") else ""))
+
+
+def for_fit(o, options: dict, task: str, recording: bool, dof: int, noise) -> tuple:
+    """(the fit's options `o` with `even_velocity` chosen and, where that changes the default steps, the kind's
+    defaults filled again with the factor from the given `options`; the choice's record)."""
+    from lagbench.replication.fit import options as fit_options
+
+    noisy = kind_defaults.noisy_recording(o.model, task, recording, dof, noise)
+    record = choose(o.even_velocity, o.model, noisy, bool(o.dissipation))
+    factor = steps_factor(record, noisy)
+    if factor != 1 and "steps" not in options:
+        filled = kind_defaults.fill(fit_options.resolve(options), task, recording, dof, noise, steps_factor=factor)
+        filled.periodic, filled.dissipation = o.periodic, o.dissipation
+        o = filled
+        record["steps"] = o.steps
+    o.even_velocity = record["chosen"]
+    return o, record

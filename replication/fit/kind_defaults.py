@@ -29,7 +29,8 @@ the claim's keeps the claim's budget and no early stop.
 in `FROM_PROTOCOL` and `patience`, and the restarts' `restart_fraction` (their steps / the protocol's) and
 `restart_lr_ratio` (their peak / the protocol's); `dof`: the data's coordinates (None: as the claim's); `noise`:
 the recording's position noise (None: not estimated). `small(kind, task, dof) -> bool`: whether `SMALL` applies;
-`noisy(kind, task, noise) -> bool`: whether `NOISY_RECORDINGS` does. `source(kind, task, recording=False,
+`noisy(kind, task, noise) -> bool`: whether the noise reaches `NOISY_RECORDINGS`'s switch, and
+`noisy_recording(kind, task, recording, dof, noise)` whether a file trains that budget. `source(kind, task, recording=False,
 dof=None, given=(), noise=None) -> str`: where the defaults come from, for the console (`given`: the options
 set by the user, whose defaults it does not name).
 
@@ -91,6 +92,11 @@ def noisy(kind: str, task: str, noise: float | None) -> bool:
     return noise is not None and (kind, task) in NOISY_RECORDINGS and noise >= NOISY_RECORDINGS[(kind, task)]
 
 
+def noisy_recording(kind: str, task: str, recording: bool, dof: int | None, noise: float | None) -> bool:
+    """A trajectory file that trains `NOISY_RECORDINGS`'s budget: noisy (`noisy`) and not sized down (`small`)."""
+    return recording and not small(kind, task, dof) and noisy(kind, task, noise)
+
+
 def _steps_factor(kind: str, task: str, recording: bool, dof: int | None = None, is_noisy: bool = False) -> int:
     return ON_RECORDINGS.get((kind, task), 1) if recording and not small(kind, task, dof) and not is_noisy else 1
 
@@ -137,7 +143,7 @@ def source(kind: str, task: str, recording: bool = False, dof: int | None = None
            noise: float | None = None) -> str:
     claim, entry, _ = _entry(kind, task)
     factor = 1 if "steps" in given else _steps_factor(kind, task, recording, dof, noisy(kind, task, noise))
-    noisy_file = recording and not small(kind, task, dof) and noisy(kind, task, noise)
+    noisy_file = noisy_recording(kind, task, recording, dof, noise)
     sized = (f", sized for {dof} coordinate{'s' if dof != 1 else ''} (the claim's system has {claim_dof(kind, task)}): "
              f"{'no restarts, ' if SMALL['restarts'] is None else ''}an early stop at patience {SMALL['patience']} "
              f"(docs/decisions/fit_budget.md)" if small(kind, task, dof) else "")

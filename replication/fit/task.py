@@ -131,8 +131,9 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         **options) -> dict:
     """Train and evaluate one model on `data`; `options` by keyword (`replication.fit.options.OPTIONS`,
     their defaults where not given). `on_choices({"periodic": record, "dissipation": record})` (and for an LNN
-    "even_velocity"): called once they are chosen, before anything is trained; `on_train(protocol)`: called before a training starts (not when an
-    earlier fit is returned), `on_log(row)` then with each training log row (`replication.fit.progress`)."""
+    "even_velocity"): called once they are chosen, before anything is trained; `on_train(protocol)`: called
+    before a training starts (not when an earlier fit is returned), `on_log(row)` then with each training log
+    row (`replication.fit.progress`)."""
     o, task, recording, dof, periodic, noise = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
@@ -146,7 +147,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         raise ValueError(f"--test {o.test}: has {tprep.dof} degrees of freedom, the training data {prep.dof}")
     dissipation = energy_trend.for_fit(o, prep)
     o.dissipation = dissipation["chosen"]   # the form trained (and its folder's label) follows the choice
-    o, even = _even_velocity(o, options, task, recording, dof, noise)
+    o, even = even_velocity.for_fit(o, options, task, recording, dof, noise)
     if on_choices:
         on_choices({"periodic": periodic, "dissipation": dissipation} | ({"even_velocity": even} if o.model == "lnn"
                                                                          else {}))
@@ -200,21 +201,6 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     if on_train:
         on_train(protocol)
     return dict(run_unit(unit, out, on_log=on_log, on_progress=on_progress), metric=metric, metric_label=label)
-
-
-def _even_velocity(o, options: dict, task: str, recording: bool, dof: int, noise) -> tuple:
-    """(the options with `even_velocity` chosen (`replication.fit.even_velocity`) and, where that changes the
-    default steps, the kind's defaults filled again with its factor; the choice's record)."""
-    noisy = recording and kind_defaults.noisy(o.model, task, noise) and not kind_defaults.small(o.model, task, dof)
-    record = even_velocity.choose(o.even_velocity, o.model, noisy, bool(o.dissipation))
-    factor = even_velocity.steps_factor(record, noisy)
-    if factor != 1 and "steps" not in options:
-        filled = kind_defaults.fill(fit_options.resolve(options), task, recording, dof, noise, steps_factor=factor)
-        filled.periodic, filled.dissipation = o.periodic, o.dissipation
-        o = filled
-        record["steps"] = o.steps
-    o.even_velocity = record["chosen"]
-    return o, record
 
 
 def file_derivatives(path, window, polyorder, gaps, time_unit) -> dict:

@@ -9,7 +9,7 @@ import pytest
 
 from lagbench.cli import main
 from lagbench.replication.fit import even_velocity, kind_defaults
-from lagbench.replication.fit.task import _even_velocity, fit, resolved
+from lagbench.replication.fit.task import fit, resolved
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +26,7 @@ def files(tmp_path_factory):
 def _choice(path, dissipation, **options):
     r = resolved(path, {"model": "lnn", **options})
     r.options.dissipation = dissipation
-    return _even_velocity(r.options, {"model": "lnn", **options}, r.task, r.recording, r.dof, r.noise)
+    return even_velocity.for_fit(r.options, {"model": "lnn", **options}, r.task, r.recording, r.dof, r.noise)
 
 
 def test_the_rule_in_every_case():
