@@ -23,7 +23,8 @@ DATA_HELP = ("a trajectory file: .csv with columns traj, t, q0..q{d-1} and optio
 def cmd_fit(args):
     from lagbench.replication.fit import kind_defaults
     from lagbench.replication.fit.progress import TrainingBar
-    from lagbench.replication.fit.task import fit, resolved
+    from lagbench.replication.fit.resolve import resolved
+    from lagbench.replication.fit.task import fit
     from lagbench.replication.training import device
 
     device.apply(args.device, (args.framework,))   # before anything is written

@@ -25,7 +25,8 @@ def _score(record: dict) -> float | None:
 
 
 def tune_fit(data, out="results/fit", n_configs: int = 4, on_log=None, on_progress=None, on_train=None, **options):
-    from lagbench.replication.fit.task import fit, resolved
+    from lagbench.replication.fit.resolve import resolved
+    from lagbench.replication.fit.task import fit
 
     o = resolved(data, options)[0]   # the model kind's defaults where not given
     if not o.heldout or o.split == "none":

@@ -9,7 +9,8 @@ import pytest
 
 from lagbench.cli import main
 from lagbench.replication.fit import kind_defaults, progress
-from lagbench.replication.fit.task import fit, resolved
+from lagbench.replication.fit.resolve import resolved
+from lagbench.replication.fit.task import fit
 from lagbench.replication.training.scouting import budget_samples
 
 

@@ -9,7 +9,7 @@ from lagbench.cli import main
 from lagbench.files import user_data
 from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.fit import time_base, trajectories
-from lagbench.replication.fit.task import resolved
+from lagbench.replication.fit.resolve import resolved
 
 RATE = 50.0
 

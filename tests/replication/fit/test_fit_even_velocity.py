@@ -9,7 +9,8 @@ import pytest
 
 from lagbench.cli import main
 from lagbench.replication.fit import even_velocity, kind_defaults
-from lagbench.replication.fit.task import fit, resolved
+from lagbench.replication.fit.resolve import resolved
+from lagbench.replication.fit.task import fit
 
 
 @pytest.fixture(scope="module")

@@ -95,7 +95,7 @@ def _trajectory_and_state_files(folder):
 def test_a_trajectory_file_gets_the_fit_studys_budget_and_a_state_file_the_claims(tmp_path):
     """`ON_RECORDINGS` multiplies the kind's steps for a trajectory file only (the restarts follow the steps);
     every other default and every other kind stays the claim's."""
-    from lagbench.replication.fit.task import resolved
+    from lagbench.replication.fit.resolve import resolved
 
     traj, states = _trajectory_and_state_files(tmp_path)
     for kind in ("lnn", "baseline"):
