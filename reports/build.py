@@ -36,6 +36,7 @@ from lagbench.reports.pdf import write_pdf
 from lagbench.reports.scorecard import scorecard_appendix, scorecard_section
 from lagbench.reports.sections_claims import claim_details, metrics_appendix, summary_sections, theme_sections
 from lagbench.reports.sections_control import control_sections
+from lagbench.reports.sections_cost import cost_sections
 from lagbench.reports.sections_fit import fit_sections, is_fit_results
 from lagbench.reports.sections_frameworks import frameworks_sections
 from lagbench.reports.sections_hessian import hessian_sections
@@ -104,7 +105,7 @@ def titled(results_dir: Path, out_dir: Path, now: dt.datetime | None = None) -> 
     first = scorecard_appendix(res)
     first.level = 2   # under the appendix's heading, on its page: the heading never stands alone on a page
     appendix = [Section("Appendix", appendix=True).add(Para(APPENDIX)), first]
-    appendix += summary_sections(res) + verify_sections(res) + _dumps(claim_details(res, moved) + speed_appendix(res, out_dir))
+    appendix += summary_sections(res) + verify_sections(res) + cost_sections(res) + _dumps(claim_details(res, moved) + speed_appendix(res, out_dir))
     appendix += findings_sections(res) + frameworks_sections(res) + _dumps(hessian_sections(res)) + stiff_sections(res) + speed[1:]
     appendix += _dumps(systems_sections(results_dir)) + mine + environment_sections(res, now)
     appendix += _dumps(metrics_appendix(res))
