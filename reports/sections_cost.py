@@ -2,11 +2,12 @@
 
 The sittings (``run.json`` and the earlier invocations' records in ``runs/``, one row each: when it started,
 how it ended, its wall hours, the units it ran, its workers) and their total; then the units' own time, by
-claim and by claim, model and framework. A unit's ``wall_time_s`` covers its training where it trained and its
-evaluation; a unit whose training another unit had already done (a second claim on the same model, a
-cohort's other seeds, a training kept from an earlier sitting) read it from the cache, so its ``wall_time_s``
-is below the ``train_time_s`` it records, and its training is not counted again. Worker hours add up over the
-run's workers, so with two workers they are about twice the wall hours. Nothing where no unit records its time.
+claim and by claim, model and framework. Worker hours are the units' ``wall_time_s`` (training where the unit
+trained, and its evaluation) summed, so with two workers about twice the wall hours; a unit resumed from a
+training snapshot records its last sitting's wall time only. Training hours count each training once, where
+several units read it (a second claim on the same model, a cohort's other seeds): of the units of one training
+(framework, model spec, protocol, seed or cohort) the one of the longest wall time, the one that trained,
+carries its ``train_time_s``, which sums the training's sittings. Nothing where no unit records its time.
 """
 
 from __future__ import annotations
@@ -26,14 +27,25 @@ def _seconds(d: dict, key: str) -> float:
     return float(v) if isinstance(v, int | float) and not isinstance(v, bool) and v >= 0 else 0.0
 
 
+def training_key(framework: str, seed, result: dict) -> str:
+    """What identifies a unit's training: its framework, model spec, protocol and seed (a cohort's seeds)."""
+    cohort = (result.get("cohort") or {}).get("seeds") if isinstance(result.get("cohort"), dict) else None
+    return json.dumps([framework, result.get("model_spec"), result.get("protocol"), cohort or str(seed)],
+                      sort_keys=True, default=str)
+
+
 def unit_costs(res: Results) -> pd.DataFrame:
-    """One row per unit with a result: claim, model, framework, worker seconds (its wall time) and the
-    training seconds it spent itself (0 where it read its training from the cache)."""
-    rows = []
-    for u in res.units:
-        wall, train = _seconds(u.result, "wall_time_s"), _seconds(u.result, "train_time_s")
-        rows.append({"claim": u.claim, "model": u.model, "framework": u.framework, "worker_s": wall,
-                     "train_s": train if train and wall >= train else 0.0})
+    """One row per unit: claim, model, framework, worker seconds (its wall time) and training seconds (its
+    training's, on the one unit that carries it)."""
+    carrier: dict = {}   # training -> (wall seconds, index) of the unit that carries it: the longest, which trained
+    for i, u in enumerate(res.units):
+        key, wall = training_key(u.framework, u.seed, u.result), _seconds(u.result, "wall_time_s")
+        carrier[key] = max(carrier.get(key, (-1.0, -1)), (wall, -i))
+    carriers = {-i for _, i in carrier.values()}
+    rows = [{"claim": u.claim, "model": u.model, "framework": u.framework,
+             "worker_s": _seconds(u.result, "wall_time_s"),
+             "train_s": _seconds(u.result, "train_time_s") if i in carriers else 0.0}
+            for i, u in enumerate(res.units)]
     return pd.DataFrame(rows, columns=["claim", "model", "framework", "worker_s", "train_s"])
 
 
