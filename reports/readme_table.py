@@ -4,18 +4,34 @@
 the paper, the verdict, each counted part with its verdict, the key model's metric in JAX and PyTorch (the
 seed mean) and the published value with what kind of number it is; below it, one line per variant.
 `python -m lagbench.reports.readme_table FOLDER` prints it from FOLDER/claims.json and FOLDER/verdicts.json (a
-sample-report folder) or FOLDER/summary/verdicts.json (a results folder). The README holds the output of
-the verdict-of-record run between the markers BEGIN and END; `tests/reports/test_readme_table.py` keeps
-it equal to this function's output on the committed `docs/sample_report/`.
+sample-report folder) or FOLDER/summary/verdicts.json (a results folder), between markers that name FOLDER
+(`begin(folder)`, `END`). The README holds such blocks, each the output on the committed folder its marker
+names (`blocks(text)` finds them); `tests/reports/test_readme_table.py` keeps every one equal to it.
 """
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
-BEGIN = "<!-- claims table: made by `python -m lagbench.reports.readme_table docs/sample_report`; do not edit by hand -->"
+MAKE = "python -m lagbench.reports.readme_table"
 END = "<!-- end of the claims table -->"
+_BEGIN = re.compile(r"<!-- claims table: made by `" + re.escape(MAKE) + r" ([^`]+)`; do not edit by hand -->")
+
+
+def begin(folder) -> str:
+    """The marker a block made from `folder` (a path relative to the project's root) opens with."""
+    return f"<!-- claims table: made by `{MAKE} {Path(folder).as_posix()}`; do not edit by hand -->"
+
+
+def blocks(text: str) -> list[tuple[str, str]]:
+    """(folder, block) of every claims table in `text`, markers included, in order."""
+    out = []
+    for m in _BEGIN.finditer(text):
+        end = text.find(END, m.end())
+        out.append((m.group(1), text[m.start():end + len(END) if end >= 0 else len(text)]))
+    return out
 FRAMEWORKS = (("jax", "JAX"), ("torch", "PyTorch"))
 
 
@@ -96,8 +112,9 @@ def read(folder) -> tuple[list[dict], dict]:
     return json.loads((folder / "claims.json").read_text())["claims"], json.loads(verdicts.read_text())
 
 
-def block(folder) -> str:
-    return f"{BEGIN}\n{table(*read(folder))}\n{END}"
+def block(folder, root=None) -> str:
+    """The claims table of `folder` between its markers; `root`: the folder the path is relative to."""
+    return f"{begin(folder)}\n{table(*read(Path(root or '.') / folder))}\n{END}"
 
 
 if __name__ == "__main__":

@@ -14,11 +14,19 @@ SAMPLE = ROOT / "docs" / "sample_report"
 
 def test_readme_table_is_the_generated_one():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert readme_table.BEGIN in text and readme_table.END in text, "the README lost the claims table's markers"
-    a = text.index(readme_table.BEGIN)
-    b = text.index(readme_table.END) + len(readme_table.END)
-    assert text[a:b] == readme_table.block(SAMPLE), ("the README's claims table differs from the sample run's; "
-                                                      "regenerate it: python -m lagbench.reports.readme_table docs/sample_report")
+    found = readme_table.blocks(text)
+    assert "docs/sample_report" in [folder for folder, _ in found], "the README lost the claims table's markers"
+    for folder, block in found:
+        assert block == readme_table.block(folder, ROOT), (f"the README's claims table of {folder} differs from "
+                                                           f"that run's; regenerate it: {readme_table.MAKE} {folder}")
+
+
+def test_blocks_are_found_by_the_folder_their_marker_names():
+    text = ("intro\n" + readme_table.begin("runs/full") + "\nA\n" + readme_table.END + "\nmiddle\n"
+            + readme_table.begin("docs/sample_report") + "\nB\n" + readme_table.END + "\n")
+    found = readme_table.blocks(text)
+    assert [f for f, _ in found] == ["runs/full", "docs/sample_report"]
+    assert found[0][1] == readme_table.begin("runs/full") + "\nA\n" + readme_table.END
 
 
 def test_the_sample_is_a_test_split_run_and_its_report_shows_the_same_verdicts():
