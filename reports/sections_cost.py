@@ -17,6 +17,7 @@ import json
 import pandas as pd
 
 from lagbench.reports.document import Para, Section, Table
+from lagbench.reports.fmt import num
 from lagbench.reports.load import Results
 
 SOURCES = ["units/*/*/*/seed*/result.json", "run.json", "runs/run-*.json"]
@@ -83,6 +84,11 @@ def _hours(df: pd.DataFrame, by: list[str]) -> pd.DataFrame:
     return g[[*by, "units", "worker h", "training h", "share"]].reset_index(drop=True)
 
 
+def _shown(df: pd.DataFrame) -> pd.DataFrame:
+    """Hours to three significant digits."""
+    return df.assign(**{c: [num(v) for v in df[c]] for c in ("wall h", "worker h", "training h") if c in df})
+
+
 def cost_sections(res: Results) -> list[Section]:
     costs = unit_costs(res)
     if not len(costs) or not costs["worker_s"].sum():
@@ -94,7 +100,8 @@ def cost_sections(res: Results) -> list[Section]:
                    f"{'s' if len(runs) != 1 else ''}; its units {costs['worker_s'].sum() / 3600:.2f} worker hours, "
                    f"{costs['train_s'].sum() / 3600:.2f} of them training (a training shared by several units "
                    "counted once, where it ran). Worker hours add up over the run's workers."))
-        s.add(Table("The run's sittings", runs, SOURCES[1:]))
-    s.add(Table("Time by claim (measured; the costliest first)", _hours(costs, ["claim"]), SOURCES[:1]))
-    s.add(Table("Time by claim, model and framework", _hours(costs, ["claim", "model", "framework"]), SOURCES[:1]))
+        s.add(Table("The run's sittings", _shown(runs), SOURCES[1:]))
+    s.add(Table("Time by claim (measured; the costliest first)", _shown(_hours(costs, ["claim"])), SOURCES[:1]))
+    s.add(Table("Time by claim, model and framework", _shown(_hours(costs, ["claim", "model", "framework"])),
+                SOURCES[:1]))
     return [s]
