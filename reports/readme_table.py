@@ -32,6 +32,8 @@ def blocks(text: str) -> list[tuple[str, str]]:
         end = text.find(END, m.end())
         out.append((m.group(1), text[m.start():end + len(END) if end >= 0 else len(text)]))
     return out
+
+
 FRAMEWORKS = (("jax", "JAX"), ("torch", "PyTorch"))
 
 
