@@ -82,11 +82,10 @@ def resolved(data, options: dict) -> Resolved:
     if o.periodic:   # the spec's checks: indices within the data's coordinates, the kind, not with --angle-wrap
         from lagbench.models import ModelSpec
         try:
-            ModelSpec(kind=o.model, dof=raw["q"].shape[1], periodic=tuple(o.periodic), angle_wrap=bool(o.angle_wrap))
+            ModelSpec(kind=o.model, dof=dof, periodic=tuple(o.periodic), angle_wrap=bool(o.angle_wrap))
         except ValueError as e:
             raise ValueError(f"--periodic: {e}") from None
     if isinstance(o.input_scale, tuple):
-        dof = raw["q"].shape[1]
         width = dof if o.model == "delan" else 3 * dof if task == "inverse_dynamics" else 2 * dof
         width += len(o.periodic)
         if len(o.input_scale) != width:
@@ -97,7 +96,7 @@ def resolved(data, options: dict) -> Resolved:
     if o.energy:  # importable and of the right shape, before any work
         from lagbench.replication.fit.evaluate import energy_function
 
-        energy_function({"energy": o.energy}, raw["q"].shape[1])
+        energy_function({"energy": o.energy}, dof)
     if o.test is not None:
         test_digest, test_raw = user_data.read(str(Path(o.test).resolve()))
         if test_digest == digest:   # its errors would be the training error, reported as a test error

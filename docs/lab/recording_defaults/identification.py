@@ -1,7 +1,8 @@
 """How well a recording identifies the friction at all: given the true conservative double pendulum, the diagonal
 friction that best explains the estimated q-double-dot of every training row, by L1 (the fit's loss) and by least
 squares; at the fit's auto derivative window, or with --windows at each of a list of windows and degrees 3 and 5.
-No model is trained.
+No model is trained. Gaps are split (`--gaps split`), so that a file with a run of dropped frames longer than the
+fit interpolates is read too.
 
     python docs/lab/recording_defaults/identification.py FILE.csv [FILE.csv ...]
     python docs/lab/recording_defaults/identification.py --windows FILE.csv
