@@ -59,8 +59,12 @@ def _schedule(protocol) -> str:
 
 
 def _loss(p: dict) -> str:
-    """The training loss in words: the task's target, or positions over windows (`--loss-target trajectory`)."""
-    t = p.get("trajectory_loss")
+    """The training loss in words: the task's target, positions over windows (`--loss-target trajectory`) or
+    q-double-dot through the derivative filter (`--loss-target filtered`)."""
+    t, f = p.get("trajectory_loss"), p.get("filter_loss")
+    if isinstance(f, dict):
+        return (f"{cell(p.get('loss'))} on q-double-dot through the derivative filter (window {f.get('window')}, "
+                f"order {f.get('polyorder')})")
     if not isinstance(t, dict):
         return cell(p.get("loss"))
     return (f"{cell(p.get('loss'))} on positions over {t.get('frames')} frames "

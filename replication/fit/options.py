@@ -148,9 +148,12 @@ OPTIONS = (
     Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
            one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
     Option("loss_target", "acceleration", "what the loss compares: acceleration (the model's q-double-dot with the "
-           "estimated one, row by row) or trajectory (a trajectory file only: the model's motion integrated by RK4 from "
+           "estimated one, row by row), trajectory (a trajectory file only: the model's motion integrated by RK4 from "
            "each recorded frame over the next --horizon-frames frames, with the recorded positions; "
-           "docs/lab/trajectory_loss.md); the held-out rows are scored by the q-double-dot error either way",
+           "docs/lab/trajectory_loss.md) or filtered (a trajectory file whose derivatives are estimated, the "
+           "acceleration task: the estimate with the model's q-double-dot at the frames the filter's window spans, "
+           "smoothed as the filter smooths it, so the model does not learn the filter's bias; "
+           "docs/lab/recording_defaults.md); the held-out rows are scored by the q-double-dot error either way",
            one_of(LOSS_TARGETS), f"one of {', '.join(LOSS_TARGETS)}"),
     Option("horizon_frames", FRAMES, "trajectory loss: the frames each window integrates over, >= 1", count(1),
            "an integer >= 1", kind=int),

@@ -13,7 +13,14 @@ from typing import NamedTuple
 
 from lagbench.files import user_data
 from lagbench.models.kinds import CAPABILITIES
-from lagbench.replication.fit import kind_defaults, periodic_coords, time_base, trajectories, windows
+from lagbench.replication.fit import (
+    filter_rows,
+    kind_defaults,
+    periodic_coords,
+    time_base,
+    trajectories,
+    windows,
+)
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit import rows as fit_data
 from lagbench.systems.registry import definition
@@ -73,7 +80,9 @@ def resolved(data, options: dict) -> Resolved:
     o.periodic = tuple(periodic["chosen"])
     if o.loss_target == "trajectory":
         windows.check_fit(path, task, recording)
-    else:
+    if o.loss_target == "filtered":
+        filter_rows.check_fit(path, task, recording, given=[k for k in ("qdot", "qddot") if k in raw])
+    if o.loss_target != "trajectory":
         given = [k for k in ("horizon_frames", "horizon_substeps", "horizon_scale")
                  if options.get(k, fit_options.BY_NAME[k].default) != fit_options.BY_NAME[k].default]
         if given:

@@ -26,7 +26,10 @@ Loss target: `loss_target` "trajectory" (a trajectory file) trains on windows of
 (`replication.fit.windows`: the model's motion integrated over `horizon_frames` frames from each recorded
 frame, against the recorded positions; the protocol's `trajectory_loss` records it, so a fit says which loss
 trained it), while the early stop and the evaluation score the held-out rows as every fit does; the
-`horizon_*` options, set to other than their defaults, are refused without it.
+`horizon_*` options, set to other than their defaults, are refused without it. `loss_target` "filtered" (a
+trajectory file whose derivatives are estimated, the acceleration task) trains on the rows whose frames the
+derivative filter spans (`replication.fit.filter_rows`: the estimate against the model's q-double-dot at those
+frames, smoothed by the filter's kernel; the protocol's `filter_loss` records the window and order).
 
 Choices from the data and the system, recorded in eval_config["periodic"] and ["dissipation"] and passed to
 `on_choices` before any training: `periodic` "auto" takes the coordinates in which the `system`'s Lagrangian is
@@ -56,6 +59,7 @@ from lagbench.replication.claims.base import ModelEntry
 from lagbench.replication.fit import (
     energy_trend,
     even_velocity,
+    filter_rows,
     kind_defaults,
     time_base,
     trajectories,
@@ -65,7 +69,15 @@ from lagbench.replication.fit import rows as fit_data
 from lagbench.replication.fit.dissipation import GATE as FRICTION_GATE
 from lagbench.replication.fit.resolve import resolved
 from lagbench.replication.run.units import Unit, run_unit
-from lagbench.replication.training.protocol import Data, EarlyStop, Guard, Protocol, Scouting, TrajectoryLoss
+from lagbench.replication.training.protocol import (
+    Data,
+    EarlyStop,
+    FilterLoss,
+    Guard,
+    Protocol,
+    Scouting,
+    TrajectoryLoss,
+)
 from lagbench.replication.training.schedules import Constant, OneCycle
 
 LOSS_NAMES = {"l1": "L1", "mse": "MSE"}
@@ -137,6 +149,10 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
         if o.loss_target == "trajectory" else None
     if trajectory_loss is not None:   # the training rows are the recording's windows
         n_train = len(windows.training_windows(prep.reference, trajectory_loss, o.loss)["q"])
+    # the filter that estimated the training file's q-double-dot: its window as its derivatives record it
+    filter_loss = FilterLoss(window=deriv["window"], polyorder=o.polyorder) if o.loss_target == "filtered" else None
+    if filter_loss is not None:   # the training rows whose frames the filter spans are all rows
+        n_train = len(filter_rows.training_rows(prep.reference, filter_loss)["q"])
     data = Data(recipe=prep.reference, n_train=n_train, n_heldout=max(1, prep.counts.get("heldout", 0)))  # the file's split
     schedule = OneCycle(lr=o.lr, start=o.lr_start, min_ratio=o.lr_min_ratio) if o.schedule == "onecycle" else Constant(lr=o.lr)
     batch = min(o.batch, n_train)
@@ -155,7 +171,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
                            anneal=patience * log_every) if patience else None
     protocol = Protocol(data=data, task=task, steps=o.steps, batch=batch, loss=o.loss, l2=o.weight_decay,
                         schedule=schedule, scouting=scouting, guard=guard, dtype=dtype, log_every=log_every,
-                        early_stop=early_stop, trajectory_loss=trajectory_loss)
+                        early_stop=early_stop, trajectory_loss=trajectory_loss, filter_loss=filter_loss)
     metric, label = metric_of(prep.counts, tprep is not None, o.loss)
     cfg = {"heldout": prep.counts.get("heldout", 0) > 0, "test": tprep.reference if tprep else None,
            "system": o.system, "energy": o.energy, "substeps": o.substeps, "source": prep.source,

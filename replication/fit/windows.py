@@ -24,6 +24,7 @@ meaning); "none": 1.
 recipe's: `replication.training.data.recipe_file`); a ValueError naming `--horizon-frames` where there are none.
 `check_fit(path, task, recording)`: the trajectory loss refused, in one line, for a file of state samples or a
 fit of the inverse dynamics (no motion of the model's to integrate).
+`runs(r)`: (rows in time order, frame on the trajectory's grid) of each trajectory of the rows `r`.
 `FRAMES`, `SUBSTEPS`: `lagbench fit`'s defaults.
 """
 from __future__ import annotations
@@ -35,7 +36,7 @@ from lagbench.replication.fit.trajectories import grid, starts
 
 FRAMES = 5      # frames a window spans: 0.05 s at 100 frames/s, short beside a double pendulum's motion
 SUBSTEPS = 2    # RK4 steps a frame, as the rollouts' default (`--substeps`)
-LOSS_TARGETS = ("acceleration", "trajectory")
+LOSS_TARGETS = ("acceleration", "trajectory", "filtered")
 
 
 def scale_of(h, frames: int, loss: str, scale: str):
@@ -46,7 +47,7 @@ def scale_of(h, frames: int, loss: str, scale: str):
     return 2.0 / (h * h * spread)
 
 
-def _runs(r: dict) -> list[tuple[np.ndarray, np.ndarray]]:
+def runs(r: dict) -> list[tuple[np.ndarray, np.ndarray]]:
     """(rows in time order, frame on the trajectory's grid) of each trajectory of the rows `r`."""
     out = []
     for rows in starts(r["traj"]):
@@ -59,7 +60,7 @@ def _runs(r: dict) -> list[tuple[np.ndarray, np.ndarray]]:
 def windows(r: dict, part, loss: str) -> dict:
     k = part.frames
     at = [np.zeros((0, k + 1), int)]   # per window, its rows: the start and the K frames after it
-    for rows, frame in _runs(r):
+    for rows, frame in runs(r):
         ok = np.flatnonzero(frame[k:] - frame[:-k] == k)   # frames strictly increase: K steps of 1
         at.append(rows[ok[:, None] + np.arange(k + 1)])
     at = np.concatenate(at)
@@ -73,7 +74,7 @@ def windows(r: dict, part, loss: str) -> dict:
 def longest(r: dict) -> int:
     """The most rows in a row on one trajectory's grid (a window of K frames needs K + 1)."""
     best = 0
-    for _, frame in _runs(r):
+    for _, frame in runs(r):
         breaks = np.flatnonzero(np.diff(frame) != 1)
         bounds = np.concatenate([[0], breaks + 1, [frame.size]])
         best = max(best, int(np.max(np.diff(bounds))) if frame.size else 0)

@@ -9,6 +9,8 @@ A *recipe* (`RECIPES[name]`) turns (system, n, rng) into a batch dict of float64
   "qddot"      the true acceleration (N, dof), kept for evaluation
   "h", "scale" a window's frame step and scale (N, 1), with `protocol.trajectory_loss` (whose "target" is then
                the window's scaled displacements: `replication.fit.windows`)
+  "q_taps", "qdot_taps"  each row's neighbouring frames (N, T*dof), with `protocol.filter_loss`
+               (`replication.fit.filter_rows`)
 `BatchStream` draws the pools and the batch order once from the seed, so the JAX and the PyTorch
 loop given the same protocol and seed see the same batches in the same order. With `data.resample` a pool is
 drawn every epoch; the state entries `data.fixed` names are those of the epoch-0 draw in every epoch.
@@ -127,7 +129,8 @@ RECIPES = {"iid": recipe_iid, "arm": recipe_arm}
 
 def recipe_file(protocol, n, rng, kind="train"):
     """A user's data file (see `lagbench.files.user_data`): the train or held-out rows, as a batch dict; with
-    `protocol.trajectory_loss`, the training rows are windows of the recording (`replication.fit.windows`)."""
+    `protocol.trajectory_loss`, the training rows are windows of the recording (`replication.fit.windows`); with
+    `protocol.filter_loss`, rows with their neighbouring frames (`replication.fit.filter_rows`)."""
     from lagbench.files.user_data import split_rows
 
     ref = protocol.data.recipe.removeprefix("file:")
@@ -135,6 +138,10 @@ def recipe_file(protocol, n, rng, kind="train"):
         from lagbench.replication.fit.windows import training_windows
 
         return training_windows(ref, protocol.trajectory_loss, protocol.loss)
+    if protocol.filter_loss is not None and kind == "train":
+        from lagbench.replication.fit.filter_rows import training_rows
+
+        return training_rows(ref, protocol.filter_loss)
     return split_rows(ref, protocol.task, kind)
 
 

@@ -1,7 +1,7 @@
 """The prediction and the loss, written once for both frameworks.
 
 The functions use only operations that JAX arrays and PyTorch tensors share (`.sum(-1)`, `.mean()`,
-`clip`, slicing, arithmetic), plus a `cat(list, axis)` function the caller passes in, so the JAX
+`clip`, `.shape`, slicing, arithmetic), plus a `cat(list, axis)` function the caller passes in, so the JAX
 and the PyTorch training loops evaluate literally the same expression. The trajectory loss's RK4 step is
 the evaluation's own (`replication.evaluation.rollout.rk4_step`, plain arithmetic).
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 from lagbench.replication.evaluation.rollout import rk4_step
 
 
-def predict(model, kind: str, task: str, batch: dict, cat, trajectory_loss=None):
+def predict(model, kind: str, task: str, batch: dict, cat, trajectory_loss=None, filter_loss=None):
     """The model's prediction of batch["target"].
 
     acceleration:     q-double-dot from (q, qdot[, extra]); DeLaN's forward model takes extra = tau.
@@ -18,9 +18,12 @@ def predict(model, kind: str, task: str, batch: dict, cat, trajectory_loss=None)
     inverse_dynamics: tau from (q, qdot, qddot = extra): DeLaN's inverse model, or a feed-forward
                       baseline given qddot as its extra input.
     With a `TrajectoryLoss` (the protocol's `trajectory_loss`; a batch of windows): `positions`.
+    With a `FilterLoss` (the protocol's `filter_loss`; a batch of rows with their neighbours): `filtered`.
     """
     if trajectory_loss is not None:
         return positions(model, task, batch, trajectory_loss.substeps, cat)
+    if filter_loss is not None:
+        return filtered(model, batch, filter_loss.kernel, cat)
     q, qdot, extra = batch["q"], batch["qdot"], batch.get("extra")
     if task == "acceleration":
         return model.acceleration(q, qdot, extra)
@@ -61,6 +64,26 @@ def positions(model, task: str, batch: dict, substeps: int, cat):
             z = rk4_step(field, z, dt)
         out.append(z[..., :dof] * batch["scale"])
     return cat(out, -1)
+
+
+def filtered(model, batch: dict, kernel, cat):
+    """The model's q-double-dot seen through the derivative filter (`FilterLoss`), as the estimate in the
+    batch's target is: (B, dof), sum over taps j of kernel[j] x the model's q-double-dot at frame j.
+
+    batch: q_taps, qdot_taps (B, T*dof), the T = len(kernel) frames about each row (q recorded, qdot
+    estimated), frame after frame (`replication.fit.filter_rows`); stacked members add a leading axis. The
+    T frames go through the model as one batch of T*B rows (frame-major), so a step makes one call."""
+    dof = batch["q_taps"].shape[-1] // len(kernel)
+    n = batch["q_taps"].shape[-2]
+
+    def frames(x):
+        return cat([x[..., j * dof:(j + 1) * dof] for j in range(len(kernel))], -2)
+
+    a = model.acceleration(frames(batch["q_taps"]), frames(batch["qdot_taps"]), None)
+    out = 0.0
+    for j, c in enumerate(kernel):
+        out = out + c * a[..., j * n:(j + 1) * n, :]
+    return out
 
 
 def loss_value(pred, target, weight, loss: str, axis=None):

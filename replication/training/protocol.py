@@ -7,11 +7,12 @@ the batch size, the dtype and the seed. The batch order is drawn once in NumPy f
 (`replication.training.data.BatchStream`) and fed to both frameworks, so two frameworks given one protocol
 see the same numbers in the same order. The optional parts, each `None` when the run does without it:
 `guard` (`Guard`), `scouting` (`Scouting`), `cohort` (seeds trained side by side), `tracking`
-(`Tracking`), `early_stop` (`EarlyStop`) and `trajectory_loss` (`TrajectoryLoss`: train on positions over
-windows of a recording; the held-out rows stay the task's).
+(`Tracking`), `early_stop` (`EarlyStop`), `trajectory_loss` (`TrajectoryLoss`: train on positions over
+windows of a recording) and `filter_loss` (`FilterLoss`: train on q-double-dot seen through the derivative
+filter); with either loss part the held-out rows stay the task's.
 
 `to_dict()` is the canonical form: every field (but `data.fixed` while empty, `tracking.keep` while off and
-`early_stop`, `trajectory_loss` while None, so the protocols without them keep their keys), records as nested
+`early_stop`, `trajectory_loss`, `filter_loss` while None, so the protocols without them keep their keys), records as nested
 dicts, and `version` (`KEY_VERSION`), so
 every cache key built from it changes when the form does; `from_dict` reads it, and the forms of earlier
 versions (`replication.training.protocol_versions`), so that older result folders still load.
@@ -28,6 +29,7 @@ from lagbench.replication.training.protocol_parts import (
     Adam,
     Data,
     EarlyStop,
+    FilterLoss,
     Guard,
     Scouting,
     Tracking,
@@ -43,15 +45,15 @@ from lagbench.replication.training.schedules import (
 from lagbench.validate import check, integer, is_integer, one_of, real
 
 __all__ = ["LOSSES", "DTYPES", "TASKS", "COORDS", "KEY_VERSION", "Protocol", "Data", "Adam", "Guard", "Scouting",
-           "Tracking", "EarlyStop", "TrajectoryLoss", "canonical_hash"]
+           "Tracking", "EarlyStop", "TrajectoryLoss", "FilterLoss", "canonical_hash"]
 
 LOSSES = ("l1", "mse", "l1_gamma")
 DTYPES = ("float32", "float64")
 TASKS = ("acceleration", "hamiltonian", "inverse_dynamics")
 KEY_VERSION = 3
 PARTS = {"guard": Guard, "tracking": Tracking, "early_stop": EarlyStop,   # optional parts stored as their fields
-         "trajectory_loss": TrajectoryLoss}
-UNSTORED_WHEN_OFF = ("early_stop", "trajectory_loss")   # parts no claim has: out of `to_dict` while None
+         "trajectory_loss": TrajectoryLoss, "filter_loss": FilterLoss}
+UNSTORED_WHEN_OFF = ("early_stop", "trajectory_loss", "filter_loss")   # parts no claim has: out of `to_dict` while None
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,9 @@ class Protocol:
     trajectory_loss: a `TrajectoryLoss` (None: off): the training loss compares positions integrated over
                windows of a recording (a user's file, task acceleration or hamiltonian) instead of the task's
                target; the held-out rows and everything evaluated stay the task's.
+    filter_loss: a `FilterLoss` (None: off): the training loss compares the estimated q-double-dot with the
+               model's seen through the filter that estimated it (a user's recording, task acceleration); the
+               held-out rows and everything evaluated stay the task's.
     cohort:    train the seeds in groups of `cohort` (>= 2) as one vectorised program
                (`replication.training.train`: seeds g*cohort .. g*cohort + cohort - 1 side by side, each its
                own init, batches, guard and stop); each seed's numbers are those of its own run (up to
@@ -92,6 +97,7 @@ class Protocol:
     log_every: int = 50
     early_stop: EarlyStop | None = None   # out of `to_dict` while None: the protocols without it keep their keys
     trajectory_loss: TrajectoryLoss | None = None   # likewise
+    filter_loss: FilterLoss | None = None   # likewise
 
     def __post_init__(self):
         for name, valid in (("loss", LOSSES), ("dtype", DTYPES), ("task", TASKS)):
@@ -128,15 +134,23 @@ class Protocol:
                   f"protocol trajectory_loss trains on windows of a recording: a file recipe, got {self.data.recipe!r}")
             check(self.data.coords == "qqdot", "protocol trajectory_loss starts each window from (q, qdot): coords qqdot, "
                                                f"got {self.data.coords}")
+        if self.filter_loss is not None:
+            check(self.trajectory_loss is None, "protocol filter_loss with trajectory_loss: each replaces the task's "
+                                                "training loss; use one of them")
+            check(self.task == "acceleration", f"protocol filter_loss filters the model's q-double-dot: task "
+                                               f"acceleration, got {self.task}")
+            check(self.data.recipe.startswith("file:"), f"protocol filter_loss trains on the frames of a recording: "
+                                                        f"a file recipe, got {self.data.recipe!r}")
         if self.cohort and self.early_stop:
             raise ValueError(f"protocol cohort {self.cohort} with early_stop: the seeds of a cohort train as one "
                              f"program and stop together; give each seed its own run")
 
     def objective_key(self) -> tuple:
         """What one optimiser step depends on besides the model: the loss and its target (task, loss, l2, the
-        trajectory loss), Adam's constants, the clip, the dtype (a compiled step serves every protocol sharing
-        them)."""
-        return self.task, self.loss, self.l2, self.optimiser, self.grad_clip, self.dtype, self.trajectory_loss
+        trajectory or filter loss), Adam's constants, the clip, the dtype (a compiled step serves every protocol
+        sharing them)."""
+        return (self.task, self.loss, self.l2, self.optimiser, self.grad_clip, self.dtype, self.trajectory_loss,
+                self.filter_loss)
 
     @property
     def grad_clip(self) -> float | None:

@@ -4,12 +4,14 @@ Always there: `Data` (what is trained on), `Adam` (the optimiser's constants) an
 (`replication.training.schedules`). Optional, `None` when a run does without them: `Guard` (the
 gradient-spike guard), `Scouting` (restarts over initialisations), `Tracking` (held-out error during
 training), `EarlyStop` (stop when the held-out error stops improving; `lagbench fit` only) and
-`TrajectoryLoss` (train on positions integrated over windows of a recording; `lagbench fit` only). Every value
+`TrajectoryLoss` (train on positions integrated over windows of a recording; `lagbench fit` only) and
+`FilterLoss` (train on q-double-dot seen through the derivative filter; `lagbench fit` only). Every value
 a part uses is written in it: nothing is inherited from the protocol.
 """
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 from lagbench.replication.training.schedules import SCHEDULES, Schedule
@@ -202,3 +204,43 @@ class TrajectoryLoss:
         for name in ("frames", "substeps"):
             object.__setattr__(self, name, integer(f"trajectory loss {name}", getattr(self, name), low=1))
         one_of("trajectory loss scale", self.scale, TRAJECTORY_SCALES)
+
+
+@dataclass(frozen=True)
+class FilterLoss:
+    """The filtered acceleration loss: the model's q-double-dot seen through the derivative filter that estimated
+    the target. A Savitzky-Golay second derivative of `window` points and order `polyorder` is a linear filter
+    c of the positions; since c annihilates constants and lines, c = k * (1, -2, 1) for a kernel k of
+    window - 2 taps summing to 1 (`kernel`), so the estimate at a frame equals k applied to the central second
+    differences of its neighbours, each q-double-dot up to h^2 q''''/12. The loss compares the estimate with k
+    applied to the model's q-double-dot at those frames (`replication.training.objective.filtered`; the rows:
+    `replication.fit.filter_rows`), so the filter's smoothing is on both sides and the model does not learn
+    the filter's bias. The held-out rows stay the task's own (the one-step error).
+
+    window:    the filter's odd window (the training file's, as its derivatives record it), >= polyorder + 2.
+    polyorder: the filter's polynomial order, >= 2."""
+
+    window: int
+    polyorder: int
+
+    def __post_init__(self):
+        object.__setattr__(self, "polyorder", integer("filter loss polyorder", self.polyorder, low=2))
+        object.__setattr__(self, "window", integer("filter loss window", self.window, low=self.polyorder + 2))
+        check(self.window % 2 == 1, f"filter loss window must be odd, got {self.window}")
+
+    @property
+    def kernel(self) -> tuple[float, ...]:
+        """The window - 2 taps k, for the frames -(window - 3)/2 .. (window - 3)/2 about the row."""
+        return filter_kernel(self.window, self.polyorder)
+
+
+@functools.lru_cache(maxsize=16)
+def filter_kernel(window: int, polyorder: int) -> tuple[float, ...]:
+    """k with c = k * (1, -2, 1) for c the Savitzky-Golay second-derivative coefficients at unit spacing
+    (`scipy.signal.savgol_coeffs`, applied as a dot product): the double cumulative sum of c, its last two
+    entries (0 up to rounding) dropped; Python floats."""
+    import numpy as np
+    from scipy.signal import savgol_coeffs
+
+    c = savgol_coeffs(window, polyorder, deriv=2, delta=1.0, use="dot")
+    return tuple(float(x) for x in np.cumsum(np.cumsum(c))[:-2])

@@ -34,7 +34,8 @@ def _to_jax(batch: dict, dtype) -> dict:
 
 def make_loss(spec, protocol):
     def loss_fn(model, batch):
-        pred = predict(model, spec.kind, protocol.task, batch, jnp.concatenate, protocol.trajectory_loss)
+        pred = predict(model, spec.kind, protocol.task, batch, jnp.concatenate, protocol.trajectory_loss,
+                       protocol.filter_loss)
         loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss)
         if protocol.l2:
             leaves = jax.tree_util.tree_leaves(eqx.filter(model, eqx.is_inexact_array))

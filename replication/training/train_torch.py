@@ -49,7 +49,8 @@ def _to_torch(batch: dict, dtype) -> dict:
 def make_loss(spec, protocol, per_member=False):
     """(model, batch) -> the protocol's loss; per_member: of stacked members, (K,)."""
     def loss_fn(model, batch):
-        pred = predict(model, spec.kind, protocol.task, batch, torch.cat, protocol.trajectory_loss)
+        pred = predict(model, spec.kind, protocol.task, batch, torch.cat, protocol.trajectory_loss,
+                       protocol.filter_loss)
         loss = loss_value(pred, batch["target"], batch.get("weight"), protocol.loss, -1 if per_member else None)
         if protocol.l2:
             loss = loss + protocol.l2 * sum((p * p).flatten(1).sum(1) if per_member else (p * p).sum()

@@ -28,7 +28,7 @@ def test_the_canonical_form_round_trips_and_holds_every_field():
         d = p.to_dict()
         assert d["version"] == KEY_VERSION
         # no field dropped while off, but the parts no claim has (the claims' keys stay as they were)
-        off = {n for n in ("early_stop", "trajectory_loss") if getattr(p, n) is None}
+        off = {n for n in ("early_stop", "trajectory_loss", "filter_loss") if getattr(p, n) is None}
         assert set(d) == {"version", *(f for f in p.__dataclass_fields__)} - off
         assert Protocol.from_dict(json.loads(json.dumps(d))) == p
     # a schedule holds only the values its shape uses
