@@ -9,7 +9,10 @@
 #   bash docs/lab/recording_defaults/run.sh OUT "0 1 2" [ARMS]
 #   ARMS: any of lnn_1x lnn_3x baseline lnn_1x_p5 baseline_p5 lnn_1x_even lnn_half_even (the last two: the
 #   Lagrangian even in qdot, --even-velocity, at the 1 x steps and at half of them, the 1 x arm's network work)
-#   and lnn (the LNN at the fit's defaults, whatever they are)
+#   and lnn (the LNN at the fit's defaults, whatever they are); delan (DeLaN at its defaults); the filtered
+#   acceleration loss (--loss-target filtered): delan_filtered, baseline_filtered at their defaults, and
+#   lnn_filtered_matched, the LNN at its defaults with its batches divided by the 9 frames a row costs at the
+#   development file's window 11 (--batch 28 --restart-batch 4: the defaults' work a step)
 #   NOISE=0.001 bash ... : the same recordings at another position noise in radians (default 0.0087, 0.5 degree)
 #   DATA_SEEDS="40 41" bash ... : other simulate seeds for the training and the test file (default: 30 31)
 set -euo pipefail
@@ -33,6 +36,10 @@ for s in $seeds; do
       lnn) $fit --model lnn --seed "$s" --out "$out/s$s-lnn" ;;
       lnn_1x_even) $fit --model lnn --steps 23437 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_1x_even" ;;
       lnn_half_even) $fit --model lnn --steps 11719 --restart-fallback 0 --even-velocity --seed "$s" --out "$out/s$s-lnn_half_even" ;;
+      delan) $fit --model delan --seed "$s" --out "$out/s$s-delan" ;;
+      delan_filtered) $fit --model delan --loss-target filtered --seed "$s" --out "$out/s$s-delan_filtered" ;;
+      baseline_filtered) $fit --model baseline --loss-target filtered --seed "$s" --out "$out/s$s-baseline_filtered" ;;
+      lnn_filtered_matched) $fit --model lnn --loss-target filtered --batch 28 --restart-batch 4 --seed "$s" --out "$out/s$s-lnn_filtered_matched" ;;
     esac
   done
 done
