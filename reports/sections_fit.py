@@ -236,9 +236,10 @@ def _data_para(units) -> Para:
 
 def _choices_para(units) -> Para | None:
     """What each fit chose from its data and system: its periodic inputs (`--periodic`), whether it learns a
-    dissipation (`--dissipation`) and whether its Lagrangian is even in q-dot (`--even-velocity`, recorded where
-    on), with the reasons; None where no fit recorded any."""
-    from lagbench.replication.fit import energy_trend, even_velocity, periodic_coords
+    dissipation (`--dissipation`), whether its Lagrangian is even in q-dot (`--even-velocity`, recorded where
+    on) and the loss `--loss-target auto` chose where not the acceleration loss, with the reasons; None where no
+    fit recorded any."""
+    from lagbench.replication.fit import energy_trend, even_velocity, loss_target, periodic_coords
 
     seen: dict[str, list[str]] = {}
     for u in units:
@@ -246,7 +247,8 @@ def _choices_para(units) -> Para | None:
         parts = ([f"periodic inputs {periodic_coords.describe(cfg['periodic'])}"] if cfg.get("periodic") else []) + \
             ([f"dissipation {energy_trend.describe(cfg['dissipation'])}"] if cfg.get("dissipation") else []) + \
             ([f"Lagrangian even in q-dot {even_velocity.describe(cfg['even_velocity'])}"] if cfg.get("even_velocity")
-             else [])
+             else []) + \
+            ([f"loss {loss_target.describe(cfg['loss_target'])}"] if cfg.get("loss_target") else [])
         if u.claim == "fit" and parts:
             seen.setdefault("; ".join(parts), []).append(_name(u))
     if not seen:

@@ -58,7 +58,7 @@ def for_fit(o, options: dict, task: str, recording: bool, dof: int, noise) -> tu
     factor = steps_factor(record, noisy)
     if factor != 1 and "steps" not in options:
         filled = kind_defaults.fill(fit_options.resolve(options), task, recording, dof, noise, steps_factor=factor)
-        filled.periodic, filled.dissipation = o.periodic, o.dissipation
+        filled.periodic, filled.dissipation, filled.loss_target = o.periodic, o.dissipation, o.loss_target
         o = filled
         record["steps"] = o.steps
     o.even_velocity = record["chosen"]

@@ -29,7 +29,7 @@ def cmd_fit(args):
 
     device.apply(args.device, (args.framework,))   # before anything is written
     given = fit_options.from_args(args)
-    o, task, recording, dof, _, noise = resolved(args.data, given)   # a refused option: one line, nothing written
+    o, task, recording, dof, _, noise, _ = resolved(args.data, given)   # a refused option: one line, nothing written
     if not args.quiet and set(kind_defaults.FROM_PROTOCOL) - set(given):
         print(f"lagbench fit: {args.model}'s defaults from "
               f"{kind_defaults.source(args.model, task, recording, dof, given, noise)} "
@@ -94,10 +94,10 @@ def cmd_fit(args):
 
 
 def choices_line(records: dict) -> None:
-    """The periodic inputs, the dissipation and, for an LNN, the even Lagrangian a fit chose (`--periodic`,
-    `--dissipation`, `--even-velocity`), and why: one line each, printed as the derivative window is, also
-    under --quiet."""
-    from lagbench.replication.fit import energy_trend, even_velocity, periodic_coords
+    """The periodic inputs, the dissipation, for an LNN the even Lagrangian, and a loss other than the
+    acceleration loss that `--loss-target auto` chose (`--periodic`, `--dissipation`, `--even-velocity`,
+    `--loss-target`), and why: one line each, printed as the derivative window is, also under --quiet."""
+    from lagbench.replication.fit import energy_trend, even_velocity, loss_target, periodic_coords
 
     if records.get("periodic"):
         print(f"lagbench fit: periodic inputs: {periodic_coords.describe(records['periodic'])}", file=sys.stderr)
@@ -106,6 +106,9 @@ def choices_line(records: dict) -> None:
     if records.get("even_velocity"):
         print(f"lagbench fit: Lagrangian even in q-dot: {even_velocity.describe(records['even_velocity'])}",
               file=sys.stderr)
+    target = records.get("loss_target") or {}
+    if target.get("mode") == "auto" and target.get("chosen") != "acceleration":
+        print(f"lagbench fit: loss: {loss_target.describe(target)}", file=sys.stderr)
 
 
 def add_fit(sub) -> None:

@@ -18,10 +18,11 @@ from lagbench.models.spec import CAPABILITIES
 from lagbench.replication.fit.energy_trend import MODES as DISSIPATION_MODES
 from lagbench.replication.fit.even_velocity import MODES as EVEN_VELOCITY_MODES
 from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
+from lagbench.replication.fit.loss_target import MODES as LOSS_TARGETS
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
 from lagbench.replication.fit.trajectories import AUTO, GAPS, MAX_GAP, POLYORDER, window_value
-from lagbench.replication.fit.windows import FRAMES, LOSS_TARGETS, SUBSTEPS
+from lagbench.replication.fit.windows import FRAMES, SUBSTEPS
 from lagbench.replication.renamed import renamed
 from lagbench.replication.training.protocol_parts import TRAJECTORY_SCALES
 from lagbench.validate import is_integer, is_real
@@ -147,8 +148,9 @@ OPTIONS = (
            lambda v: is_real(v) and v >= 0, "a finite number >= 0", kind=float),
     Option("loss", BY_KIND, "l1 | mse (per sample summed over components, mean over the batch)" + KIND,
            one_of(LOSSES), f"one of {', '.join(LOSSES)}"),
-    Option("loss_target", "acceleration", "what the loss compares: acceleration (the model's q-double-dot with the "
-           "estimated one, row by row), trajectory (a trajectory file only: the model's motion integrated by RK4 from "
+    Option("loss_target", AUTO, "what the loss compares: auto (filtered for DeLaN on a trajectory file whose "
+           "q-double-dot is estimated from q, by a registered study; acceleration otherwise), acceleration (the "
+           "model's q-double-dot with the estimated one, row by row), trajectory (a trajectory file only: the model's motion integrated by RK4 from "
            "each recorded frame over the next --horizon-frames frames, with the recorded positions; "
            "docs/lab/trajectory_loss.md) or filtered (a trajectory file whose derivatives are estimated, the "
            "acceleration task: the estimate with the model's q-double-dot at the frames the filter's window spans, "

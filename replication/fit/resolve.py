@@ -16,6 +16,7 @@ from lagbench.models.kinds import CAPABILITIES
 from lagbench.replication.fit import (
     filter_rows,
     kind_defaults,
+    loss_target,
     periodic_coords,
     time_base,
     trajectories,
@@ -45,13 +46,15 @@ class Resolved(NamedTuple):
     the task the data and model give, whether the data are a trajectory file (a recording) rather than a file of
     state samples, the data's coordinates (the kind's defaults follow them: `kind_defaults.small`), what
     the fit records of its periodic inputs (`periodic_coords.choose`) and the recording's position noise where
-    the kind's budget follows it (`kind_defaults.NOISY_RECORDINGS`; None otherwise)."""
+    the kind's budget follows it (`kind_defaults.NOISY_RECORDINGS`; None otherwise), and what it records of its
+    loss (`loss_target.choose`; `options.loss_target` is the loss chosen)."""
     options: SimpleNamespace
     task: str
     recording: bool
     dof: int
     periodic: dict
     noise: float | None = None
+    loss_target: dict | None = None
 
 
 def resolved(data, options: dict) -> Resolved:
@@ -78,6 +81,8 @@ def resolved(data, options: dict) -> Resolved:
         raise ValueError(f"--system {o.system}: has {definition(o.system).dof} coordinates, the data {path} {dof}")
     periodic = periodic_coords.choose(o.periodic, o.system, bool(o.angle_wrap))
     o.periodic = tuple(periodic["chosen"])
+    target = loss_target.choose(o.loss_target, o.model, task, recording, [k for k in ("qdot", "qddot") if k in raw])
+    o.loss_target = target["chosen"]
     if o.loss_target == "trajectory":
         windows.check_fit(path, task, recording)
     if o.loss_target == "filtered":
@@ -117,4 +122,4 @@ def resolved(data, options: dict) -> Resolved:
             task_of(o.model, test_tau, o.test)  # an LNN / HNN given tau: refused with the reason
             raise ValueError(f"--test {o.test}: {'has' if test_tau else 'lacks'} tau columns, the training data "
                              f"{'lacks' if test_tau else 'has'} them; give both files the same columns")
-    return Resolved(o, task, recording, dof, periodic, noise)
+    return Resolved(o, task, recording, dof, periodic, noise, target)

@@ -127,7 +127,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     "even_velocity"): called once they are chosen, before anything is trained; `on_train(protocol)`: called
     before a training starts (not when an earlier fit is returned), `on_log(row)` then with each training log
     row (`replication.fit.progress`)."""
-    o, task, recording, dof, periodic, noise = resolved(data, options)   # every check that needs no work, before the output folder is made
+    o, task, recording, dof, periodic, noise, target = resolved(data, options)   # every check that needs no work, before the output folder is made
     path = str(Path(data).resolve())
     out = R.output_folder(out, "--out")
     deriv = file_derivatives(path, o.window, o.polyorder, o.gaps, o.time_unit)
@@ -142,8 +142,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
     o.dissipation = dissipation["chosen"]   # the form trained (and its folder's label) follows the choice
     o, even = even_velocity.for_fit(o, options, task, recording, dof, noise)
     if on_choices:
-        on_choices({"periodic": periodic, "dissipation": dissipation} | ({"even_velocity": even} if o.model == "lnn"
-                                                                         else {}))
+        on_choices({"periodic": periodic, "dissipation": dissipation, "loss_target": target}
+                   | ({"even_velocity": even} if o.model == "lnn" else {}))
     n_train = prep.counts["train"]
     trajectory_loss = TrajectoryLoss(frames=o.horizon_frames, substeps=o.horizon_substeps, scale=o.horizon_scale) \
         if o.loss_target == "trajectory" else None
@@ -180,6 +180,8 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
            "trajectories": prep.trajectories, "periodic": periodic, "dissipation": dissipation}
     if even["chosen"]:   # recorded only when on: the other fits keep their keys
         cfg["even_velocity"] = even
+    if target["mode"] == "auto" and target["chosen"] != "acceleration":   # likewise: a loss auto chose
+        cfg["loss_target"] = target
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
     if o.dissipation:   # how its friction is checked: a fit checked by another rule is evaluated again

@@ -36,7 +36,6 @@ from lagbench.replication.fit.trajectories import grid, starts
 
 FRAMES = 5      # frames a window spans: 0.05 s at 100 frames/s, short beside a double pendulum's motion
 SUBSTEPS = 2    # RK4 steps a frame, as the rollouts' default (`--substeps`)
-LOSS_TARGETS = ("acceleration", "trajectory", "filtered")
 
 
 def scale_of(h, frames: int, loss: str, scale: str):

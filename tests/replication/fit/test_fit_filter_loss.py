@@ -71,3 +71,24 @@ def test_input_it_does_not_apply_to_fails_in_one_line(recording, tmp_path, case,
         fit(data, out=tmp_path / "out", model=model, framework="torch", steps=2, hidden=(4,), loss_target="filtered")
     assert "\n" not in str(e.value)
     assert not (tmp_path / "out" / "units").exists()   # refused before anything trained
+
+
+@pytest.mark.parametrize("model, edit, chosen", [("delan", {}, "filtered"), ("baseline", {}, "acceleration"),
+                                                 ("lnn", {}, "acceleration"), ("delan", {"qdot0": 0.0}, "acceleration")])
+def test_auto_chooses_the_filtered_loss_for_delan_on_estimated_derivatives_alone(recording, tmp_path, model, edit,
+                                                                                chosen):
+    """`--loss-target auto` (the default): the filtered loss for DeLaN on a trajectory file whose q-double-dot is
+    estimated from q, the registered study's adoption; the acceleration loss for the LNN and the baseline (the
+    study's arms that lost) and for a file that gives qdot. Recorded in the protocol and, where it chose the
+    filtered loss, in eval_config with the reason; passed to `on_choices` always."""
+    data = _edited(recording, tmp_path / "given.csv", **edit) if edit else recording
+    seen = {}
+    r = fit(data, out=tmp_path / "out", model=model, framework="jax", steps=3, hidden=(4,), restarts=0,
+            on_choices=seen.update)
+    assert seen["loss_target"]["mode"] == "auto" and seen["loss_target"]["chosen"] == chosen
+    assert ("filter_loss" in r["protocol"]) == (chosen == "filtered")
+    assert ("loss_target" in r["eval_config"]) == (chosen == "filtered")
+    given = fit(recording, out=tmp_path / "given", model="delan", framework="jax", steps=3, hidden=(4,),
+                loss_target="acceleration") if model == "delan" and not edit else None
+    if given is not None:   # as given: the acceleration loss, and nothing recorded of a choice
+        assert "filter_loss" not in given["protocol"] and "loss_target" not in given["eval_config"]
