@@ -155,7 +155,7 @@ OPTIONS = (
            "docs/lab/trajectory_loss.md) or filtered (a trajectory file whose derivatives are estimated, the "
            "acceleration task: the estimate with the model's q-double-dot at the frames the filter's window spans, "
            "smoothed as the filter smooths it, so the model does not learn the filter's bias; "
-           "docs/lab/recording_defaults.md); the held-out rows are scored by the q-double-dot error either way",
+           "docs/fit.md); the held-out rows are scored by the q-double-dot error either way",
            one_of(LOSS_TARGETS), f"one of {', '.join(LOSS_TARGETS)}"),
     Option("horizon_frames", FRAMES, "trajectory loss: the frames each window integrates over, >= 1", count(1),
            "an integer >= 1", kind=int),
