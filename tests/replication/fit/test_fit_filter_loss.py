@@ -3,8 +3,8 @@ pendulum recording with position noise, a fit trained on the filtered accelerati
 one-step error well below the null predictor's), its record names the filter it follows (the training file's
 window, as its derivatives record it), and input it does not apply to fails in one line before any training."""
 import numpy as np
-import pandas as pd
 import pytest
+from fit_files_kit import edited, states
 
 from lagbench.cli import main
 from lagbench.files import results as R
@@ -41,21 +41,6 @@ def test_a_fit_on_the_filtered_loss_learns_and_says_so(recording, tmp_path):
     assert _loss(r["protocol"]) == f"l1 on q-double-dot through the derivative filter (window {window}, order 3)"
 
 
-def _edited(recording, path, **columns):
-    df = pd.read_csv(recording)
-    for name, value in columns.items():
-        df[name] = value
-    df.to_csv(path, index=False)
-    return path
-
-
-def _states(path):
-    rng = np.random.default_rng(0)
-    q, qdot = rng.normal(size=(40, 1)), rng.normal(size=(40, 1))
-    np.savez(path, q=q, qdot=qdot, qddot=-9.81 * np.sin(q))
-    return path
-
-
 @pytest.mark.parametrize("case, model, match", [
     ("a file of states", "baseline", "^--loss-target filtered: .*states.npz is a file of state samples"),
     ("given velocities", "baseline", "^--loss-target filtered: .*qdot.csv gives qdot, so its q-double-dot is not"),
@@ -63,9 +48,9 @@ def _states(path):
     ("an HNN", "hnn", "^--loss-target filtered: an HNN's loss reads its time derivatives"),
 ])
 def test_input_it_does_not_apply_to_fails_in_one_line(recording, tmp_path, case, model, match):
-    data = {"a file of states": lambda: _states(tmp_path / "states.npz"),
-            "given velocities": lambda: _edited(recording, tmp_path / "qdot.csv", qdot0=0.0),
-            "torques: the inverse dynamics": lambda: _edited(recording, tmp_path / "tau.csv", tau0=0.0),
+    data = {"a file of states": lambda: states(tmp_path / "states.npz"),
+            "given velocities": lambda: edited(recording, tmp_path / "qdot.csv", qdot0=0.0),
+            "torques: the inverse dynamics": lambda: edited(recording, tmp_path / "tau.csv", tau0=0.0),
             }.get(case, lambda: recording)()
     with pytest.raises(ValueError, match=match) as e:
         fit(data, out=tmp_path / "out", model=model, framework="torch", steps=2, hidden=(4,), loss_target="filtered")
@@ -81,7 +66,7 @@ def test_auto_chooses_the_filtered_loss_for_delan_on_estimated_derivatives_alone
     estimated from q, the registered study's adoption; the acceleration loss for the LNN and the baseline (the
     study's arms that lost) and for a file that gives qdot. Recorded in the protocol and, where it chose the
     filtered loss, in eval_config with the reason; passed to `on_choices` always."""
-    data = _edited(recording, tmp_path / "given.csv", **edit) if edit else recording
+    data = edited(recording, tmp_path / "given.csv", **edit) if edit else recording
     seen = {}
     r = fit(data, out=tmp_path / "out", model=model, framework="jax", steps=3, hidden=(4,), restarts=0,
             on_choices=seen.update)

@@ -4,6 +4,7 @@ one-step error well below the null predictor's), its record says which loss trai
 in one line before any training."""
 import numpy as np
 import pytest
+from fit_files_kit import edited, states
 
 from lagbench.cli import main
 from lagbench.files import results as R
@@ -39,22 +40,6 @@ def test_a_fit_on_windows_of_a_noisy_recording_learns(recording, tmp_path):
     assert m["heldout_l1"] < 0.4 * m["null_heldout_l1"], (m["heldout_l1"], m["null_heldout_l1"])
 
 
-def _with_tau(recording, path):
-    import pandas as pd
-
-    df = pd.read_csv(recording)
-    df["tau0"] = 0.0
-    df.to_csv(path, index=False)
-    return path
-
-
-def _states(path):
-    rng = np.random.default_rng(0)
-    q, qdot = rng.normal(size=(40, 1)), rng.normal(size=(40, 1))
-    np.savez(path, q=q, qdot=qdot, qddot=-9.81 * np.sin(q))
-    return path
-
-
 @pytest.mark.parametrize("case, options, match", [
     ("frames below 1", {"horizon_frames": 0}, "^--horizon-frames: 0 is not valid; expected an integer >= 1$"),
     ("frames beyond every trajectory", {"horizon_frames": 1000},
@@ -65,8 +50,8 @@ def _states(path):
      "^--horizon-substeps: an option of the trajectory loss; give it with --loss-target trajectory$"),
 ])
 def test_bad_input_fails_in_one_line(recording, tmp_path, case, options, match):
-    data = {"a file of states": lambda: _states(tmp_path / "states.npz"),
-            "torques: the inverse dynamics": lambda: _with_tau(recording, tmp_path / "tau.csv")}.get(case, lambda: recording)()
+    data = {"a file of states": lambda: states(tmp_path / "states.npz"),
+            "torques: the inverse dynamics": lambda: edited(recording, tmp_path / "tau.csv", tau0=0.0)}.get(case, lambda: recording)()
     with pytest.raises(ValueError, match=match) as e:
         fit(data, out=tmp_path / "out", model="baseline", framework="torch", steps=2, hidden=(4,),
             **{"loss_target": "trajectory", **options})

@@ -6,20 +6,15 @@ misses it by the filter's bias, the two frameworks give one loss and one gradien
 never reach past an end or a missing frame, and the part keeps every other protocol's key."""
 import json
 
-import equinox as eqx
-import jax.numpy as jnp
 import numpy as np
 import pytest
-import torch
+from loss_kit import Exact, jax_loss, torch_loss
 
-import lagbench.models.jax
-import lagbench.models.torch
 from lagbench import systems
 from lagbench.models import ModelSpec, init_params
 from lagbench.replication.fit.filter_rows import filter_rows, neighbours
 from lagbench.replication.fit.simulate import simulate
 from lagbench.replication.fit.trajectories import derivative
-from lagbench.replication.training import train_jax, train_torch
 from lagbench.replication.training.objective import filtered
 from lagbench.replication.training.protocol import Data, FilterLoss, Protocol, TrajectoryLoss
 from lagbench.replication.training.protocol_parts import filter_kernel
@@ -42,16 +37,6 @@ def test_the_kernel_gives_the_filter_from_second_differences(window, polyorder):
         assert np.einsum("j,jd->d", k, second[i - 1 - half:i + half]) == pytest.approx(estimate[i], abs=1e-9)
 
 
-class _Exact:
-    """The pendulum's true q-double-dot as a model (NumPy arrays in and out)."""
-
-    def __init__(self, system):
-        self.s = system
-
-    def acceleration(self, q, qdot, extra=None):
-        return self.s.acceleration(q, qdot, backend="numpy")
-
-
 def test_an_exact_model_seen_through_the_filter_meets_its_estimate():
     """A noise-free pendulum recording at 25 frames/s, derivatives by a window of 15 (a large bias): the exact
     q-double-dot at a row misses the filter's estimate by the filter's bias; the exact q-double-dot at the frames
@@ -67,7 +52,7 @@ def test_an_exact_model_seen_through_the_filter_meets_its_estimate():
                      "qdot": g[["qdot0"]].to_numpy()[keep], "qddot": est[keep]})
     r = {k: np.concatenate([x[k] for x in rows]) for k in rows[0]}
     b = filter_rows(r, part)
-    model = _Exact(systems.get("pendulum"))
+    model = Exact(systems.get("pendulum"))
     through = filtered(model, b, part.kernel, np.concatenate)
     own = model.acceleration(b["q"], b["qdot"])
     miss_own, miss_through = np.abs(own - b["target"]).max(), np.abs(through - b["target"]).max()
@@ -81,19 +66,6 @@ def _batch(dof: int, taps: int, rng) -> dict:
     return {"q": qt[:, mid], "qdot": vt[:, mid], "q_taps": qt, "qdot_taps": vt, "target": rng.normal(size=(4, dof))}
 
 
-def _jax_loss(spec, params, protocol, batch):
-    loss, grads = eqx.filter_value_and_grad(train_jax.make_loss(spec, protocol))(
-        lagbench.models.jax.build(spec, params), {k: jnp.asarray(v) for k, v in batch.items()})
-    return float(loss), lagbench.models.jax.to_params(grads)
-
-
-def _torch_loss(spec, params, protocol, batch):
-    model = lagbench.models.torch.build(spec, params)
-    loss = train_torch.make_loss(spec, protocol)(model, {k: torch.as_tensor(v) for k, v in batch.items()})
-    loss.backward()
-    return float(loss.detach()), {k: p.grad.numpy() for k, p in model.named_parameters()}
-
-
 @pytest.mark.parametrize("kind, fields, loss", [("lnn", {"dissipation": True, "periodic": (0,)}, "l1"),
                                                 ("lnn", {"dissipation": True, "even_velocity": True}, "mse"),
                                                 ("baseline", {}, "mse"), ("delan", {"dissipation": True}, "l1")])
@@ -104,7 +76,7 @@ def test_the_frameworks_give_one_loss_and_one_gradient(kind, fields, loss):
     params = init_params(spec, seed=0)
     batch = _batch(2, len(PART.kernel), np.random.default_rng(0))
     protocol = Protocol(data=FILE, steps=1, batch=4, dtype="float64", loss=loss, l2=1e-3, filter_loss=PART)
-    (lj, gj), (lt, gt) = _jax_loss(spec, params, protocol, batch), _torch_loss(spec, params, protocol, batch)
+    (lj, gj), (lt, gt) = jax_loss(spec, params, protocol, batch), torch_loss(spec, params, protocol, batch)
     assert lj == pytest.approx(lt, rel=1e-12)
     assert gj.keys() == gt.keys()
     largest = max(np.max(np.abs(g)) for g in gj.values())
@@ -112,7 +84,7 @@ def test_the_frameworks_give_one_loss_and_one_gradient(kind, fields, loss):
     for name in gj:
         assert np.max(np.abs(gj[name] - gt[name])) <= 1e-10 * max(np.max(np.abs(gj[name])), 1e-3 * largest), name
     # the frames' smoothed q-double-dot, not the row's own: without the part the same weights score otherwise
-    assert abs(_torch_loss(spec, params, protocol.replace(filter_loss=None), batch)[0] - lt) > 1e-6 * abs(lt)
+    assert abs(torch_loss(spec, params, protocol.replace(filter_loss=None), batch)[0] - lt) > 1e-6 * abs(lt)
 
 
 def test_rows_never_reach_past_an_end_or_a_missing_frame():

@@ -5,19 +5,14 @@ positions to RK4's order, windows never cross an end or a missing frame, and the
 protocol's key."""
 import json
 
-import equinox as eqx
-import jax.numpy as jnp
 import numpy as np
 import pytest
-import torch
+from loss_kit import Exact, jax_loss, torch_loss
 
-import lagbench.models.jax
-import lagbench.models.torch
 from lagbench import systems
 from lagbench.models import ModelSpec, init_params
 from lagbench.replication.fit.simulate import simulate
 from lagbench.replication.fit.windows import scale_of, windows
-from lagbench.replication.training import train_jax, train_torch
 from lagbench.replication.training.objective import positions
 from lagbench.replication.training.protocol import Data, Protocol, TrajectoryLoss
 
@@ -32,19 +27,6 @@ def _batch(dof: int, frames: int, rng) -> dict:
             "scale": scale_of(h, frames, "l1", "acceleration"), "target": rng.normal(size=(4, frames * dof))}
 
 
-def _jax_loss(spec, params, protocol, batch):
-    loss, grads = eqx.filter_value_and_grad(train_jax.make_loss(spec, protocol))(
-        lagbench.models.jax.build(spec, params), {k: jnp.asarray(v) for k, v in batch.items()})
-    return float(loss), lagbench.models.jax.to_params(grads)
-
-
-def _torch_loss(spec, params, protocol, batch):
-    model = lagbench.models.torch.build(spec, params)
-    loss = train_torch.make_loss(spec, protocol)(model, {k: torch.as_tensor(v) for k, v in batch.items()})
-    loss.backward()
-    return float(loss.detach()), {k: p.grad.numpy() for k, p in model.named_parameters()}
-
-
 @pytest.mark.parametrize("kind, fields, task, loss", [("lnn", {"dissipation": True, "periodic": (0,)}, "acceleration", "l1"),
                                                       ("baseline", {}, "acceleration", "mse"),
                                                       ("delan", {}, "acceleration", "l1"), ("hnn", {}, "hamiltonian", "l1")])
@@ -57,7 +39,7 @@ def test_the_frameworks_give_one_loss_and_one_gradient(kind, fields, task, loss)
     batch = _batch(2, PART.frames, np.random.default_rng(0))
     protocol = Protocol(data=FILE, steps=1, batch=4, dtype="float64", task=task, loss=loss, l2=1e-3,
                         trajectory_loss=PART)
-    (lj, gj), (lt, gt) = _jax_loss(spec, params, protocol, batch), _torch_loss(spec, params, protocol, batch)
+    (lj, gj), (lt, gt) = jax_loss(spec, params, protocol, batch), torch_loss(spec, params, protocol, batch)
     assert lj == pytest.approx(lt, rel=1e-12)
     assert gj.keys() == gt.keys()
     largest = max(np.max(np.abs(g)) for g in gj.values())
@@ -66,17 +48,7 @@ def test_the_frameworks_give_one_loss_and_one_gradient(kind, fields, task, loss)
         assert np.max(np.abs(gj[name] - gt[name])) <= 1e-10 * max(np.max(np.abs(gj[name])), 1e-3 * largest), name
     # the positions' loss, not the one-step loss: without the part the same weights score otherwise
     other = {**batch, "target": batch["target"][:, :2 if task == "acceleration" else 4]}   # the task's width
-    assert abs(_torch_loss(spec, params, protocol.replace(trajectory_loss=None), other)[0] - lt) > 1e-6 * abs(lt)
-
-
-class _Exact:
-    """The pendulum's true q-double-dot, as a model (NumPy arrays in and out)."""
-
-    def __init__(self, system):
-        self.s = system
-
-    def acceleration(self, q, qdot, extra=None):
-        return self.s.acceleration(q, qdot, backend="numpy")
+    assert abs(torch_loss(spec, params, protocol.replace(trajectory_loss=None), other)[0] - lt) > 1e-6 * abs(lt)
 
 
 def test_an_exact_model_reaches_the_recorded_positions_to_rk4_order():
@@ -86,7 +58,7 @@ def test_an_exact_model_reaches_the_recorded_positions_to_rk4_order():
     df = simulate("pendulum", trajectories=3, duration=2.0, rate=20.0, seed=1, velocities=True)
     r = {"traj": df["traj"].to_numpy(float), "t": df["t"].to_numpy(), "q": df[["q0"]].to_numpy(),
          "qdot": df[["qdot0"]].to_numpy()}
-    model, errors = _Exact(systems.get("pendulum")), []
+    model, errors = Exact(systems.get("pendulum")), []
     for substeps in (1, 2, 4):
         b = windows(r, TrajectoryLoss(frames=4, substeps=substeps), "l1")
         pred = positions(model, "acceleration", b, substeps, np.concatenate)
