@@ -21,15 +21,14 @@ from __future__ import annotations
 import numpy as np
 
 from lagbench.files import user_data
-from lagbench.replication.fit.windows import runs
+from lagbench.replication.fit.windows import consecutive, runs
 
 
 def neighbours(r: dict, taps: int) -> tuple[np.ndarray, np.ndarray]:
     half = taps // 2
     keep, at = [np.zeros(0, int)], [np.zeros((0, taps), int)]
     for rows, frame in runs(r):
-        # frames strictly increase, so taps frames in a row on the grid span exactly taps - 1 steps
-        ok = np.flatnonzero(frame[taps - 1:] - frame[:frame.size - taps + 1] == taps - 1)
+        ok = consecutive(frame, taps - 1)
         keep.append(rows[ok + half])
         at.append(rows[ok[:, None] + np.arange(taps)])
     return np.concatenate(keep), np.concatenate(at)

@@ -81,12 +81,13 @@ def resolved(data, options: dict) -> Resolved:
         raise ValueError(f"--system {o.system}: has {definition(o.system).dof} coordinates, the data {path} {dof}")
     periodic = periodic_coords.choose(o.periodic, o.system, bool(o.angle_wrap))
     o.periodic = tuple(periodic["chosen"])
-    target = loss_target.choose(o.loss_target, o.model, task, recording, [k for k in ("qdot", "qddot") if k in raw])
+    derivatives = [k for k in ("qdot", "qddot") if k in raw]   # given in the file, not estimated by the fit
+    target = loss_target.choose(o.loss_target, o.model, task, recording, derivatives)
     o.loss_target = target["chosen"]
     if o.loss_target == "trajectory":
         windows.check_fit(path, task, recording)
     if o.loss_target == "filtered":
-        filter_rows.check_fit(path, task, recording, given=[k for k in ("qdot", "qddot") if k in raw])
+        filter_rows.check_fit(path, task, recording, given=derivatives)
     if o.loss_target != "trajectory":
         given = [k for k in ("horizon_frames", "horizon_substeps", "horizon_scale")
                  if options.get(k, fit_options.BY_NAME[k].default) != fit_options.BY_NAME[k].default]

@@ -24,7 +24,8 @@ meaning); "none": 1.
 recipe's: `replication.training.data.recipe_file`); a ValueError naming `--horizon-frames` where there are none.
 `check_fit(path, task, recording)`: the trajectory loss refused, in one line, for a file of state samples or a
 fit of the inverse dynamics (no motion of the model's to integrate).
-`runs(r)`: (rows in time order, frame on the trajectory's grid) of each trajectory of the rows `r`.
+`runs(r)`: (rows in time order, frame on the trajectory's grid) of each trajectory of the rows `r`;
+`consecutive(frame, k)`: the indices i where frames i .. i + k are k + 1 frames in a row of that grid.
 `FRAMES`, `SUBSTEPS`: `lagbench fit`'s defaults.
 """
 from __future__ import annotations
@@ -56,11 +57,16 @@ def runs(r: dict) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def consecutive(frame, k: int):
+    # frames strictly increase, so k + 1 of them span exactly k steps only where none is missing
+    return np.flatnonzero(frame[k:] - frame[:frame.size - k] == k)
+
+
 def windows(r: dict, part, loss: str) -> dict:
     k = part.frames
     at = [np.zeros((0, k + 1), int)]   # per window, its rows: the start and the K frames after it
     for rows, frame in runs(r):
-        ok = np.flatnonzero(frame[k:] - frame[:-k] == k)   # frames strictly increase: K steps of 1
+        ok = consecutive(frame, k)
         at.append(rows[ok[:, None] + np.arange(k + 1)])
     at = np.concatenate(at)
     first, q, t = at[:, 0], r["q"], r["t"]
