@@ -10,7 +10,9 @@ knobs' order; the same list for every model. `lagbench tune` tries all of them.
 `extensions(tried, chosen) -> [knob values]`: the declared edge rule. For each chosen configuration whose value
 of a knob is the smallest or the largest tried, the configuration one `STEP` further in that direction (lr x or
 / 3, width x or / 2, the other knob as chosen), not yet tried; `lagbench tune` tries the union of them for
-every model alike, once.
+every model alike, once. `EDGE_LIMITS[(claim, profile)]` bounds a knob where a step further would cost more
+training than the profile's time allows (for every model of the claim alike); `stopped(...)` gives the points
+the bound kept out, for the ledger.
 `configs(n, seed=0) -> [knob values]`: the registered setting first (all multipliers 1), then n - 1 other
 combinations drawn without replacement (generator `seed`); the same list for every model (`lagbench fit
 --tune N`, and a partial search that no claim may adopt).
@@ -27,12 +29,16 @@ import numpy as np
 
 from lagbench.replication.claims.tuned import scaled_widths, with_knobs
 
-__all__ = ["KNOBS", "REGISTERED", "SIZE", "STEP", "apply", "configs", "extensions", "grid", "scaled_widths", "sweep"]
+__all__ = ["EDGE_LIMITS", "KNOBS", "REGISTERED", "SIZE", "STEP", "apply", "configs", "extensions", "grid", "scaled_widths",
+           "stopped", "sweep"]
 
 KNOBS = {"lr": (1 / 3, 1.0, 3.0), "width": (0.5, 1.0, 2.0)}
 REGISTERED = {"lr": 1.0, "width": 1.0}
 SIZE = math.prod(len(v) for v in KNOBS.values())   # the search's combinations
 STEP = {"lr": 3.0, "width": 2.0}   # the ratio between neighbouring values of each knob
+# The largest value of a knob the edge step may reach, per (claim, profile), the same for every model of the
+# claim; declared with its measured cost in docs/decisions/tuning_edge_limits.md before the points were trained.
+EDGE_LIMITS = {("dp_loss", "full"): {"width": 2.0}}
 
 
 def grid() -> list[dict]:
@@ -40,7 +46,19 @@ def grid() -> list[dict]:
     return [dict(REGISTERED), *[c for c in every if c != REGISTERED]]
 
 
-def extensions(tried: list[dict], chosen: list[dict]) -> list[dict]:
+def extensions(tried: list[dict], chosen: list[dict], limits: dict | None = None) -> list[dict]:
+    return [p for p in _steps(tried, chosen) if _within(p, limits or {})]
+
+
+def stopped(tried: list[dict], chosen: list[dict], limits: dict | None = None) -> list[dict]:
+    return [p for p in _steps(tried, chosen) if not _within(p, limits or {})]
+
+
+def _within(point: dict, limits: dict) -> bool:
+    return all(point[k] <= v or math.isclose(point[k], v) for k, v in limits.items())
+
+
+def _steps(tried: list[dict], chosen: list[dict]) -> list[dict]:
     out = []
     for c in chosen:
         for knob, step in STEP.items():

@@ -6,7 +6,8 @@ The declared search (`kind` "search"), the same for every model of the claim:
    `POOLED_SEEDS` development seeds) and scored by `choose.score_metric`.
 2. edge: where a model's best configuration (an ablation's joint choice: `choose.joint`) lies on an edge of
    a knob's range, the configuration one step further (`search.extensions`); the union of those points is
-   tried for every model alike, once.
+   tried for every model alike, once; a point beyond the claim's declared `search.EDGE_LIMITS` is not tried,
+   and the ledger names it (`edge_limits`, `edge_stopped`).
 3. confirmation (`CONFIRM_SEEDS` development seeds; a pooled claim's cohort is its confirmation): each
    model's best configuration and the registered one (the runner-up where the best is the registered) are
    trained on development seeds 1 and 2 too; the one with the lower mean over the three seeds is chosen.
@@ -182,9 +183,11 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
     runner.run("grid", _plan(configs, labels, seeds))
     df = pd.DataFrame(runner.rows)
     first, ranks = _choices(claim, df, range(len(configs)))
-    confirmation = {}
+    confirmation, limits, kept_out = {}, {}, []
     if kind == "search":
-        ext = search.extensions(configs, [configs[k] for k in first.values() if k is not None])
+        best = [configs[k] for k in first.values() if k is not None]
+        limits = search.EDGE_LIMITS.get((claim.id, profile), {})
+        ext, kept_out = search.extensions(configs, best, limits), search.stopped(configs, best, limits)
         configs = configs + ext
         runner.run("edge", _plan(configs, labels, seeds, range(len(configs) - len(ext), len(configs))))
         df = pd.DataFrame(runner.rows)
@@ -193,6 +196,8 @@ def tune(claim_id: str, profile: str = "quick", frameworks=("jax",), out="result
             confirmation = _confirm(runner, claim, configs, first, seeds, splits.DEV.seeds(confirm))
     df = pd.DataFrame(runner.rows)
     ledger = _ledger(claim, profile, kind, configs, seeds, frameworks, df, first, ranks, confirmation, labels)
+    if kind == "search" and limits:
+        ledger["edge_limits"], ledger["edge_stopped"] = dict(limits), kept_out
     for folder in dict.fromkeys([out, *([record.parent] if record is not None else [])]):
         R.write_csv(folder / "ledger.csv", df.drop(columns=["key"]))
         R.write_json(folder / "ledger.json", ledger)
