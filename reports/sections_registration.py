@@ -4,7 +4,8 @@
 registration line it matches, how its models were tuned (`tuning_text`) and its seed count's rule.
 `tuning_table(res)`: per claim and trained model, the configurations its protocol was chosen among by
 `lagbench tune`, the split they were scored on and the choice (knobs as multiples of the registered
-setting); a model chosen among fewer configurations than a rival of its claim is flagged.
+setting); a model chosen among fewer configurations than a rival of its claim is flagged, and so is a search
+whose edge step was bounded (`search.EDGE_LIMITS`).
 `disclosed(res)`: the claims registered anew after a look at test-split numbers, with the note that says so.
 `add_to(section, res)`: both tables, with their notes, and each disclosure in full; `summary(res)`: one
 paragraph of both for the scorecard, naming the disclosed claims.
@@ -52,6 +53,10 @@ def _knobs(k: dict | None) -> str:
     return "registered setting (by hand)" if not k else ", ".join(f"{n} x{v:.3g}" for n, v in k.items())
 
 
+def _bounds(limits: dict) -> str:
+    return ", ".join(f"{n} at most x{v:.3g}" for n, v in limits.items())
+
+
 def tuning_table(res: Results) -> pd.DataFrame | None:
     rows = []
     for claim in res.claims:
@@ -65,6 +70,8 @@ def tuning_table(res: Results) -> pd.DataFrame | None:
             searched = t["configs_tried"] > 0   # 0: by hand
             flags += [f"partial search ({t['configs_tried']} of {SEARCH_SIZE})"] * (0 < t["configs_tried"] < SEARCH_SIZE)
             flags += ["unconfirmed: one seed"] * (searched and len(confirmed) < 2)
+            if t.get("edge_limits"):
+                flags.append(f"edge step bounded ({_bounds(t['edge_limits'])}, every model alike)")
             rows.append({"claim": claim["id"], "model": model, "configurations": t["configs_tried"],
                          "scored on": cell(t["scored_on"]), "dev seeds": ", ".join(map(str, t["seeds"])) or "-",
                          "confirmed on": ", ".join(map(str, confirmed)) or "-", "chosen": _knobs(t["knobs"]),

@@ -150,7 +150,8 @@ def tuning(claim, profile: str, adopted: dict | None = None) -> dict:
             continue
         a = m.adopted
         out[m.label] = ({"configs_tried": a.configs_tried, "scored_on": a.split, "knobs": dict(a.knobs),
-                         "seeds": list(a.seeds), "confirm_seeds": list(a.confirm_seeds), "ledger_hash": a.ledger_hash}
+                         "seeds": list(a.seeds), "confirm_seeds": list(a.confirm_seeds), "ledger_hash": a.ledger_hash,
+                         **({"edge_limits": dict(a.edge_limits)} if a.edge_limits else {})}
                         if a else dict(_BY_HAND))
     return out
 

@@ -3,7 +3,8 @@
 `tuned.json` (beside this file): {claim id: {profile: record}}, a record being {"ledger_hash" (the
 `canonical_hash` of the adopted ledger.json), "split" ("dev", the only split a choice may read), "seeds",
 "frameworks", "configs" (configurations tried per model), "search" (the knobs and their values), "adopted"
-(the date), "ledger" (its file, where the adopted search names it), "models": {label: {"knobs",
+(the date), "ledger" (its file, where the adopted search names it), "edge_limits" (where the search declared
+them: the knob bounds of its edge step, `search.EDGE_LIMITS`), "models": {label: {"knobs",
 "configs_tried", "score", "confirm_seeds"}}}. Written by
 `python -m lagbench.replication.tuning.adopt OUT/ledger.json` from a ledger of `lagbench tune`.
 
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
@@ -61,11 +62,13 @@ class Adopted:
     ledger: str | None     # the ledger's file, where the record names it
     split: str             # "dev"
     seeds: tuple           # the search's seeds
+    edge_limits: dict = field(default_factory=dict)   # the bounds of the search's edge step, where declared
 
     def describe(self) -> dict:
         return {"claim": self.claim, "profile": self.profile, "label": self.label, "knobs": dict(self.knobs),
                 "configs_tried": self.configs_tried, "confirm_seeds": list(self.confirm_seeds), "score": self.score,
-                "ledger_hash": self.ledger_hash, "ledger": self.ledger, "split": self.split, "seeds": list(self.seeds)}
+                "ledger_hash": self.ledger_hash, "ledger": self.ledger, "split": self.split, "seeds": list(self.seeds),
+                **({"edge_limits": dict(self.edge_limits)} if self.edge_limits else {})}
 
 
 def searched(claim, entry, profile: str) -> bool:
@@ -130,7 +133,7 @@ def choice(claim, entry, profile: str, adopted: dict) -> Adopted | None:
     return Adopted(claim=source, profile=at, label=label, knobs=dict(chosen["knobs"]),
                    configs_tried=chosen["configs_tried"], confirm_seeds=tuple(chosen.get("confirm_seeds", [])),
                    score=chosen.get("score"), ledger_hash=rec["ledger_hash"], ledger=rec.get("ledger"),
-                   split=rec["split"], seeds=tuple(rec["seeds"]))
+                   split=rec["split"], seeds=tuple(rec["seeds"]), edge_limits=dict(rec.get("edge_limits") or {}))
 
 
 def equal(tuning_: dict) -> bool:

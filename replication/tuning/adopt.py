@@ -71,7 +71,8 @@ def adopt(ledger_file, today: str | None = None) -> dict:
                      "confirm_seeds": m.get("confirm_seeds") or []}
     rec = {"ledger": _named(path), "ledger_hash": canonical_hash(ledger, 16), "split": "dev", "seeds": ledger["seeds"],
            "frameworks": ledger["frameworks"], "configs": tried.pop(), "search": ledger["search"],
-           "adopted": today or date.today().isoformat(), "models": models}
+           "adopted": today or date.today().isoformat(), "models": models,
+           **({"edge_limits": ledger["edge_limits"]} if ledger.get("edge_limits") else {})}
     data = json.loads(tuned.FILE.read_text()) if tuned.FILE.is_file() else {}
     data.setdefault(claim.id, {})[profile] = rec
     tuned.FILE.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")

@@ -41,6 +41,16 @@ def test_a_choice_on_an_edge_is_extended_one_step_in_that_direction_only():
     assert both == [{"lr": 1.0, "width": 4.0}, {"lr": 9.0, "width": 1.0}]
 
 
+def test_an_edge_limit_keeps_a_step_out_for_every_model_and_names_it():
+    g, best = search.grid(), [{"lr": 3.0, "width": 2.0}, {"lr": 1.0, "width": 2.0}]
+    assert search.extensions(g, best) == [{"lr": 9.0, "width": 2.0}, {"lr": 3.0, "width": 4.0}, {"lr": 1.0, "width": 4.0}]
+    assert search.extensions(g, best, {"width": 2.0}) == [{"lr": 9.0, "width": 2.0}]
+    assert search.stopped(g, best, {"width": 2.0}) == [{"lr": 3.0, "width": 4.0}, {"lr": 1.0, "width": 4.0}]
+    assert search.stopped(g, best) == [] and search.extensions(g, best, {}) == search.extensions(g, best)
+    # claim 1 under full: declared, on widths only
+    assert search.EDGE_LIMITS[("dp_loss", "full")] == {"width": 2.0}
+
+
 def _fake_search(monkeypatch, score):
     """The search's stages on a made-up score(model, knobs, seed): no training, the choices and the record only."""
     monkeypatch.setattr(tune_module, "run_units", lambda *a, **k: None)
@@ -80,6 +90,15 @@ def test_the_whole_search_extends_an_edge_for_every_model_and_confirms_on_three_
     from lagbench.replication.tuning import summary
     text = summary.table([record.parent / "ledger.json"])
     assert "| dp_loss | smoke | lnn | 11 | lr x1, width x4 |" in text and "| dp_loss | smoke | baseline | 11 | lr x1, width x1 |" in text
+
+
+def test_a_declared_edge_limit_stops_the_step_for_both_models_and_the_ledger_says_so(tmp_path, monkeypatch):
+    _fake_search(monkeypatch, lambda label, knobs, seed: 1.0 / knobs["width"] + abs(knobs["lr"] - 1) + seed)  # widest best
+    monkeypatch.setitem(search.EDGE_LIMITS, ("dp_loss", "smoke"), {"width": 2.0})
+    ledger = tune("dp_loss", profile="smoke", out=tmp_path, progress=False)
+    assert all(m["configs_tried"] == 9 for m in ledger["models"].values())   # width x 4 tried by neither
+    assert ledger["edge_limits"] == {"width": 2.0} and ledger["edge_stopped"] == [{"lr": 1.0, "width": 4.0}]
+    assert all(m["chosen_knobs"] == {"lr": 1.0, "width": 2.0} for m in ledger["models"].values())
 
 
 def test_an_ablation_gives_every_arm_one_configuration(tmp_path, monkeypatch):

@@ -184,6 +184,21 @@ def test_report_flags_a_model_tuned_less_than_its_rivals():
     assert set(ledger.index.get_level_values(0)) == {"a", "b", "d"}
 
 
+def test_a_bounded_edge_step_reaches_the_record_the_verdicts_and_the_report(record_file):
+    from lagbench.reports import sections_registration as sr
+    ledger = {**_ledger("dp_loss", profile="full"), "edge_limits": {"width": 2.0},
+              "edge_stopped": [{"lr": 3.0, "width": 4.0}]}
+    rec = adopt.adopt(_write(record_file, ledger))
+    assert rec["edge_limits"] == {"width": 2.0}
+    t = tuning(get("dp_loss"), "full")
+    assert t and all(x["edge_limits"] == {"width": 2.0} for x in t.values())
+    assert all("edge_limits" not in x for x in tuning(get("dp_loss"), "quick").values())   # quick's record: none
+    res = SimpleNamespace(claims=[{"id": "dp_loss"}], run={"profile": "full"}, verdict_profile="full",
+                          verdicts={"dp_loss": {"preregistration": {"tuning": t}}})
+    flags = sr.tuning_table(res)["flag"]
+    assert all("edge step bounded (width at most x2, every model alike)" in f for f in flags)
+
+
 def test_the_scorecard_says_in_one_paragraph_how_each_claim_was_chosen():
     from lagbench.reports import sections_registration as sr
 
