@@ -4,8 +4,8 @@
 sections in place of the claim sections, scorecard and findings, which speak of papers' claims).
 ``fit_sections(res, out_dir) -> list[Section]``: the data and the models side by side (what each was
 trained on and how: task, loss, steps, widths, activation, weight decay, schedule, time), one-step errors
-per component (``one_step.csv``), the periodic inputs and dissipation each fit chose from its data and why
-(``eval_config``), rollout and energy metrics (``result.json``, ``rollouts.csv``), and the
+per component (``one_step.csv``), the paragraphs of ``reports.fit_paragraphs`` (the data, what each fit chose
+from it and why, the fits no better than the null predictor, the recommended fit), rollout and energy metrics (``result.json``, ``rollouts.csv``), and the
 figures: prediction against data (``arrays.npz`` ``<set>_target``/``<set>_pred``), a test trajectory,
 energy against truth, DeLaN's terms and the training curves (the drawing functions of ``reports.figures``).
 Failed or corrupt units are listed with their reason and left out of every number.
@@ -22,12 +22,18 @@ from lagbench.replication.evaluation.diverged import DIVERGED, SCALED, is_diverg
 from lagbench.reports import figures as F
 from lagbench.reports import figures_delan as FD
 from lagbench.reports.document import Figure, Para, Section, Table
+from lagbench.reports.fit_paragraphs import (
+    choices_para,
+    competence_para,
+    data_para,
+    recommendation_para,
+    unit_name,
+)
 from lagbench.reports.fmt import cell, count, num
 from lagbench.reports.load import Results, protocol_of
 from lagbench.reports.tables import problem_units_table
 
 CLAIMS = ("fit", "evaluate")
-SETS = {"train": "train", "heldout": "held-out", "test": "test"}
 SRC = "units/{claim}/<framework>/<model>/seed<k>/"
 ROLLOUT_METRICS = [("n_diverged", f"rollouts diverged (state error over {DIVERGED:g} x the data's spread, or not finite)"),
                    ("rollout_gmean_err", "state error, geometric mean over time"),
@@ -48,10 +54,6 @@ ROLLOUT_METRICS = [("n_diverged", f"rollouts diverged (state error over {DIVERGE
 
 def is_fit_results(res: Results) -> bool:
     return bool(res.units) and all(u.claim in CLAIMS for u in res.units)
-
-
-def _name(u) -> str:
-    return f"{u.model} ({u.framework}, seed {u.seed})"
 
 
 def _schedule(protocol) -> str:
@@ -78,7 +80,7 @@ def _models_table(units) -> pd.DataFrame:
         cfg = r.get("eval_config") or {}
         # a fit's --test rows are recorded apart from its own split's
         counts = {**(cfg.get("rows") or {}), **({"test": cfg["test_rows"]} if cfg.get("test_rows") is not None else {})}
-        rows.append({"unit": f"{u.claim}: {_name(u)}", "task": cell(p.get("task")), "loss": _loss(p),
+        rows.append({"unit": f"{u.claim}: {unit_name(u)}", "task": cell(p.get("task")), "loss": _loss(p),
                      "steps": count(r.get("train_steps")) if u.claim == "fit" else "(the fit's)",
                      "hidden": ",".join(map(str, s.get("hidden") or [])), "activation": cell(s.get("activation")),
                      "weight decay (l2)": num(p.get("l2")), "schedule": _schedule(protocol_of(r)),
@@ -88,54 +90,12 @@ def _models_table(units) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _competence(u) -> dict | None:
-    """`replication.fit.competence.competence` of the unit on the set it reports: the test file's, else held-out."""
-    from lagbench.replication.fit.competence import competence
-
-    m, loss = u.result.get("metrics") or {}, (u.result.get("protocol") or {}).get("loss", "l1")
-    return next((c for c in (competence(m, f"{s}_{loss}") for s in ("test", "heldout")) if c is not None), None)
-
-
-def _competence_para(units) -> Para | None:
-    """The fits and evaluations not clearly better than the null predictor on the set they report, named."""
-    from lagbench.replication.fit.competence import describe
-
-    flagged = [f"{_name(u)} ({u.claim}), {c['metric']}: {describe(c)}" for u in units
-               if (c := _competence(u)) is not None and not c["learned"]]
-    if not flagged:
-        return None
-    return Para("Not clearly better than the null predictor (at most half its error): " + "; ".join(flagged) + ".")
-
-
-RECOMMEND_WITHIN = 2.0   # the recommendation: the fewest parameters among the fits within this x the best rollout error
-
-
-def _recommendation_para(units) -> Para | None:
-    """The fit to use on this data: among the fits that learned, the one with the fewest parameters whose
-    rollout error (test file, else held-out) is within RECOMMEND_WITHIN x the best; None with fewer than two."""
-    from lagbench.reports.systems_table import params_of
-
-    cands = []
-    for u in units:
-        err = u.metric("test_rollout_gmean_err")
-        err = u.metric("heldout_rollout_gmean_err") if err is None else err
-        if u.claim == "fit" and err is not None and np.isfinite(err) and (_competence(u) or {}).get("learned"):
-            cands.append((err, params_of(u), _name(u)))
-    if len(cands) < 2:
-        return None
-    best = min(cands)
-    pick = min((c for c in cands if c[0] <= RECOMMEND_WITHIN * best[0]), key=lambda c: (c[1], c[0]))
-    return Para(f"Recommended on this data: {pick[2]} (rollout error {num(pick[0])}, {count(pick[1])} parameters), the "
-                f"fewest parameters among the fits within {RECOMMEND_WITHIN:g} x the best rollout error ({best[2]}: "
-                f"{num(best[0])}); fits not clearly better than the null predictor are left out.")
-
-
 def _one_step_table(units) -> pd.DataFrame | None:
     frames = []
     for u in units:
         df = u.table("one_step.csv")
         if df is not None and {"set", "quantity", "component", "mae", "rel_mae"} <= set(df.columns):
-            frames.append(df.assign(model=_name(u), claim=u.claim))
+            frames.append(df.assign(model=unit_name(u), claim=u.claim))
     if not frames:
         return None
     df = pd.concat(frames, ignore_index=True)
@@ -163,7 +123,7 @@ def _rollout_table(units) -> pd.DataFrame | None:
         for where in ("heldout", "test"):
             vals = {label: _rollout_value(u, where, k) for k, label in ROLLOUT_METRICS}
             if any(v != "–" for v in vals.values()):
-                rows.append({"model": f"{u.claim}: {_name(u)}", "rows": where, **vals})
+                rows.append({"model": f"{u.claim}: {unit_name(u)}", "rows": where, **vals})
     if not rows:
         return None
     df = pd.DataFrame(rows)
@@ -177,7 +137,7 @@ def parity(units, path: Path) -> bool:
         arr = u.arrays() or {}
         where = (u.result.get("counters") or {}).get("primary")
         if f"{where}_target" in arr and f"{where}_pred" in arr:
-            found[_name(u) + ("" if u.claim == "fit" else " [evaluate]")] = (arr[f"{where}_target"], arr[f"{where}_pred"])
+            found[unit_name(u) + ("" if u.claim == "fit" else " [evaluate]")] = (arr[f"{where}_target"], arr[f"{where}_pred"])
             one = u.table("one_step.csv")
             if not names and one is not None and {"set", "quantity", "component"} <= set(one.columns):
                 rows = one[one["set"] == where]
@@ -201,62 +161,6 @@ def parity(units, path: Path) -> bool:
     return F.save(fig, path)
 
 
-def _path(ref) -> str:
-    return str(ref or "").removeprefix("file:").split("#sha256=")[0]
-
-
-def _data_para(units) -> Para:
-    from lagbench.replication.fit.derivative_window import describe
-    from lagbench.replication.fit.rows import Overlap
-
-    seen: dict[str, list[str]] = {}
-    for u in units:
-        cfg = u.result.get("eval_config") or {}
-        src = _path(cfg.get("source"))
-        d = cfg.get("derivatives") or {}
-        traj = cfg.get("trajectories") or {}
-        rows = cfg.get("rows") or {}
-        split = " / ".join(f"{rows[k]} {SETS[k]}" for k in SETS if k in rows)
-        whole = " / ".join(f"{traj[k]}" for k in SETS if traj.get(k))
-        text = (f"{cell(src, 'unknown file')}: {split} rows"
-                + (f" ({whole} whole trajectories); derivatives the file lacked estimated by Savitzky–Golay "
-                   f"({describe(d)})" if any(traj.values()) else "")
-                + (f"; test file {_path(cfg['test_source'])}: {cfg.get('test_rows')} rows"
-                   + (f" ({cfg['test_trajectories']} whole trajectories)" if cfg.get("test_trajectories") else "")
-                   + (f", its derivatives by the same rule ({describe(cfg['test_derivatives'])})"
-                      if cfg.get("test_derivatives") else "")
-                   if cfg.get("test_source") else "")
-                + (f"; WARNING: {Overlap(**cfg['training_rows']).words()} are training rows of the fit evaluated, "
-                   f"so its errors there are not predictions of unseen data" if cfg.get("training_rows") else "")
-                + (f"; true energy from system {cfg['system']}" if cfg.get("system") else "")
-                + (f"; true energy from {cfg['energy']}" if cfg.get("energy") else ""))
-        seen.setdefault(text, []).append(f"{u.claim} {_name(u)}")
-    return Para("Data: " + " | ".join(f"{text} ({', '.join(names)})" for text, names in seen.items()) + ".")
-
-
-def _choices_para(units) -> Para | None:
-    """What each fit chose from its data and system: its periodic inputs (`--periodic`), whether it learns a
-    dissipation (`--dissipation`), whether its Lagrangian is even in q-dot (`--even-velocity`, recorded where
-    on) and the loss `--loss-target auto` chose where not the acceleration loss, with the reasons; None where no
-    fit recorded any."""
-    from lagbench.replication.fit import energy_trend, even_velocity, loss_target, periodic_coords
-
-    seen: dict[str, list[str]] = {}
-    for u in units:
-        cfg = u.result.get("eval_config") or {}
-        parts = ([f"periodic inputs {periodic_coords.describe(cfg['periodic'])}"] if cfg.get("periodic") else []) + \
-            ([f"dissipation {energy_trend.describe(cfg['dissipation'])}"] if cfg.get("dissipation") else []) + \
-            ([f"Lagrangian even in q-dot {even_velocity.describe(cfg['even_velocity'])}"] if cfg.get("even_velocity")
-             else []) + \
-            ([f"loss {loss_target.describe(cfg['loss_target'])}"] if cfg.get("loss_target") else [])
-        if u.claim == "fit" and parts:
-            seen.setdefault("; ".join(parts), []).append(_name(u))
-    if not seen:
-        return None
-    return Para("Chosen for the data: " + " | ".join(f"{', '.join(names)}: {text}" for text, names in seen.items())
-                + ".")
-
-
 def fit_sections(res: Results, out_dir: Path) -> list[Section]:
     units = res.usable()
     s = Section("Fitted models")
@@ -269,7 +173,7 @@ def fit_sections(res: Results, out_dir: Path) -> list[Section]:
         s.add(Table("Failed and corrupt units (left out of every number)", bad, ["units/*/*/*/seed*/result.json"]))
     if not units:
         return [s]
-    s.add(_data_para(units), _choices_para(units), _competence_para(units), _recommendation_para(units))
+    s.add(data_para(units), choices_para(units), competence_para(units), recommendation_para(units))
     s.add(Table("The models side by side", _models_table(units), [SRC.format(claim="*") + "result.json"]))
     out = [s]
     e = Section("Errors", level=2)

@@ -16,7 +16,7 @@ HELDOUT_STATES = 4096
 
 
 def cmd_train_target(args):
-    from lagbench.replication.fit.options import widths
+    from lagbench.replication.fit.option_values import widths
     from lagbench.replication.run import splits
     from lagbench.speedstudy import target_distribution as dist
     from lagbench.speedstudy.train_target import protocols

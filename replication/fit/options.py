@@ -1,7 +1,8 @@
 """`lagbench fit`'s options, written once: the keyword of `fit`, the command-line flag, the default, the
 help, how the flag's text is read and what a valid value is.
 
-`OPTIONS`: the records, in the order of the command's help. `resolve(given) -> Options` (attribute access):
+`OPTIONS`: the records, in the order of the command's help (their parsers and validators:
+`replication.fit.option_values`). `resolve(given) -> Options` (attribute access):
 every option's value, the default where not given; a TypeError names a keyword that is no option.
 `check(values)`: a ValueError naming the first invalid option of `values` (any subset, by keyword) and
 what it accepts. `add_arguments(parser)`: the flags of `lagbench fit`. `from_args(args) -> dict`: the
@@ -19,13 +20,21 @@ from lagbench.replication.fit.energy_trend import MODES as DISSIPATION_MODES
 from lagbench.replication.fit.even_velocity import MODES as EVEN_VELOCITY_MODES
 from lagbench.replication.fit.kind_defaults import HELDOUT_CHECKS, MIN_IMPROVEMENT
 from lagbench.replication.fit.loss_target import MODES as LOSS_TARGETS
+from lagbench.replication.fit.option_values import (
+    count,
+    one_of,
+    periodic_value,
+    scale,
+    valid_periodic,
+    widths,
+)
 from lagbench.replication.fit.rows import HELDOUT, SPLITS
 from lagbench.replication.fit.time_base import TIME_UNITS
 from lagbench.replication.fit.trajectories import AUTO, GAPS, MAX_GAP, POLYORDER, window_value
 from lagbench.replication.fit.windows import FRAMES, SUBSTEPS
 from lagbench.replication.renamed import renamed
 from lagbench.replication.training.protocol_parts import TRAJECTORY_SCALES
-from lagbench.validate import is_integer, is_real
+from lagbench.validate import is_real
 
 MODELS = ("lnn", "hnn", "delan", "baseline")
 FRAMEWORKS = ("jax", "torch")
@@ -44,47 +53,6 @@ BY_KIND = _ByKind()
 KIND = " (default: the model kind's, from the suite's protocols; see docs/fit.md)"
 HORIZON_HELP = ("seconds from each trajectory's start that the rollouts cover (longer trajectories are rolled "
                 "out and scored to there)")
-
-
-def count(low):
-    return lambda v: is_integer(v) and v >= low
-
-
-def one_of(values):
-    return lambda v: v in values
-
-
-def widths(text: str, option: str = "--hidden") -> tuple:
-    """Layer widths from "128,128"; a ValueError naming `option` otherwise (also `lagbench train-target`'s)."""
-    try:
-        out = tuple(int(x) for x in text.split(","))
-    except ValueError:
-        out = ()
-    if not out or min(out) < 1:
-        raise ValueError(f"{option} takes comma-separated layer widths >= 1 such as 128,128; got {text!r}")
-    return out
-
-
-def scale(text: str):
-    """--input-scale: None (none), "auto" or a tuple of numbers."""
-    if text in ("none", "auto"):
-        return None if text == "none" else "auto"
-    try:
-        return tuple(float(x) for x in text.split(","))
-    except ValueError:
-        raise ValueError(f"--input-scale takes none, auto or comma-separated numbers such as 1,1,0.3,0.3; got "
-                         f"{text!r}") from None
-
-
-def periodic_value(text: str):
-    """--periodic: "auto", () for none, or a tuple of indices (a non-digit left for `valid_periodic` to refuse)."""
-    if text in (AUTO, "none"):
-        return AUTO if text == AUTO else ()
-    return tuple(int(x) if x.strip().isdigit() else x for x in text.split(","))
-
-
-def valid_periodic(v) -> bool:
-    return v == AUTO or (isinstance(v, tuple | list) and all(count(0)(k) for k in v))
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from lagbench.files.results import write_csv
 from lagbench.replication.fit import energy_trend, periodic_coords, trajectories
 from lagbench.replication.fit import options as fit_options
 from lagbench.replication.fit.simulate import simulate
-from lagbench.reports.sections_fit import _choices_para
+from lagbench.reports.fit_paragraphs import choices_para as _choices_para
 
 # (system, trajectories, duration, rate): small files of the recordings the rule was calibrated on
 RECORDINGS = {"pendulum": (3, 5.0, 50.0), "double_pendulum": (3, 4.0, 100.0)}
