@@ -28,6 +28,10 @@ def cmd_tune(args):
                      + ", ".join(f"{k}: {_num(v)}" for k, v in m["confirmation"].items()) + ")")
         print(f"{label:<22} chose config {m['chosen']} {m['chosen_knobs']} of {m['configs_tried']} "
               f"({scores}){confirmed}")
+    if ledger.get("edge_stopped"):
+        print("edge step bounded (" + ", ".join(f"{k} at most x{v:g}" for k, v in ledger["edge_limits"].items())
+              + ", every model alike): not tried " + ", ".join(f"lr x{p['lr']:.3g} width x{p['width']:g}"
+                                                               for p in ledger["edge_stopped"]))
     c = ledger["compute"]
     print(f"compute: {c['units']} units, {c['train_s'] / 3600:.2f} h of training")
     return 0

@@ -92,10 +92,12 @@ def test_the_whole_search_extends_an_edge_for_every_model_and_confirms_on_three_
     assert "| dp_loss | smoke | lnn | 11 | lr x1, width x4 |" in text and "| dp_loss | smoke | baseline | 11 | lr x1, width x1 |" in text
 
 
-def test_a_declared_edge_limit_stops_the_step_for_both_models_and_the_ledger_says_so(tmp_path, monkeypatch):
+def test_a_declared_edge_limit_stops_the_step_for_both_models_and_the_ledger_says_so(tmp_path, monkeypatch, capsys):
     _fake_search(monkeypatch, lambda label, knobs, seed: 1.0 / knobs["width"] + abs(knobs["lr"] - 1) + seed)  # widest best
     monkeypatch.setitem(search.EDGE_LIMITS, ("dp_loss", "smoke"), {"width": 2.0})
-    ledger = tune("dp_loss", profile="smoke", out=tmp_path, progress=False)
+    assert main(["tune", "--claim", "dp_loss", "--profile", "smoke", "--out", str(tmp_path), "--quiet"]) == 0
+    assert "edge step bounded (width at most x2, every model alike): not tried lr x1 width x4" in capsys.readouterr().out
+    ledger = json.loads((tmp_path / "ledger.json").read_text())
     assert all(m["configs_tried"] == 9 for m in ledger["models"].values())   # width x 4 tried by neither
     assert ledger["edge_limits"] == {"width": 2.0} and ledger["edge_stopped"] == [{"lr": 1.0, "width": 4.0}]
     assert all(m["chosen_knobs"] == {"lr": 1.0, "width": 2.0} for m in ledger["models"].values())
