@@ -186,7 +186,7 @@ def test_full_profile_inherits_quick_where_a_claim_is_silent():
     # the double pendulum trains longer and is judged on the paper's held-out size and energy horizon
     u, q = full["dp_energy/jax/lnn/seed0"], quick["dp_energy/jax/lnn/seed0"]
     assert u.protocol().steps > q.protocol().steps and u.protocol().data.n_heldout == 100_000
-    assert u.claim.evaluation_config("full")["n_ics"] == 40 and u.spec().hidden == (128, 128, 128)
+    assert u.claim.evaluation_config("full")["n_ics"] == 40 and u.spec().hidden == (256, 256, 256)   # widths x 2, adopted
     # a claim without a full entry runs exactly its quick protocol and model
     w, wq = full["hnn_energy/jax/hnn_spring/seed0"], quick["hnn_energy/jax/hnn_spring/seed0"]
     assert w.protocol() == wq.protocol() and w.spec() == wq.spec()
