@@ -106,9 +106,8 @@ def choices_line(records: dict) -> None:
     if records.get("even_velocity"):
         print(f"lagbench fit: Lagrangian even in q-dot: {even_velocity.describe(records['even_velocity'])}",
               file=sys.stderr)
-    target = records.get("loss_target") or {}
-    if target.get("mode") == "auto" and target.get("chosen") != "acceleration":
-        print(f"lagbench fit: loss: {loss_target.describe(target)}", file=sys.stderr)
+    if loss_target.auto_departed(records.get("loss_target") or {}):
+        print(f"lagbench fit: loss: {loss_target.describe(records['loss_target'])}", file=sys.stderr)
 
 
 def add_fit(sub) -> None:

@@ -6,7 +6,8 @@ derivative columns the file has, none), where a registered study measured it (do
 "The study: the filtered acceleration loss": on simulated double-pendulum recordings at 0.5 degree of noise
 DeLaN read the friction within 3.4 % on the median seed against 16 % under the acceleration loss, with 0.61 x
 its rollout error; the LNN, at the acceleration loss's work a step, and the baseline rolled out worse under it);
-"acceleration" otherwise. `describe(record)` in words for the console and the report.
+"acceleration" otherwise. `describe(record)` in words for the console and the report; `auto_departed(record)`:
+whether `auto` chose another loss than the acceleration loss (what the console and eval_config report).
 """
 from __future__ import annotations
 
@@ -29,3 +30,7 @@ def choose(mode: str, kind: str, task: str, recording: bool, given) -> dict:
 
 def describe(record: dict) -> str:
     return f"{record.get('chosen')} (--loss-target {record.get('mode')}): {record.get('why')}"
+
+
+def auto_departed(record: dict) -> bool:
+    return record.get("mode") == "auto" and record.get("chosen") != "acceleration"

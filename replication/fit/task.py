@@ -61,6 +61,7 @@ from lagbench.replication.fit import (
     even_velocity,
     filter_rows,
     kind_defaults,
+    loss_target,
     time_base,
     trajectories,
     windows,
@@ -180,7 +181,7 @@ def fit(data, out="results/fit", dtype="float32", on_log=None, on_progress=None,
            "trajectories": prep.trajectories, "periodic": periodic, "dissipation": dissipation}
     if even["chosen"]:   # recorded only when on: the other fits keep their keys
         cfg["even_velocity"] = even
-    if target["mode"] == "auto" and target["chosen"] != "acceleration":   # likewise: a loss auto chose
+    if loss_target.auto_departed(target):   # likewise: a loss auto chose
         cfg["loss_target"] = target
     if o.horizon is not None:   # recorded only when given: fits without it keep their keys
         cfg["horizon"] = float(o.horizon)
