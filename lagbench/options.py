@@ -117,14 +117,14 @@ def respell(parser, old: str, new: str, why: str = "", **changes) -> argparse.Ac
     return added
 
 
-def _names(text) -> tuple[str, ...]:
+def names(text) -> tuple[str, ...]:
     """The names of a comma-separated text, stripped, each once, in order."""
     return tuple(dict.fromkeys(t.strip() for t in str(text).split(",") if t.strip()))
 
 
 def frameworks(text: str, option: str = "--frameworks") -> tuple[str, ...]:
     """The frameworks of a --frameworks text ("jax,torch"), each once; a ValueError naming `option` otherwise."""
-    got = _names(text)
+    got = names(text)
     if not got or any(t not in FRAMEWORKS for t in got):
         raise ValueError(f"{option} {text}: expected a comma-separated subset of {', '.join(FRAMEWORKS)}")
     return got
@@ -135,7 +135,7 @@ def one_framework(command: str):
     def check(text):
         if text is None:
             return None
-        got = _names(text)
+        got = names(text)
         if len(got) != 1 or got[0] not in FRAMEWORKS:
             raise ValueError(f"--frameworks {text}: `lagbench {command}` runs in one framework; give one of "
                              f"{', '.join(FRAMEWORKS)}")

@@ -1,14 +1,16 @@
 """`lagbench verify`: a results folder re-checked by retraining some of its units from scratch.
 
-`verify(results, n, seed=0, jobs=1, progress=True) -> DataFrame`: picks `n` of the folder's finished units
-at random (NumPy's generator seeded with `seed`, over the candidates sorted by name: the same seed picks the
+`verify(results, n, seed=0, jobs=1, progress=True, only=None) -> DataFrame`: picks `n` of the folder's finished
+units at random (NumPy's generator seeded with `seed`, over the candidates sorted by name: the same seed picks the
 same units), retrains each from nothing in a temporary folder through the code a run uses
 (`executor.run_units`: no training cache, the unit's protocol, seed, framework and evaluation) and compares
 what it gets with what the folder holds: every metric of result.json, the status, the final training loss,
 the steps and samples trained. A metric of wall time (`TIMING`: microseconds per rollout step, a controller's
 compute time) differs from run to run: it is written beside the others as "timing", not compared. The candidates are the units this code can rerun as they were made:
 verified, of a claim and model this code has (a user's model is not: its code is not in the folder), and
-current (`runner.is_current`: the same protocol, spec and evaluation as this code's).
+current (`runner.is_current`: the same protocol, spec and evaluation as this code's). `only` ({"claims":
+names, "frameworks": names, "models": names}, each optional) narrows the candidates before the draw, so that a
+check can aim at a costly claim or at one framework; a name no candidate has is an error naming it.
 
 Each value is "identical" (equal bit for bit; both absent or NaN count as equal), else its relative difference
 |a - b| / max(|a|, |b|) is held against a tolerance: `SAME_TOL` where the unit retrained where it was made (the
@@ -78,6 +80,25 @@ def candidates(results) -> tuple[list, list[str]]:
     return sorted(units, key=lambda u: u.name), skipped
 
 
+FILTERS = {"claims": ("--claims", lambda u: u.claim.id), "frameworks": ("--frameworks", lambda u: u.framework),
+           "models": ("--models", lambda u: u.entry.label)}
+
+
+def narrowed(units: list, only: dict | None) -> list:
+    """The units whose claim, framework and model are among `only`'s names (a key left out or None: any)."""
+    for key, names in (only or {}).items():
+        if not names:
+            continue
+        option, name_of = FILTERS[key]
+        have = {name_of(u) for u in units}
+        missing = [n for n in names if n not in have]
+        if missing:
+            raise ValueError(f"{option} {','.join(names)}: no unit to retrain of {', '.join(missing)}"
+                             f" (the folder's candidates have {', '.join(sorted(have)) or 'none'})")
+        units = [u for u in units if name_of(u) in names]
+    return units
+
+
 def pick(units: list, n: int, seed: int) -> list:
     idx = np.random.default_rng(seed).choice(len(units), size=min(n, len(units)), replace=False)
     return [units[i] for i in sorted(idx)]
@@ -137,7 +158,7 @@ def where() -> str:
 
 
 @R.writes
-def verify(results, n: int, seed: int = 0, jobs: int = 1, progress: bool = True) -> pd.DataFrame:
+def verify(results, n: int, seed: int = 0, jobs: int = 1, progress: bool = True, only: dict | None = None) -> pd.DataFrame:
     results = Path(results)
     if not is_integer(n) or n < 1:
         raise ValueError(f"--units: {n!r} is not valid; expected an integer >= 1 (how many units to retrain)")
@@ -149,6 +170,7 @@ def verify(results, n: int, seed: int = 0, jobs: int = 1, progress: bool = True)
     if not units:
         raise ValueError(f"--results {results}: no finished unit this code can retrain as it was made"
                          + (f" ({skipped[0]}{'; ...' if len(skipped) > 1 else ''})" if skipped else ""))
+    units = narrowed(units, only)
     chosen = pick(units, n, seed)
     folder = R.output_folder(results / FILE.parent, "--results")
     at, here, commit = env.now(), where(), env.commit()

@@ -9,11 +9,14 @@ from lagbench.replication.training.device import HELP as DEVICE_HELP
 
 
 def cmd_verify(args):
+    from lagbench.options import frameworks, names
     from lagbench.replication.run.verify import summary, verify
     from lagbench.replication.training import device
 
     device.apply(args.device, ("jax", "torch"))
-    rows = verify(args.results, args.units, seed=args.seed, jobs=args.jobs, progress=not args.quiet)
+    only = {"claims": args.claims and names(args.claims), "models": args.models and names(args.models),
+            "frameworks": args.frameworks and frameworks(args.frameworks)}
+    rows = verify(args.results, args.units, seed=args.seed, jobs=args.jobs, progress=not args.quiet, only=only)
     print(summary(rows))
     print(f"written to {args.results}/verify/verify.csv")
     return 0 if rows["outcome"].isin(("identical", "within", "timing")).all() else 1
@@ -34,6 +37,12 @@ def add_command(sub) -> None:
     s.add_argument("--units", type=int, default=3, help="how many units to retrain (default: 3)")
     s.add_argument("--seed", type=int, default=0, help="the seed of the random choice of units: the same seed "
                    "picks the same units (default: 0)")
+    s.add_argument("--claims", help="comma-separated claim ids: draw the units among these claims' only, e.g. "
+                   "dp_loss for a double-pendulum training (default: every claim)")
+    s.add_argument("--frameworks", help="comma-separated: jax, torch: draw among these frameworks' units only "
+                   "(default: both)")
+    s.add_argument("--models", help="comma-separated model labels: draw among these models' units only (default: "
+                   "every model)")
     s.add_argument("--jobs", type=int, default=1, help="worker processes, as `lagbench run --jobs` (default: 1)")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)

@@ -92,3 +92,18 @@ def test_a_packed_training_retrained_alone_is_held_to_the_tolerance_of_another_e
     assert not V.same_environment(packed, env)
     assert {r["tolerance"] for r in V.compare(packed, {**env, "metrics": {"m": 1.01}})} == {V.OTHER_TOL}
     assert V.same_environment(packed, dict(packed))
+
+
+def test_the_draw_can_be_narrowed_to_claims_frameworks_and_models_and_a_missing_name_is_named(two_units, capsys):
+    units, _ = V.candidates(two_units)
+    assert V.narrowed(units, {"claims": ("dp_loss",), "models": ("baseline",), "frameworks": None}) == units
+    assert V.narrowed(units, None) == units
+    with pytest.raises(ValueError, match=r"--frameworks torch: no unit to retrain of torch .*have jax\)"):
+        V.narrowed(units, {"frameworks": ("torch",)})
+    with pytest.raises(ValueError, match=r"--models baseline,lnn: no unit to retrain of lnn"):
+        V.narrowed(units, {"models": ("baseline", "lnn")})
+    before = sorted(p.name for p in two_units.rglob("*"))
+    code = main(["verify", "--results", str(two_units), "--claims", "rel_coords", "--quiet"])
+    err = capsys.readouterr().err
+    assert code != 0 and "--claims rel_coords: no unit to retrain of rel_coords" in err
+    assert sorted(p.name for p in two_units.rglob("*")) == before   # nothing written
