@@ -2,8 +2,13 @@
 steps at a constant rate LR (its spec kept, no restarts, no early stop), and what it then reads of the friction
 and its errors on the test file. The fit starts from the given parameters by standing in for the init.
 
-    python docs/lab/recording_defaults/finetune_trajectory.py OUT/s0-lnn OUT/s0-lnn_ft STEPS LR [FRAMES]
+    python docs/lab/recording_defaults/finetune_trajectory.py OUT/s0-lnn OUT/s0-lnn_ft STEPS LR [FRAMES] [--both]
     (run.sh's folder layout: the training and test files in OUT/data)
+
+--both: every window also read backwards (the model integrated from the window's last frame to its first, h < 0).
+A window's start velocity is a noisy estimate; matching the positions after it, a model with more damping
+forgets that error sooner and so fits better (the friction read high), while integrated backwards more
+damping amplifies it: the two directions pull the friction opposite ways, to first order equally.
 """
 import glob
 import sys
@@ -12,12 +17,31 @@ from pathlib import Path
 
 import numpy as np
 
-from lagbench.replication.fit import task
+from lagbench.replication.fit import task, windows
 from lagbench.replication.fit.load import load_fitted
 from lagbench.replication.training import train
 
 
-def main(folder: str, out: str, steps: int, lr: float, frames: int = 5) -> None:
+def both_directions(forward):
+    def both(r, part, loss):
+        k = part.frames
+        at = [np.zeros((0, k + 1), int)]
+        for rows, frame in windows.runs(r):
+            ok = windows.consecutive(frame, k)
+            at.append(rows[ok[:, None] + np.arange(k + 1)])
+        at = np.concatenate(at)
+        at = np.concatenate([at, at[:, ::-1]])
+        first, q, t = at[:, 0], r["q"], r["t"]
+        h = ((t[at[:, -1]] - t[first]) / k)[:, None]
+        scale = windows.scale_of(h, k, loss, part.scale)
+        target = ((q[at[:, 1:]] - q[first][:, None, :]) * scale[:, :, None]).reshape(first.size, k * q.shape[1])
+        return {"q": q[first], "qdot": r["qdot"][first], "h": h, "scale": scale, "target": target}
+    return both
+
+
+def main(folder: str, out: str, steps: int, lr: float, frames: int = 5, both: bool = False) -> None:
+    if both:
+        windows.windows = both_directions(windows.windows)
     f = load_fitted(glob.glob(folder + "/units/fit/jax/*/seed0")[0])
     start = {k: np.asarray(v) for k, v in f.params.items()}
     fresh = train.init_params
@@ -41,4 +65,5 @@ def main(folder: str, out: str, steps: int, lr: float, frames: int = 5) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4]), *(int(a) for a in sys.argv[5:6]))
+    args = [a for a in sys.argv[1:] if a != "--both"]
+    main(args[0], args[1], int(args[2]), float(args[3]), *(int(a) for a in args[4:5]), both="--both" in sys.argv)
