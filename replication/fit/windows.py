@@ -11,7 +11,8 @@ frames of its grid, each of them a row; by trajectory (in the rows' order), then
   scale    (B, 1): the factor `scale_of` gives the window;
   target   (B, K*dof): (q_k - q_0) x scale for k = 1..K, frame after frame (what
            `replication.training.objective.positions` predicts).
-A window never crosses a trajectory's end, a cut `--gaps split` makes (its pieces are trajectories of their own)
+`window_rows(r, k)` gives each window's rows and `windows_of(r, at, part, loss)` the batch dict of any such
+rows (a lab pilot reads windows backwards through it). A window never crosses a trajectory's end, a cut `--gaps split` makes (its pieces are trajectories of their own)
 or an interpolated frame: `--gaps interpolate` fills dropped frames for the derivative filter only, and a window
 that would hold a filled frame is not cut (its positions are made up).
 
@@ -62,13 +63,22 @@ def consecutive(frame, k: int):
     return np.flatnonzero(frame[k:] - frame[:frame.size - k] == k)
 
 
-def windows(r: dict, part, loss: str) -> dict:
-    k = part.frames
-    at = [np.zeros((0, k + 1), int)]   # per window, its rows: the start and the K frames after it
+def window_rows(r: dict, k: int) -> np.ndarray:
+    """(windows, k + 1): each window's rows, its start and the K frames after it."""
+    at = [np.zeros((0, k + 1), int)]
     for rows, frame in runs(r):
         ok = consecutive(frame, k)
         at.append(rows[ok[:, None] + np.arange(k + 1)])
-    at = np.concatenate(at)
+    return np.concatenate(at)
+
+
+def windows(r: dict, part, loss: str) -> dict:
+    return windows_of(r, window_rows(r, part.frames), part, loss)
+
+
+def windows_of(r: dict, at: np.ndarray, part, loss: str) -> dict:
+    """The batch dict of the windows whose rows `at` holds (`window_rows`), frame by frame from its first."""
+    k = part.frames
     first, q, t = at[:, 0], r["q"], r["t"]
     h = ((t[at[:, -1]] - t[first]) / k)[:, None]
     scale = scale_of(h, k, loss, part.scale)

@@ -22,26 +22,15 @@ from lagbench.replication.fit.load import load_fitted
 from lagbench.replication.training import train
 
 
-def both_directions(forward):
-    def both(r, part, loss):
-        k = part.frames
-        at = [np.zeros((0, k + 1), int)]
-        for rows, frame in windows.runs(r):
-            ok = windows.consecutive(frame, k)
-            at.append(rows[ok[:, None] + np.arange(k + 1)])
-        at = np.concatenate(at)
-        at = np.concatenate([at, at[:, ::-1]])
-        first, q, t = at[:, 0], r["q"], r["t"]
-        h = ((t[at[:, -1]] - t[first]) / k)[:, None]
-        scale = windows.scale_of(h, k, loss, part.scale)
-        target = ((q[at[:, 1:]] - q[first][:, None, :]) * scale[:, :, None]).reshape(first.size, k * q.shape[1])
-        return {"q": q[first], "qdot": r["qdot"][first], "h": h, "scale": scale, "target": target}
-    return both
+def both_directions(r, part, loss):
+    """`windows.windows`, with every window also read from its last frame to its first."""
+    at = windows.window_rows(r, part.frames)
+    return windows.windows_of(r, np.concatenate([at, at[:, ::-1]]), part, loss)
 
 
 def main(folder: str, out: str, steps: int, lr: float, frames: int = 5, both: bool = False) -> None:
     if both:
-        windows.windows = both_directions(windows.windows)
+        windows.windows = both_directions
     f = load_fitted(glob.glob(folder + "/units/fit/jax/*/seed0")[0])
     start = {k: np.asarray(v) for k, v in f.params.items()}
     fresh = train.init_params
