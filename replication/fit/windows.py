@@ -59,7 +59,10 @@ def runs(r: dict) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def consecutive(frame, k: int):
-    # frames strictly increase, so k + 1 of them span exactly k steps only where none is missing
+    # frames strictly increase, so k + 1 of them span exactly k steps only where none is missing; a run of at
+    # most k frames holds no such span (and `frame[:size - k]` would wrap around)
+    if frame.size <= k:
+        return np.zeros(0, int)
     return np.flatnonzero(frame[k:] - frame[:frame.size - k] == k)
 
 

@@ -57,3 +57,13 @@ def test_bad_input_fails_in_one_line(recording, tmp_path, case, options, match):
             **{"loss_target": "trajectory", **options})
     assert "\n" not in str(e.value)
     assert not (tmp_path / "out" / "units").exists()   # refused before anything trained
+
+
+def test_a_run_shorter_than_a_window_holds_no_window():
+    import numpy as np
+
+    from lagbench.replication.fit.windows import consecutive
+
+    for size in range(7):
+        assert consecutive(np.arange(size), 5).tolist() == ([0] if size == 6 else [])
+    assert consecutive(np.array([0, 1, 2, 4, 5, 6, 7, 8]), 3).tolist() == [3, 4]
