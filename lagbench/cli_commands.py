@@ -57,11 +57,15 @@ def cmd_list(args):
 
 def cmd_run(args):
     from lagbench.replication.claims.base import run_frameworks
+    from lagbench.replication.run import environment
     from lagbench.replication.run.runner import run
     from lagbench.replication.training import device
 
     frameworks = _csv(args.frameworks)   # None: the profile's (`PROFILE_FRAMEWORKS`)
     seeds = options.seeds_or_count(args)   # None: the profile's
+    if environment.worker_torch_threads(args.executor, args.jobs) is not None:
+        environment.one_thread_jax()   # the estimate's JAX probes at the workers' one thread, before the
+        # device check below starts JAX's backend
     device.apply(args.device, run_frameworks(args.profile, frameworks))
     summary = run(profile=args.profile, out=args.out or f"results/{args.profile}", claims=_csv(args.claims),
                   frameworks=frameworks, seeds=seeds, models=_csv(args.models),

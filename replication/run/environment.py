@@ -18,8 +18,10 @@ WORKER_THREADS = 1   # PyTorch / OpenMP / MKL threads of a worker process or Ray
 
 def one_thread_env(env) -> dict:
     """The environment variables that hold a new process's JAX (XLA's Eigen pool off, appended to any
-    XLA_FLAGS already in `env`), PyTorch/OpenMP and MKL to one thread."""
-    return {"XLA_FLAGS": f"{env.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip(), "OMP_NUM_THREADS": str(WORKER_THREADS),
+    XLA_FLAGS already in `env` unless there), PyTorch/OpenMP and MKL to one thread."""
+    flags = env.get("XLA_FLAGS", "")
+    xla = flags if ONE_CORE_XLA in flags else f"{flags} {ONE_CORE_XLA}".strip()
+    return {"XLA_FLAGS": xla, "OMP_NUM_THREADS": str(WORKER_THREADS),
             "MKL_NUM_THREADS": str(WORKER_THREADS)}
 
 
@@ -36,6 +38,21 @@ def one_thread_children():
     finally:
         for k, v in saved.items():
             os.environ.pop(k, None) if v is None else os.environ.__setitem__(k, v)
+
+
+def one_thread_jax() -> bool:
+    """Hold this process's JAX to one thread, as a worker's (`ONE_CORE_XLA`, which XLA reads when JAX's backend
+    starts): True if that is in force (in XLA_FLAGS already, or set here before the start); False once the
+    backend has started without it, when this process's JAX runs on every core."""
+    from lagbench.models.jax.compiled import _backend_started
+
+    flags = os.environ.get("XLA_FLAGS", "")
+    if ONE_CORE_XLA in flags:
+        return True
+    if _backend_started():
+        return False
+    os.environ["XLA_FLAGS"] = f"{flags} {ONE_CORE_XLA}".strip()
+    return True
 
 
 def _exit_with(parent: int, every: float = 1.0):

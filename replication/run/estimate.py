@@ -14,7 +14,10 @@ The probes run on the device the units will train on (`replication.training.devi
 and PyTorch at `torch_threads` intra-op threads: the setting of the processes that will train
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
 one local job trains them here): probed at another thread count than the workers', a step on busy cores
-can take many times as long (measurements: `docs/decisions/run_estimate.md`). What the estimate leaves
+can take many times as long (measurements: `docs/decisions/run_estimate.md`). Where the workers run on one
+thread, JAX is probed on one too (`environment.one_thread_jax`, which holds this process's XLA to it before
+its backend starts): probed on both cores of the 2-core machine, `full`'s double-pendulum LNN step took 2.5 x
+as long in a worker beside another as in the probe. What the estimate leaves
 out: two workers slow each other down, evaluation, and the first step of a PyTorch phase under
 torch.compile (`compile_torch.like`: the probe compiles as the phase will), which compiles.
 
@@ -97,16 +100,20 @@ def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: 
     {claim id: seconds}, "by_group": {training program: seconds}}. A training that several claims share
     (claims 1, 2 and 11 train the same double-pendulum models) counts for the first claim planned with it.
     `keep`: write this machine's probes to OUT/`PROBES`, so that a resumed run on the same machine reuses them
-    rather than probing again. `members`: {framework: seeds a program} of a packed run (module docstring)."""
+    rather than probing again. `members`: {framework: seeds a program} of a packed run (module docstring).
+    `torch_threads` given (the units train in workers): JAX is probed on one thread as well."""
     threads = torch_threads if any(u.framework == "torch" for u in units) else None
-    known = _read_probes(out, threads)
+    jax_threads = None   # this process's own, where one local job trains the units here
+    if torch_threads is not None and any(u.framework == "jax" for u in units):
+        jax_threads = env.WORKER_THREADS if env.one_thread_jax() else "every core"
+    known = _read_probes(out, threads, jax_threads)
     with threads_of_torch(threads):
         est = _estimate(units, out, jobs, known)
         packs = _packs(units, members)
         if packs:
             est["cohorts"] = _packed(units, out, jobs, known, est["by_group"], packs)
     if keep:
-        R.write_json(Path(out) / PROBES, {"machine": _machine(threads), "per_step": {
+        R.write_json(Path(out) / PROBES, {"machine": _machine(threads, jax_threads), "per_step": {
             k: [plain, {str(m): s for m, s in members.items()}] for k, (plain, members) in known.items()}})
     return est
 
@@ -115,23 +122,32 @@ def estimate(units, out, jobs: int = 1, torch_threads: int | None = None, keep: 
 PROBES = "estimate_probes.json"
 
 
-def _machine(torch_threads) -> dict:
+# each framework's threads in the record: a change to one probes that framework's configurations again
+THREADS = {"torch": "torch_threads", "jax": "jax_threads"}
+
+
+def _machine(torch_threads, jax_threads=None) -> dict:
     """What a probe's time depends on besides the configuration: the hardware, the device the run trains
-    on, PyTorch's threads and the versions of the frameworks."""
+    on, PyTorch's and JAX's threads and the versions of the frameworks."""
     hw = env.hardware()
     return {**{k: hw.get(k) for k in ("cpu", "cpu_model", "cpu_features", "cores", "gpu")},
-            "device": dev.request(), "torch_threads": torch_threads, "probe_steps": PROBE_STEPS,
+            "device": dev.request(), "torch_threads": torch_threads, "jax_threads": jax_threads,
+            "probe_steps": PROBE_STEPS,
             **{k: v for k, v in env.versions().items() if k in ("python", "jax", "jaxlib", "torch")}}
 
 
-def _read_probes(out, torch_threads) -> dict:
-    """The probes of OUT's record when they ran on this machine as it is now (else none)."""
+def _read_probes(out, torch_threads, jax_threads=None) -> dict:
+    """The probes of OUT's record when they ran on this machine as it is now (else none), of the frameworks
+    whose threads are as they are now."""
     try:
         rec = json.loads((Path(out) / PROBES).read_text())
-        if rec.get("machine") != json.loads(json.dumps(_machine(torch_threads))):
+        was, now = rec["machine"], json.loads(json.dumps(_machine(torch_threads, jax_threads)))
+        if {k: v for k, v in was.items() if k not in THREADS.values()} != \
+                {k: v for k, v in now.items() if k not in THREADS.values()}:
             return {}
+        same = {fw for fw, key in THREADS.items() if was.get(key) == now[key]}
         return {k: (float(plain), {int(m): float(x) for m, x in members.items()})
-                for k, (plain, members) in rec["per_step"].items()}
+                for k, (plain, members) in rec["per_step"].items() if json.loads(k)[0] in same}
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return {}   # none, unreadable or of another form: probed again
 

@@ -179,6 +179,59 @@ def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, m
     assert worker_torch_threads("ray", 1) == 1 and worker_torch_threads("local", 3) == 1
 
 
+def test_estimate_probes_jax_on_the_workers_one_thread_and_a_change_of_threads_reprobes_that_framework_alone(
+        tmp_path, monkeypatch):
+    # workers run XLA on one thread; a probe on every core of a 2-core machine read 2.5 x fast (estimate.py)
+    import json
+    import os
+
+    from lagbench.models.jax import compiled
+    from lagbench.replication.run import estimate as E
+    from lagbench.replication.run.environment import ONE_CORE_XLA
+
+    calls = []
+    monkeypatch.setattr(E, "_plain_step", lambda fw, *a: calls.append(fw) or 2.0)
+    monkeypatch.setattr(E, "_members_step", lambda fw, *a: calls.append(fw) or 3.0)
+    units = plan("smoke", claims=["dp_loss"], models=["lnn"])
+    monkeypatch.setenv("XLA_FLAGS", "--xla_dump_to=/nowhere")
+    monkeypatch.setattr(compiled, "_backend_started", lambda: True)   # too late to hold it: every core
+    estimate(units, tmp_path, jobs=2, torch_threads=1, keep=True)
+    assert json.loads((tmp_path / E.PROBES).read_text())["machine"]["jax_threads"] == "every core"
+    assert os.environ["XLA_FLAGS"] == "--xla_dump_to=/nowhere" and set(calls) == {"jax", "torch"}
+    monkeypatch.setattr(compiled, "_backend_started", lambda: False)  # before the backend starts: held to one
+    calls.clear()
+    again = estimate(units, tmp_path, jobs=2, torch_threads=1, keep=True)
+    assert os.environ["XLA_FLAGS"] == f"--xla_dump_to=/nowhere {ONE_CORE_XLA}"
+    assert json.loads((tmp_path / E.PROBES).read_text())["machine"]["jax_threads"] == 1
+    assert set(calls) == {"jax"} and 0 < again["probes_reused"] < again["probes"]   # PyTorch's probes kept
+    calls.clear()
+    assert estimate(units, tmp_path, jobs=2, torch_threads=1)["probes_reused"] == again["probes"] and not calls
+    calls.clear()
+    estimate(units, tmp_path, jobs=1)   # one job: both at this process's own setting, both probed again
+    assert set(calls) == {"jax", "torch"}
+
+
+def test_run_holds_jax_to_the_workers_one_thread_before_the_device_check_starts_its_backend(tmp_path, monkeypatch):
+    import os
+
+    from lagbench.models.jax import compiled
+    from lagbench.replication.run.environment import ONE_CORE_XLA
+    from lagbench.replication.training import device
+
+    def apply(*_):   # the device check starts JAX's backend: what XLA_FLAGS hold then is what XLA reads
+        seen.append(os.environ["XLA_FLAGS"])
+        raise device.DeviceError("stopped here by the test")
+
+    seen = []
+    monkeypatch.setattr(device, "apply", apply)
+    monkeypatch.setattr(compiled, "_backend_started", lambda: False)
+    for jobs, held in (("1", False), ("2", True)):   # one job trains here, at this process's own setting
+        monkeypatch.setenv("XLA_FLAGS", "")
+        assert main(["run", "--profile", "smoke", "--claims", "hnn_energy", "--dry-run", "--jobs", jobs,
+                     "--out", str(tmp_path / "out")]) == 2
+        assert (ONE_CORE_XLA in seen[-1]) == held
+
+
 def test_full_profile_inherits_quick_where_a_claim_is_silent():
     full = {u.name: u for u in plan("full", frameworks=("jax",))}
     quick = {u.name: u for u in plan("quick", frameworks=("jax",))}

@@ -26,10 +26,10 @@ from identification import oracle  # noqa: E402
 def main(noisy: str, clean: str, windows: list[int]) -> None:
     exact = systems.registry.get("double_pendulum", friction=0.2)
     exact_conservative = systems.registry.get("double_pendulum", friction=0.0)
-    files = {name: user_data.read(path)[1] for name, path in (("noisy", noisy), ("clean", clean))}
+    paths = {"noisy": noisy, "clean": clean}
+    files = {name: user_data.read(path)[1] for name, path in paths.items()}
     for w in windows:
-        r = {name: trajectories.with_derivatives(d, path, w, 3, gaps="split")
-             for (name, d), path in zip(files.items(), (noisy, clean))}
+        r = {name: trajectories.with_derivatives(d, paths[name], w, 3, gaps="split") for name, d in files.items()}
         if not np.array_equal(r["noisy"]["t"], r["clean"]["t"]):
             raise SystemExit("the two files do not hold the same rows: simulate both with the same seed")
         c = {k: np.asarray(r["clean"][k], np.float64) for k in ("q", "qdot", "qddot")}
