@@ -181,7 +181,7 @@ def test_estimate_probes_pytorch_at_the_threads_the_units_train_with(tmp_path, m
 
 def test_estimate_probes_jax_on_the_workers_one_thread_and_a_change_of_threads_reprobes_that_framework_alone(
         tmp_path, monkeypatch):
-    # workers run XLA on one thread; a probe on every core of a 2-core machine read 2.5 x fast (estimate.py)
+    # workers run XLA on one thread: the probes time JAX as they train (estimate.py)
     import json
     import os
 
