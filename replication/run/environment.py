@@ -46,12 +46,11 @@ def one_thread_jax() -> bool:
     backend has started without it, when this process's JAX runs on every core."""
     from lagbench.models.jax.compiled import _backend_started
 
-    flags = os.environ.get("XLA_FLAGS", "")
-    if ONE_CORE_XLA in flags:
+    if ONE_CORE_XLA in os.environ.get("XLA_FLAGS", ""):
         return True
     if _backend_started():
         return False
-    os.environ["XLA_FLAGS"] = f"{flags} {ONE_CORE_XLA}".strip()
+    os.environ["XLA_FLAGS"] = one_thread_env(os.environ)["XLA_FLAGS"]
     return True
 
 

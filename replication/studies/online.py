@@ -244,11 +244,10 @@ def one_thread() -> dict:
     one thread by `online_study` itself."""
     import os
 
-    from lagbench.models.jax.compiled import _backend_started, async_dispatch, use_sync_dispatch
-    from lagbench.replication.run.environment import ONE_CORE_XLA
+    from lagbench.models.jax.compiled import async_dispatch, use_sync_dispatch
+    from lagbench.replication.run.environment import one_thread_jax
 
-    if not _backend_started() and ONE_CORE_XLA not in os.environ.get("XLA_FLAGS", ""):
-        os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} {ONE_CORE_XLA}".strip()
+    one_thread_jax()
     use_sync_dispatch()
     return {"xla_flags": os.environ.get("XLA_FLAGS", ""), "jax_dispatch": "async" if async_dispatch() else "sync",
             "torch_threads": 1}
