@@ -11,8 +11,8 @@ feed-forward call plus the buffer write and the steps). The plant's simulation i
 the robot. The inference mode runs the untrained model: a call's cost does not depend on the weights' values, so
 its timing is the trained model's.
 
-Threads: one, as the online study holds them (`online.one_thread()`: XLA without its Eigen pool, intra-op
-parallelism 1, JAX's CPU programs run inline; PyTorch at 1 intra-op thread). `one_thread()` acts only before
+Threads: one, as the online study holds them (`online.one_thread()`: XLA on one thread, its backend started on one
+CPU, JAX's CPU programs run inline; PyTorch at 1 intra-op thread). `one_thread()` acts only before
 JAX's backend starts, so the bench stage (`control_rate_stage`) measures in a fresh process
 (`python -m lagbench.speedstudy.control_rate`), whose environment also holds OpenMP and MKL to one thread.
 

@@ -5,6 +5,7 @@ import importlib.metadata
 import os
 import platform
 import subprocess
+import sys
 from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
@@ -17,8 +18,9 @@ WORKER_THREADS = 1   # PyTorch / OpenMP / MKL threads of a worker process or Ray
 
 
 def one_thread_env(env) -> dict:
-    """The environment variables that hold a new process's JAX (XLA's Eigen pool off, appended to any
-    XLA_FLAGS already in `env` unless there), PyTorch/OpenMP and MKL to one thread."""
+    """The environment variables of a new process at one thread: PyTorch/OpenMP and MKL, and XLA's Eigen pool
+    off (appended to any XLA_FLAGS already in `env` unless there; XLA's own pool is held by the process's
+    start, `one_thread_jax`)."""
     flags = env.get("XLA_FLAGS", "")
     xla = flags if ONE_CORE_XLA in flags else f"{flags} {ONE_CORE_XLA}".strip()
     return {"XLA_FLAGS": xla, "OMP_NUM_THREADS": str(WORKER_THREADS),
@@ -41,17 +43,57 @@ def one_thread_children():
 
 
 def one_thread_jax() -> bool:
-    """Hold this process's JAX to one thread, as a worker's (`ONE_CORE_XLA`, which XLA reads when JAX's backend
-    starts): True if that is in force (in XLA_FLAGS already, or set here before the start); False once the
-    backend has started without it, when this process's JAX runs on every core."""
+    """Hold this process's JAX to one thread, as a worker's: True if its XLA runs on one thread (JAX's backend
+    started here on one CPU, `_start_jax_on_one_cpu`), False once the backend has started on more. Sets
+    `ONE_CORE_XLA` in XLA_FLAGS before the start, as the workers' environment has it."""
     from lagbench.models.jax.compiled import _backend_started
 
-    if ONE_CORE_XLA in os.environ.get("XLA_FLAGS", ""):
-        return True
     if _backend_started():
-        return False
+        return jax_threads() == 1
     os.environ["XLA_FLAGS"] = one_thread_env(os.environ)["XLA_FLAGS"]
-    return True
+    _start_jax_on_one_cpu()
+    return jax_threads() == 1
+
+
+_JAX_THREADS = None   # XLA's CPU threads where this process started JAX's backend itself (`_start_jax_on_one_cpu`)
+
+
+def _start_jax_on_one_cpu():
+    """Start JAX's backend with one CPU thread. XLA's CPU client sizes its thread pool to the CPUs this
+    process may run on when the backend starts, and reads no flag for it (`ONE_CORE_XLA` leaves a thread a
+    core, each busy: two workers on two cores then run four threads and slow each other, measured in
+    `docs/decisions/run_estimate.md`). So the backend starts with this thread pinned to one CPU, and then every
+    thread of the process gets the whole set back: the pool has one thread, which the OS places on any core."""
+    global _JAX_THREADS
+    import jax
+
+    cpus = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
+    if not cpus or len(cpus) == 1:   # no affinity to set (not Linux), or one CPU already
+        jax.devices()
+        _JAX_THREADS = 1 if cpus else None
+        return
+    os.sched_setaffinity(0, {min(cpus)})
+    try:
+        jax.devices()
+    finally:
+        for task in os.listdir("/proc/self/task"):
+            try:
+                os.sched_setaffinity(int(task), cpus)
+            except OSError:   # a thread that ended meanwhile
+                pass
+    _JAX_THREADS = 1
+
+
+def jax_threads() -> int | None:
+    """XLA's CPU threads in this process: one where `_start_jax_on_one_cpu` started JAX's backend, else the
+    CPUs the process may run on (what XLA sizes its pool to when the backend starts); None before it starts."""
+    from lagbench.models.jax.compiled import _backend_started
+
+    if _JAX_THREADS is not None:
+        return _JAX_THREADS
+    if "jax" not in sys.modules or not _backend_started():
+        return None
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
 def _exit_with(parent: int, every: float = 1.0):
@@ -64,12 +106,13 @@ def _exit_with(parent: int, every: float = 1.0):
 
 
 def worker_start(driver: int):
-    """A worker process's start: PyTorch at `WORKER_THREADS`, and an exit of its own once its driver (the
+    """A worker process's start: JAX (`one_thread_jax`) and PyTorch at `WORKER_THREADS`, and an exit of its own once its driver (the
     process `driver`) is gone."""
     import threading
 
     import torch
 
+    one_thread_jax()
     torch.set_num_threads(WORKER_THREADS)
     threading.Thread(target=_exit_with, args=(driver,), daemon=True, name="lagbench-driver-watch").start()
 
@@ -147,7 +190,9 @@ def hardware() -> dict:
         gpu = devs[0].device_kind if devs else None
     except Exception:
         gpu = None
-    return {**cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
+    torch = sys.modules.get("torch")   # threads: how this process sums, so part of what its numbers are
+    return {**cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform(),
+            "jax_threads": jax_threads(), "torch_threads": torch.get_num_threads() if torch else None}
 
 
 @lru_cache(maxsize=1)

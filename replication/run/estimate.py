@@ -15,10 +15,9 @@ and PyTorch at `torch_threads` intra-op threads: the setting of the processes th
 the units (`environment.worker_torch_threads`: one per worker or Ray task; None: this process's own, where
 one local job trains them here): probed at another thread count than the workers', a step on busy cores
 can take many times as long (measurements: `docs/decisions/run_estimate.md`). Where the workers run on one
-thread, JAX is probed on one too (`environment.one_thread_jax`, which holds this process's XLA to it before
-its backend starts; on the idle 2-core machine that reads `full`'s double-pendulum LNN 2 % slower than
-on both cores). What the estimate leaves out: two workers slow each other down (that LNN's JAX step took
-1.8-2.5 x its probe in a worker beside another), evaluation, and the first step of a PyTorch phase under
+thread, JAX is probed on one too (`environment.one_thread_jax`, which starts this process's JAX backend on
+one CPU). What the estimate leaves out: two workers slow each other down (two JAX LNNs of claim 1 on one
+thread each: 1.05-1.12 x the step of one alone), evaluation, and the first step of a PyTorch phase under
 torch.compile (`compile_torch.like`: the probe compiles as the phase will), which compiles.
 
 Where the run packs seeds (`members`: {framework: seeds a program}, `replication.run.packing.members`, more than

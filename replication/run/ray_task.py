@@ -25,6 +25,7 @@ from pathlib import Path
 
 from lagbench.replication.run import unit_files
 from lagbench.replication.run.chains import run_one, unit_of
+from lagbench.replication.run.environment import one_thread_jax
 
 
 class Board:
@@ -48,6 +49,7 @@ def worker_dir() -> Path:
 
 
 def run_unit_task(ref, prev, board=None) -> dict:
+    one_thread_jax()   # XLA's pool at one thread, as a local worker's (the first task of a Ray worker starts it)
     unit = unit_of(ref)
     if board is not None:
         board.start.remote(unit.name)

@@ -238,8 +238,8 @@ def online_study(models=("delan", "ff"), frameworks=("jax", "torch"), seeds=(0,)
 
 
 def one_thread() -> dict:
-    """Hold this process's compute to one thread where it still can, and say what is in force: XLA without its
-    Eigen pool and with intra-op parallelism 1 (`environment.ONE_CORE_XLA`, read when JAX's backend starts)
+    """Hold this process's compute to one thread where it still can, and say what is in force: XLA on one
+    thread (`environment.one_thread_jax`: its backend started on one CPU, with `ONE_CORE_XLA` in XLA_FLAGS)
     and JAX's CPU programs run inline (`use_sync_dispatch`), both only before that start; PyTorch is set to
     one thread by `online_study` itself."""
     import os
@@ -247,8 +247,8 @@ def one_thread() -> dict:
     from lagbench.models.jax.compiled import async_dispatch, use_sync_dispatch
     from lagbench.replication.run.environment import one_thread_jax
 
+    use_sync_dispatch()   # before `one_thread_jax` starts the backend
     one_thread_jax()
-    use_sync_dispatch()
     return {"xla_flags": os.environ.get("XLA_FLAGS", ""), "jax_dispatch": "async" if async_dispatch() else "sync",
             "torch_threads": 1}
 

@@ -186,6 +186,7 @@ def test_estimate_probes_jax_on_the_workers_one_thread_and_a_change_of_threads_r
     import os
 
     from lagbench.models.jax import compiled
+    from lagbench.replication.run import environment
     from lagbench.replication.run import estimate as E
     from lagbench.replication.run.environment import ONE_CORE_XLA
 
@@ -199,6 +200,7 @@ def test_estimate_probes_jax_on_the_workers_one_thread_and_a_change_of_threads_r
     assert json.loads((tmp_path / E.PROBES).read_text())["machine"]["jax_threads"] == "every core"
     assert os.environ["XLA_FLAGS"] == "--xla_dump_to=/nowhere" and set(calls) == {"jax", "torch"}
     monkeypatch.setattr(compiled, "_backend_started", lambda: False)  # before the backend starts: held to one
+    monkeypatch.setattr(environment, "_JAX_THREADS", None)   # restored after: this process's own setting
     calls.clear()
     again = estimate(units, tmp_path, jobs=2, torch_threads=1, keep=True)
     assert os.environ["XLA_FLAGS"] == f"--xla_dump_to=/nowhere {ONE_CORE_XLA}"
@@ -215,6 +217,7 @@ def test_run_holds_jax_to_the_workers_one_thread_before_the_device_check_starts_
     import os
 
     from lagbench.models.jax import compiled
+    from lagbench.replication.run import environment
     from lagbench.replication.run.environment import ONE_CORE_XLA
     from lagbench.replication.training import device
 
@@ -225,6 +228,7 @@ def test_run_holds_jax_to_the_workers_one_thread_before_the_device_check_starts_
     seen = []
     monkeypatch.setattr(device, "apply", apply)
     monkeypatch.setattr(compiled, "_backend_started", lambda: False)
+    monkeypatch.setattr(environment, "_JAX_THREADS", None)
     for jobs, held in (("1", False), ("2", True)):   # one job trains here, at this process's own setting
         monkeypatch.setenv("XLA_FLAGS", "")
         assert main(["run", "--profile", "smoke", "--claims", "hnn_energy", "--dry-run", "--jobs", jobs,

@@ -197,3 +197,32 @@ def test_a_dead_worker_loses_only_its_chain(tmp_path):
     written = {f"{p.parts[-5]}/{p.parts[-4]}/{p.parts[-3]}/{p.parts[-2]}"
                for p in tmp_path.glob("units/*/*/*/seed*/result.json")}
     assert written == {u.name for u in todo} - {lost}
+
+
+_XLA_POOL = """
+import os, sys
+from lagbench.replication.run import environment as env
+if sys.argv[1] == "held":
+    env.one_thread_jax()
+import jax, jax.numpy as jnp
+x = jnp.ones((256, 256))
+jax.jit(lambda x: jnp.tanh(x @ x) @ x)(x).block_until_ready()
+pool = sum("XLAEigen" in open(f"/proc/self/task/{t}/comm").read() for t in os.listdir("/proc/self/task"))
+print(pool, env.hardware()["jax_threads"], sorted(os.sched_getaffinity(0)) == sorted(range(os.cpu_count())))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2,
+                    reason="needs Linux and two CPUs")
+def test_a_worker_start_gives_xla_one_thread_on_every_core():
+    """XLA sizes its CPU pool to the CPUs a process may use when JAX's backend starts, whatever XLA_FLAGS say
+    (the control: a process started with `ONE_CORE_XLA` alone has a thread a CPU); `one_thread_jax`, which a
+    worker's start calls, leaves one, and gives the process every CPU back."""
+    env = {**os.environ, **one_thread_env(os.environ)}
+    out = {how: subprocess.run([sys.executable, "-c", _XLA_POOL, how], capture_output=True, text=True, env=env,
+                               check=True).stdout.split() for how in ("held", "flags")}
+    cpus = len(os.sched_getaffinity(0))
+    if out["flags"][0] == "0":
+        pytest.skip("XLA's pool threads are not named XLAEigen in this jaxlib")
+    assert out["flags"][:2] == [str(cpus), str(cpus)]
+    assert out["held"] == ["1", "1", "True"]
