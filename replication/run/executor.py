@@ -214,15 +214,16 @@ def check_jobs(jobs) -> None:
         raise ValueError(f"--jobs: {jobs!r} is not valid; expected an integer >= 1 (worker processes)")
 
 
-def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None, members=None):
+def run_units(todo, out, profile, progress=True, jobs=1, seconds=None, on_done=None, members=None, workers=False):
     """`seconds`: each unit's estimated seconds (`unit_seconds`), what the bar advances by (default: one each);
-    `on_done(unit)`: called in this process once a unit's run has ended (its result written, or not)."""
+    `on_done(unit)`: called in this process once a unit's run has ended (its result written, or not);
+    `workers`: train in worker processes at one job too (`lagbench verify`: units a run trained in workers)."""
     check_jobs(jobs)
     seconds = list(seconds) if seconds is not None else [1.0] * len(todo)
     on_done = on_done or (lambda u: None)
     # jobs > 1 trains even a single unit in a worker: its one CPU thread rounds float32 otherwise than this
     # process's threads, and a search or run at N workers keeps one rounding for every unit (nothing to train
     # opens no workers)
-    if jobs == 1 or not todo:
+    if (jobs == 1 and not workers) or not todo:
         return _serial(todo, out, profile, progress, seconds, on_done, members)
     return _parallel(todo, out, profile, progress, jobs, seconds, on_done, members)

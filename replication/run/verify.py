@@ -3,7 +3,9 @@
 `verify(results, n, seed=0, jobs=1, progress=True, only=None) -> DataFrame`: picks `n` of the folder's finished
 units at random (NumPy's generator seeded with `seed`, over the candidates sorted by name: the same seed picks the
 same units), retrains each from nothing in a temporary folder through the code a run uses
-(`executor.run_units`: no training cache, the unit's protocol, seed, framework and evaluation) and compares
+(`executor.run_units`: no training cache, the unit's protocol, seed, framework and evaluation), each at the
+threads it trained on (`trained_threads`: in `jobs` worker processes, one thread each, the units a run trained
+in workers; in this process the others), and compares
 what it gets with what the folder holds: every metric of result.json, the status, the final training loss,
 the steps and samples trained. A metric of wall time (`TIMING`: microseconds per rollout step, a controller's
 compute time) differs from run to run: it is written beside the others as "timing", not compared. The candidates are the units this code can rerun as they were made:
@@ -14,7 +16,7 @@ check can aim at a costly claim or at one framework; a name no candidate has is 
 
 Each value is "identical" (equal bit for bit; both absent or NaN count as equal), else its relative difference
 |a - b| / max(|a|, |b|) is held against a tolerance: `SAME_TOL` where the unit retrained where it was made (the
-same CPU model and vector features, GPU, training device and library versions: training is deterministic
+same CPU model and vector features, GPU, training device, library versions and threads: training is deterministic
 there, so any difference is a finding), `OTHER_TOL` elsewhere. float32 training is chaotic at the level of
 rounding: another CPU's kernels or another library version round differently, the difference grows over
 thousands of steps, and a rollout of a chaotic system (the double pendulum's valid-prediction time) can
@@ -105,11 +107,32 @@ def pick(units: list, n: int, seed: int) -> list:
 
 
 def same_environment(a: dict, b: dict) -> bool:
-    """Whether two results were computed on the same kind of machine with the same libraries, both packed with
-    other seeds or both alone (a packed training's products run stacked: other rounding, `run.packing`)."""
+    """Whether two results were computed on the same kind of machine with the same libraries and threads, both
+    packed with other seeds or both alone (a packed training's products run stacked: other rounding,
+    `run.packing`)."""
     ha, hb = a.get("hardware") or {}, b.get("hardware") or {}
+    ta, tb = trained_threads(a), trained_threads(b)
     return (all(ha.get(k) == hb.get(k) for k in SAME_HARDWARE) and a.get("versions") == b.get("versions")
-            and a.get("train_device") == b.get("train_device") and _packed(a) == _packed(b))
+            and a.get("train_device") == b.get("train_device") and _packed(a) == _packed(b)
+            and ta is not None and ta == tb)
+
+
+def trained_threads(record: dict) -> int | None:
+    """The CPU threads a unit's framework trained on (they sum in their own order, so they are part of what its
+    numbers are): as recorded (`environment.hardware`); where not recorded, JAX's pool at the machine's cores
+    (what XLA sizes it to when the backend starts) and PyTorch's unknown (None)."""
+    hw = record.get("hardware") or {}
+    if record.get("framework") == "jax":
+        return hw.get("jax_threads", hw.get("cores"))
+    return hw.get("torch_threads")
+
+
+def in_worker(record: dict) -> bool:
+    """Whether a unit retrains in a worker process (one thread a framework) rather than in this process: it
+    trained on one thread, or on threads not recorded (PyTorch's before they were: the suite's runs train in
+    workers)."""
+    threads = trained_threads(record)
+    return threads is None or threads == env.WORKER_THREADS
 
 
 def _packed(record: dict) -> bool:
@@ -176,7 +199,12 @@ def verify(results, n: int, seed: int = 0, jobs: int = 1, progress: bool = True,
     at, here, commit = env.now(), where(), env.commit()
     rows = []
     with tempfile.TemporaryDirectory(prefix="lagbench-verify-") as tmp:
-        _, errors = run_units(chosen, tmp, "verify", progress, jobs)
+        # each unit at the threads it trained on: in workers those a run trained in workers, here the others
+        made = {u.name: in_worker(R.load_result(u.folder(results))) for u in chosen}
+        errors = []
+        for there in (False, True):
+            part = [u for u in chosen if made[u.name] == there]
+            errors += run_units(part, tmp, "verify", progress, jobs if there else 1, workers=there)[1] if part else []
         failed = {e.partition(": ")[0]: e.partition(": ")[2] for e in errors}
         for u in chosen:
             stored = R.load_result(u.folder(results))

@@ -43,7 +43,8 @@ def add_command(sub) -> None:
                    "(default: both)")
     s.add_argument("--models", help="comma-separated model labels: draw among these models' units only (default: "
                    "every model)")
-    s.add_argument("--jobs", type=int, default=1, help="worker processes, as `lagbench run --jobs` (default: 1)")
+    s.add_argument("--jobs", type=int, default=1, help="worker processes for the units a run trained in "
+                   "workers, as `lagbench run --jobs` (default: 1)")
     s.add_argument("--quiet", action="store_true", help="no progress bars")
     s.add_argument("--device", default="auto", choices=("auto", "cpu", "gpu"), help=DEVICE_HELP)
     s.set_defaults(func=cmd_verify)

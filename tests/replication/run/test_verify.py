@@ -86,7 +86,8 @@ def test_the_report_has_no_verification_section_without_a_verification(two_units
 
 def test_a_packed_training_retrained_alone_is_held_to_the_tolerance_of_another_environment():
     """Packed seeds (`run --pack-seeds`) multiply stacked: another rounding than the unit's run alone."""
-    env = {"hardware": {"cpu": "x"}, "versions": {"jax": "1"}, "train_device": "cpu", "metrics": {"m": 1.0}}
+    env = {"framework": "jax", "hardware": {"cpu": "x", "jax_threads": 1}, "versions": {"jax": "1"},
+           "train_device": "cpu", "metrics": {"m": 1.0}}
     packed = {**env, "cohort": {"seeds": [0, 1], "packed": True}}
     assert V.same_environment(env, {**env, "cohort": None})
     assert not V.same_environment(packed, env)
@@ -107,3 +108,39 @@ def test_the_draw_can_be_narrowed_to_claims_frameworks_and_models_and_a_missing_
     err = capsys.readouterr().err
     assert code != 0 and "--claims rel_coords: no unit to retrain of rel_coords" in err
     assert sorted(p.name for p in two_units.rglob("*")) == before   # nothing written
+
+
+def test_threads_are_part_of_the_environment_and_choose_where_a_unit_retrains():
+    """A unit's framework sums in another order on other threads: the same machine at other threads is another
+    environment. JAX's pool without a record is the machine's cores (what XLA sizes it to); PyTorch's unknown,
+    never the same. A unit trained on one thread, or on PyTorch threads not recorded, retrains in a worker."""
+    def rec(fw, **hw):
+        return {"framework": fw, "hardware": {"cpu": "x", **hw}, "versions": {}, "train_device": "cpu"}
+
+    assert V.same_environment(rec("jax", jax_threads=1), rec("jax", jax_threads=1, torch_threads=2))
+    assert not V.same_environment(rec("jax", jax_threads=1), rec("jax", jax_threads=2))
+    assert V.same_environment(rec("jax", cores=2), rec("jax", jax_threads=2, cores=2))
+    assert not V.same_environment(rec("jax", cores=2), rec("jax", jax_threads=1, cores=2))
+    assert not V.same_environment(rec("torch", cores=2), rec("torch", torch_threads=1))
+    assert V.same_environment(rec("torch", torch_threads=1, jax_threads=2), rec("torch", torch_threads=1))
+    assert [V.in_worker(r) for r in (rec("jax", jax_threads=1), rec("jax", cores=2), rec("jax", cores=1),
+                                     rec("torch"), rec("torch", torch_threads=2))] == [True, False, True, True, False]
+
+
+def test_a_unit_trained_in_a_worker_retrains_in_one(two_units, tmp_path, monkeypatch):
+    folder = tmp_path / "results"
+    shutil.copytree(two_units, folder)
+    calls, real = [], V.run_units
+    monkeypatch.setattr(V, "run_units", lambda part, *a, **kw: calls.append(([u.name for u in part], kw)) or
+                        real(part, *a, **kw))
+    unit = next(folder.glob("units/*/*/*/seed*/result.json")).parent
+    d = R.load_result(unit)
+    R.write_json(unit / "result.json", {**d, "hardware": {**d["hardware"], "jax_threads": 1}}, checksum=True)
+    other = [f.parent for f in folder.glob("units/*/*/*/seed*/result.json") if f.parent != unit]
+    for o in other:   # the other unit at two threads: retrained here
+        d = R.load_result(o)
+        R.write_json(o / "result.json", {**d, "hardware": {**d["hardware"], "jax_threads": 2}}, checksum=True)
+    V.verify(folder, 2, progress=False)
+    name = lambda f: "/".join(f.relative_to(folder / "units").parts)   # noqa: E731
+    assert [(names, kw["workers"]) for names, kw in calls] == [([name(o) for o in other], False),
+                                                               ([name(unit)], True)]
