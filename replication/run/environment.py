@@ -68,20 +68,20 @@ def _start_jax_on_one_cpu():
     import jax
 
     cpus = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
-    if not cpus or len(cpus) == 1:   # no affinity to set (not Linux), or one CPU already
-        jax.devices()
-        _JAX_THREADS = 1 if cpus else None
-        return
-    os.sched_setaffinity(0, {min(cpus)})
+    pinned = bool(cpus) and len(cpus) > 1   # else no affinity to set (not Linux), or one CPU already
+    if pinned:
+        os.sched_setaffinity(0, {min(cpus)})
     try:
         jax.devices()
+    except RuntimeError:   # no backend JAX can start (a platform asked for and missing): a JAX unit says so
+        return
     finally:
-        for task in os.listdir("/proc/self/task"):
+        for task in os.listdir("/proc/self/task") if pinned else ():
             try:
                 os.sched_setaffinity(int(task), cpus)
             except OSError:   # a thread that ended meanwhile
                 pass
-    _JAX_THREADS = 1
+    _JAX_THREADS = 1 if cpus else None
 
 
 def jax_threads() -> int | None:
@@ -106,8 +106,8 @@ def _exit_with(parent: int, every: float = 1.0):
 
 
 def worker_start(driver: int):
-    """A worker process's start: JAX (`one_thread_jax`) and PyTorch at `WORKER_THREADS`, and an exit of its own once its driver (the
-    process `driver`) is gone."""
+    """A worker process's start: JAX (`one_thread_jax`) and PyTorch at `WORKER_THREADS`, and an exit of its
+    own once its driver (the process `driver`) is gone."""
     import threading
 
     import torch
