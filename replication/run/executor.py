@@ -13,7 +13,8 @@ The run's progress bar advances by each unit's estimated seconds (`replication.r
 `check_jobs(jobs)`: the one check of a worker count (`lagbench run`, `tune`, `verify`).
 
 jobs = 1: in this process, a progress bar per unit's training. jobs = N > 1: N worker processes (spawned,
-so each starts clean), each given one CPU thread for JAX (its backend started on one CPU: `environment.one_thread_jax`) and for PyTorch and
+so each starts clean), each given one CPU thread for JAX (its backend started on one CPU:
+`environment.one_thread_jax`) and for PyTorch and
 OpenMP, so that N workers share N cores instead of each spreading over all of them. Units that train the
 same model (a claim pair sharing a trained model; a cohort of seeds trained as one program: `training.group_key`)
 form one *chain* (`replication.run.chains`, shared with the Ray executor, `replication.run.executor_ray`; a packed

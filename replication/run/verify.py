@@ -199,22 +199,22 @@ def verify(results, n: int, seed: int = 0, jobs: int = 1, progress: bool = True,
     at, here, commit = env.now(), where(), env.commit()
     rows = []
     with tempfile.TemporaryDirectory(prefix="lagbench-verify-") as tmp:
+        stored = {u.name: R.load_result(u.folder(results)) for u in chosen}
         # each unit at the threads it trained on: in workers those a run trained in workers, here the others
-        made = {u.name: in_worker(R.load_result(u.folder(results))) for u in chosen}
-        errors = []
-        for there in (False, True):
-            part = [u for u in chosen if made[u.name] == there]
-            errors += run_units(part, tmp, "verify", progress, jobs if there else 1, workers=there)[1] if part else []
+        there = [u for u in chosen if in_worker(stored[u.name])]
+        local = [u for u in chosen if u not in there]
+        errors = ((run_units(local, tmp, "verify", progress, 1, workers=False)[1] if local else [])
+                  + (run_units(there, tmp, "verify", progress, jobs, workers=True)[1] if there else []))
         failed = {e.partition(": ")[0]: e.partition(": ")[2] for e in errors}
         for u in chosen:
-            stored = R.load_result(u.folder(results))
             try:
                 new = R.load_result(u.folder(tmp))
             except R.CorruptResult:
-                rows.append({"unit": u.name, "value": "-", "outcome": "error", "stored_commit": stored.get("commit"),
+                rows.append({"unit": u.name, "value": "-", "outcome": "error",
+                             "stored_commit": stored[u.name].get("commit"),
                              "note": failed.get(u.name, "no result written")})
                 continue
-            rows += [{"unit": u.name, **r} for r in compare(stored, new)]
+            rows += [{"unit": u.name, **r} for r in compare(stored[u.name], new)]
     df = pd.DataFrame(rows).assign(verified_at=at, where=here, commit=commit).reindex(columns=COLUMNS)
     path = folder / FILE.name
     if path.is_file():

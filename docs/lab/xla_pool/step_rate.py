@@ -16,19 +16,19 @@ import time
 import jax
 import torch
 
+from lagbench.replication.run.environment import one_thread_jax
 from lagbench.replication.run.runner import plan
 from lagbench.replication.training.train import run_training
 
 
 def main(fw, model, claim, steps, mode):
-    full = os.sched_getaffinity(0)
-    if mode in ("pin", "release"):   # JAX's backend starts below, on one CPU
-        os.sched_setaffinity(0, {sorted(full)[os.getpid() % len(full)]})
+    if mode == "release":
+        one_thread_jax()
+    elif mode == "pin":   # the whole process on one CPU
+        full = sorted(os.sched_getaffinity(0))
+        os.sched_setaffinity(0, {full[os.getpid() % len(full)]})
     jax.devices()
     torch.set_num_threads(1)
-    if mode == "release":
-        for t in os.listdir("/proc/self/task"):
-            os.sched_setaffinity(int(t), full)
     u = plan("full", claims=[claim], frameworks=[fw], models=[model])[0]
     p = dataclasses.replace(u.protocol(), steps=steps, scouting=None, early_stop=None, tracking=None, log_every=50)
     marks = []
