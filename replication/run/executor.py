@@ -8,7 +8,8 @@ errors)`; failures: "<unit>: <reason>" of units whose training failed (a result 
 before the first of its units runs; None or 1: each seed alone.
 
 The run's progress bar advances by each unit's estimated seconds (`replication.run.unit_seconds`, given as
-`seconds`), so that its remaining time is the work left; `on_done(unit)` is told of each unit whose run ended
+`seconds`), credited as the unit runs (`unit_seconds.InFlight`), so that its remaining time is the work left
+at the run's pace; `on_done(unit)` is told of each unit whose run ended
 (a store trims the unit's folder: `replication.run.store`).
 `check_jobs(jobs)`: the one check of a worker count (`lagbench run`, `tune`, `verify`).
 
@@ -47,12 +48,14 @@ from lagbench.replication.run.chains import cost as _cost  # noqa: F401 - re-exp
 from lagbench.replication.run.chains import ref as _ref
 from lagbench.replication.run.chains import run_one as _one
 from lagbench.replication.run.environment import one_thread_children, worker_start
+from lagbench.replication.run.unit_seconds import InFlight
 from lagbench.replication.training.scouting import progress_steps
 
 
 def _bar(seconds, desc, progress):
-    """The run's bar: it advances by each unit's estimated seconds (`unit_seconds`), so that its remaining time
-    is the work left at the run's own pace; the units done are counted in its postfix."""
+    """The run's bar: it advances by each unit's estimated seconds (`unit_seconds`, credited as the unit runs:
+    `InFlight`), so that its remaining time is the work left at the run's own pace; the units done are
+    counted in its postfix."""
     return tqdm(total=sum(seconds), desc=desc, disable=not progress, smoothing=0,
                 bar_format="{desc}: {percentage:3.0f}%|{bar}| [{elapsed}<{remaining}{postfix}]")
 
@@ -61,14 +64,17 @@ def _serial(todo, out, profile, progress, seconds, on_done, members):
     failures, errors = [], []
     packs = packing.by_unit(todo, out, members)
     bar = _bar(seconds, f"lagbench {profile}", progress)
+    credit = InFlight(bar)
     try:
         for i, (u, weight) in enumerate(zip(todo, seconds, strict=True)):
             bar.set_postfix_str(f"{i}/{len(todo)} units; {u.name}")
+            credit.start(i, weight)
             steps = progress_steps(u.protocol()) if u.entry.train else 0
             inner = tqdm(total=steps, desc=u.name, unit="step", leave=False, disable=not progress or steps == 0)
             last = {"step": -1}
 
             def on_log(row, inner=inner, last=last):
+                credit.tick()
                 inner.update(row["step"] - last["step"])
                 last["step"] = row["step"]
                 inner.set_postfix(loss=f"{row['loss']:.3g}")
@@ -79,7 +85,7 @@ def _serial(todo, out, profile, progress, seconds, on_done, members):
                 inner.close()
             failures += [failure] if failure else []
             errors += [error] if error else []
-            bar.update(weight)
+            credit.end(i)
             on_done(u)
         bar.set_postfix_str(f"{len(todo)}/{len(todo)} units")
     finally:
@@ -162,17 +168,18 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
     with one_thread_children():
         workers = _Workers(jobs)
         bar = _bar(seconds, f"lagbench {profile} ({jobs} workers)", progress)
+        credit = InFlight(bar)
         pending, held = list(enumerate(work)), {}
 
-        def record(done, chain):
-            """A chain's outcomes; its units' estimated seconds on the bar; `on_done` told of each unit (one
-            that finished before its worker stopped has its result)."""
+        def record(done, cid, chain):
+            """A chain's outcomes; the rest of its units' estimated seconds on the bar; `on_done` told of each
+            unit (one that finished before its worker stopped has its result)."""
             nonlocal failures, errors, count
             for _name, failure, error in done:
                 failures += [failure] if failure else []
                 errors += [error] if error else []
             count += len(chain)
-            bar.update(sum(weight[id(u)] for u in chain))
+            credit.end(cid)
             bar.set_postfix_str(f"{count}/{len(todo)} units; {chain[-1].name}")
             for u in chain:
                 on_done(u)
@@ -181,7 +188,9 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
                 while pending and (slot := workers.idle()) is not None:
                     cid, chain = pending.pop(0)
                     held[cid] = chain
+                    credit.start(cid, sum(weight[id(u)] for u in chain))
                     workers.assign(slot, cid, [_ref(u) for u in chain], out, members)
+                credit.tick()
                 try:
                     cid, done, error, full = workers.results.get(timeout=0.5)
                 except queue.Empty:
@@ -189,7 +198,7 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
                     for cid, code in workers.dead():
                         lost = held.pop(cid)
                         record([(u.name, None, f"{u.name}: worker stopped (exit code {code}); a rerun retries it")
-                                for u in lost], lost)
+                                for u in lost], cid, lost)
                     continue
                 if full is not None:
                     raise DiskFull(*full)
@@ -197,7 +206,7 @@ def _parallel(todo, out, profile, progress, jobs, seconds, on_done, members):
                 workers.finished(cid)
                 if chain is not None:
                     record(done if error is None else [(u.name, None, f"{u.name}: worker error: {error}") for u in chain],
-                           chain)
+                           cid, chain)
         except BaseException:
             workers.close(wait=False)
             raise

@@ -9,9 +9,17 @@ every unit adds `EVAL_S` for its evaluation. A training's seconds are the run's 
 one (`estimate.estimate`'s "by_group": the long profiles probe each training before they start), else a
 proxy: the training budget in samples (`scouting.budget_samples`) x the model's summed width x the kind's
 nanoseconds per sample and unit of width (`KIND_NS`) x `chains.TORCH_COST` for PyTorch x the cohort's seeds.
+
+`InFlight(bar)`: the bar's credit for the work under way. A unit (or a worker's chain of units) in flight is
+credited with its estimated seconds as its wall time passes, at most its estimate, and the rest when it ends.
+So from the first minute the bar advances by the work being done (N workers at the estimate's pace: N
+estimated seconds a second) and its remaining time is the estimate's at the run's measured pace, not a rate
+read off the few units finished (a run's first finished units are often ones whose training another unit
+holds: 5 estimated seconds, minutes of wall time, hundreds of hours "remaining").
 """
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from lagbench.replication.run.chains import TORCH_COST
@@ -49,3 +57,27 @@ def unit_seconds(todo, out, by_group: dict | None = None) -> list[float]:
                     train = proxy_seconds(u)
         seconds.append(train + EVAL_S)
     return seconds
+
+
+class InFlight:
+    """`start(key, seconds)` as a unit or chain goes out; `tick()` as often as convenient (it credits each one
+    held with its wall time so far, at most its estimate); `end(key)` when it ends (the rest of its estimate)."""
+
+    def __init__(self, bar, clock=time.monotonic):
+        self.bar, self.clock, self.held = bar, clock, {}
+
+    def start(self, key, seconds: float) -> None:
+        self.held[key] = [self.clock(), float(seconds), 0.0]   # [started, estimate, credited]
+
+    def tick(self) -> None:
+        now = self.clock()
+        for h in self.held.values():
+            due = min(h[1], now - h[0])
+            if due > h[2]:
+                self.bar.update(due - h[2])
+                h[2] = due
+
+    def end(self, key) -> None:
+        _, seconds, credited = self.held.pop(key)
+        if seconds > credited:
+            self.bar.update(seconds - credited)

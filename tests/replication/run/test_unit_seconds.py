@@ -75,3 +75,23 @@ def test_a_run_weighs_its_units_by_their_estimates(bars, tmp_path):
     assert _outer(bars).total > len(todo) * W.EVAL_S   # the training's estimate is in it, not a unit count
 
 
+
+
+def test_work_in_flight_is_credited_as_its_wall_time_passes_at_most_its_estimate():
+    """Two chains out at once on a fake clock: the bar reads their wall time so far (each at most its
+    estimate) before either ends, and each one's whole estimate once it has."""
+    now = [0.0]
+    bar = Bars(total=150.0)
+    credit = W.InFlight(bar, clock=lambda: now[0])
+    credit.start("long", 100.0)
+    credit.start("short", 50.0)
+    now[0] = 10.0
+    credit.tick()
+    assert bar.n == pytest.approx(20.0)   # two workers at the estimate's pace: 2 estimated seconds a second
+    now[0] = 70.0
+    credit.tick()
+    assert bar.n == pytest.approx(70.0 + 50.0)   # the short one over its estimate is held at it
+    credit.end("short")
+    assert bar.n == pytest.approx(120.0)
+    credit.end("long")   # ends early: the rest of its estimate at once
+    assert bar.n == pytest.approx(150.0) and not credit.held
