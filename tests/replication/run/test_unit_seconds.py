@@ -75,8 +75,6 @@ def test_a_run_weighs_its_units_by_their_estimates(bars, tmp_path):
     assert _outer(bars).total > len(todo) * W.EVAL_S   # the training's estimate is in it, not a unit count
 
 
-
-
 def test_work_in_flight_is_credited_as_its_wall_time_passes_at_most_its_estimate():
     """Two chains out at once on a fake clock: the bar reads their wall time so far (each at most its
     estimate) before either ends, and each one's whole estimate once it has."""
