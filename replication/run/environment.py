@@ -106,11 +106,14 @@ def _exit_with(parent: int, every: float = 1.0):
 
 
 def worker_start(driver: int):
-    """A worker process's start: JAX (`one_thread_jax`) and PyTorch at `WORKER_THREADS`, and an exit of its
-    own once its driver (the process `driver`) is gone."""
+    """A worker process's start: JAX (`one_thread_jax`) and PyTorch at `WORKER_THREADS` with subnormal floats
+    flushed (`models.torch.subnormals`, before PyTorch computes), and an exit of its own once its driver (the
+    process `driver`) is gone."""
     import threading
 
     import torch
+
+    import lagbench.models.torch  # noqa: F401  (flushes subnormals)
 
     one_thread_jax()
     torch.set_num_threads(WORKER_THREADS)
@@ -175,7 +178,7 @@ def cpu_description(cpuinfo: str) -> dict:
 
 
 @lru_cache(maxsize=1)
-def hardware() -> dict:
+def _machine() -> dict:
     try:
         cpuinfo = Path("/proc/cpuinfo").read_text()
     except OSError:
@@ -190,9 +193,17 @@ def hardware() -> dict:
         gpu = devs[0].device_kind if devs else None
     except Exception:
         gpu = None
-    torch = sys.modules.get("torch")   # threads: how this process sums, so part of what its numbers are
-    return {**cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform(),
-            "jax_threads": jax_threads(), "torch_threads": torch.get_num_threads() if torch else None}
+    return {**cpu, "cores": os.cpu_count(), "gpu": gpu, "platform": platform.platform()}
+
+
+def hardware() -> dict:
+    """The machine (read once) and how this process computes now: JAX's and PyTorch's threads (each sums in
+    its own order, so they are part of what its numbers are) and whether PyTorch keeps subnormal floats
+    (`models.torch.subnormals`; None where PyTorch is not imported)."""
+    torch = sys.modules.get("torch")
+    flushed = sys.modules.get("lagbench.models.torch.subnormals")
+    return {**_machine(), "jax_threads": jax_threads(), "torch_threads": torch.get_num_threads() if torch else None,
+            "torch_subnormals": flushed.mode() if flushed else ("kept" if torch else None)}
 
 
 @lru_cache(maxsize=1)

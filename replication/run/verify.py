@@ -109,12 +109,19 @@ def pick(units: list, n: int, seed: int) -> list:
 def same_environment(a: dict, b: dict) -> bool:
     """Whether two results were computed on the same kind of machine with the same libraries and threads, both
     packed with other seeds or both alone (a packed training's products run stacked: other rounding,
-    `run.packing`)."""
+    `run.packing`), and for PyTorch with subnormal floats handled alike (`models.torch.subnormals`; not
+    recorded: kept, as PyTorch does unless told)."""
     ha, hb = a.get("hardware") or {}, b.get("hardware") or {}
     ta, tb = trained_threads(a), trained_threads(b)
     return (all(ha.get(k) == hb.get(k) for k in SAME_HARDWARE) and a.get("versions") == b.get("versions")
             and a.get("train_device") == b.get("train_device") and _packed(a) == _packed(b)
-            and ta is not None and ta == tb)
+            and ta is not None and ta == tb and _subnormals(a) == _subnormals(b))
+
+
+def _subnormals(record: dict) -> str | None:
+    if record.get("framework") != "torch":
+        return None
+    return (record.get("hardware") or {}).get("torch_subnormals") or "kept"
 
 
 def trained_threads(record: dict) -> int | None:

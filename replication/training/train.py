@@ -29,10 +29,14 @@ log = logging.getLogger("lagbench")
 
 
 def train_key(framework, spec, protocol, seed) -> str:
-    """The training's cache key: framework, spec, protocol (a user file by its content, not its path) and seed."""
+    """The training's cache key: framework, spec, protocol (a user file by its content, not its path) and seed;
+    for PyTorch also its handling of subnormal floats (`models.torch.subnormals`: flushed), so that a training
+    made while PyTorch kept them is not taken up again."""
     from lagbench.files.user_data import content_only
 
     key = {"fw": framework, "spec": spec.to_dict(), "protocol": content_only(protocol.to_dict()), "seed": seed}
+    if framework == "torch":
+        key["subnormals"] = "flushed"
     targets = targets_version(protocol)
     if targets:
         key["targets"] = targets

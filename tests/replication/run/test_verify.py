@@ -127,6 +127,23 @@ def test_threads_are_part_of_the_environment_and_choose_where_a_unit_retrains():
                                      rec("torch"), rec("torch", torch_threads=2))] == [True, False, True, True, False]
 
 
+def test_pytorch_keeping_subnormal_floats_is_another_environment():
+    """A PyTorch unit trained while subnormals were kept (not recorded: kept) rounds otherwise than one trained
+    with them flushed (`models.torch.subnormals`): held to the other environment's tolerance. JAX's record
+    of PyTorch's setting is no part of a JAX unit's environment."""
+    def rec(fw, **hw):
+        return {"framework": fw, "hardware": {"cpu": "x", "torch_threads": 1, "jax_threads": 1, **hw},
+                "versions": {}, "train_device": "cpu", "metrics": {"m": 1.0}}
+
+    flushed = rec("torch", torch_subnormals="flushed")
+    assert V.same_environment(flushed, rec("torch", torch_subnormals="flushed"))
+    assert not V.same_environment(flushed, rec("torch"))
+    assert not V.same_environment(flushed, rec("torch", torch_subnormals="kept"))
+    assert V.same_environment(rec("torch"), rec("torch", torch_subnormals="kept"))
+    assert {r["tolerance"] for r in V.compare(rec("torch"), {**flushed, "metrics": {"m": 1.01}})} == {V.OTHER_TOL}
+    assert V.same_environment(rec("jax"), rec("jax", torch_subnormals="flushed"))
+
+
 def test_a_unit_trained_in_a_worker_retrains_in_one(two_units, tmp_path, monkeypatch):
     folder = tmp_path / "results"
     shutil.copytree(two_units, folder)
