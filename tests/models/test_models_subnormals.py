@@ -9,7 +9,7 @@ import numpy as np
 # float32's smallest normal number times 0.25 over 2^22 entries on two threads: zero everywhere where every
 # thread flushes subnormals; the values it keeps elsewhere
 PROBE = """
-import json, sys, torch
+import json, torch
 torch.set_num_threads(2)
 {setup}
 x = torch.full((1 << 22,), torch.finfo(torch.float32).tiny) * 0.25

@@ -16,7 +16,6 @@ import numpy as np
 import torch
 
 torch.set_num_threads(1)
-torch.set_flush_denormal(False)   # measure both settings from PyTorch's own
 
 from lagbench.files import results as R  # noqa: E402
 from lagbench.models.init import init_params  # noqa: E402
