@@ -37,14 +37,14 @@ def main(folder: str, which: str = "val-test", rows: int = 3000) -> None:
         s = np.abs(qd[:, j])
         edges = np.quantile(s, QUANTILES)
         print(f"angle {j + 1}: |qdot| bin, local scale H_jj / M_jj (median), damping applied (least squares)")
-        for lo, hi in zip(edges[:-1], edges[1:]):
+        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
             k = (s >= lo) & (s <= hi)
             damping = -np.sum(force[k, j] * qd[k, j]) / np.sum(qd[k, j] ** 2)
             print(f"  {lo:6.2f}-{hi:6.2f} rad/s: {np.median(h[k, j, j] / m[k, j, j]):.3f}, {damping:.3f} ({k.sum()} rows)")
     speed = np.linalg.norm(qd, axis=1)
     edges = np.quantile(speed, QUANTILES)
     print("|qdot| bin: scale c of H against M, residual")
-    for lo, hi in zip(edges[:-1], edges[1:]):
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         k = (speed >= lo) & (speed <= hi)
         ck = float(np.sum(h[k] * m[k]) / np.sum(m[k] ** 2))
         print(f"  {lo:6.2f}-{hi:6.2f}: {ck:.3f}, {np.linalg.norm(h[k] - ck * m[k]) / np.linalg.norm(h[k]):.3f}")
