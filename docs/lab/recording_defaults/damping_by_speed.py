@@ -8,15 +8,17 @@ the scale c of H against M and the residual |H - c M| / |H| per bin of the speed
 """
 import glob
 import sys
+from pathlib import Path
 
 import numpy as np
 
-from lagbench import systems
-from lagbench.files import user_data
-from lagbench.replication.fit.dissipation import softplus
-from lagbench.replication.fit.load import load_fitted
+sys.path.insert(0, str(Path(__file__).parent))
+from model_friction import EXACT  # noqa: E402
 
-EXACT = systems.registry.get("double_pendulum", friction=0.0)
+from lagbench.files import user_data  # noqa: E402
+from lagbench.replication.fit.dissipation import softplus  # noqa: E402
+from lagbench.replication.fit.load import load_fitted  # noqa: E402
+
 QUANTILES = (0, 0.25, 0.5, 0.75, 0.9, 1)
 
 
