@@ -1,6 +1,6 @@
-"""The README's claims table is the output of `reports.readme_table` on the committed sample report of the
-verdict-of-record run (`docs/sample_report/`), never typed by hand; the sample's verdicts agree with its own
-report."""
+"""The README's claims tables are the output of `reports.readme_table` on the committed runs their markers name
+(the quick run's report folder `docs/quick_report/`; the store `runs/full/`, whose report is
+`docs/sample_report/`), never typed by hand; each run's verdicts agree with its own report."""
 import json
 from pathlib import Path
 
@@ -9,13 +9,20 @@ from markdown_tables import claim_rows
 from lagbench.reports import readme_table
 
 ROOT = Path(__file__).resolve().parents[2]
-SAMPLE = ROOT / "docs" / "sample_report"
+QUICK = "docs/quick_report"
+# The report made from a store lives beside the docs; a report folder is its own.
+REPORT_OF = {"runs/full": "docs/sample_report"}
+
+
+def _verdicts(folder: Path) -> dict:
+    path = folder / "verdicts.json"
+    return json.loads((path if path.exists() else folder / "summary" / "verdicts.json").read_text())
 
 
 def test_readme_table_is_the_generated_one():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     found = readme_table.blocks(text)
-    assert "docs/sample_report" in [folder for folder, _ in found], "the README lost the claims table's markers"
+    assert QUICK in [folder for folder, _ in found], "the README lost the claims table's markers"
     for folder, block in found:
         assert block == readme_table.block(folder, ROOT), (f"the README's claims table of {folder} differs from "
                                                            f"that run's; regenerate it: {readme_table.MAKE} {folder}")
@@ -29,15 +36,18 @@ def test_blocks_are_found_by_the_folder_their_marker_names():
     assert found[0][1] == readme_table.begin("runs/full") + "\nA\n" + readme_table.END
 
 
-def test_the_sample_is_a_test_split_run_and_its_report_shows_the_same_verdicts():
-    verdicts = json.loads((SAMPLE / "verdicts.json").read_text())
-    assert verdicts["split"] == "test"
-    report = (SAMPLE / "REPORT.md").read_text(encoding="utf-8")
-    rows = {}
-    for title in ("Scorecard", "Checks"):   # by their "claim" and "verdict" columns
-        rows.update({cid: r["verdict"] for cid, r in claim_rows(report, title).items()})
-    for c in verdicts["claims"]:
-        assert rows[c["id"]].startswith(c["verdict"]), c["id"]
+def test_each_table_is_a_test_split_run_and_its_report_shows_the_same_verdicts():
+    folders = [folder for folder, _ in readme_table.blocks((ROOT / "README.md").read_text(encoding="utf-8"))]
+    assert QUICK in folders
+    for folder in folders:
+        verdicts = _verdicts(ROOT / folder)
+        assert verdicts["split"] == "test", folder
+        report = (ROOT / REPORT_OF.get(folder, folder) / "REPORT.md").read_text(encoding="utf-8")
+        rows = {}
+        for title in ("Scorecard", "Checks"):   # by their "claim" and "verdict" columns
+            rows.update({cid: r["verdict"] for cid, r in claim_rows(report, title).items()})
+        for c in verdicts["claims"]:
+            assert rows[c["id"]].startswith(c["verdict"]), (folder, c["id"])
 
 
 def test_table_lists_every_claim_with_its_verdict_and_variants():
