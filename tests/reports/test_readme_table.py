@@ -1,7 +1,6 @@
 """The README's claims tables are the output of `reports.readme_table` on the committed runs their markers name
 (the quick run's report folder `docs/quick_report/`; the store `runs/full/`, whose report is
 `docs/sample_report/`), never typed by hand; each run's verdicts agree with its own report."""
-import json
 from pathlib import Path
 
 from markdown_tables import claim_rows
@@ -12,11 +11,6 @@ ROOT = Path(__file__).resolve().parents[2]
 QUICK = "docs/quick_report"
 # The report made from a store lives beside the docs; a report folder is its own.
 REPORT_OF = {"runs/full": "docs/sample_report"}
-
-
-def _verdicts(folder: Path) -> dict:
-    path = folder / "verdicts.json"
-    return json.loads((path if path.exists() else folder / "summary" / "verdicts.json").read_text())
 
 
 def test_readme_table_is_the_generated_one():
@@ -40,7 +34,7 @@ def test_each_table_is_a_test_split_run_and_its_report_shows_the_same_verdicts()
     folders = [folder for folder, _ in readme_table.blocks((ROOT / "README.md").read_text(encoding="utf-8"))]
     assert QUICK in folders
     for folder in folders:
-        verdicts = _verdicts(ROOT / folder)
+        _, verdicts = readme_table.read(ROOT / folder)
         assert verdicts["split"] == "test", folder
         report = (ROOT / REPORT_OF.get(folder, folder) / "REPORT.md").read_text(encoding="utf-8")
         rows = {}
