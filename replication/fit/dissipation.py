@@ -46,14 +46,16 @@ ABLATION_MIN = 1.1
 # coefficient at 0.4 of its own, the other kept, still passed.
 BRACKET = (0.5, 2.0)
 BRACKET_MIN = 1.02
-GATE = f"rollouts with b x {BRACKET[0]:g} and x {BRACKET[1]:g} >= {BRACKET_MIN:g} x; else one-step ablation >= {ABLATION_MIN:g}"
+GATE = (f"rollouts with b x {BRACKET[0]:g} and x {BRACKET[1]:g} >= {BRACKET_MIN:g} x; else one-step ablation >= "
+        f"{ABLATION_MIN:g}; read for an LNN and a DeLaN fitted to accelerations")
 OFF = -50.0   # a raw coefficient whose softplus, about 2e-22, is no friction at all
 
 
 def dissipation_metrics(f, r, name, system, out, rollouts: dict | None = None) -> None:
-    """A dissipative LNN's Rayleigh coefficients b = softplus(raw) (the Lagrangian's own scale), and with a
-    system the coefficients in the system's units: a Lagrangian learned from accelerations is fixed only up to
-    a factor c (of either sign), its velocity Hessian H = c M, so the friction the data obey is b / |c|, c the
+    """A dissipative model's Rayleigh coefficients b = softplus(raw) (the Lagrangian's own scale), and for an LNN
+    or a DeLaN fitted to accelerations with a system the coefficients in the system's units: a Lagrangian learned
+    from accelerations is fixed only up to a factor c (of either sign), its velocity Hessian H = c M
+    (`kinetic_matrix`: a DeLaN's is its mass matrix), so the friction the data obey is b / |c|, c the
     least-squares factor of H against the system's mass matrix M over S's states (S_dissipation_scale), given
     where the model learned (`competence`, on S's one-step error), H is close to c M
     (S_dissipation_hessian_residual at most `HESSIAN_RESIDUAL_MAX`) and the friction is what the data show: with
@@ -65,10 +67,10 @@ def dissipation_metrics(f, r, name, system, out, rollouts: dict | None = None) -
     out.metrics.update({f"dissipation_b{k}": float(v) for k, v in enumerate(b)})
     if f.spec.kind == "delan" and f.task == "inverse_dynamics":   # fitted to torques: b is in their units
         out.metrics.update({f"{name}_dissipation_coefficient_{k}": float(v) for k, v in enumerate(b)})
-    if system is None or f.spec.kind != "lnn":   # an HNN's b is per unit of its momentum, qdot as it trained
-        return
+    if system is None or f.spec.kind not in ("lnn", "delan") or f.task == "inverse_dynamics":
+        return   # an HNN's b is per unit of its momentum, qdot as it trained
     q, qd = r["q"][:KEEP], r["qdot"][:KEEP]
-    h, m = np.asarray(f.model.velocity_hessian(q, qd), np.float64), system.mass_matrix(q)
+    h, m = kinetic_matrix(f, q, qd), system.mass_matrix(q)
     c = float(np.sum(h * m) / np.sum(m * m))
     residual = float(np.linalg.norm(h - c * m) / np.linalg.norm(h))
     out.metrics[f"{name}_dissipation_scale"] = c
@@ -85,6 +87,13 @@ def dissipation_metrics(f, r, name, system, out, rollouts: dict | None = None) -
         out.counters[f"{name}_dissipation_coefficient"] = f"not estimated: {why}"
         return
     out.metrics.update({f"{name}_dissipation_coefficient_{k}": float(v / abs(c)) for k, v in enumerate(b)})
+
+
+def kinetic_matrix(f, q, qd) -> np.ndarray:
+    """The fitted model's velocity Hessian of its Lagrangian at the states (q, qd): an LNN's through its
+    network, a DeLaN's its mass matrix M(q) (its Lagrangian is quadratic in qdot)."""
+    h = f.model.mass_matrix(q) if f.spec.kind == "delan" else f.model.velocity_hessian(q, qd)
+    return np.asarray(h, np.float64)
 
 
 def _unbracketed(f, r, name, out, rollouts) -> str | None:

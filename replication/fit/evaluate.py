@@ -28,9 +28,9 @@ energy     (no torques) the model's own energy along its rollout (`Fitted.energy
            E(q, qdot) - E(q, 0) over S's states (energy offsets cancel). With a system: its energy along the
            rollout against along the data (or the user's energy function's), `metrics.energy_errors` with scale = its mean kinetic
            energy over S: S_energy_err_final, S_energy_err_max, ...
-dissipation (spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; an LNN's with a system, and a
-           DeLaN's fitted to torques, S_dissipation_coefficient_<k> in the system's units where the checks of
-           `replication.fit.dissipation` read it (on the set's rollouts where it has them).
+dissipation (spec.dissipation) dissipation_b<k>, the learned Rayleigh coefficients; an LNN's or a DeLaN's with a
+           system, and a DeLaN's fitted to torques, S_dissipation_coefficient_<k> in the system's units where the
+           checks of `replication.fit.dissipation` read it (on the set's rollouts where it has them).
 DeLaN      M, c, g on S's states; with a system, S_{mass_matrix,coriolis,gravity}_rel_err = mean over states
            of |pred - true| / |true| (Frobenius / Euclidean), and S_mass_matrix_min_eig. Trained on
            accelerations, a Lagrangian is fixed only up to a constant factor: the terms are then compared at

@@ -1,7 +1,8 @@
 """The dissipative fit of docs/fit.md ('Friction: a dissipative fit'), run as written from its own text: on a
 pendulum with viscous friction 0.3, the LNN with a learned Rayleigh function recovers the friction (the default
 run: the block's data and its dissipative fit) and rolls out better than the conservative LNN, which cannot lose
-energy; the baseline, trained alike, tracks best (`tox -e slow`: the whole block)."""
+energy; the baseline, trained alike, tracks best (`tox -e slow`: the whole block). DeLaN with a learned Rayleigh
+function on the same data reads the friction through the same checks."""
 import dataclasses
 import json
 import re
@@ -73,6 +74,32 @@ def friction_folder(dissipative_folder):
     return dissipative_folder
 
 
+@pytest.fixture(scope="module")
+def delan_folder(dissipative_folder):
+    """DeLaN with a learned Rayleigh function on the block's data, at its defaults but for 2 000 steps, in a folder
+    of its own (the block's report compares the three fits it names)."""
+    data = "results/friction_data/"
+    _run(dissipative_folder, [["fit", "--data", data + "train.csv", "--test", data + "test.csv", "--system", "pendulum",
+                               "--model", "delan", "--dissipation", "on", "--periodic", "none", "--steps", "2000",
+                               "--out", "results/friction_delan"]])
+    return dissipative_folder
+
+
+def _fitted(folder, kind):
+    out = "friction_delan" if kind == "delan_dissipative" else "friction"
+    return load_fitted(next(folder.glob(f"results/{out}/units/fit/*/{kind}/seed0")))
+
+
+def test_the_dissipative_delan_recovers_the_friction(delan_folder):
+    """DeLaN's Lagrangian is quadratic in qdot, its velocity Hessian its mass matrix: the friction is read off
+    b / |c| against that, through the same checks as an LNN's."""
+    m = _fitted(delan_folder, "delan_dissipative").result["metrics"]
+    assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
+    assert m["test_dissipation_hessian_residual"] < 0.1
+    assert m["test_dissipation_bracket_half"] >= BRACKET_MIN and m["test_dissipation_bracket_double"] >= BRACKET_MIN
+    assert m["test_l1"] < 0.1 * m["null_test_l1"]
+
+
 def test_the_dissipative_lnn_recovers_the_friction(dissipative_folder):
     m = _metrics(dissipative_folder)["lnn_dissipative"]
     assert m["test_dissipation_coefficient_0"] == pytest.approx(0.3, rel=0.1)
@@ -102,15 +129,17 @@ def _test_rows(folder):
     return user_data.rows(str(next(folder.glob("results/friction/data/test-*.csv"))), "test")   # as prepared
 
 
+@pytest.mark.parametrize("kind", ["lnn_dissipative", "delan_dissipative"])
 @pytest.mark.parametrize("scale", [0.0, 0.3, 3.0])
-def test_rollouts_refuse_a_friction_the_data_do_not_single_out(dissipative_folder, scale):
+def test_rollouts_refuse_a_friction_the_data_do_not_single_out(request, kind, scale):
     """The fitted model with its coefficients removed, at 0.3 and at 3 times their learned values: each still
     learned (one-step) and keeps its velocity Hessian, but the test file's rollouts do not bracket its friction
     (removed: halving or doubling nothing changes nothing; too little: more rolls out better; too much: less
-    does), so no friction is read, where the fit's own is (the test above)."""
-    f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
+    does), so no friction is read, where the fit's own is (the tests above)."""
+    folder = request.getfixturevalue("delan_folder" if kind == "delan_dissipative" else "dissipative_folder")
+    f = _fitted(folder, kind)
     g = with_coefficients(f, scale * softplus(f.params["dissipation.raw"]))
-    rows = _test_rows(dissipative_folder)
+    rows = _test_rows(folder)
     out = Evaluation()
     b, pred = g.one_step(rows)
     out.metrics.update({"test_l1": float(np.mean(np.sum(np.abs(pred - b["target"]), -1))),
@@ -141,14 +170,15 @@ def test_it_rolls_out_better_than_the_conservative_lnn(friction_folder):
     assert lnn["test_energy_err_final"] > 5 * d["test_energy_err_final"]
 
 
-def test_a_starved_fit_reports_no_friction(tmp_path, monkeypatch):
+@pytest.mark.parametrize("kind", ["lnn", "delan"])
+def test_a_starved_fit_reports_no_friction(tmp_path, monkeypatch, kind):
     """Five steps: the model learned nothing, and its b / |c| (which can land anywhere) is not reported."""
     monkeypatch.chdir(tmp_path)
     for args in (["simulate", "--system", "pendulum", "--set", "friction=0.3", "--trajectories", "4", "--out", "d.csv"],
-                 ["fit", "--data", "d.csv", "--model", "lnn", "--dissipation", "--system", "pendulum", "--steps", "5",
-                  "--restarts", "0", "--hidden", "16,16", "--out", "r", "--quiet"]):
+                 ["fit", "--data", "d.csv", "--model", kind, "--dissipation", "--system", "pendulum", "--steps", "5",
+                  *(["--restarts", "0"] if kind == "lnn" else []), "--hidden", "16,16", "--out", "r", "--quiet"]):
         assert main(args) == 0
-    d = json.loads(next(tmp_path.glob("r/units/fit/*/lnn_dissipative/seed0/result.json")).read_text())
+    d = json.loads(next(tmp_path.glob(f"r/units/fit/*/{kind}_dissipative/seed0/result.json")).read_text())
     assert not any(k.startswith("heldout_dissipation_coefficient") for k in d["metrics"])
     assert d["counters"]["heldout_dissipation_coefficient"] == ("not estimated: the model is not clearly better "
                                                                 "than the null predictor")
