@@ -112,7 +112,7 @@ def test_the_dissipative_lnn_recovers_the_friction(dissipative_folder):
 def test_a_fit_whose_friction_carries_nothing_reports_none(dissipative_folder):
     """The same trained model with its dissipation removed: it still learned (better than the null) and its
     velocity Hessian is as close to c M, but the friction it would report explains nothing of the data."""
-    f = load_fitted(next(dissipative_folder.glob("results/friction/units/fit/*/lnn_dissipative/seed0")))
+    f = _fitted(dissipative_folder, "lnn_dissipative")
     params = {**f.params, "dissipation.raw": np.full_like(np.asarray(f.params["dissipation.raw"]), OFF)}
     g = dataclasses.replace(f, params=params, model=Padded(adapter(f.framework, f.spec, params)))
     rows = _test_rows(dissipative_folder)
